@@ -1,0 +1,346 @@
+//! The USB HID report descriptor.
+//!
+//! Built at compile time from usbd-hid's item tags (`usbd-hid-descriptors`) by a small `const`
+//! builder. usbd-hid's `gen_hid_descriptor!` macro cannot emit Unit items nor Feature reports, and
+//! the pen needs both (physical units on X/Y/Z, feature reports for information and
+//! configuration), so the items are written out here; the result is exposed through usbd-hid's
+//! [`SerializedDescriptor`] and [`AsInputReport`] traits, which embassy-usb and usb-device HID
+//! classes consume. The bytes the firmware presents are [`REPORT_DESCRIPTOR`], and the host's
+//! tests parse those same bytes with an independent parser.
+//!
+//! Two application collections:
+//!
+//! * Digitizer / Pen: report 0x01, what the operating system's pen stack understands.
+//! * Vendor 0xFF00 / 0x01: the diagnostics input report 0x02 and the feature reports 0x03–0x06,
+//!   opaque byte arrays whose layout the report codecs define.
+
+use usbd_hid::descriptor::{AsInputReport, BufferOverflow, SerializedDescriptor};
+use usbd_hid_descriptors::{GlobalItemKind as G, ItemType, LocalItemKind as L, MainItemKind as M};
+
+use crate::ReportId;
+use crate::codec::Report;
+use crate::config::Config;
+use crate::info::DeviceInfo;
+use crate::pen::{POSITION_LOGICAL_MAX, PenReport};
+use crate::status::{Command, Status};
+use crate::tof::TofReport;
+
+/// HID usage pages and usages the descriptor uses (HID Usage Tables 1.5).
+pub mod usage {
+    /// Generic Desktop page.
+    pub const PAGE_GENERIC_DESKTOP: u16 = 0x01;
+    /// Digitizer page.
+    pub const PAGE_DIGITIZER: u16 = 0x0D;
+    /// The first vendor-defined page.
+    pub const PAGE_VENDOR: u16 = 0xFF00;
+
+    /// Generic Desktop X.
+    pub const X: u16 = 0x30;
+    /// Generic Desktop Y.
+    pub const Y: u16 = 0x31;
+    /// Generic Desktop Z.
+    pub const Z: u16 = 0x32;
+
+    /// Digitizer: Pen (application collection).
+    pub const PEN: u16 = 0x02;
+    /// Digitizer: Stylus (physical collection).
+    pub const STYLUS: u16 = 0x20;
+    /// Digitizer: In Range.
+    pub const IN_RANGE: u16 = 0x32;
+    /// Digitizer: Tip Switch (SW1).
+    pub const TIP_SWITCH: u16 = 0x42;
+    /// Digitizer: Barrel Switch (SW2).
+    pub const BARREL_SWITCH: u16 = 0x44;
+    /// Digitizer: Secondary Barrel Switch (SW3).
+    pub const SECONDARY_BARREL_SWITCH: u16 = 0x5A;
+
+    /// Vendor: the configuration and diagnostics application collection.
+    pub const VENDOR_COLLECTION: u16 = 0x01;
+    /// Vendor: position is in the display frame (1 bit).
+    pub const VENDOR_DISPLAY_FRAME: u16 = 0x10;
+    /// Vendor: sequence number.
+    pub const VENDOR_SEQUENCE: u16 = 0x11;
+    /// Vendor: device timestamp.
+    pub const VENDOR_TIMESTAMP: u16 = 0x12;
+    /// Vendor: receivers used.
+    pub const VENDOR_RECEIVERS_USED: u16 = 0x13;
+    /// Vendor: RMS range residual.
+    pub const VENDOR_RESIDUAL: u16 = 0x14;
+    /// Vendor: dilution of precision.
+    pub const VENDOR_DOP: u16 = 0x15;
+    /// Vendor usages of the vendor collection's reports are 0x20 + the report ID.
+    pub const VENDOR_REPORT_BASE: u16 = 0x20;
+}
+
+/// HID collection kinds.
+mod collection {
+    pub const PHYSICAL: u32 = 0x00;
+    pub const APPLICATION: u32 = 0x01;
+}
+
+/// Main item flags (HID 1.11 §6.2.2.5).
+mod flags {
+    /// Data, Variable, Absolute.
+    pub const DATA_VAR_ABS: u32 = 0x02;
+    /// Constant, Variable, Absolute: padding.
+    pub const CONST_VAR_ABS: u32 = 0x03;
+}
+
+/// Unit item values (HID 1.11 §6.2.2.7): system nibble 1 = SI linear.
+mod unit {
+    pub const NONE: u32 = 0x00;
+    /// SI linear, length¹: centimetres.
+    pub const CENTIMETRE: u32 = 0x11;
+    /// SI linear, time¹: seconds.
+    pub const SECOND: u32 = 0x1001;
+}
+
+/// Room for the descriptor; the builder fails to compile if it overflows.
+const CAPACITY: usize = 256;
+
+/// A `const` HID report descriptor builder: each method appends one item.
+#[derive(Clone, Copy)]
+struct Builder {
+    buf: [u8; CAPACITY],
+    len: usize,
+}
+
+impl Builder {
+    const fn new() -> Self {
+        Builder {
+            buf: [0; CAPACITY],
+            len: 0,
+        }
+    }
+
+    const fn byte(mut self, b: u8) -> Self {
+        self.buf[self.len] = b;
+        self.len += 1;
+        self
+    }
+
+    /// A short item whose data is `size` bytes of `data`, little-endian (size 0, 1, 2 or 4).
+    const fn item(mut self, typ: ItemType, tag: u8, data: u32, size: usize) -> Self {
+        let size_code = match size {
+            0 => 0,
+            1 => 1,
+            2 => 2,
+            _ => 3,
+        };
+        self = self.byte((tag << 4) | ((typ as u8) << 2) | size_code);
+        let mut i = 0;
+        while i < size {
+            self = self.byte((data >> (8 * i)) as u8);
+            i += 1;
+        }
+        self
+    }
+
+    /// An item with unsigned data in its shortest form.
+    const fn unsigned(self, typ: ItemType, tag: u8, v: u32) -> Self {
+        let size = if v <= 0xFF {
+            1
+        } else if v <= 0xFFFF {
+            2
+        } else {
+            4
+        };
+        self.item(typ, tag, v, size)
+    }
+
+    /// An item with signed data in its shortest two's-complement form.
+    const fn signed(self, typ: ItemType, tag: u8, v: i32) -> Self {
+        let size = if v >= i8::MIN as i32 && v <= i8::MAX as i32 {
+            1
+        } else if v >= i16::MIN as i32 && v <= i16::MAX as i32 {
+            2
+        } else {
+            4
+        };
+        self.item(typ, tag, v as u32, size)
+    }
+
+    const fn global(self, kind: G, v: u32) -> Self {
+        self.unsigned(ItemType::Global, kind as u8, v)
+    }
+
+    const fn global_signed(self, kind: G, v: i32) -> Self {
+        self.signed(ItemType::Global, kind as u8, v)
+    }
+
+    const fn usage_page(self, page: u16) -> Self {
+        self.global(G::UsagePage, page as u32)
+    }
+
+    const fn usage(self, id: u16) -> Self {
+        self.unsigned(ItemType::Local, L::Usage as u8, id as u32)
+    }
+
+    const fn collection(self, kind: u32) -> Self {
+        self.unsigned(ItemType::Main, M::Collection as u8, kind)
+    }
+
+    const fn end_collection(self) -> Self {
+        self.item(ItemType::Main, M::EndCollection as u8, 0, 0)
+    }
+
+    const fn report_id(self, id: ReportId) -> Self {
+        self.global(G::ReportID, id as u8 as u32)
+    }
+
+    const fn logical(self, min: i32, max: i32) -> Self {
+        self.global_signed(G::LogicalMin, min).global_signed(G::LogicalMax, max)
+    }
+
+    const fn physical(self, min: i32, max: i32) -> Self {
+        self.global_signed(G::PhysicalMin, min)
+            .global_signed(G::PhysicalMax, max)
+    }
+
+    /// Unit and unit exponent; the exponent is a 4-bit two's-complement nibble (HID 1.11 §6.2.2.7).
+    const fn unit(self, unit: u32, exponent: i8) -> Self {
+        self.global(G::Unit, unit)
+            .global(G::UnitExponent, (exponent as u8 & 0x0F) as u32)
+    }
+
+    const fn fields(self, bits: u32, count: u32) -> Self {
+        self.global(G::ReportSize, bits).global(G::ReportCount, count)
+    }
+
+    const fn input(self, flags: u32) -> Self {
+        self.unsigned(ItemType::Main, M::Input as u8, flags)
+    }
+
+    const fn feature(self, flags: u32) -> Self {
+        self.unsigned(ItemType::Main, M::Feature as u8, flags)
+    }
+
+    /// A vendor report of `len` bytes (report ID included) as an opaque byte array.
+    const fn vendor_bytes(self, id: ReportId, len: usize, feature: bool) -> Self {
+        let b = self
+            .report_id(id)
+            .usage(usage::VENDOR_REPORT_BASE + id as u8 as u16)
+            .fields(8, (len - 1) as u32);
+        if feature {
+            b.feature(flags::DATA_VAR_ABS)
+        } else {
+            b.input(flags::DATA_VAR_ABS)
+        }
+    }
+
+    const fn descriptor(self) -> Self {
+        use usage::*;
+        let max = POSITION_LOGICAL_MAX as i32;
+        self.usage_page(PAGE_DIGITIZER)
+            .usage(PEN)
+            .collection(collection::APPLICATION)
+            .report_id(ReportId::Pen)
+            .usage(STYLUS)
+            .collection(collection::PHYSICAL)
+            // Byte 1: SW1, SW2, SW3, In Range, display-frame flag, 3 bits padding.
+            .usage(TIP_SWITCH)
+            .usage(BARREL_SWITCH)
+            .usage(SECONDARY_BARREL_SWITCH)
+            .usage(IN_RANGE)
+            .logical(0, 1)
+            .fields(1, 4)
+            .input(flags::DATA_VAR_ABS)
+            .usage_page(PAGE_VENDOR)
+            .usage(VENDOR_DISPLAY_FRAME)
+            .fields(1, 1)
+            .input(flags::DATA_VAR_ABS)
+            .fields(1, 3)
+            .input(flags::CONST_VAR_ABS)
+            // Bytes 2–7: X, Y, Z, signed 16-bit, 0.1 mm (centimetres × 10⁻²).
+            .usage_page(PAGE_GENERIC_DESKTOP)
+            .usage(X)
+            .usage(Y)
+            .usage(Z)
+            .logical(-max, max)
+            .physical(-max, max)
+            .unit(unit::CENTIMETRE, -2)
+            .fields(16, 3)
+            .input(flags::DATA_VAR_ABS)
+            // Bytes 8–9: sequence number.
+            .usage_page(PAGE_VENDOR)
+            .usage(VENDOR_SEQUENCE)
+            .logical(0, 0xFFFF)
+            .physical(0, 0)
+            .unit(unit::NONE, 0)
+            .fields(16, 1)
+            .input(flags::DATA_VAR_ABS)
+            // Bytes 10–13: timestamp, µs. HID logical values are signed 32-bit at most, so the
+            // declared maximum is 2³¹−1; hosts read the field as unsigned and unwrap it.
+            .usage(VENDOR_TIMESTAMP)
+            .logical(0, i32::MAX)
+            .unit(unit::SECOND, -6)
+            .fields(32, 1)
+            .input(flags::DATA_VAR_ABS)
+            // Bytes 14–16: receivers used, residual (0.1 mm), DOP (×10).
+            .usage(VENDOR_RECEIVERS_USED)
+            .logical(0, 8)
+            .unit(unit::NONE, 0)
+            .fields(8, 1)
+            .input(flags::DATA_VAR_ABS)
+            .usage(VENDOR_RESIDUAL)
+            .logical(0, 255)
+            .physical(0, 255)
+            .unit(unit::CENTIMETRE, -2)
+            .fields(8, 1)
+            .input(flags::DATA_VAR_ABS)
+            .usage(VENDOR_DOP)
+            .physical(0, 0)
+            .unit(unit::NONE, 0)
+            .input(flags::DATA_VAR_ABS)
+            .end_collection()
+            .end_collection()
+            // The vendor collection: diagnostics and feature reports as byte arrays.
+            .usage_page(PAGE_VENDOR)
+            .usage(VENDOR_COLLECTION)
+            .collection(collection::APPLICATION)
+            .vendor_bytes(ReportId::Tof, TofReport::LEN, false)
+            .vendor_bytes(ReportId::DeviceInfo, DeviceInfo::LEN, true)
+            .vendor_bytes(ReportId::Config, Config::LEN, true)
+            .vendor_bytes(ReportId::Status, Status::LEN, true)
+            .vendor_bytes(ReportId::Command, Command::LEN, true)
+            .end_collection()
+    }
+
+    /// The first `N` bytes, where `N` must be the builder's length.
+    const fn take<const N: usize>(self) -> [u8; N] {
+        assert!(N == self.len, "descriptor length mismatch");
+        let mut out = [0u8; N];
+        let mut i = 0;
+        while i < N {
+            out[i] = self.buf[i];
+            i += 1;
+        }
+        out
+    }
+}
+
+const BUILT: Builder = Builder::new().descriptor();
+
+/// The report descriptor's length in bytes.
+pub const REPORT_DESCRIPTOR_LEN: usize = BUILT.len;
+
+/// The report descriptor the device presents and the host parses.
+pub const REPORT_DESCRIPTOR: [u8; REPORT_DESCRIPTOR_LEN] = BUILT.take();
+
+impl SerializedDescriptor for PenReport {
+    fn desc() -> &'static [u8] {
+        &REPORT_DESCRIPTOR
+    }
+}
+
+impl AsInputReport for PenReport {
+    fn serialize(&self, buffer: &mut [u8]) -> Result<usize, BufferOverflow> {
+        self.encode(buffer).map_err(|_| BufferOverflow)
+    }
+}
+
+impl AsInputReport for TofReport {
+    fn serialize(&self, buffer: &mut [u8]) -> Result<usize, BufferOverflow> {
+        self.encode(buffer).map_err(|_| BufferOverflow)
+    }
+}

@@ -1,0 +1,34 @@
+# Sourced by run.sh and test.sh: installs what a fresh Debian machine with rustup lacks.
+# Idempotent and quiet when everything is already there.
+
+# Debian packages the scripts need: binutils for `size` (firmware image figures).
+DEB_PACKAGES=(binutils)
+# The board's target; clippy and rustfmt for the checks.
+RUST_TARGETS=(thumbv7em-none-eabihf)
+RUST_COMPONENTS=(clippy rustfmt)
+
+setup() {
+    local missing=()
+    for pkg in "${DEB_PACKAGES[@]}"; do
+        dpkg-query -W -f='${Status}' "$pkg" 2>/dev/null | grep -q "install ok installed" || missing+=("$pkg")
+    done
+    if ((${#missing[@]})); then
+        echo "setup: installing Debian packages: ${missing[*]}" >&2
+        local sudo=""
+        [ "$(id -u)" -eq 0 ] || sudo="sudo"
+        $sudo apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
+    fi
+
+    local installed
+    installed=$(rustup target list --installed)
+    for t in "${RUST_TARGETS[@]}"; do
+        grep -qx "$t" <<<"$installed" || { echo "setup: adding Rust target $t" >&2; rustup target add "$t" >/dev/null 2>&1; }
+    done
+    installed=$(rustup component list --installed)
+    for c in "${RUST_COMPONENTS[@]}"; do
+        grep -q "^$c" <<<"$installed" || { echo "setup: adding Rust component $c" >&2; rustup component add "$c" >/dev/null 2>&1; }
+    done
+}
+
+setup
