@@ -1,0 +1,435 @@
+//! The engine: one measurement cycle in, pen reports out, configuration requests answered.
+//!
+//! It holds no hardware and does no waiting. The station (`station.rs`) feeds it capture times
+//! and switch samples at the times the hardware (or the simulated pen) provides, and sends what
+//! it reports.
+
+use pen_protocol::{
+    Command, Config, DeviceInfo, Filter, FirmwareVersion, GetFeature, MAX_RECEIVERS, Message, NO_ARRIVAL,
+    PROTOCOL_VERSION, PenReport, Position, Quality, Report, ReportId, Status, StatusCode, TofReport,
+};
+
+use crate::debounce::Debouncer;
+use crate::filter::{OneEuroParams, Smoother};
+use crate::math::Vec3;
+use crate::settings::{Settings, default_config};
+use crate::solver::{self, Fix, Geometry, NoFix};
+use crate::sound::{range_mm, time_of_flight_ns};
+use crate::store::ConfigStore;
+use crate::track::Track;
+
+/// The shortest measurement cycle, µs: the listening window plus time for the echoes of the
+/// previous burst to die away. 6.5 ms is 153.8 fixes per second.
+pub const MIN_CYCLE_US: u64 = 6_500;
+/// How long after the burst the receivers are listened to, µs: 1.5 m of flight even at
+/// 300 m/s (−40 °C).
+pub const LISTEN_US: u64 = 5_000;
+/// How often switches are sampled and reports polled, µs.
+pub const TICK_US: u64 = 500;
+
+/// One measurement cycle as the receivers heard it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Cycle {
+    /// Device time of the burst, µs.
+    pub t0_us: u64,
+    /// Capture time of each receiver's first arrival after the burst, ns; `None` for no arrival
+    /// within the listening window.
+    pub arrival_ns: [Option<u32>; MAX_RECEIVERS],
+}
+
+/// What a cycle produced, for diagnostics and the simulator's traces.
+#[derive(Debug, Clone, Copy, PartialEq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct CycleResult {
+    /// The accepted fix before smoothing (solved and through the tracking gate), or why there
+    /// was none.
+    pub fix: Result<Fix, NoFix>,
+    /// The reported position in mm (smoothed, constrained, in the reporting frame) when in range.
+    pub reported_mm: Option<Vec3>,
+}
+
+/// Something the firmware must do outside the engine after a request.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Action {
+    /// Restart into the ROM DFU bootloader (after the status has been sent).
+    EnterBootloader,
+}
+
+/// Counters since start-up.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Counters {
+    /// Measurement cycles.
+    pub cycles: u32,
+    /// Cycles with a fix.
+    pub fixes: u32,
+    /// Fixes that left one receiver out as inconsistent.
+    pub rejected_receivers: u32,
+    /// Cycles without a fix because the ranges disagreed, were ambiguous or pointed behind the
+    /// display.
+    pub inconsistent: u32,
+    /// Fixes held back by the tracking gate (a jump, or the first fix after a gap).
+    pub gated: u32,
+    /// Cycles with fewer than three arrivals.
+    pub too_few: u32,
+    /// Pen reports produced.
+    pub reports: u32,
+}
+
+/// The switch transitions not yet reported, so that a click between two reports is never lost.
+#[derive(Debug, Clone, Copy, Default)]
+struct SwitchLatch {
+    reported: [bool; 3],
+    pending: [u8; 3],
+}
+
+impl SwitchLatch {
+    fn any_pending(&self) -> bool {
+        self.pending.iter().any(|&p| p > 0)
+    }
+
+    /// The levels to report now: each pending transition is reported once, in order.
+    fn take(&mut self, current: [bool; 3]) -> [bool; 3] {
+        for ((reported, pending), current) in self.reported.iter_mut().zip(&mut self.pending).zip(current) {
+            match *pending {
+                0 => *reported = current,
+                n => {
+                    *reported = !*reported;
+                    *pending = n - 1;
+                }
+            }
+        }
+        self.reported
+    }
+}
+
+/// The state of the base station.
+pub struct Engine {
+    settings: Settings,
+    smoother: Smoother,
+    track: Track,
+    debouncer: Debouncer,
+    latch: SwitchLatch,
+    firmware: FirmwareVersion,
+    unique_id: [u8; 12],
+    status: Status,
+    // The latest cycle.
+    position: Position,
+    in_range: bool,
+    quality: Quality,
+    timestamp_us: u32,
+    tof: TofReport,
+    last_result: Option<CycleResult>,
+    // Reporting.
+    fresh: bool,
+    seq: u16,
+    last_report_us: Option<u64>,
+    counters: Counters,
+}
+
+fn smoother_for(filter: Filter) -> Smoother {
+    Smoother::new(match filter {
+        Filter::Off => None,
+        Filter::OneEuro {
+            min_cutoff_hz,
+            beta,
+            d_cutoff_hz,
+        } => Some(OneEuroParams {
+            min_cutoff_hz,
+            beta,
+            d_cutoff_hz,
+        }),
+    })
+}
+
+impl Engine {
+    /// An engine running `config`, or the defaults when `config` is `None` or invalid.
+    pub fn new(config: Option<Config>, firmware: FirmwareVersion, unique_id: [u8; 12]) -> Engine {
+        let settings = config
+            .and_then(|c| Settings::new(c).ok())
+            .or_else(|| Settings::new(default_config()).ok())
+            .unwrap_or_else(|| unreachable!("the default configuration is valid (tested)"));
+        Engine {
+            smoother: smoother_for(settings.config.filter),
+            settings,
+            track: Track::new(),
+            debouncer: Debouncer::new(),
+            latch: SwitchLatch::default(),
+            firmware,
+            unique_id,
+            status: Status::ok(0),
+            position: Position::default(),
+            in_range: false,
+            quality: Quality::NONE,
+            timestamp_us: 0,
+            tof: TofReport {
+                seq: 0,
+                timestamp_us: 0,
+                receiver_count: 0,
+                used_mask: 0,
+                tof_ns: [NO_ARRIVAL; MAX_RECEIVERS],
+                speed_of_sound_m_s: 0.0,
+            },
+            last_result: None,
+            fresh: false,
+            seq: 0,
+            last_report_us: None,
+            counters: Counters::default(),
+        }
+    }
+
+    /// The running configuration.
+    pub fn config(&self) -> &Config {
+        &self.settings.config
+    }
+
+    /// The derived settings.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// Counters since start-up.
+    pub fn counters(&self) -> Counters {
+        self.counters
+    }
+
+    /// What the latest cycle produced.
+    pub fn last_result(&self) -> Option<CycleResult> {
+        self.last_result
+    }
+
+    /// The debounced switches.
+    pub fn switches(&self) -> [bool; 3] {
+        self.debouncer.state()
+    }
+
+    /// The measurement cycle's period, µs: the report interval, but never shorter than
+    /// [`MIN_CYCLE_US`]; faster report rates repeat the latest fix between cycles.
+    pub fn cycle_period_us(&self) -> u64 {
+        self.settings.report_interval_us.max(MIN_CYCLE_US)
+    }
+
+    /// The device information report.
+    pub fn device_info(&self) -> DeviceInfo {
+        DeviceInfo {
+            protocol: PROTOCOL_VERSION,
+            firmware: self.firmware,
+            receiver_count: self.settings.config.receiver_count,
+            max_receivers: MAX_RECEIVERS as u8,
+            fix_rate_hz: ((1_000_000 + self.cycle_period_us() / 2) / self.cycle_period_us()) as u16,
+            unique_id: self.unique_id,
+        }
+    }
+
+    /// Takes a sample of the raw switch levels (true = pressed).
+    pub fn on_switches(&mut self, now_us: u64, raw: [bool; 3]) {
+        let changed = self.debouncer.sample(now_us, raw, self.settings.debounce_us);
+        for (pending, changed) in self.latch.pending.iter_mut().zip(changed) {
+            *pending = pending.saturating_add(changed as u8);
+        }
+    }
+
+    /// Solves a measurement cycle and updates the position the next report carries.
+    pub fn on_cycle(&mut self, cycle: &Cycle) -> CycleResult {
+        let s = &self.settings;
+        let mut ranges = [None; MAX_RECEIVERS];
+        let mut tof_ns = [NO_ARRIVAL; MAX_RECEIVERS];
+        for i in 0..s.count {
+            if let Some(t) = cycle.arrival_ns[i].and_then(|a| time_of_flight_ns(a, s.delays_ns[i])) {
+                tof_ns[i] = t;
+                ranges[i] = Some(range_mm(t, s.speed_m_s));
+            }
+        }
+        let geometry = Geometry {
+            receivers: &s.receivers[..s.count],
+            front: s.front(),
+        };
+        let hint = self.track.hint(cycle.t0_us);
+        let raw = solver::solve(&geometry, &ranges, &|p| s.height(p), hint)
+            .and_then(|fix| self.track.gate(cycle.t0_us, fix.position).map(|()| fix));
+        self.counters.cycles += 1;
+        let reported = match raw {
+            Ok(fix) => {
+                self.counters.fixes += 1;
+                if (fix.used as usize) < ranges.iter().filter(|r| r.is_some()).count() {
+                    self.counters.rejected_receivers += 1;
+                }
+                self.report_position(cycle.t0_us, fix)
+            }
+            Err(e) => {
+                match e {
+                    NoFix::TooFewRanges => self.counters.too_few += 1,
+                    NoFix::Jump | NoFix::Acquiring => self.counters.gated += 1,
+                    _ => self.counters.inconsistent += 1,
+                }
+                None
+            }
+        };
+        self.in_range = reported.is_some();
+        self.quality = match raw {
+            Ok(fix) if self.in_range => Quality::new(fix.used, fix.residual_rms_mm, fix.dop),
+            _ => Quality::NONE,
+        };
+        // The device clock wraps in the report, as the protocol defines.
+        self.timestamp_us = cycle.t0_us as u32;
+        self.tof = TofReport {
+            seq: self.seq,
+            timestamp_us: self.timestamp_us,
+            receiver_count: self.settings.count as u8,
+            used_mask: raw.map_or(0, |f| f.used_mask),
+            tof_ns,
+            speed_of_sound_m_s: self.settings.speed_m_s,
+        };
+        self.fresh = true;
+        let result = CycleResult {
+            fix: raw,
+            reported_mm: reported,
+        };
+        self.last_result = Some(result);
+        result
+    }
+
+    /// Smooths, constrains and transforms a fix; `None` if it cannot be reported.
+    fn report_position(&mut self, t_us: u64, fix: Fix) -> Option<Vec3> {
+        let s = &self.settings;
+        let mut p = self.smoother.filter(t_us, fix.position);
+        if let Some(display) = &s.display {
+            // While the tip switch is pressed the tip is on the display surface.
+            if self.debouncer.state()[0] {
+                p = display.onto_surface(p);
+            }
+            if s.config.report_display_frame {
+                p = display.to_display(p);
+            }
+        }
+        let position = Position::from_mm(p.to_array())?;
+        self.position = position;
+        Some(p)
+    }
+
+    /// The next pen report, if one is due at `now_us`: after each cycle, after a switch
+    /// transition, and between cycles at the report rate when it exceeds the cycle rate.
+    pub fn poll_report(&mut self, now_us: u64) -> Option<PenReport> {
+        let interval = self.settings.report_interval_us;
+        let between_cycles = interval < self.cycle_period_us()
+            && self
+                .last_report_us
+                .is_some_and(|t| now_us.saturating_sub(t) >= interval);
+        if !(self.fresh || self.latch.any_pending() || between_cycles) {
+            return None;
+        }
+        self.fresh = false;
+        self.last_report_us = Some(now_us);
+        let [sw1, sw2, sw3] = self.latch.take(self.debouncer.state());
+        let report = PenReport {
+            sw1,
+            sw2,
+            sw3,
+            in_range: self.in_range,
+            display_frame: self.settings.config.report_display_frame,
+            position: self.position,
+            seq: self.seq,
+            timestamp_us: self.timestamp_us,
+            quality: self.quality,
+        };
+        self.seq = self.seq.wrapping_add(1);
+        self.counters.reports += 1;
+        Some(report)
+    }
+
+    /// The time-of-flight report of the latest cycle, when the configuration streams them.
+    pub fn tof_report(&self) -> Option<TofReport> {
+        self.settings.config.stream_tof.then_some(self.tof)
+    }
+
+    /// Answers a feature-report read (HID GET_REPORT); returns the bytes written to `out`.
+    pub fn get_feature(&self, id: u8, out: &mut [u8]) -> Option<usize> {
+        match ReportId::from_u8(id)? {
+            ReportId::DeviceInfo => self.device_info().encode(out).ok(),
+            ReportId::Config => self.settings.config.encode(out).ok(),
+            ReportId::Status => self.status.encode(out).ok(),
+            _ => None,
+        }
+    }
+
+    /// The status of the last request.
+    pub fn status(&self) -> Status {
+        self.status
+    }
+
+    /// Applies a feature-report write (HID SET_REPORT, or a report sent over the serial link).
+    /// The outcome is also what the status report says next.
+    pub fn set_feature(&mut self, bytes: &[u8], store: &mut impl ConfigStore) -> (Status, Option<Action>) {
+        let request = bytes.first().copied().unwrap_or(0);
+        let (status, action) = match Message::decode(bytes) {
+            Ok(Message::Config(config)) => (self.apply_config(config), None),
+            Ok(Message::Command(command)) => self.command(command, store),
+            Ok(Message::DeviceInfo(_) | Message::Status(_)) => (Status::failed(request, StatusCode::ReadOnly), None),
+            Ok(_) => (Status::failed(request, StatusCode::UnknownReport), None),
+            Err(pen_protocol::DecodeError::UnknownReportId(_)) => {
+                (Status::failed(request, StatusCode::UnknownReport), None)
+            }
+            Err(_) => (Status::failed(request, StatusCode::Malformed), None),
+        };
+        self.status = status;
+        (status, action)
+    }
+
+    fn apply_config(&mut self, config: Config) -> Status {
+        let request = ReportId::Config as u8;
+        match Settings::new(config) {
+            Ok(settings) => {
+                let filter_changed = settings.config.filter != self.settings.config.filter;
+                self.settings = settings;
+                if filter_changed {
+                    self.smoother = smoother_for(config.filter);
+                } else {
+                    // New geometry or frame: old history would drag fixes from the old frame.
+                    self.smoother.reset();
+                }
+                Status::ok(request)
+            }
+            Err(e) => Status::from_config_error(request, e),
+        }
+    }
+
+    fn command(&mut self, command: Command, store: &mut impl ConfigStore) -> (Status, Option<Action>) {
+        let request = ReportId::Command as u8;
+        match command {
+            Command::SaveConfig => match store.save(&self.settings.config) {
+                Ok(()) => (Status::ok(request), None),
+                Err(_) => (Status::failed(request, StatusCode::StorageFailed), None),
+            },
+            Command::LoadDefaults => {
+                let status = self.apply_config(default_config());
+                (Status { request, ..status }, None)
+            }
+            Command::EnterBootloader => (Status::ok(request), Some(Action::EnterBootloader)),
+        }
+    }
+
+    /// Answers a request that arrived over the serial link: a get-feature request gets the
+    /// feature report, a configuration or command gets the status report. Returns the length of
+    /// the answer written to `out` (a report, to be framed) and any action to take.
+    pub fn handle_request(
+        &mut self,
+        payload: &[u8],
+        out: &mut [u8],
+        store: &mut impl ConfigStore,
+    ) -> (Option<usize>, Option<Action>) {
+        if let Ok(get) = GetFeature::decode(payload) {
+            return (self.get_feature(get.report as u8, out), None);
+        }
+        let (status, action) = if payload.first() == Some(&(ReportId::GetFeature as u8)) {
+            // A get-feature request for something that is not a readable feature report.
+            let status = Status::failed(ReportId::GetFeature as u8, StatusCode::UnknownReport);
+            self.status = status;
+            (status, None)
+        } else {
+            self.set_feature(payload, store)
+        };
+        (status.encode(out).ok(), action)
+    }
+}

@@ -1,0 +1,118 @@
+//! The hardware seams, and the measurement loop that drives the engine through them.
+//!
+//! The board implements these traits with timers, GPIOs and USB; the simulated pen implements
+//! them with physics and a virtual clock. Both run the same [`Station::cycle`], so the simulator
+//! exercises exactly the code that runs on the board.
+
+use core::cell::RefCell;
+use core::future::Future;
+
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_sync::blocking_mutex::raw::RawMutex;
+use pen_protocol::{MAX_RECEIVERS, PenReport, TofReport};
+
+use crate::engine::{Cycle, CycleResult, Engine, LISTEN_US, TICK_US};
+
+/// The ultrasonic front end: a burst from the pen and the receivers' first arrivals.
+pub trait Ranging {
+    /// Fires a burst; the capture time base starts with it.
+    fn fire(&mut self);
+    /// The first arrival at each receiver since the last burst, ns after it; `None` for a
+    /// receiver that heard nothing.
+    fn collect(&mut self) -> [Option<u32>; MAX_RECEIVERS];
+}
+
+/// The pen's switches.
+pub trait Switches {
+    /// The raw levels of SW1, SW2, SW3 (true = pressed), bounce and all.
+    fn read(&mut self) -> [bool; 3];
+}
+
+/// Device time.
+pub trait Clock {
+    /// Microseconds since start-up.
+    fn now_us(&self) -> u64;
+    /// Returns at `t_us` (at once if it has passed).
+    fn wait_until(&mut self, t_us: u64) -> impl Future<Output = ()>;
+}
+
+/// Where reports go: USB HID, the serial link, the simulator's byte stream.
+pub trait ReportSink {
+    /// Sends a pen report.
+    fn pen(&mut self, report: &PenReport) -> impl Future<Output = ()>;
+    /// Sends a time-of-flight diagnostics report.
+    fn tof(&mut self, report: &TofReport) -> impl Future<Output = ()>;
+}
+
+/// The engine behind a mutex, shared with the USB request handlers.
+pub type SharedEngine<M> = Mutex<M, RefCell<Engine>>;
+
+/// The measurement loop over a set of hardware seams.
+pub struct Station<'e, M: RawMutex, R, S, C, K> {
+    engine: &'e SharedEngine<M>,
+    /// The ultrasonic front end.
+    pub ranging: R,
+    /// The switches.
+    pub switches: S,
+    /// The clock.
+    pub clock: C,
+    /// Where reports go.
+    pub sink: K,
+}
+
+impl<'e, M: RawMutex, R: Ranging, S: Switches, C: Clock, K: ReportSink> Station<'e, M, R, S, C, K> {
+    /// A station driving `engine`.
+    pub fn new(engine: &'e SharedEngine<M>, ranging: R, switches: S, clock: C, sink: K) -> Self {
+        Station {
+            engine,
+            ranging,
+            switches,
+            clock,
+            sink,
+        }
+    }
+
+    fn with<T>(&self, f: impl FnOnce(&mut Engine) -> T) -> T {
+        self.engine.lock(|e| f(&mut e.borrow_mut()))
+    }
+
+    /// One measurement cycle: fire the burst, sample the switches every tick, collect the
+    /// arrivals when the listening window closes, send every report that falls due, and return
+    /// when the next cycle may start.
+    pub async fn cycle(&mut self) -> CycleResult {
+        let t0 = self.clock.now_us();
+        let period = self.with(|e| e.cycle_period_us());
+        self.ranging.fire();
+        let mut result = None;
+        // Ticks at t0, t0 + TICK_US, … up to the end of the period.
+        let mut t = t0;
+        while t < t0 + period {
+            self.clock.wait_until(t).await;
+            let raw = self.switches.read();
+            self.with(|e| e.on_switches(t, raw));
+            let mut tof = None;
+            if result.is_none() && t >= t0 + LISTEN_US {
+                let cycle = Cycle {
+                    t0_us: t0,
+                    arrival_ns: self.ranging.collect(),
+                };
+                let (r, streamed) = self.with(|e| (e.on_cycle(&cycle), e.tof_report()));
+                result = Some(r);
+                tof = streamed;
+            }
+            while let Some(report) = self.with(|e| e.poll_report(t)) {
+                self.sink.pen(&report).await;
+            }
+            if let Some(tof) = tof {
+                self.sink.tof(&tof).await;
+            }
+            t += TICK_US;
+        }
+        self.clock.wait_until(t0 + period).await;
+        match result {
+            Some(r) => r,
+            // The listening window always closes within the period (MIN_CYCLE_US > LISTEN_US).
+            None => unreachable!("cycle period shorter than the listening window"),
+        }
+    }
+}

@@ -1,0 +1,142 @@
+//! Configuration storage: a log of checksummed records in one flash region.
+//!
+//! Each save appends a record; loading takes the newest record that checks out. The region is
+//! erased only when it is full, so a save is a write of 200 bytes (under a millisecond on the
+//! STM32F4) rather than a sector erase (about a second), and the flash wears out hundreds of
+//! times more slowly. A save interrupted by power loss leaves a record whose CRC fails; it is
+//! skipped and the previous configuration loads.
+//!
+//! Record layout (little-endian, 200 bytes, a multiple of the flash's 4-byte write unit):
+//! magic `PCFG` (u32), sequence (u32), the configuration report (187 bytes) and one zero byte,
+//! CRC-32 of the preceding 196 bytes (u32).
+
+use pen_protocol::{CRC, Config, Report};
+
+/// Bytes of one record.
+pub const RECORD_LEN: usize = 200;
+const MAGIC: u32 = u32::from_le_bytes(*b"PCFG");
+const BODY: usize = RECORD_LEN - 4;
+
+/// A flash region the store owns: reads, writes of erased bytes, and erasing all of it.
+pub trait FlashRegion {
+    /// The region's size in bytes.
+    fn size(&self) -> usize;
+    /// Reads `buf.len()` bytes at `offset`.
+    fn read(&mut self, offset: usize, buf: &mut [u8]) -> Result<(), StoreError>;
+    /// Programs bytes at `offset`, which must be erased; offset and length are multiples of 4.
+    fn write(&mut self, offset: usize, bytes: &[u8]) -> Result<(), StoreError>;
+    /// Erases the whole region (every byte becomes 0xFF).
+    fn erase(&mut self) -> Result<(), StoreError>;
+}
+
+/// Why storage failed.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum StoreError {
+    /// The flash driver reported an error.
+    Flash,
+    /// A record read back differs from what was written.
+    Verify,
+}
+
+/// Where configurations are kept across power cycles.
+pub trait ConfigStore {
+    /// The newest stored configuration that decodes and validates, if any.
+    fn load(&mut self) -> Option<Config>;
+    /// Stores `config`.
+    fn save(&mut self, config: &Config) -> Result<(), StoreError>;
+}
+
+/// The record log over a flash region.
+pub struct LogStore<F> {
+    flash: F,
+}
+
+// A short-lived value on the stack during a scan; without an allocator there is nothing to gain
+// from boxing the large variant.
+#[allow(clippy::large_enum_variant)]
+enum Slot {
+    Erased,
+    Valid { seq: u32, config: Config },
+    Invalid,
+}
+
+impl<F: FlashRegion> LogStore<F> {
+    /// A store over `flash`.
+    pub fn new(flash: F) -> Self {
+        LogStore { flash }
+    }
+
+    /// The flash region, back.
+    pub fn into_inner(self) -> F {
+        self.flash
+    }
+
+    fn slots(&self) -> usize {
+        self.flash.size() / RECORD_LEN
+    }
+
+    fn read_slot(&mut self, index: usize) -> Result<Slot, StoreError> {
+        let mut rec = [0u8; RECORD_LEN];
+        self.flash.read(index * RECORD_LEN, &mut rec)?;
+        if rec.iter().all(|&b| b == 0xFF) {
+            return Ok(Slot::Erased);
+        }
+        let word = |at: usize| u32::from_le_bytes([rec[at], rec[at + 1], rec[at + 2], rec[at + 3]]);
+        if word(0) != MAGIC || word(BODY) != CRC.checksum(&rec[..BODY]) {
+            return Ok(Slot::Invalid);
+        }
+        match Config::decode(&rec[8..8 + Config::LEN]) {
+            Ok(config) if config.validate().is_ok() => Ok(Slot::Valid { seq: word(4), config }),
+            _ => Ok(Slot::Invalid),
+        }
+    }
+
+    /// The newest valid record and the index after the last used slot.
+    fn scan(&mut self) -> Result<(Option<(u32, Config)>, usize), StoreError> {
+        let (mut newest, mut next_free) = (None::<(u32, Config)>, 0);
+        for i in 0..self.slots() {
+            match self.read_slot(i)? {
+                Slot::Erased => {}
+                Slot::Valid { seq, config } => {
+                    if newest.is_none_or(|(s, _)| seq >= s) {
+                        newest = Some((seq, config));
+                    }
+                    next_free = i + 1;
+                }
+                Slot::Invalid => next_free = i + 1,
+            }
+        }
+        Ok((newest, next_free))
+    }
+}
+
+impl<F: FlashRegion> ConfigStore for LogStore<F> {
+    fn load(&mut self) -> Option<Config> {
+        self.scan().ok()?.0.map(|(_, c)| c)
+    }
+
+    fn save(&mut self, config: &Config) -> Result<(), StoreError> {
+        let (newest, mut slot) = self.scan()?;
+        let seq = newest.map_or(0, |(s, _)| s.wrapping_add(1));
+        if slot >= self.slots() {
+            self.flash.erase()?;
+            slot = 0;
+        }
+        let mut rec = [0u8; RECORD_LEN];
+        rec[..4].copy_from_slice(&MAGIC.to_le_bytes());
+        rec[4..8].copy_from_slice(&seq.to_le_bytes());
+        config
+            .encode(&mut rec[8..8 + Config::LEN])
+            .map_err(|_| StoreError::Flash)?;
+        let crc = CRC.checksum(&rec[..BODY]);
+        rec[BODY..].copy_from_slice(&crc.to_le_bytes());
+        self.flash.write(slot * RECORD_LEN, &rec)?;
+        let mut back = [0u8; RECORD_LEN];
+        self.flash.read(slot * RECORD_LEN, &mut back)?;
+        if back != rec {
+            return Err(StoreError::Verify);
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,313 @@
+//! The engine: cycles to reports, switches, configuration requests, serial requests.
+
+mod common;
+
+use pen_core::{Action, ConfigStore, Cycle, Engine, NoFix, StoreError, Vec3, default_config};
+use pen_protocol::*;
+
+const FIRMWARE: FirmwareVersion = FirmwareVersion {
+    major: 1,
+    minor: 2,
+    patch: 3,
+};
+const PERIOD_US: u64 = 6_666;
+
+/// A store in RAM that can be told to fail.
+#[derive(Default)]
+struct RamStore {
+    saved: Option<Config>,
+    fail: bool,
+}
+
+impl ConfigStore for RamStore {
+    fn load(&mut self) -> Option<Config> {
+        self.saved
+    }
+    fn save(&mut self, config: &Config) -> Result<(), StoreError> {
+        if self.fail {
+            return Err(StoreError::Flash);
+        }
+        self.saved = Some(*config);
+        Ok(())
+    }
+}
+
+fn engine() -> Engine {
+    Engine::new(None, FIRMWARE, [7; 12])
+}
+
+/// The captures a pen at `p` produces for the engine's configuration.
+fn cycle_at(e: &Engine, t0_us: u64, p: Vec3) -> Cycle {
+    let s = e.settings();
+    let mut arrival_ns = [None; MAX_RECEIVERS];
+    for ((slot, r), delay) in arrival_ns.iter_mut().zip(&s.receivers[..s.count]).zip(s.delays_ns) {
+        let tof_ns = (p - *r).length() as f64 / (s.speed_m_s as f64 * 1e-6);
+        *slot = Some((tof_ns + delay as f64).round() as u32);
+    }
+    Cycle { t0_us, arrival_ns }
+}
+
+fn encode(m: &Message) -> Vec<u8> {
+    let mut buf = [0u8; MAX_PAYLOAD];
+    let n = m.encode(&mut buf).expect("fits");
+    buf[..n].to_vec()
+}
+
+/// Runs `n` cycles with the pen at `p`; returns the reports.
+fn run(e: &mut Engine, from: u64, n: u64, p: Vec3) -> Vec<PenReport> {
+    let mut out = Vec::new();
+    for k in 0..n {
+        let t0 = from + k * PERIOD_US;
+        e.on_cycle(&cycle_at(e, t0, p));
+        out.extend(e.poll_report(t0 + 5_000));
+    }
+    out
+}
+
+#[test]
+fn cycles_become_reports() {
+    let mut e = engine();
+    let p = Vec3::new(300.0, 170.0, 80.0);
+    let first = e.on_cycle(&cycle_at(&e, 0, p));
+    // The first fix after a gap waits for the next one to confirm it.
+    assert_eq!(first.fix, Err(NoFix::Acquiring));
+    let r0 = e.poll_report(5_000).expect("a report after every cycle");
+    assert!(!r0.in_range);
+    assert_eq!(r0.quality, Quality::NONE);
+    assert_eq!(e.poll_report(5_500), None, "nothing more until the next cycle");
+    let reports = run(&mut e, PERIOD_US, 20, p);
+    assert_eq!(reports.len(), 20);
+    for (i, r) in reports.iter().enumerate() {
+        assert!(r.in_range);
+        assert_eq!(r.seq, i as u16 + 1);
+        assert_eq!(r.timestamp_us as u64, (i as u64 + 1) * PERIOD_US);
+        assert_eq!(r.quality.receivers_used, 4);
+        let got = Vec3::from_array(r.position.to_mm());
+        assert!((got - p).length() < 0.1, "{got:?}");
+    }
+    assert_eq!(e.counters().cycles, 21);
+    assert_eq!(e.counters().gated, 1);
+    assert_eq!(e.counters().reports, 21);
+}
+
+#[test]
+fn a_lost_pen_is_out_of_range() {
+    let mut e = engine();
+    let p = Vec3::new(300.0, 170.0, 80.0);
+    run(&mut e, 0, 3, p);
+    let mut c = cycle_at(&e, 3 * PERIOD_US, p);
+    c.arrival_ns[0] = None;
+    c.arrival_ns[2] = None;
+    assert_eq!(e.on_cycle(&c).fix, Err(NoFix::TooFewRanges));
+    let r = e.poll_report(3 * PERIOD_US + 5_000).expect("report");
+    assert!(!r.in_range);
+    assert_eq!(r.quality.receivers_used, 0);
+    assert_eq!(e.counters().too_few, 1);
+}
+
+#[test]
+fn a_click_between_reports_is_reported() {
+    let mut e = engine();
+    e.on_switches(100, [false; 3]);
+    // SW2 pressed and released (after the debounce time) before the next report.
+    e.on_switches(1_000, [false, true, false]);
+    e.on_switches(7_000, [false, false, false]);
+    let r1 = e.poll_report(7_500).expect("the press is due");
+    assert!(r1.sw2);
+    let r2 = e.poll_report(8_000).expect("the release is due");
+    assert!(!r2.sw2);
+    assert_eq!(e.poll_report(8_500), None);
+    assert_eq!(r2.seq, r1.seq + 1);
+}
+
+#[test]
+fn the_tip_rests_on_the_display_while_pressed() {
+    let mut e = engine();
+    // The emitter 6 mm above the surface: the tip is on it.
+    let p = Vec3::new(200.0, 100.0, 6.0);
+    e.on_switches(0, [true, false, false]);
+    let reports = run(&mut e, 0, 10, p);
+    let last = reports.last().expect("reports");
+    assert!(last.sw1 && last.in_range);
+    assert_eq!(last.position.z, 0);
+    assert!((last.position.to_mm()[0] - 200.0).abs() < 0.2);
+    // Released, the height comes back.
+    e.on_switches(20 * PERIOD_US, [false; 3]);
+    let reports = run(&mut e, 21 * PERIOD_US, 10, p);
+    assert!((reports.last().expect("reports").position.to_mm()[2] - 6.0).abs() < 0.2);
+}
+
+#[test]
+fn display_frame_reports() {
+    let mut e = engine();
+    let mut config = default_config();
+    // The display frame 100 mm to the right of the tracker frame.
+    config.display = Some(DisplayPose {
+        rotation: [1.0, 0.0, 0.0, 0.0],
+        translation_mm: [-100.0, 0.0, 0.0],
+        scale: 1.0,
+    });
+    config.report_display_frame = true;
+    let mut store = RamStore::default();
+    assert_eq!(
+        e.set_feature(&encode(&Message::Config(config)), &mut store).0.code,
+        StatusCode::Ok
+    );
+    let reports = run(&mut e, 0, 10, Vec3::new(300.0, 170.0, 50.0));
+    let r = reports.last().expect("reports");
+    assert!(r.display_frame);
+    let mm = r.position.to_mm();
+    assert!(
+        (mm[0] - 200.0).abs() < 0.2 && (mm[1] - 170.0).abs() < 0.2 && (mm[2] - 50.0).abs() < 0.2,
+        "{mm:?}"
+    );
+}
+
+#[test]
+fn report_rate_above_the_cycle_rate_repeats_fixes() {
+    let mut e = engine();
+    let mut config = default_config();
+    config.report_rate_hz = 1000;
+    e.set_feature(&encode(&Message::Config(config)), &mut RamStore::default());
+    assert_eq!(e.cycle_period_us(), 6_500);
+    assert_eq!(e.device_info().fix_rate_hz, 154);
+    e.on_cycle(&cycle_at(&e, 0, Vec3::new(1.0, 2.0, 3.0)));
+    let mut times = Vec::new();
+    for t in (5_000..11_500).step_by(500) {
+        if let Some(r) = e.poll_report(t) {
+            times.push((t, r.timestamp_us));
+        }
+    }
+    // After the cycle's report, one per millisecond, all from the same fix.
+    assert_eq!(
+        times.iter().map(|t| t.0).collect::<Vec<_>>(),
+        [5_000, 6_000, 7_000, 8_000, 9_000, 10_000, 11_000]
+    );
+    assert!(times.iter().all(|t| t.1 == 0));
+}
+
+#[test]
+fn time_of_flight_reports_stream_when_asked() {
+    let mut e = engine();
+    assert_eq!(e.tof_report(), None);
+    let mut config = default_config();
+    config.stream_tof = true;
+    config.transducer_delay_us[1] = 25.0;
+    e.set_feature(&encode(&Message::Config(config)), &mut RamStore::default());
+    let p = Vec3::new(300.0, 170.0, 80.0);
+    run(&mut e, 0, 2, p);
+    let tof = e.tof_report().expect("streaming");
+    assert_eq!(tof.receiver_count, 4);
+    assert_eq!(tof.used_mask, 0b1111);
+    let s = e.settings();
+    for i in 0..4 {
+        // Delay subtracted: the flight time alone.
+        let expected = (p - s.receivers[i]).length() as f64 / (s.speed_m_s as f64 * 1e-6);
+        assert!((tof.tof_ns[i] as f64 - expected).abs() <= 1.0, "receiver {i}");
+    }
+    assert_eq!(tof.tof_ns[4], NO_ARRIVAL);
+}
+
+#[test]
+fn configuration_is_validated_and_nonsense_keeps_the_old_one() {
+    let mut e = engine();
+    let mut store = RamStore::default();
+    let mut good = default_config();
+    good.temperature_c = 25.0;
+    let (status, action) = e.set_feature(&encode(&Message::Config(good)), &mut store);
+    assert_eq!((status, action), (Status::ok(ReportId::Config as u8), None));
+    assert_eq!(e.config().temperature_c, 25.0);
+
+    let mut bad = good;
+    bad.receivers_mm[3] = bad.receivers_mm[0];
+    let (status, _) = e.set_feature(&encode(&Message::Config(bad)), &mut store);
+    assert_eq!(status.code, StatusCode::Degenerate);
+    assert_eq!(status.config_field(), Some(ConfigField::Receiver(3)));
+    assert_eq!(e.config(), &good, "the old configuration stays");
+
+    // The status report says the same.
+    let mut out = [0u8; 64];
+    let n = e.get_feature(ReportId::Status as u8, &mut out).expect("status");
+    assert_eq!(Status::decode(&out[..n]), Ok(status));
+
+    let mut bytes = encode(&Message::Config(good));
+    bytes.truncate(100);
+    assert_eq!(e.set_feature(&bytes, &mut store).0.code, StatusCode::Malformed);
+    assert_eq!(
+        e.set_feature(&[0x42, 1, 2], &mut store).0.code,
+        StatusCode::UnknownReport
+    );
+    let info = encode(&Message::DeviceInfo(e.device_info()));
+    assert_eq!(e.set_feature(&info, &mut store).0.code, StatusCode::ReadOnly);
+    assert_eq!(e.config(), &good);
+}
+
+#[test]
+fn commands() {
+    let mut e = engine();
+    let mut store = RamStore::default();
+    let mut c = default_config();
+    c.debounce_ms = 9;
+    e.set_feature(&encode(&Message::Config(c)), &mut store);
+    let save = encode(&Message::Command(Command::SaveConfig));
+    assert_eq!(e.set_feature(&save, &mut store).0.code, StatusCode::Ok);
+    assert_eq!(store.saved, Some(c));
+    store.fail = true;
+    assert_eq!(e.set_feature(&save, &mut store).0.code, StatusCode::StorageFailed);
+    let defaults = encode(&Message::Command(Command::LoadDefaults));
+    assert_eq!(
+        e.set_feature(&defaults, &mut store).0,
+        Status::ok(ReportId::Command as u8)
+    );
+    assert_eq!(e.config(), &default_config());
+    let boot = encode(&Message::Command(Command::EnterBootloader));
+    assert_eq!(e.set_feature(&boot, &mut store).1, Some(Action::EnterBootloader));
+}
+
+#[test]
+fn serial_requests() {
+    let mut e = engine();
+    let mut store = RamStore::default();
+    let mut out = [0u8; MAX_PAYLOAD];
+    let get = |id| encode(&Message::GetFeature(GetFeature { report: id }));
+
+    let (n, _) = e.handle_request(&get(ReportId::DeviceInfo), &mut out, &mut store);
+    let info = DeviceInfo::decode(&out[..n.expect("answer")]).expect("device info");
+    assert_eq!(
+        (info.firmware, info.unique_id, info.receiver_count),
+        (FIRMWARE, [7; 12], 4)
+    );
+    assert_eq!(info.protocol, PROTOCOL_VERSION);
+    assert_eq!(info.fix_rate_hz, 150);
+
+    let (n, _) = e.handle_request(&get(ReportId::Config), &mut out, &mut store);
+    assert_eq!(Config::decode(&out[..n.expect("answer")]), Ok(default_config()));
+
+    let mut c = default_config();
+    c.report_rate_hz = 100;
+    let (n, _) = e.handle_request(&encode(&Message::Config(c)), &mut out, &mut store);
+    assert_eq!(
+        Status::decode(&out[..n.expect("answer")]),
+        Ok(Status::ok(ReportId::Config as u8))
+    );
+    assert_eq!(e.cycle_period_us(), 10_000);
+
+    // A get-feature request for a report that cannot be read.
+    let (n, _) = e.handle_request(&[0x80, 0x06], &mut out, &mut store);
+    let s = Status::decode(&out[..n.expect("answer")]).expect("status");
+    assert_eq!((s.request, s.code), (0x80, StatusCode::UnknownReport));
+    // Garbage that framed correctly but is no request.
+    let (n, _) = e.handle_request(&[0x01, 0x02], &mut out, &mut store);
+    assert_eq!(
+        Status::decode(&out[..n.expect("answer")]).map(|s| s.code),
+        Ok(StatusCode::Malformed)
+    );
+}
+
+#[test]
+fn an_invalid_stored_configuration_falls_back_to_the_defaults() {
+    let mut bad = default_config();
+    bad.receiver_count = 2;
+    let e = Engine::new(Some(bad), FIRMWARE, [0; 12]);
+    assert_eq!(e.config(), &default_config());
+}
