@@ -1,6 +1,12 @@
-//! Link with cortex-m-rt's script (memory.x comes from embassy-stm32's `memory-x` feature) and
-//! defmt's, which places the log strings in the ELF rather than in flash.
+//! Link with cortex-m-rt's script and this board's memory.x (which leaves the last flash sector
+//! to the configuration), and with defmt's script, which keeps log strings out of flash.
+use std::{env, fs, path::PathBuf};
+
 fn main() {
+    let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
+    fs::copy("memory.x", out.join("memory.x")).expect("memory.x is readable");
+    println!("cargo:rustc-link-search={}", out.display());
+    println!("cargo:rerun-if-changed=memory.x");
     println!("cargo:rustc-link-arg-bins=--nmagic");
     println!("cargo:rustc-link-arg-bins=-Tlink.x");
     println!("cargo:rustc-link-arg-bins=-Tdefmt.x");

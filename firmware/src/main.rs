@@ -1,35 +1,56 @@
 //! Firmware of the pen's base station (STM32F411CE "Black Pill").
 //!
-//! This first image brings up the USB HID pen interface with the protocol crate's report
-//! descriptor, answers the device-information feature report, and sends a pen report per cycle
-//! marked out of range. Tracking (ultrasonic capture, solving, filtering, switches) and the
-//! CDC-ACM serial link arrive with the firmware issue; the wiring here stays as it is: clocks,
-//! interrupts, driver, builder, classes, join.
+//! This file only wires the hardware to the core (`pen-core`), in embassy's order: clocks,
+//! interrupts, peripherals, the USB builder and its classes, then the tasks joined. All tracking
+//! logic — ranges, solving, smoothing, debouncing, reports, configuration — lives in the core,
+//! which the host tests and the simulated pen drive through the same traits this board
+//! implements (`capture`, `switches`, `clock`, `usb`). Pins and wiring: docs/hardware.md.
 #![no_std]
 #![no_main]
 
-use defmt::{info, warn};
+mod bootloader;
+mod capture;
+mod clock;
+mod flash_store;
+mod switches;
+mod usb;
+
+use core::cell::RefCell;
+
+use defmt::{debug, info, warn};
 use embassy_executor::Spawner;
-use embassy_futures::join::join;
+use embassy_futures::join::{join, join3};
+use embassy_futures::select::{Either, select};
+use embassy_stm32::flash::Flash;
+use embassy_stm32::gpio::{Input, Pull};
 use embassy_stm32::time::Hertz;
-use embassy_stm32::usb::{self, Driver};
+use embassy_stm32::usb::Driver;
+use embassy_stm32::wdg::IndependentWatchdog;
 use embassy_stm32::{Config, bind_interrupts, peripherals, uid};
-use embassy_time::{Duration, Instant, Ticker};
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_time::{Duration, Instant, Timer};
 use embassy_usb::Builder;
-use embassy_usb::class::hid::{self, HidBootProtocol, HidSubclass, HidWriter, ReportId as HidReportId, RequestHandler};
-use embassy_usb::control::OutResponse;
-use pen_protocol::{
-    DeviceInfo, FirmwareVersion, MAX_RECEIVERS, PROTOCOL_VERSION, PenReport, Position, Quality, REPORT_DESCRIPTOR,
-    Report, Status, StatusCode, USB_PID, USB_VID,
-};
+use embassy_usb::class::cdc_acm::{self, CdcAcmClass};
+use embassy_usb::class::hid::{self, HidBootProtocol, HidSubclass, HidWriter};
+use pen_core::{ConfigStore, Engine, LogStore, Station};
+use pen_protocol::{FirmwareVersion, PROTOCOL_VERSION, REPORT_DESCRIPTOR, USB_PID, USB_VID};
 use {defmt_rtt as _, panic_probe as _};
 
+use crate::capture::{BoardRanging, Pins, burst_pin, capture_pin};
+use crate::clock::BoardClock;
+use crate::flash_store::ConfigSector;
+use crate::switches::BoardSwitches;
+use crate::usb::{BoardSink, BusState, FeatureHandler, HID_PACKET, HidQueue, SerialQueue};
+
 bind_interrupts!(struct Irqs {
-    OTG_FS => usb::InterruptHandler<peripherals::USB_OTG_FS>;
+    OTG_FS => embassy_stm32::usb::InterruptHandler<peripherals::USB_OTG_FS>;
+    TIM2 => capture::Tim2Captures;
+    TIM3 => capture::Tim3Captures;
 });
 
-/// Cycles per second of this image's report loop.
-const CYCLE_HZ: u16 = 100;
+/// The watchdog resets the board if the station stops for this long. Longer than a flash
+/// sector erase (about 1 s, 2 s at most), the longest the CPU ever stalls.
+const WATCHDOG_US: u32 = 4_000_000;
 
 /// Parses a decimal version component at compile time.
 const fn parse_u8(s: &str) -> u8 {
@@ -51,35 +72,13 @@ const FIRMWARE: FirmwareVersion = FirmwareVersion {
     patch: parse_u8(env!("CARGO_PKG_VERSION_PATCH")),
 };
 
-/// Answers the host's feature-report requests.
-struct Features {
-    info: DeviceInfo,
-    status: Status,
-}
-
-impl RequestHandler for Features {
-    fn get_report(&mut self, id: HidReportId, buf: &mut [u8]) -> Option<usize> {
-        match id {
-            HidReportId::Feature(id) if id == DeviceInfo::ID as u8 => self.info.encode(buf).ok(),
-            HidReportId::Feature(id) if id == Status::ID as u8 => self.status.encode(buf).ok(),
-            _ => None,
-        }
-    }
-
-    fn set_report(&mut self, id: HidReportId, _data: &[u8]) -> OutResponse {
-        // Configuration and commands arrive with the firmware issue; until then every write is
-        // refused and the status report says so.
-        let request = match id {
-            HidReportId::Feature(id) | HidReportId::Out(id) | HidReportId::In(id) => id,
-        };
-        self.status = Status::failed(request, StatusCode::Unsupported);
-        OutResponse::Rejected
-    }
-}
-
 #[embassy_executor::main]
 async fn main(_spawner: Spawner) {
-    // Clocks: 25 MHz crystal → PLL: 96 MHz system clock and the 48 MHz USB clock.
+    // A restart into the ROM bootloader must happen before anything is initialised.
+    bootloader::enter_if_requested();
+
+    // Clocks: 25 MHz crystal → PLL: 96 MHz system clock, 48 MHz for USB; APB1 48 MHz (its
+    // timers 96 MHz), APB2 96 MHz.
     let mut config = Config::default();
     {
         use embassy_stm32::rcc::*;
@@ -103,9 +102,49 @@ async fn main(_spawner: Spawner) {
     let p = embassy_stm32::init(config);
     info!("pen base station, firmware {}, protocol {}", FIRMWARE, PROTOCOL_VERSION);
 
-    // USB driver. The Black Pill has no VBUS sense wired, so VBUS detection stays off.
+    let mut watchdog = IndependentWatchdog::new(p.IWDG, WATCHDOG_US);
+    watchdog.unleash();
+
+    // The configuration: the newest saved one, or the defaults.
+    let store = Mutex::new(RefCell::new(LogStore::new(ConfigSector {
+        flash: Flash::new_blocking(p.FLASH),
+    })));
+    let saved = store.lock(|s| s.borrow_mut().load());
+    if saved.is_none() {
+        info!("no saved configuration: using the defaults");
+    }
+    let engine = Mutex::new(RefCell::new(Engine::new(saved, FIRMWARE, uid::uid())));
+    let receivers = engine.lock(|e| e.borrow().settings().count);
+
+    // The front end, the switches, the clock.
+    let pins = Pins {
+        burst: burst_pin(p.PA8),
+        tim2: (
+            capture_pin(p.PA15),
+            capture_pin(p.PB3),
+            capture_pin(p.PB10),
+            capture_pin(p.PA3),
+        ),
+        tim3: (
+            capture_pin(p.PA6),
+            capture_pin(p.PA7),
+            capture_pin(p.PB0),
+            capture_pin(p.PB1),
+        ),
+    };
+    let ranging = BoardRanging::new(p.TIM1, p.TIM2, p.TIM3, pins, receivers);
+    let switches = BoardSwitches {
+        pins: [
+            Input::new(p.PB12, Pull::Up),
+            Input::new(p.PB14, Pull::Up),
+            Input::new(p.PB15, Pull::Up),
+        ],
+    };
+
+    // USB: a composite device with the HID pen and a CDC-ACM serial link. The Black Pill has no
+    // VBUS sense, so VBUS detection stays off.
     let mut ep_out_buffer = [0u8; 256];
-    let mut usb_config = usb::Config::default();
+    let mut usb_config = embassy_stm32::usb::Config::default();
     usb_config.vbus_detection = false;
     let driver = Driver::new_fs(p.USB_OTG_FS, Irqs, p.PA12, p.PA11, &mut ep_out_buffer, usb_config);
 
@@ -115,20 +154,21 @@ async fn main(_spawner: Spawner) {
     device.serial_number = None;
     device.max_power = 100;
     device.max_packet_size_0 = 64;
+    device.supports_remote_wakeup = true;
+    // Interface association descriptors for the CDC function in a composite device.
+    device.composite_with_iads = true;
+    device.device_class = 0xEF;
+    device.device_sub_class = 0x02;
+    device.device_protocol = 0x01;
 
     // Everything the USB stack borrows is declared before the builder, so it outlives it.
-    let mut features = Features {
-        info: DeviceInfo {
-            protocol: PROTOCOL_VERSION,
-            firmware: FIRMWARE,
-            receiver_count: 0,
-            max_receivers: MAX_RECEIVERS as u8,
-            fix_rate_hz: CYCLE_HZ,
-            unique_id: uid::uid(),
-        },
-        status: Status::ok(0),
+    let mut features = FeatureHandler {
+        engine: &engine,
+        store: &store,
     };
+    let mut bus_state = BusState;
     let mut hid_state = hid::State::new();
+    let mut cdc_state = cdc_acm::State::new();
     let mut config_descriptor = [0; 256];
     let mut bos_descriptor = [0; 256];
     let mut msos_descriptor = [0; 0];
@@ -142,42 +182,87 @@ async fn main(_spawner: Spawner) {
         &mut msos_descriptor,
         &mut control_buf,
     );
-
+    builder.handler(&mut bus_state);
     let hid_config = hid::Config {
         report_descriptor: &REPORT_DESCRIPTOR,
         request_handler: Some(&mut features),
         poll_ms: 1,
-        max_packet_size: 64,
+        max_packet_size: HID_PACKET as u16,
         hid_subclass: HidSubclass::No,
         hid_boot_protocol: HidBootProtocol::None,
     };
-    let mut writer = HidWriter::<_, 64>::new(&mut builder, &mut hid_state, hid_config);
-
+    let hid_writer = HidWriter::<_, HID_PACKET>::new(&mut builder, &mut hid_state, hid_config);
+    let cdc = CdcAcmClass::new(&mut builder, &mut cdc_state, 64);
+    let (cdc_sender, cdc_receiver, cdc_control) = cdc.split_with_control();
     let mut usb = builder.build();
 
-    let reports = async {
-        let mut ticker = Ticker::every(Duration::from_hz(CYCLE_HZ as u64));
-        let mut seq: u16 = 0;
+    let hid_queue = HidQueue::new();
+    let serial_queue = SerialQueue::new();
+
+    // The USB device, waking the host when the pen asks to while the bus is suspended.
+    let usb_task = async {
         loop {
-            ticker.next().await;
-            let report = PenReport {
-                sw1: false,
-                sw2: false,
-                sw3: false,
-                in_range: false,
-                display_frame: false,
-                position: Position::default(),
-                seq,
-                // The device clock in µs, wrapping as the protocol defines.
-                timestamp_us: Instant::now().as_micros() as u32,
-                quality: Quality::NONE,
-            };
-            if let Err(e) = writer.write_serialize(&report).await {
-                warn!("pen report not sent: {}", e);
+            usb.run_until_suspend().await;
+            if let Either::Second(()) = select(usb.wait_resume(), usb::WAKE_HOST.wait()).await
+                && let Err(e) = usb.remote_wakeup().await
+            {
+                warn!("remote wakeup refused: {}", e);
             }
-            seq = seq.wrapping_add(1);
         }
     };
 
-    join(usb.run(), reports).await;
+    // The measurement loop: one cycle after another, paused while the bus is suspended.
+    let sink = BoardSink {
+        hid: &hid_queue,
+        serial: &serial_queue,
+        serial_control: &cdc_control,
+    };
+    let mut station = Station::new(&engine, ranging, switches, BoardClock, sink);
+    let station_task = async {
+        let mut next_log = Instant::now();
+        loop {
+            watchdog.pet();
+            if usb::SUSPENDED.load(core::sync::atomic::Ordering::Relaxed) {
+                // No bursts during suspend; a press of the tip wakes the host.
+                use pen_core::Switches;
+                if station.switches.read()[0] {
+                    usb::WAKE_HOST.signal(());
+                }
+                Timer::after_millis(10).await;
+                continue;
+            }
+            let receivers = engine.lock(|e| e.borrow().settings().count);
+            station.ranging.set_receivers(receivers);
+            station.cycle().await;
+            if Instant::now() >= next_log {
+                next_log += Duration::from_secs(10);
+                let c = engine.lock(|e| e.borrow().counters());
+                debug!(
+                    "{} dropped HID, {} dropped serial, {} bad frames",
+                    usb::DROPPED_HID.load(core::sync::atomic::Ordering::Relaxed),
+                    usb::DROPPED_SERIAL.load(core::sync::atomic::Ordering::Relaxed),
+                    usb::BAD_FRAMES.load(core::sync::atomic::Ordering::Relaxed)
+                );
+                info!("{}", c);
+            }
+        }
+    };
+
+    // Restart into the bootloader once the request's answer has gone out.
+    let bootloader_task = async {
+        usb::BOOTLOADER.wait().await;
+        info!("restarting into the DFU bootloader");
+        Timer::after_millis(50).await;
+        bootloader::restart_into_bootloader()
+    };
+
+    join(
+        join3(usb_task, station_task, bootloader_task),
+        join3(
+            usb::hid_writer(hid_writer, &hid_queue),
+            usb::serial_writer(cdc_sender, &serial_queue),
+            usb::serial_reader(cdc_receiver, &engine, &store, &serial_queue),
+        ),
+    )
+    .await;
 }

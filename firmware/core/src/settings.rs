@@ -10,7 +10,7 @@ use crate::sound::speed_of_sound_m_s;
 /// lower-left corner at the origin, x along the bottom edge, y up the surface, z out of it
 /// towards the user; a receiver beside each corner, the bottom-right and top-left ones on
 /// 150 mm posts. Four receivers in one plane would leave every point a mirror image; raising a
-/// diagonal pair makes the solution unique and keeps the dilution of precision between 1.5 and
+/// diagonal pair makes the solution unique and keeps the dilution of precision between 1.6 and
 /// 3.7 over the workspace (2.2 on average; a flat rectangle of receivers reaches 27 near the
 /// surface).
 pub fn default_config() -> Config {
