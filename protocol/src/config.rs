@@ -62,7 +62,9 @@ pub struct Config {
     pub temperature_c: f32,
     /// A measured speed of sound, m/s, used instead of the temperature's when set.
     pub speed_of_sound_m_s: Option<f32>,
-    /// Pen reports per second (at most the fix rate; cycles in between are not reported).
+    /// Pen reports per second, or 0 for one report per measurement cycle at the fastest cycle
+    /// rate. A rate below the fastest cycle rate slows the cycles to match; a rate above it
+    /// repeats the latest fix between cycles.
     pub report_rate_hz: u16,
     /// Position smoothing.
     pub filter: Filter,
@@ -360,8 +362,9 @@ pub mod limits {
     pub const TEMPERATURE_C: (f32, f32) = (-40.0, 85.0);
     /// Speed of sound range, m/s.
     pub const SPEED_OF_SOUND_M_S: (f32, f32) = (300.0, 400.0);
-    /// Report rate range, Hz (a full-speed USB interrupt endpoint polls at most every 1 ms).
-    pub const REPORT_RATE_HZ: (u16, u16) = (1, 1000);
+    /// Report rate range, Hz (a full-speed USB interrupt endpoint polls at most every 1 ms);
+    /// 0 means one report per measurement cycle.
+    pub const REPORT_RATE_HZ: (u16, u16) = (0, 1000);
     /// Debounce range, ms.
     pub const DEBOUNCE_MS: (u8, u8) = (0, 50);
     /// 1€ cutoff range (both cutoffs), Hz.

@@ -267,7 +267,11 @@ fn config_values() {
         ConfigField::SpeedOfSound,
         Problem::OutOfRange,
     );
-    fails(&|c| c.report_rate_hz = 0, ConfigField::ReportRate, Problem::OutOfRange);
+    fails(
+        &|c| c.report_rate_hz = 1001,
+        ConfigField::ReportRate,
+        Problem::OutOfRange,
+    );
     fails(
         &|c| {
             c.filter = Filter::OneEuro {

@@ -81,7 +81,7 @@ fn bench(c: &mut Criterion) {
     let mut t0 = 0;
     c.bench_function("engine/cycle and report", |b| {
         b.iter(|| {
-            t0 += 6_666;
+            t0 += 6_500;
             let result = engine.on_cycle(&Cycle {
                 t0_us: t0,
                 arrival_ns: black_box(arrival_ns),

@@ -208,7 +208,7 @@ impl Engine {
     /// The measurement cycle's period, µs: the report interval, but never shorter than
     /// [`MIN_CYCLE_US`]; faster report rates repeat the latest fix between cycles.
     pub fn cycle_period_us(&self) -> u64 {
-        self.settings.report_interval_us.max(MIN_CYCLE_US)
+        self.settings.report_interval_us.unwrap_or(0).max(MIN_CYCLE_US)
     }
 
     /// The device information report.
@@ -312,11 +312,13 @@ impl Engine {
     /// The next pen report, if one is due at `now_us`: after each cycle, after a switch
     /// transition, and between cycles at the report rate when it exceeds the cycle rate.
     pub fn poll_report(&mut self, now_us: u64) -> Option<PenReport> {
-        let interval = self.settings.report_interval_us;
-        let between_cycles = interval < self.cycle_period_us()
-            && self
-                .last_report_us
-                .is_some_and(|t| now_us.saturating_sub(t) >= interval);
+        let period = self.cycle_period_us();
+        let between_cycles = self.settings.report_interval_us.is_some_and(|interval| {
+            interval < period
+                && self
+                    .last_report_us
+                    .is_some_and(|t| now_us.saturating_sub(t) >= interval)
+        });
         if !(self.fresh || self.latch.any_pending() || between_cycles) {
             return None;
         }

@@ -27,7 +27,7 @@ pub fn default_config() -> Config {
         transducer_delay_us: [0.0; MAX_RECEIVERS],
         temperature_c: 20.0,
         speed_of_sound_m_s: None,
-        report_rate_hz: 150,
+        report_rate_hz: 0,
         filter: Filter::OneEuro {
             min_cutoff_hz: 0.5,
             beta: 0.1,
@@ -123,8 +123,8 @@ pub struct Settings {
     pub display: Option<DisplayFrame>,
     /// Debounce time, µs.
     pub debounce_us: u64,
-    /// Interval between reports, µs.
-    pub report_interval_us: u64,
+    /// Interval between reports, µs; `None` for one report per cycle.
+    pub report_interval_us: Option<u64>,
 }
 
 impl Settings {
@@ -149,7 +149,10 @@ impl Settings {
             delays_ns,
             display: config.display.as_ref().map(DisplayFrame::new),
             debounce_us: config.debounce_ms as u64 * 1000,
-            report_interval_us: 1_000_000 / config.report_rate_hz as u64,
+            report_interval_us: match config.report_rate_hz {
+                0 => None,
+                hz => Some(1_000_000 / hz as u64),
+            },
         })
     }
 
@@ -181,7 +184,7 @@ mod tests {
         let s = Settings::new(default_config()).expect("valid");
         assert_eq!(s.count, 4);
         assert!((s.speed_m_s - 343.2).abs() < 0.05);
-        assert_eq!(s.report_interval_us, 6666);
+        assert_eq!(s.report_interval_us, None);
     }
 
     #[test]

@@ -10,7 +10,7 @@ const FIRMWARE: FirmwareVersion = FirmwareVersion {
     minor: 2,
     patch: 3,
 };
-const PERIOD_US: u64 = 6_666;
+const PERIOD_US: u64 = 6_500;
 
 /// A store in RAM that can be told to fail.
 #[derive(Default)]
@@ -278,7 +278,7 @@ fn serial_requests() {
         (FIRMWARE, [7; 12], 4)
     );
     assert_eq!(info.protocol, PROTOCOL_VERSION);
-    assert_eq!(info.fix_rate_hz, 150);
+    assert_eq!(info.fix_rate_hz, 154);
 
     let (n, _) = e.handle_request(&get(ReportId::Config), &mut out, &mut store);
     assert_eq!(Config::decode(&out[..n.expect("answer")]), Ok(default_config()));
