@@ -1,8 +1,9 @@
 # Sourced by run.sh and test.sh: installs what a fresh Debian machine with rustup lacks.
 # Idempotent and quiet when everything is already there.
 
-# Debian packages the scripts need: binutils for `size` (firmware image figures).
-DEB_PACKAGES=(binutils)
+# Debian packages the scripts need: binutils for `size` (firmware image figures), QEMU for the
+# firmware core's run on an emulated Cortex-M4F (hil-tests/tests/qemu.rs).
+DEB_PACKAGES=(binutils qemu-system-arm)
 # The board's target; clippy and rustfmt for the checks.
 RUST_TARGETS=(thumbv7em-none-eabihf)
 RUST_COMPONENTS=(clippy rustfmt)

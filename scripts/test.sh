@@ -18,7 +18,7 @@ step "tests (host workspace)"
 cargo test --workspace --locked
 
 step "firmware: lint and release image for thumbv7em-none-eabihf"
-(cd firmware && cargo clippy --release --locked -- -D warnings && cargo build --release --locked)
+(cd firmware && cargo clippy --release --locked --workspace -- -D warnings && cargo build --release --locked)
 scripts/firmware-size.sh
 
 step "all checks passed"

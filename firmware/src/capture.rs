@@ -28,6 +28,7 @@ use embassy_stm32::timer::simple_pwm::PwmPin;
 use embassy_stm32::timer::{Ch1, Ch2, Ch3, Ch4, Channel};
 use embassy_stm32::{Peri, interrupt, pac};
 use pen_core::Ranging;
+use pen_core::capture::{SLOW_TIMER_HZ, ns_per_tick, ticks_to_ns};
 use pen_protocol::MAX_RECEIVERS;
 
 /// Periods of 40 kHz per burst: long enough for the transducer to ring up, short enough to end
@@ -35,8 +36,6 @@ use pen_protocol::MAX_RECEIVERS;
 pub const BURST_CYCLES: u16 = 8;
 /// The transducer's resonance.
 const BURST_HZ: u32 = 40_000;
-/// TIM3's tick rate: 16 bits must span the 5 ms listening window.
-const TIM3_TICK_HZ: u32 = 8_000_000;
 
 const NO_CAPTURE: u32 = u32::MAX;
 /// The first capture of each receiver since the last burst, in timer ticks.
@@ -149,7 +148,7 @@ impl<'d> BoardRanging<'d> {
         tim2.regs_gp32().psc().write_value(0);
         tim2.regs_gp32().arr().write_value(u32::MAX);
         let mut tim3 = Timer::new(tim3);
-        tim3.set_tick_freq(Hertz(TIM3_TICK_HZ));
+        tim3.set_tick_freq(Hertz(SLOW_TIMER_HZ));
         tim3.regs_gp16().arr().write(|w| w.set_arr(u16::MAX));
         for ch in CHANNELS {
             tim2.set_input_ti_selection(ch, InputTISelection::Normal);
@@ -167,8 +166,9 @@ impl<'d> BoardRanging<'d> {
         tim3.generate_update_event();
         tim2.start();
         tim3.start();
-        let ns_per_tick_tim2 = 1e9 / tim2.get_clock_frequency().0 as f32;
-        let ns_per_tick_tim3 = 1e9 / TIM3_TICK_HZ as f32;
+        // The clock tree gives TIM2 the 96 MHz the core's FAST_TIMER_HZ assumes.
+        let ns_per_tick_tim2 = ns_per_tick(tim2.get_clock_frequency().0);
+        let ns_per_tick_tim3 = ns_per_tick(SLOW_TIMER_HZ);
         interrupt::typelevel::TIM2::unpend();
         interrupt::typelevel::TIM3::unpend();
         // SAFETY: the handlers are bound in main's `bind_interrupts!` and touch only the
@@ -229,7 +229,7 @@ impl Ranging for BoardRanging<'_> {
                 } else {
                     self.ns_per_tick_tim3
                 };
-                *slot = Some((ticks as f32 * ns_per_tick) as u32);
+                *slot = Some(ticks_to_ns(ticks, ns_per_tick));
             }
         }
         out

@@ -1,6 +1,24 @@
 //! The simulated pen and base station.
 //!
-//! This crate will model what makes ultrasonic tracking hard (receiver geometry, temperature,
-//! timing jitter, echoes, dropouts, switch bounce, a human hand), drive the real firmware core
-//! through its hardware traits and yield the exact report bytes the device sends: in process,
-//! over a pseudo-terminal, and on an emulated Cortex-M4F. The simulated-pen issue fills it in.
+//! It models what makes ultrasonic tracking hard — receiver geometry ([`rig`]), the speed of
+//! sound and its drift, timing jitter, timer quantisation, late echoes and dropouts
+//! ([`acoustics`]), a human hand with tremor and bouncing switch contacts ([`hand`]) — plays
+//! scripted sessions of the seed's operations ([`script`], [`scenarios`]), and drives the real
+//! firmware core through its hardware traits ([`sim`]), so what comes out are the exact report
+//! bytes the device sends. Three ways out: in process ([`sim::Simulation`]), over a
+//! pseudo-terminal like a real serial device ([`pty`]), and the core itself on an emulated
+//! Cortex-M4F ([`qemu`]). [`accuracy`] measures it; [`trace`] records it.
+#![cfg_attr(not(test), warn(clippy::unwrap_used))]
+
+pub mod accuracy;
+pub mod acoustics;
+pub mod hand;
+pub mod pty;
+pub mod qemu;
+pub mod rig;
+pub mod scenarios;
+pub mod script;
+pub mod sim;
+pub mod trace;
+
+pub use sim::{CycleRecord, Scenario, Sent, Simulation};

@@ -29,7 +29,7 @@ fn bench(c: &mut Criterion) {
     );
     let s = *engine.settings();
     let four = &s.receivers[..4];
-    let five: Vec<Vec3> = [four, &[Vec3::new(640.0, -40.0, 0.0)]].concat();
+    let five: Vec<Vec3> = [four, &[Vec3::new(640.0, -40.0, 300.0)]].concat();
     let p = Vec3::new(260.0, 140.0, 90.0);
     let height = |q: Vec3| q.z;
 

@@ -14,6 +14,7 @@
 #![no_std]
 #![cfg_attr(not(test), warn(clippy::unwrap_used))]
 
+pub mod capture;
 pub mod debounce;
 pub mod engine;
 pub mod filter;

@@ -1,6 +1,48 @@
 //! Small fixed-size linear algebra in `f32`, written out so that every operation happens in the
 //! same order on the host and on the Cortex-M4F: their results are bit-identical.
 
+/// The square root, correctly rounded as IEEE 754 requires, so every platform gives the same
+/// bits. On a hard-float ARM core it is the FPU's VSQRT.F32 (14 cycles on the Cortex-M4F):
+/// core has no `f32::sqrt`, and libm's portable routine costs over a hundred instructions,
+/// which made square roots most of a fix's cost there.
+#[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+#[allow(unsafe_code)]
+pub fn sqrt(x: f32) -> f32 {
+    // SAFETY: `pen_vsqrtf` (below) takes and returns an f32 in s0 per the hard-float ABI,
+    // touches nothing else, and the FPU it needs is part of every eabihf target.
+    unsafe { pen_vsqrtf(x) }
+}
+
+#[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+#[allow(unsafe_code)]
+unsafe extern "C" {
+    fn pen_vsqrtf(x: f32) -> f32;
+}
+
+// A function in assembly rather than `asm!`: the inline form's FPU register operands need a
+// target feature that stable Rust cannot enable on ARM.
+#[cfg(all(target_arch = "arm", target_abi = "eabihf"))]
+#[allow(unsafe_code)]
+mod vsqrt {
+    core::arch::global_asm!(
+        ".section .text.pen_vsqrtf,\"ax\",%progbits",
+        ".global pen_vsqrtf",
+        ".type pen_vsqrtf,%function",
+        ".thumb_func",
+        ".fpu fpv4-sp-d16",
+        "pen_vsqrtf:",
+        "vsqrt.f32 s0, s0",
+        "bx lr",
+    );
+}
+
+/// The square root, correctly rounded (libm's, which uses the CPU's instruction where it has
+/// one).
+#[cfg(not(all(target_arch = "arm", target_abi = "eabihf")))]
+pub fn sqrt(x: f32) -> f32 {
+    libm::sqrtf(x)
+}
+
 use core::ops::{Add, AddAssign, Mul, Neg, Sub};
 
 /// A 3-vector (mm, or a direction).
@@ -57,7 +99,7 @@ impl Vec3 {
 
     /// Length.
     pub fn length(self) -> f32 {
-        libm::sqrtf(self.length_squared())
+        sqrt(self.length_squared())
     }
 
     /// Whether every component is finite.

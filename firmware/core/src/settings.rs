@@ -8,18 +8,18 @@ use crate::sound::speed_of_sound_m_s;
 
 /// The reference build's configuration (docs/hardware.md): a display of 600 × 340 mm with its
 /// lower-left corner at the origin, x along the bottom edge, y up the surface, z out of it
-/// towards the user; a receiver beside each corner, the bottom-right and top-left ones on
-/// 150 mm posts. Four receivers in one plane would leave every point a mirror image; raising a
-/// diagonal pair makes the solution unique and keeps the dilution of precision between 1.6 and
-/// 3.7 over the workspace (2.2 on average; a flat rectangle of receivers reaches 27 near the
+/// towards the user; a receiver beside each corner, the bottom-left and top-right ones on
+/// 300 mm posts. Four receivers in one plane would leave every point a mirror image; raising a
+/// diagonal pair makes the solution unique and keeps the dilution of precision between 1.5 and
+/// 2.4 over the workspace (1.8 on average; a flat rectangle of receivers reaches 27 near the
 /// surface).
 pub fn default_config() -> Config {
     let mut receivers_mm = [[0.0; 3]; MAX_RECEIVERS];
     receivers_mm[..4].copy_from_slice(&[
-        [-40.0, -40.0, 0.0],
-        [640.0, -40.0, 150.0],
-        [-40.0, 380.0, 150.0],
-        [640.0, 380.0, 0.0],
+        [-40.0, -40.0, 300.0],
+        [640.0, -40.0, 0.0],
+        [-40.0, 380.0, 0.0],
+        [640.0, 380.0, 300.0],
     ]);
     Config {
         receiver_count: 4,
@@ -57,7 +57,7 @@ impl DisplayFrame {
     /// From a validated pose; the quaternion is normalised here.
     pub fn new(pose: &DisplayPose) -> DisplayFrame {
         let [w, x, y, z] = pose.rotation;
-        let n = libm::sqrtf(w * w + x * x + y * y + z * z);
+        let n = crate::math::sqrt(w * w + x * x + y * y + z * z);
         let (w, x, y, z) = (w / n, x / n, y / n, z / n);
         let rows = [
             Vec3::new(

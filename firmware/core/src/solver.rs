@@ -36,10 +36,17 @@ pub const RANGE_SIGMA_MM: f32 = 0.8;
 const CHI2_999: [f32; 6] = [0.0, 10.828, 13.816, 16.266, 18.467, 20.515];
 /// How far behind the display a solution may lie before it is taken for the mirror image, mm.
 pub const BEHIND_MARGIN_MM: f32 = 20.0;
-/// Gauss–Newton iterations per solve at most.
+/// Gauss–Newton iterations per solve at most: enough for the slow convergence along a poorly
+/// observed direction (a pen near the plane of three receivers).
 pub const MAX_ITERATIONS: usize = 12;
+/// Iterations for each subset when leaving receivers out: a subset without the bad range
+/// converges from its linear start in a few; one that has not by then keeps the bad range, and
+/// more iterations would only cost time (up to 40 % of the cycle on the Cortex-M4F).
+pub const SUBSET_ITERATIONS: usize = 6;
 /// A step shorter than this ends the iteration, mm.
 const CONVERGED_MM: f32 = 1e-3;
+/// Damping increases tried per iteration before giving up.
+const MAX_TRIES: usize = 5;
 /// Reciprocal condition below which the linear start is not trusted.
 const LINEAR_MIN_RCOND: f32 = 1e-4;
 /// The dilution of precision reported for a geometry that does not determine the position in
@@ -89,6 +96,9 @@ pub enum NoFix {
     Jump,
     /// The first fix after a gap, held until the next one confirms it (the tracking gate).
     Acquiring,
+    /// The receivers used place the pen too poorly to report it (dilution of precision above
+    /// the engine's limit).
+    PoorGeometry,
 }
 
 /// One least-squares problem: receivers with their ranges.
@@ -158,7 +168,7 @@ impl Problem<'_> {
     fn dop(&self, x: Vec3, mask: u8) -> f32 {
         match self.normal_equations(x, mask).and_then(|(h, _)| h.inverse(1e-12)) {
             // `min` also turns a NaN into MAX_DOP.
-            Some(inv) => libm::sqrtf(inv.trace().max(0.0)).min(MAX_DOP),
+            Some(inv) => crate::math::sqrt(inv.trace().max(0.0)).min(MAX_DOP),
             None => MAX_DOP,
         }
     }
@@ -226,30 +236,34 @@ impl Problem<'_> {
         }
         let d2 = (r2 - spread) * inv_n;
         // Ranges shorter than the spread allow no point: start just in front of the centroid.
-        let d = if d2 > 1.0 { libm::sqrtf(d2) } else { 1.0 };
+        let d = if d2 > 1.0 { crate::math::sqrt(d2) } else { 1.0 };
         c + front * d
     }
 
     /// Levenberg–Marquardt from `start`.
-    fn refine(&self, start: Vec3, mask: u8) -> Option<Solution> {
+    fn refine(&self, start: Vec3, mask: u8, iterations: usize) -> Option<Solution> {
         let mut best = self.evaluate(start, mask);
         let mut lambda = 1e-3f32;
-        for _ in 0..MAX_ITERATIONS {
+        for _ in 0..iterations {
             let (h, g) = self.normal_equations(best.x, mask)?;
             let mut improved = false;
-            // Raise the damping until a step lowers the cost (a few tries at most).
-            while lambda < 1e6 {
+            // Raise the damping until a step lowers the cost, a few tries at most. A step too
+            // short to matter ends the iteration whether or not it lowers the cost: at the
+            // minimum, rounding decides that, and retrying would only burn time.
+            for _ in 0..MAX_TRIES {
                 let Some(inv) = h.damped(lambda).inverse(1e-12) else {
                     lambda *= 10.0;
                     continue;
                 };
                 let step = -inv.mul_vec(g);
+                if step.length() < CONVERGED_MM {
+                    break;
+                }
                 let trial = self.evaluate(best.x + step, mask);
                 if trial.sse.is_finite() && trial.sse <= best.sse {
-                    let small = step.length() < CONVERGED_MM;
                     best = trial;
                     lambda = (lambda * 0.1).max(1e-7);
-                    improved = !small;
+                    improved = true;
                     break;
                 }
                 lambda *= 10.0;
@@ -262,19 +276,25 @@ impl Problem<'_> {
     }
 
     /// Start, refine, and resolve the mirror ambiguity for the receivers in `mask`.
-    fn solve_subset(&self, mask: u8, front: Vec3, behind: &dyn Fn(Vec3) -> f32) -> Result<Solution, NoFix> {
+    fn solve_subset(
+        &self,
+        mask: u8,
+        front: Vec3,
+        behind: &dyn Fn(Vec3) -> f32,
+        iterations: usize,
+    ) -> Result<Solution, NoFix> {
         let n = mask.count_ones() as usize;
         let start = match n {
             4.. => self.linear_start(mask, n),
             _ => None,
         }
         .unwrap_or_else(|| self.centroid_start(mask, n, front));
-        let mut sol = self.refine(start, mask).ok_or(NoFix::Degenerate)?;
+        let mut sol = self.refine(start, mask, iterations).ok_or(NoFix::Degenerate)?;
         if behind(sol.x) < -BEHIND_MARGIN_MM {
             // Try the mirror image through the receivers' plane.
             let (c, normal) = self.plane(mask, front);
             let mirrored = sol.x - normal * (2.0 * (sol.x - c).dot(normal));
-            match self.refine(mirrored, mask) {
+            match self.refine(mirrored, mask, iterations) {
                 Some(m) if behind(m.x) >= -BEHIND_MARGIN_MM => sol = m,
                 _ => return Err(NoFix::Behind),
             }
@@ -282,6 +302,10 @@ impl Problem<'_> {
         Ok(sol)
     }
 }
+
+/// A receiver left out must miss the subset's solution by this many standard deviations of the
+/// range noise.
+const OUTLIER_SIGMAS: f32 = 4.0;
 
 /// Subset solutions closer together than this many standard deviations of the position error
 /// (σ_range · DOP) are the same answer.
@@ -310,7 +334,7 @@ pub fn solve(
     if n < 3 {
         return Err(NoFix::TooFewRanges);
     }
-    let mut best = problem.solve_subset(mask, geometry.front, height);
+    let mut best = problem.solve_subset(mask, geometry.front, height, MAX_ITERATIONS);
     if !matches!(best, Ok(s) if consistent(s.sse, n as usize)) {
         if n < 5 {
             return Err(match best {
@@ -322,8 +346,12 @@ pub fn solve(
         let mut candidates: [Option<(u8, Solution)>; MAX_RECEIVERS] = [None; MAX_RECEIVERS];
         for i in (0..MAX_RECEIVERS).filter(|i| mask & (1 << i) != 0) {
             let m = mask & !(1 << i);
-            if let Ok(s) = problem.solve_subset(m, geometry.front, height)
+            // The subset must fit, and the receiver left out must not: otherwise the subset
+            // fits only by chance and the bad range is among those it kept.
+            if let Ok(s) = problem.solve_subset(m, geometry.front, height, SUBSET_ITERATIONS)
                 && consistent(s.sse, n as usize - 1)
+                && let Some(r) = ranges[i]
+                && ((s.x - geometry.receivers[i]).length() - r).abs() > OUTLIER_SIGMAS * RANGE_SIGMA_MM
             {
                 candidates[i] = Some((m, s));
             }
@@ -362,7 +390,7 @@ pub fn solve(
         position: sol.x,
         used_mask: mask,
         used,
-        residual_rms_mm: libm::sqrtf(sol.sse / used as f32),
+        residual_rms_mm: crate::math::sqrt(sol.sse / used as f32),
         dop: problem.dop(sol.x, mask),
     })
 }

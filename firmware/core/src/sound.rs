@@ -3,7 +3,7 @@
 /// The speed of sound in dry air at `temperature_c` °C, m/s: 331.3·√(1 + T/273.15).
 /// A wrong temperature scales every range: 0.17 % per °C.
 pub fn speed_of_sound_m_s(temperature_c: f32) -> f32 {
-    331.3 * libm::sqrtf(1.0 + temperature_c / 273.15)
+    331.3 * crate::math::sqrt(1.0 + temperature_c / 273.15)
 }
 
 /// Time of flight in ns: the capture time after the burst minus the receiver's transducer and

@@ -6,6 +6,7 @@
 
 use core::cell::RefCell;
 use core::future::Future;
+use core::ops::Deref;
 
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::RawMutex;
@@ -47,9 +48,10 @@ pub trait ReportSink {
 /// The engine behind a mutex, shared with the USB request handlers.
 pub type SharedEngine<M> = Mutex<M, RefCell<Engine>>;
 
-/// The measurement loop over a set of hardware seams.
-pub struct Station<'e, M: RawMutex, R, S, C, K> {
-    engine: &'e SharedEngine<M>,
+/// The measurement loop over a set of hardware seams. `E` is how the station reaches the shared
+/// engine: a reference on the board, a reference-counted handle in the simulator.
+pub struct Station<M: RawMutex, E: Deref<Target = SharedEngine<M>>, R, S, C, K> {
+    engine: E,
     /// The ultrasonic front end.
     pub ranging: R,
     /// The switches.
@@ -60,9 +62,17 @@ pub struct Station<'e, M: RawMutex, R, S, C, K> {
     pub sink: K,
 }
 
-impl<'e, M: RawMutex, R: Ranging, S: Switches, C: Clock, K: ReportSink> Station<'e, M, R, S, C, K> {
+impl<M, E, R, S, C, K> Station<M, E, R, S, C, K>
+where
+    M: RawMutex,
+    E: Deref<Target = SharedEngine<M>>,
+    R: Ranging,
+    S: Switches,
+    C: Clock,
+    K: ReportSink,
+{
     /// A station driving `engine`.
-    pub fn new(engine: &'e SharedEngine<M>, ranging: R, switches: S, clock: C, sink: K) -> Self {
+    pub fn new(engine: E, ranging: R, switches: S, clock: C, sink: K) -> Self {
         Station {
             engine,
             ranging,
@@ -70,6 +80,11 @@ impl<'e, M: RawMutex, R: Ranging, S: Switches, C: Clock, K: ReportSink> Station<
             clock,
             sink,
         }
+    }
+
+    /// The engine.
+    pub fn engine(&self) -> &SharedEngine<M> {
+        &self.engine
     }
 
     fn with<T>(&self, f: impl FnOnce(&mut Engine) -> T) -> T {

@@ -10,8 +10,9 @@
 use crate::math::Vec3;
 use crate::solver::NoFix;
 
-/// The fastest the pen is taken to move, mm per µs (3 m/s, a quick flick of the wrist).
-pub const MAX_SPEED_MM_PER_US: f32 = 0.003;
+/// The fastest the pen is taken to move between two fixes, mm per µs (1.5 m/s). A faster move
+/// costs a cycle: the first fix after it is held back and the next one confirms it.
+pub const MAX_SPEED_MM_PER_US: f32 = 0.0015;
 /// Added to the distance the pen can move, for noise, mm.
 pub const GATE_MARGIN_MM: f32 = 10.0;
 /// A fix older than this no longer gates nor hints, µs.
@@ -73,11 +74,11 @@ mod tests {
         let a = Vec3::new(100.0, 100.0, 50.0);
         assert_eq!(t.gate(0, a), Err(NoFix::Acquiring));
         assert_eq!(t.gate(6_500, a + Vec3::new(2.0, 0.0, 0.0)), Ok(()));
-        // 6.5 ms later: up to 3 mm/ms · 6.5 ms + 10 mm = 29.5 mm away is reachable.
-        assert_eq!(t.gate(13_000, a + Vec3::new(30.0, 0.0, 0.0)), Ok(()));
+        // 6.5 ms later: up to 1.5 mm/ms · 6.5 ms + 10 mm = 19.75 mm away is reachable.
+        assert_eq!(t.gate(13_000, a + Vec3::new(19.0, 0.0, 0.0)), Ok(()));
         // A wild fix is held back, and the track continues past it.
         assert_eq!(t.gate(19_500, a + Vec3::new(300.0, 0.0, 0.0)), Err(NoFix::Jump));
-        assert_eq!(t.gate(26_000, a + Vec3::new(31.0, 0.0, 0.0)), Ok(()));
+        assert_eq!(t.gate(26_000, a + Vec3::new(20.0, 0.0, 0.0)), Ok(()));
         // Two agreeing fixes far from the track start a new one (the old track was wrong).
         assert_eq!(t.gate(32_500, Vec3::new(500.0, 0.0, 0.0)), Err(NoFix::Jump));
         assert_eq!(t.gate(39_000, Vec3::new(501.0, 0.0, 0.0)), Ok(()));

@@ -54,9 +54,9 @@ fn workspace_points() -> Vec<Vec3> {
     pts
 }
 
-/// The reference build with the optional fifth receiver at the foot of the bottom-right post.
+/// The reference build with a fifth receiver at the top of a 300 mm bottom-right post.
 fn five_receivers() -> Vec<Vec3> {
-    [reference_receivers(), vec![Vec3::new(640.0, -40.0, 0.0)]].concat()
+    [reference_receivers(), vec![Vec3::new(640.0, -40.0, 300.0)]].concat()
 }
 
 #[test]

@@ -37,10 +37,10 @@ impl Rng {
 /// The reference build's receivers (`default_config`).
 pub fn reference_receivers() -> Vec<Vec3> {
     vec![
-        Vec3::new(-40.0, -40.0, 0.0),
-        Vec3::new(640.0, -40.0, 150.0),
-        Vec3::new(-40.0, 380.0, 150.0),
-        Vec3::new(640.0, 380.0, 0.0),
+        Vec3::new(-40.0, -40.0, 300.0),
+        Vec3::new(640.0, -40.0, 0.0),
+        Vec3::new(-40.0, 380.0, 0.0),
+        Vec3::new(640.0, 380.0, 300.0),
     ]
 }
 

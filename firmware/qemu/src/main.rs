@@ -1,0 +1,332 @@
+//! The firmware core on an emulated Cortex-M4F.
+//!
+//! Reads `cycles.bin` (a replay recorded by the simulated pen, format in docs/simulator.md)
+//! through semihosting, drives pen-core's station with it — the same engine, the same station
+//! loop, compiled for `thumbv7em-none-eabihf` — and prints every report it sends as
+//! `R <device µs> <hex>` on the host's standard output. Then it replays the cycles once more
+//! straight into the engine, timing each with SysTick, and prints the cost per fix. Run with
+//! `-icount shift=0`, QEMU's virtual clock advances one nanosecond per instruction, so the
+//! counts are instructions. It ends with a semihosting exit: status 0, or 1 on a bad replay.
+#![no_std]
+#![no_main]
+
+use core::cell::RefCell;
+use core::fmt::Write;
+
+use cortex_m::peripheral::SYST;
+use cortex_m::peripheral::syst::SystClkSource;
+use cortex_m_rt::entry;
+use cortex_m_semihosting::{debug, hio, syscall};
+use embassy_futures::block_on;
+use embassy_sync::blocking_mutex::Mutex;
+use embassy_sync::blocking_mutex::raw::NoopRawMutex;
+use pen_core::{Clock, Cycle, Engine, Ranging, ReportSink, SharedEngine, Station, Switches};
+use pen_protocol::{Config, FirmwareVersion, MAX_RECEIVERS, PenReport, Report, TofReport};
+
+const MAGIC: &[u8; 4] = b"PRPL";
+const VERSION: u32 = 1;
+const NO_ARRIVAL: u32 = u32::MAX;
+/// Switch samples a cycle may have: the longest cycle, 1 s at a 1 Hz report rate, has 2000.
+const MAX_TICKS: usize = 2048;
+
+/// After a semihosting exit QEMU has stopped; on anything else, sleep.
+fn halt() -> ! {
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+#[panic_handler]
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    if let Ok(mut out) = hio::hstderr() {
+        let _ = writeln!(out, "pen-qemu: {info}");
+    }
+    debug::exit(debug::EXIT_FAILURE);
+    halt()
+}
+
+/// A file on the host, read through semihosting.
+struct HostFile(usize);
+
+impl HostFile {
+    fn open(name: &str) -> Option<HostFile> {
+        // Semihosting wants a NUL-terminated name and its length without the NUL.
+        let mut path = [0u8; 64];
+        path.get_mut(..name.len())?.copy_from_slice(name.as_bytes());
+        // SAFETY: a valid pointer to a NUL-terminated name; mode 1 is "rb".
+        let fd = unsafe { syscall!(OPEN, path.as_ptr(), 1, name.len()) } as isize;
+        (fd >= 0).then_some(HostFile(fd as usize))
+    }
+
+    /// Fills `buf` entirely, or returns false at the end of the file.
+    fn read_exact(&mut self, buf: &mut [u8]) -> bool {
+        if buf.is_empty() {
+            return true;
+        }
+        // SAFETY: a valid buffer of the given length; the result is the count NOT read.
+        let left = unsafe { syscall!(READ, self.0, buf.as_mut_ptr(), buf.len()) };
+        left == 0
+    }
+}
+
+struct Input {
+    file: HostFile,
+}
+
+struct CycleIn {
+    t0_us: u64,
+    arrival_ns: [Option<u32>; MAX_RECEIVERS],
+    ticks: usize,
+    switches: [u8; MAX_TICKS],
+}
+
+impl Input {
+    fn u32(&mut self) -> Option<u32> {
+        let mut b = [0u8; 4];
+        self.file.read_exact(&mut b).then(|| u32::from_le_bytes(b))
+    }
+
+    fn next_cycle(&mut self) -> Option<CycleIn> {
+        let mut b = [0u8; 8];
+        if !self.file.read_exact(&mut b) {
+            return None;
+        }
+        let t0_us = u64::from_le_bytes(b);
+        let mut arrival_ns = [None; MAX_RECEIVERS];
+        for a in arrival_ns.iter_mut() {
+            let v = self.u32()?;
+            *a = (v != NO_ARRIVAL).then_some(v);
+        }
+        let mut n = [0u8; 2];
+        if !self.file.read_exact(&mut n) {
+            return None;
+        }
+        let ticks = u16::from_le_bytes(n) as usize;
+        let mut switches = [0u8; MAX_TICKS];
+        if ticks > MAX_TICKS || !self.file.read_exact(&mut switches[..ticks]) {
+            return None;
+        }
+        Some(CycleIn {
+            t0_us,
+            arrival_ns,
+            ticks,
+            switches,
+        })
+    }
+}
+
+/// The replayed hardware: one cycle's recorded captures and switch samples.
+struct Replay {
+    now_us: u64,
+    cycle: Option<CycleIn>,
+    tick: usize,
+    /// Samples asked for beyond those recorded: the replay and the station disagree.
+    overrun: bool,
+}
+
+struct R<'a>(&'a RefCell<Replay>);
+
+impl Ranging for R<'_> {
+    fn fire(&mut self) {}
+    fn collect(&mut self) -> [Option<u32>; MAX_RECEIVERS] {
+        self.0
+            .borrow()
+            .cycle
+            .as_ref()
+            .map_or([None; MAX_RECEIVERS], |c| c.arrival_ns)
+    }
+}
+
+impl Switches for R<'_> {
+    fn read(&mut self) -> [bool; 3] {
+        let mut r = self.0.borrow_mut();
+        let i = r.tick;
+        r.tick += 1;
+        let bits = match &r.cycle {
+            Some(c) if i < c.ticks => c.switches[i],
+            _ => {
+                r.overrun = true;
+                0
+            }
+        };
+        [bits & 1 != 0, bits & 2 != 0, bits & 4 != 0]
+    }
+}
+
+impl Clock for R<'_> {
+    fn now_us(&self) -> u64 {
+        self.0.borrow().now_us
+    }
+    async fn wait_until(&mut self, t_us: u64) {
+        let mut r = self.0.borrow_mut();
+        r.now_us = r.now_us.max(t_us);
+    }
+}
+
+/// Prints each report as a line; buffered, as every semihosting call is a trap to the host.
+struct Printer<'a> {
+    replay: &'a RefCell<Replay>,
+    out: hio::HostStream,
+    line: [u8; 160],
+}
+
+impl Printer<'_> {
+    fn print<T: Report>(&mut self, report: &T) {
+        let mut bytes = [0u8; 64];
+        let Ok(n) = report.encode(&mut bytes) else { return };
+        let t = self.replay.borrow().now_us;
+        let mut w = LineWriter {
+            buf: &mut self.line,
+            len: 0,
+        };
+        let _ = write!(w, "R {t} ");
+        for b in &bytes[..n] {
+            let _ = write!(w, "{b:02x}");
+        }
+        let _ = w.write_str("\n");
+        let len = w.len;
+        let _ = self.out.write_all(&self.line[..len]);
+    }
+}
+
+struct LineWriter<'a> {
+    buf: &'a mut [u8],
+    len: usize,
+}
+
+impl Write for LineWriter<'_> {
+    fn write_str(&mut self, s: &str) -> core::fmt::Result {
+        let end = self.len + s.len();
+        self.buf
+            .get_mut(self.len..end)
+            .ok_or(core::fmt::Error)?
+            .copy_from_slice(s.as_bytes());
+        self.len = end;
+        Ok(())
+    }
+}
+
+impl ReportSink for Printer<'_> {
+    async fn pen(&mut self, report: &PenReport) {
+        self.print(report);
+    }
+    async fn tof(&mut self, report: &TofReport) {
+        self.print(report);
+    }
+}
+
+/// SysTick counts since `start`, on the 24-bit down-counter.
+fn elapsed(start: u32) -> u32 {
+    start.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF
+}
+
+fn fail(out: &mut hio::HostStream, why: &str) -> ! {
+    let _ = writeln!(out, "E {why}");
+    debug::exit(debug::EXIT_FAILURE);
+    halt()
+}
+
+#[entry]
+fn main() -> ! {
+    let mut out = match hio::hstdout() {
+        Ok(o) => o,
+        Err(()) => {
+            debug::exit(debug::EXIT_FAILURE);
+            halt()
+        }
+    };
+    let mut cp = cortex_m::Peripherals::take().unwrap_or_else(|| fail(&mut out, "peripherals taken"));
+    cp.SYST.set_clock_source(SystClkSource::Core);
+    cp.SYST.set_reload(0x00FF_FFFF);
+    cp.SYST.clear_current();
+    cp.SYST.enable_counter();
+
+    // SysTick counts per instruction, from a loop of exactly two instructions per iteration.
+    let iterations: u32 = 1_000_000;
+    let start = SYST::get_current();
+    // SAFETY: a register-only countdown loop.
+    unsafe {
+        core::arch::asm!("1:", "subs {0}, {0}, #1", "bne 1b", inout(reg) iterations => _, options(nomem, nostack));
+    }
+    let calibration = elapsed(start);
+    let _ = writeln!(out, "C {} {}", 2 * iterations, calibration);
+
+    let Some(file) = HostFile::open("cycles.bin") else {
+        fail(&mut out, "cannot open cycles.bin")
+    };
+    let mut input = Input { file };
+    let mut magic = [0u8; 4];
+    if !input.file.read_exact(&mut magic) || &magic != MAGIC || input.u32() != Some(VERSION) {
+        fail(&mut out, "cycles.bin is not a version 1 replay");
+    }
+    let mut config_bytes = [0u8; Config::LEN];
+    if !input.file.read_exact(&mut config_bytes) {
+        fail(&mut out, "cycles.bin ends in its configuration");
+    }
+    let Ok(config) = Config::decode(&config_bytes) else {
+        fail(&mut out, "bad configuration in cycles.bin")
+    };
+    let firmware = FirmwareVersion {
+        major: 0,
+        minor: 1,
+        patch: 0,
+    };
+    let id = *b"penscape-sim";
+
+    // Pass 1: the station, exactly as the board runs it, printing every report.
+    let engine: SharedEngine<NoopRawMutex> = Mutex::new(RefCell::new(Engine::new(Some(config), firmware, id)));
+    let replay = RefCell::new(Replay {
+        now_us: 0,
+        cycle: None,
+        tick: 0,
+        overrun: false,
+    });
+    let printer = Printer {
+        replay: &replay,
+        out,
+        line: [0; 160],
+    };
+    let mut station = Station::new(&engine, R(&replay), R(&replay), R(&replay), printer);
+    let mut cycles = 0u32;
+    while let Some(c) = input.next_cycle() {
+        {
+            let mut r = replay.borrow_mut();
+            r.now_us = c.t0_us;
+            r.tick = 0;
+            r.cycle = Some(c);
+        }
+        block_on(station.cycle());
+        let r = replay.borrow();
+        if r.overrun || r.cycle.as_ref().is_some_and(|c| c.ticks != r.tick) {
+            drop(r);
+            fail(&mut out, "the replay's switch samples do not match the station's ticks");
+        }
+        cycles += 1;
+    }
+
+    // Pass 2: the fusion alone, cycle by cycle, timed.
+    let Some(file) = HostFile::open("cycles.bin") else {
+        fail(&mut out, "cannot reopen cycles.bin")
+    };
+    let mut input = Input { file };
+    let mut skip = [0u8; 8 + Config::LEN];
+    let _ = input.file.read_exact(&mut skip);
+    let mut engine = Engine::new(Some(config), firmware, id);
+    let (mut total, mut worst, mut n) = (0u64, 0u32, 0u32);
+    while let Some(c) = input.next_cycle() {
+        let cycle = Cycle {
+            t0_us: c.t0_us,
+            arrival_ns: c.arrival_ns,
+        };
+        let start = SYST::get_current();
+        let result = engine.on_cycle(&cycle);
+        let counts = elapsed(start);
+        core::hint::black_box(result);
+        total += counts as u64;
+        worst = worst.max(counts);
+        n += 1;
+    }
+    let _ = writeln!(out, "F {cycles} {n} {total} {worst}");
+    debug::exit(debug::EXIT_SUCCESS);
+    halt()
+}

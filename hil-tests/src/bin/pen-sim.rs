@@ -1,0 +1,280 @@
+//! `pen-sim`: the simulated pen and base station.
+//!
+//! Exit status: 0 on success, 1 on an error (reason on stderr), 2 on a usage error.
+
+use std::io::{BufWriter, IsTerminal, Write};
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use anyhow::{Context, Result, bail};
+use clap::{Parser, Subcommand};
+use indicatif::{ProgressBar, ProgressStyle};
+use pen_sim::{Simulation, accuracy, pty, qemu, scenarios, trace};
+
+#[derive(Parser)]
+#[command(
+    name = "pen-sim",
+    version,
+    about = "The simulated 3D pen and base station",
+    propagate_version = true
+)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Serve the simulated pen on a pseudo-terminal until killed.
+    ///
+    /// Prints the device path (/dev/pts/N) on the first line of stdout, then streams the serial
+    /// framing there in real time and answers requests, as the base station's serial link does.
+    Serve {
+        /// Create a pseudo-terminal (the only transport so far; required for clarity).
+        #[arg(long, required = true)]
+        pty: bool,
+        /// The session to play, repeated.
+        #[arg(long, default_value = "modeling-session")]
+        scenario: String,
+        /// Seed of the randomness.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Also create this symbolic link to the device.
+        #[arg(long, value_name = "PATH")]
+        link: Option<PathBuf>,
+        /// Device seconds per real second (0: as fast as the host reads).
+        #[arg(long, default_value_t = 1.0)]
+        speed: f64,
+    },
+    /// Write a trace as JSON lines: a header, then one line per measurement cycle.
+    Trace {
+        /// The session.
+        #[arg(long)]
+        scenario: String,
+        /// How long to run, device seconds.
+        #[arg(long)]
+        seconds: f64,
+        /// Seed of the randomness.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+    },
+    /// Run the standard scenarios and print their accuracy figures.
+    Accuracy {
+        /// Print {"scenarios": [...]} as JSON.
+        #[arg(long)]
+        json: bool,
+        /// Seed of the randomness.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Scenarios to run (default: static-grid, hand-sweep, echoes).
+        #[arg(long = "scenario", value_name = "NAME")]
+        scenarios: Vec<String>,
+    },
+    /// Replay a scenario's cycles through the core on QEMU's Cortex-M4F (mps2-an386), compare
+    /// its reports with this host build's, and print the instructions a fix costs there.
+    Qemu {
+        /// The session.
+        #[arg(long, default_value = "hand-sweep")]
+        scenario: String,
+        /// How long to run, device seconds.
+        #[arg(long, default_value_t = 5.0)]
+        seconds: f64,
+        /// Seed of the randomness.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Print the figures as one JSON object.
+        #[arg(long)]
+        json: bool,
+    },
+    /// List the scenarios.
+    Scenarios,
+}
+
+fn scenario(name: &str) -> Result<pen_sim::Scenario> {
+    match scenarios::by_name(name) {
+        Some(s) => Ok(s),
+        None => bail!("unknown scenario {name:?}; `pen-sim scenarios` lists them"),
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::Serve {
+            pty: _,
+            scenario: name,
+            seed,
+            link,
+            speed,
+        } => {
+            if !(speed >= 0.0 && speed.is_finite()) {
+                bail!("--speed must be a finite number ≥ 0");
+            }
+            let options = pty::ServeOptions {
+                scenario: scenario(&name)?,
+                seed,
+                link,
+                speed,
+            };
+            pty::serve(
+                &options,
+                |path| {
+                    println!("{}", path.display());
+                    let _ = std::io::stdout().flush();
+                },
+                |c| {
+                    eprintln!(
+                        "pen-sim: {} frames sent, {} dropped (host not reading), {} requests, {} bad frames",
+                        c.frames, c.dropped, c.requests, c.bad_frames
+                    )
+                },
+            )?;
+            Ok(())
+        }
+        Command::Trace {
+            scenario: name,
+            seconds,
+            seed,
+        } => {
+            if !(seconds > 0.0 && seconds.is_finite()) {
+                bail!("--seconds must be a positive number");
+            }
+            let s = scenario(&name)?;
+            let mut sim = Simulation::new(&s, seed);
+            let mut out = BufWriter::new(std::io::stdout().lock());
+            writeln!(out, "{}", trace::header(&sim))?;
+            let end = (seconds * 1e6) as u64;
+            while sim.now_us() < end {
+                let r = sim.step();
+                writeln!(out, "{}", trace::line(&r, s.rig.receivers_mm.len()))?;
+            }
+            out.flush().context("writing the trace")?;
+            Ok(())
+        }
+        Command::Accuracy {
+            json,
+            seed,
+            scenarios: names,
+        } => {
+            let names = if names.is_empty() {
+                vec!["static-grid".to_string(), "hand-sweep".into(), "echoes".into()]
+            } else {
+                names
+            };
+            let bar = if std::io::stderr().is_terminal() {
+                ProgressBar::new(names.len() as u64)
+            } else {
+                ProgressBar::hidden()
+            };
+            bar.set_style(
+                ProgressStyle::with_template("{bar:30} {pos}/{len} {msg}").unwrap_or(ProgressStyle::default_bar()),
+            );
+            let mut results = Vec::new();
+            for name in &names {
+                bar.set_message(name.clone());
+                let s = scenario(name)?;
+                let mut sim = Simulation::new(&s, seed);
+                let records = sim.run_for(s.timeline.duration_s());
+                results.push(accuracy::evaluate(&s, &records));
+                bar.inc(1);
+            }
+            bar.finish_and_clear();
+            if json {
+                println!("{}", serde_json::json!({ "scenarios": results }));
+            } else {
+                println!(
+                    "{:<18} {:>8} {:>8} {:>6} {:>7} {:>7} {:>7} {:>9} {:>6} {:>6}",
+                    "scenario",
+                    "rmse_mm",
+                    "crlb_mm",
+                    "ratio",
+                    "p50_mm",
+                    "p99_mm",
+                    "max_mm",
+                    "fixes/s",
+                    "false",
+                    "missed"
+                );
+                for m in &results {
+                    println!(
+                        "{:<18} {:>8.3} {:>8.3} {:>6.3} {:>7.3} {:>7.3} {:>7.3} {:>9.1} {:>6} {:>6}",
+                        m.name,
+                        m.rmse_mm,
+                        m.crlb_mm,
+                        m.rmse_mm / m.crlb_mm,
+                        m.p50_mm,
+                        m.p99_mm,
+                        m.max_mm,
+                        m.fix_rate_hz,
+                        m.false_switch_events,
+                        m.missed_switch_events
+                    );
+                }
+            }
+            Ok(())
+        }
+        Command::Qemu {
+            scenario: name,
+            seconds,
+            seed,
+            json,
+        } => {
+            let s = scenario(&name)?;
+            let mut sim = Simulation::new(&s, seed);
+            let records = sim.run_for(seconds);
+            let host: Vec<pen_sim::Sent> = records.iter().flat_map(|r| r.sent.clone()).collect();
+            let elf = qemu::build_pen_qemu()?;
+            let run = qemu::run(
+                &elf,
+                &qemu::replay(&s.config, &records),
+                std::time::Duration::from_secs(600),
+            )?;
+            let identical = run.reports == host;
+            let first_difference = host.iter().zip(&run.reports).position(|(a, b)| a != b);
+            if json {
+                println!(
+                    "{}",
+                    serde_json::json!({
+                        "scenario": name, "cycles": run.cycles, "reports": run.reports.len(),
+                        "identical": identical, "first_difference": first_difference,
+                        "instructions_per_fix_mean": run.mean_instructions(),
+                        "instructions_per_fix_max": run.worst_instructions(),
+                    })
+                );
+            } else {
+                println!(
+                    "{} cycles, {} reports from the emulated core, {} from the host build",
+                    run.cycles,
+                    run.reports.len(),
+                    host.len()
+                );
+                println!("reports bit-identical: {identical}");
+                println!(
+                    "fusion per cycle on the Cortex-M4F: {:.0} instructions on average, {:.0} at most ({:.2} per SysTick count)",
+                    run.mean_instructions(),
+                    run.worst_instructions(),
+                    run.instructions_per_count()
+                );
+            }
+            if !identical {
+                bail!("the emulated core's reports differ from the host's (first at report {first_difference:?})");
+            }
+            Ok(())
+        }
+        Command::Scenarios => {
+            for (name, about) in scenarios::NAMES {
+                println!("{name:<18} {about}");
+            }
+            Ok(())
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    match run(Cli::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("pen-sim: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

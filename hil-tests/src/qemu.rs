@@ -1,0 +1,239 @@
+//! The firmware core on QEMU's Cortex-M4F (`mps2-an386`), fed recorded cycles.
+//!
+//! A simulation records what the core was given — each cycle's captures and every switch
+//! sample — as a replay file. `pen-qemu` (firmware/qemu), pen-core compiled for
+//! `thumbv7em-none-eabihf`, replays it through the same station loop under QEMU and prints the
+//! reports it sends; they are compared with the reports of the host build. It then times the
+//! fusion of each cycle with SysTick under `-icount shift=0`, where virtual time counts
+//! instructions.
+//!
+//! Replay format (little-endian): `PRPL`, version u32 = 1, the configuration report (187
+//! bytes); then per cycle the burst time u64 µs, 8 × u32 capture times in ns (`0xFFFFFFFF`:
+//! none), u16 switch-sample count, and one byte per sample (SW1 = 1, SW2 = 2, SW3 = 4).
+
+use std::io::Read;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use pen_protocol::{Config, Report};
+use thiserror::Error;
+
+use crate::sim::{CycleRecord, Sent};
+
+/// Why the emulated run failed.
+#[derive(Debug, Error)]
+pub enum QemuError {
+    /// A program could not be started.
+    #[error("cannot run {program}: {source} (the test set-up installs qemu-system-arm; see README)")]
+    Spawn {
+        /// The program.
+        program: String,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// Building `pen-qemu` failed.
+    #[error("building pen-qemu failed:\n{0}")]
+    Build(String),
+    /// QEMU did not finish in time.
+    #[error("QEMU did not finish within {0:?}")]
+    Timeout(Duration),
+    /// The emulated program reported a failure or printed something unexpected.
+    #[error("the emulated core failed: {0}")]
+    Emulated(String),
+    /// Files could not be written or read.
+    #[error("i/o: {0}")]
+    Io(#[from] std::io::Error),
+}
+
+/// The replay file for `records`, run with `config`.
+pub fn replay(config: &Config, records: &[CycleRecord]) -> Vec<u8> {
+    let mut out = Vec::new();
+    out.extend_from_slice(b"PRPL");
+    out.extend_from_slice(&1u32.to_le_bytes());
+    let mut c = [0u8; Config::LEN];
+    // A buffer of exactly the report's length.
+    let _ = config.encode(&mut c);
+    out.extend_from_slice(&c);
+    for r in records {
+        out.extend_from_slice(&r.t0_us.to_le_bytes());
+        for a in r.heard.arrival_ns {
+            out.extend_from_slice(&a.unwrap_or(u32::MAX).to_le_bytes());
+        }
+        out.extend_from_slice(&(r.switch_samples.len() as u16).to_le_bytes());
+        out.extend_from_slice(&r.switch_samples);
+    }
+    out
+}
+
+/// What the emulated core printed.
+#[derive(Debug, Clone, PartialEq)]
+pub struct QemuRun {
+    /// The reports, in order.
+    pub reports: Vec<Sent>,
+    /// Cycles replayed through the station.
+    pub cycles: u32,
+    /// Cycles timed in the fusion pass.
+    pub timed: u32,
+    /// SysTick counts over all timed cycles.
+    pub total_counts: u64,
+    /// The most SysTick counts of one cycle.
+    pub worst_counts: u32,
+    /// Calibration: instructions executed and the SysTick counts they took.
+    pub calibration: (u64, u32),
+}
+
+impl QemuRun {
+    /// Instructions per SysTick count, from the calibration loop.
+    pub fn instructions_per_count(&self) -> f64 {
+        self.calibration.0 as f64 / self.calibration.1.max(1) as f64
+    }
+
+    /// Mean instructions of one cycle's fusion.
+    pub fn mean_instructions(&self) -> f64 {
+        self.total_counts as f64 / self.timed.max(1) as f64 * self.instructions_per_count()
+    }
+
+    /// Most instructions of one cycle's fusion.
+    pub fn worst_instructions(&self) -> f64 {
+        self.worst_counts as f64 * self.instructions_per_count()
+    }
+}
+
+/// The firmware workspace.
+pub fn firmware_dir() -> PathBuf {
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../firmware"))
+}
+
+/// Builds `pen-qemu` (release, for the board's target) and returns its ELF.
+pub fn build_pen_qemu() -> Result<PathBuf, QemuError> {
+    let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
+    let dir = firmware_dir();
+    let out = Command::new(&cargo)
+        .args(["build", "--release", "--locked", "-q", "-p", "pen-qemu"])
+        .current_dir(&dir)
+        .output()
+        .map_err(|source| QemuError::Spawn {
+            program: cargo.clone(),
+            source,
+        })?;
+    if !out.status.success() {
+        return Err(QemuError::Build(String::from_utf8_lossy(&out.stderr).into_owned()));
+    }
+    Ok(dir.join("target/thumbv7em-none-eabihf/release/pen-qemu"))
+}
+
+fn parse(stdout: &str) -> Result<QemuRun, QemuError> {
+    let mut run = QemuRun {
+        reports: Vec::new(),
+        cycles: 0,
+        timed: 0,
+        total_counts: 0,
+        worst_counts: 0,
+        calibration: (0, 0),
+    };
+    let bad = |line: &str| QemuError::Emulated(format!("unexpected output line {line:?}"));
+    let mut finished = false;
+    for line in stdout.lines() {
+        let mut f = line.split_whitespace();
+        match f.next() {
+            Some("R") => {
+                let t_us = f.next().and_then(|t| t.parse().ok()).ok_or_else(|| bad(line))?;
+                let hex = f.next().ok_or_else(|| bad(line))?;
+                let bytes = (0..hex.len())
+                    .step_by(2)
+                    .map(|i| hex.get(i..i + 2).and_then(|h| u8::from_str_radix(h, 16).ok()))
+                    .collect::<Option<Vec<u8>>>()
+                    .ok_or_else(|| bad(line))?;
+                run.reports.push(Sent { t_us, bytes });
+            }
+            Some("C") => {
+                let n: Vec<u64> = f.filter_map(|v| v.parse().ok()).collect();
+                run.calibration = match n[..] {
+                    [insns, counts] => (insns, counts as u32),
+                    _ => return Err(bad(line)),
+                };
+            }
+            Some("F") => {
+                let n: Vec<u64> = f.filter_map(|v| v.parse().ok()).collect();
+                let [cycles, timed, total, worst] = n[..] else {
+                    return Err(bad(line));
+                };
+                (run.cycles, run.timed, run.total_counts, run.worst_counts) =
+                    (cycles as u32, timed as u32, total, worst as u32);
+                finished = true;
+            }
+            Some("E") => return Err(QemuError::Emulated(line[1..].trim().to_string())),
+            _ => return Err(bad(line)),
+        }
+    }
+    if finished {
+        Ok(run)
+    } else {
+        Err(QemuError::Emulated(
+            "no final figures: the program did not finish".into(),
+        ))
+    }
+}
+
+/// Runs `elf` under QEMU `mps2-an386` with `replay` as its `cycles.bin`.
+pub fn run(elf: &Path, replay: &[u8], timeout: Duration) -> Result<QemuRun, QemuError> {
+    let dir = std::env::temp_dir().join(format!("pen-qemu-{}-{}", std::process::id(), rand::random::<u32>()));
+    std::fs::create_dir_all(&dir)?;
+    std::fs::write(dir.join("cycles.bin"), replay)?;
+    let program = "qemu-system-arm";
+    let mut child = Command::new(program)
+        .args(["-M", "mps2-an386", "-nographic", "-monitor", "none", "-serial", "none"])
+        .args([
+            "-semihosting-config",
+            "enable=on,target=native",
+            "-icount",
+            "shift=0",
+            "-kernel",
+        ])
+        .arg(elf)
+        .current_dir(&dir)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .map_err(|source| QemuError::Spawn {
+            program: program.into(),
+            source,
+        })?;
+    let mut stdout = child
+        .stdout
+        .take()
+        .ok_or_else(|| QemuError::Emulated("no stdout".into()))?;
+    let reader = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = stdout.read_to_string(&mut s);
+        s
+    });
+    let start = Instant::now();
+    let status = loop {
+        if let Some(status) = child.try_wait()? {
+            break status;
+        }
+        if start.elapsed() > timeout {
+            let _ = child.kill();
+            let _ = child.wait();
+            let _ = std::fs::remove_dir_all(&dir);
+            return Err(QemuError::Timeout(timeout));
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let stdout = reader.join().unwrap_or_default();
+    let mut stderr = String::new();
+    if let Some(mut e) = child.stderr.take() {
+        let _ = e.read_to_string(&mut stderr);
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+    let run = parse(&stdout);
+    if !status.success() {
+        return Err(match run {
+            Err(e) => e,
+            Ok(_) => QemuError::Emulated(format!("exit status {status}: {stderr}")),
+        });
+    }
+    run
+}
