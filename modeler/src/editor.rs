@@ -1,0 +1,2 @@
+//! Edits with undo and redo.
+pub struct Editor;
