@@ -1,6 +1,6 @@
 //! Durable file writes: the document and the journal must survive a crash at any instant.
 
-use std::fs::{self, File};
+use std::fs::File;
 use std::io::{self, Write};
 use std::path::Path;
 
@@ -37,13 +37,5 @@ pub fn sync_dir(dir: &Path) -> io::Result<()> {
     {
         let _ = (dir, File::open);
         Ok(())
-    }
-}
-
-/// Removes `path`, ignoring that it does not exist.
-pub fn remove_if_exists(path: &Path) -> io::Result<()> {
-    match fs::remove_file(path) {
-        Err(e) if e.kind() != io::ErrorKind::NotFound => Err(e),
-        _ => Ok(()),
     }
 }
