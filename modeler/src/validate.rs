@@ -155,7 +155,7 @@ pub fn grid(g: &Grid) -> Result<(), ValidationError> {
     if g.cols == 0 || g.rows == 0 {
         return Err(ValidationError::new("grid", Problem::EmptyGrid));
     }
-    if !(g.cell_size.is_finite() && g.cell_size > 0.0) || !g.width().is_finite() || !g.height().is_finite() {
+    if !(g.cell_size.is_finite() && g.cell_size > 0.0 && g.width().is_finite() && g.height().is_finite()) {
         return Err(ValidationError::new("grid.cell_size", Problem::CellSize(g.cell_size)));
     }
     let cells = u64::from(g.cols) * u64::from(g.rows);
