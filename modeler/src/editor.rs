@@ -152,8 +152,11 @@ impl Editor {
             path: path.to_owned(),
             source,
         })?;
-        let text = String::from_utf8_lossy(&bytes);
-        let doc = Document::from_json(&text)?;
+        let text = std::str::from_utf8(&bytes).map_err(|e| LoadError::Io {
+            path: path.to_owned(),
+            source: io::Error::new(io::ErrorKind::InvalidData, e),
+        })?;
+        let doc = Document::from_json(text)?;
         let base = journal::fingerprint(&bytes);
         let mut editor = Editor::new(doc).map_err(LoadError::from)?;
         let mut report = OpenReport::default();
@@ -277,16 +280,17 @@ impl Editor {
             match preview_target(&edit) {
                 Some((at, property, _)) if at == p.at && property == p.property => {
                     original = Some(set(at, property, p.original));
-                    self.preview = None;
                 }
                 _ => {
                     self.cancel_preview()?;
                 }
             }
         }
+        // A refused commit leaves the preview as it was.
         let mut outcome = self.engine.apply(&edit)?;
         if let Some(inverse) = original {
             outcome.inverse = inverse;
+            self.preview = None;
         }
         if let Err(e) = self.log(&Entry::Do { edit: edit.clone() }) {
             // Not journaled, so not done: restore.

@@ -119,6 +119,16 @@ impl Mask {
             .map(|(i, _)| self.cell(i))
     }
 
+    /// This set without the cells that are not in `other` (same box).
+    pub fn intersect(mut self, other: &Mask) -> Mask {
+        for i in 0..self.bits.len() {
+            if self.bits[i] && !other.contains(self.cell(i)) {
+                self.bits[i] = false;
+            }
+        }
+        self
+    }
+
     /// The first cell (row by row) in both sets.
     pub fn first_common(&self, other: &Mask) -> Option<Cell> {
         let c0 = self.c0.max(other.c0);

@@ -163,6 +163,13 @@ struct RegionNode {
     plateau: Option<(Vec<f32>, Vec<f32>)>,
 }
 
+/// The cells of the nested region a closed curve bounds. Validation keeps a closed figure strictly
+/// inside its region, which puts its cells inside the region's; the intersection only guards
+/// against a rounding tie at a cell border, so that no region paints outside its parent.
+fn nested_mask(grid: &Grid, points: &[crate::document::Point], parent: &Mask) -> Mask {
+    raster::closed_mask(grid, points).intersect(parent)
+}
+
 /// The cells a figure stands on; a closed figure's are its nested region's.
 fn sources(grid: &Grid, f: &Figure, child: Option<&RegionNode>) -> Vec<Cell> {
     match child {
@@ -174,7 +181,7 @@ fn sources(grid: &Grid, f: &Figure, child: Option<&RegionNode>) -> Vec<Cell> {
 impl FigureNode {
     fn build(grid: &Grid, region: &Mask, f: &Figure, m: Method) -> FigureNode {
         let child = (f.kind == FigureKind::Closed).then(|| {
-            let mask = raster::closed_mask(grid, &f.points);
+            let mask = nested_mask(grid, &f.points, region);
             Box::new(RegionNode::build(grid, mask, &f.figures, Some(f.slope), m))
         });
         FigureNode {
@@ -216,7 +223,13 @@ impl RegionNode {
     fn outline(&mut self, grid: &Grid, k: usize, figs: &[Figure], m: Method) {
         let f = &figs[k];
         if let Some(child) = self.figures[k].child.as_deref_mut() {
-            child.reshape(grid, raster::closed_mask(grid, &f.points), &f.figures, Some(f.slope), m);
+            child.reshape(
+                grid,
+                nested_mask(grid, &f.points, &self.mask),
+                &f.figures,
+                Some(f.slope),
+                m,
+            );
         }
         let node = &mut self.figures[k];
         node.dp = m.figure_distance(&self.mask, &sources(grid, f, node.child.as_deref()));

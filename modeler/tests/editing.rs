@@ -298,6 +298,24 @@ fn preview_is_not_recorded_and_commit_undoes_to_before() {
     let text = fs::read_to_string(journal::path_for(&path)).unwrap();
     assert_eq!(text.lines().count(), 3, "{text}");
     assert!(text.lines().nth(1).unwrap().contains("\"height\":42.0"));
+    // A refused commit keeps the preview, which cancelling then undoes.
+    editor
+        .preview(&Edit::SetHeight {
+            at: at.clone(),
+            height: 77.0,
+        })
+        .unwrap();
+    assert!(
+        editor
+            .apply(Edit::SetHeight {
+                at: at.clone(),
+                height: f64::NAN
+            })
+            .is_err()
+    );
+    assert_eq!(at.get(editor.document()).unwrap().height, 77.0);
+    editor.cancel_preview().unwrap();
+    assert_eq!(editor.document(), &sample());
     // An uncommitted preview is cancelled by saving: the saved document has the old value.
     editor
         .preview(&Edit::SetHeight {
@@ -380,4 +398,49 @@ fn corrupt_journal_line_is_an_error() {
     let err = Editor::open(&path).err().expect("refused");
     let msg = err.to_string();
     assert!(msg.contains("line 3"), "{msg}");
+}
+
+#[test]
+fn an_edit_regenerates_only_its_region() {
+    let mut doc = sample();
+    doc.regions[0].boundary = polygon([12.0, 20.0], 9.0, 8, 0.1);
+    doc.regions[0].figures = vec![point([11.0, 19.0], 30.0, -1.0)];
+    doc.regions.push(penmodel::Region {
+        boundary: polygon([31.0, 20.0], 7.0, 8, 0.1),
+        figures: vec![point([31.0, 21.0], 20.0, 0.0)],
+    });
+    let mut engine = Engine::new(doc).unwrap();
+    let region1 = penmodel::raster::closed_mask(&engine.document().grid, &engine.document().regions[1].boundary);
+    let before = engine.heightmap().clone();
+    for edit in [
+        Edit::SetHeight {
+            at: FigurePath::new(0, 0),
+            height: 44.0,
+        },
+        Edit::SetSlope {
+            at: FigurePath::new(0, 0),
+            slope: 1.0,
+        },
+        Edit::MoveFigure {
+            at: FigurePath::new(0, 0),
+            by: [1.5, -0.5],
+        },
+        Edit::MovePoint {
+            curve: CurvePath::Boundary(0),
+            index: 2,
+            to: [14.0, 27.5],
+        },
+    ] {
+        let out = engine.apply(&edit).unwrap();
+        // The changed rectangle lies left of region 1's box, and region 1's heights are untouched.
+        assert!(
+            out.changed.c0 + out.changed.width <= region1.c0,
+            "{edit:?}: {:?}",
+            out.changed
+        );
+        for (c, r) in region1.cells() {
+            assert_eq!(engine.heightmap().get(c, r).to_bits(), before.get(c, r).to_bits());
+        }
+        assert_matches_full(&engine, &format!("{edit:?}"));
+    }
 }
