@@ -1,0 +1,67 @@
+//! `penmodel generate`: document in, heightmap and meshes out.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use penmodel::editor::Editor;
+use penmodel::{Heightmap, export};
+
+/// Arguments of `penmodel generate`.
+#[derive(clap::Args)]
+#[command(
+    after_help = "Example:\n  penmodel generate modeler/examples/volcano.json --raw volcano.f32 --png volcano.png"
+)]
+pub struct Args {
+    /// The document (JSON). A pending journal beside it (DOC.json.journal) is replayed, read-only.
+    #[arg(value_name = "DOC.json")]
+    doc: PathBuf,
+    /// Heights as raw float32: rows × cols little-endian, row-major (index r·cols + c), metres.
+    #[arg(long, value_name = "OUT.f32")]
+    raw: PathBuf,
+    /// Heights as a 16-bit grayscale PNG; the height range is in its tEXt chunks.
+    #[arg(long, value_name = "OUT.png")]
+    png: Option<PathBuf>,
+    /// The terrain mesh as Wavefront OBJ.
+    #[arg(long, value_name = "OUT.obj")]
+    obj: Option<PathBuf>,
+    /// The terrain mesh as binary glTF.
+    #[arg(long, value_name = "OUT.glb")]
+    glb: Option<PathBuf>,
+}
+
+fn write(path: &Path, bytes: &[u8]) -> Result<()> {
+    std::fs::write(path, bytes).with_context(|| format!("cannot write {}", path.display()))
+}
+
+fn export(
+    map: &Heightmap,
+    path: &Option<PathBuf>,
+    f: impl FnOnce(&Heightmap, &mut Vec<u8>) -> Result<(), export::ExportError>,
+) -> Result<()> {
+    if let Some(path) = path {
+        let mut bytes = Vec::new();
+        f(map, &mut bytes).with_context(|| format!("cannot export {}", path.display()))?;
+        write(path, &bytes)?;
+    }
+    Ok(())
+}
+
+/// Runs the command.
+pub fn run(args: &Args) -> Result<()> {
+    let (editor, report) = Editor::open_read_only(&args.doc)?;
+    let map = editor.heightmap();
+    let mut raw = Vec::new();
+    export::write_raw(map, &mut raw)?;
+    write(&args.raw, &raw)?;
+    export(map, &args.png, |m, out| export::write_png(m, out).map(|_| ()))?;
+    export(map, &args.obj, |m, out| export::write_obj(m, out))?;
+    export(map, &args.glb, |m, out| export::write_glb(m, out))?;
+    let (lo, hi) = map.range();
+    let journal = if report.replayed > 0 {
+        format!(", {} journal entries replayed", report.replayed)
+    } else {
+        String::new()
+    };
+    println!("{} × {} cells, heights {lo} to {hi} m{journal}", map.cols(), map.rows());
+    Ok(())
+}

@@ -1,0 +1,80 @@
+//! 4-neighbour distance maps over a region, in linear time.
+//!
+//! Both maps are breadth-first searches from a set of sources, moving only through the region's
+//! cells: every cell is queued once and looks at its four neighbours once, so a map costs
+//! O(cells of the region's box). The seed's method (repeat sweeps over the grid until nothing
+//! changes) computes the same numbers in O(cells × largest distance); it is kept in
+//! [`crate::baseline`] as the reference and benchmark baseline.
+//!
+//! Maps are laid out over the region mask's bounding box, row-major; cells outside the region
+//! hold [`UNREACHABLE`].
+
+use crate::raster::{Cell, Mask};
+
+/// Distance of a cell no path within the region reaches (and of cells outside the region).
+pub const UNREACHABLE: u32 = u32::MAX;
+
+/// The box indices of the 4-neighbours of box index `i` that lie in the box.
+#[inline]
+pub(crate) fn neighbours(mask: &Mask, i: usize) -> [Option<usize>; 4] {
+    let w = mask.width as usize;
+    let (x, y) = (i % w, i / w);
+    [
+        (x > 0).then(|| i - 1),
+        (x + 1 < w).then(|| i + 1),
+        (y > 0).then(|| i - w),
+        (y + 1 < mask.height as usize).then(|| i + w),
+    ]
+}
+
+/// Whether region cell `i` has a 4-neighbour outside the region (or the box, hence the grid).
+pub(crate) fn on_edge(mask: &Mask, i: usize) -> bool {
+    let bits = mask.bits();
+    neighbours(mask, i).iter().any(|n| n.is_none_or(|j| !bits[j]))
+}
+
+fn bfs(mask: &Mask, dist: &mut [u32], queue: &mut Vec<u32>) {
+    let bits = mask.bits();
+    let mut head = 0;
+    while head < queue.len() {
+        let i = queue[head] as usize;
+        head += 1;
+        let d = dist[i] + 1;
+        for j in neighbours(mask, i).into_iter().flatten() {
+            if bits[j] && dist[j] == UNREACHABLE {
+                dist[j] = d;
+                queue.push(j as u32);
+            }
+        }
+    }
+}
+
+/// `dp`: the distance of every region cell from the nearest of `sources`, moving through region
+/// cells only. Sources outside the region are ignored.
+pub fn from_sources(mask: &Mask, sources: &[Cell]) -> Vec<u32> {
+    let mut dist = vec![UNREACHABLE; mask.box_len()];
+    let mut queue = Vec::with_capacity(mask.box_len());
+    for &s in sources {
+        if let Some(i) = mask.index(s).filter(|&i| mask.bits()[i] && dist[i] != 0) {
+            dist[i] = 0;
+            queue.push(i as u32);
+        }
+    }
+    bfs(mask, &mut dist, &mut queue);
+    dist
+}
+
+/// `df`: the layer count from the region's edge. Region cells with a 4-neighbour outside the
+/// region (or the grid) are 0, the next layer 1, and so on.
+pub fn edge_layers(mask: &Mask) -> Vec<u32> {
+    let mut dist = vec![UNREACHABLE; mask.box_len()];
+    let mut queue = Vec::with_capacity(mask.box_len());
+    for (i, &inside) in mask.bits().iter().enumerate() {
+        if inside && on_edge(mask, i) {
+            dist[i] = 0;
+            queue.push(i as u32);
+        }
+    }
+    bfs(mask, &mut dist, &mut queue);
+    dist
+}

@@ -1,0 +1,446 @@
+//! Edits of a document: what the pen does to it (add, delete and move figures and single points,
+//! set a figure's height or slope) and their inverses, for undo.
+//!
+//! Applying an edit checks the result and leaves the document unchanged when it would not be
+//! valid. Every edit has an inverse that restores the exact previous document (moves are undone
+//! by restoring the old points, not by moving back, which could round differently).
+
+use serde::{Deserialize, Serialize};
+use thiserror::Error;
+
+use crate::document::{Document, Figure, FigureKind, Point, Region};
+use crate::path::{CurvePath, FigurePath};
+use crate::raster::{self, Mask};
+use crate::validate::{self, Problem, ValidationError};
+
+/// One change to a document. Serialised (in the journal) as an object tagged by `"op"`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "op", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Edit {
+    /// Inserts a top-level region at `index`.
+    AddRegion {
+        /// Its index once inserted.
+        index: usize,
+        /// The region, with its figures.
+        region: Region,
+    },
+    /// Removes top-level region `index` and its figures.
+    DeleteRegion {
+        /// The region.
+        index: usize,
+    },
+    /// Moves a region and its figures by `by` metres.
+    MoveRegion {
+        /// The region.
+        index: usize,
+        /// Displacement `[dx, dy]`.
+        by: Point,
+    },
+    /// Replaces a region and its figures.
+    ReplaceRegion {
+        /// The region.
+        index: usize,
+        /// The new region.
+        region: Region,
+    },
+    /// Inserts a figure so that it ends up at `at`.
+    AddFigure {
+        /// The new figure's path.
+        at: FigurePath,
+        /// The figure, with any nested figures.
+        figure: Figure,
+    },
+    /// Removes a figure and everything nested in it.
+    DeleteFigure {
+        /// The figure.
+        at: FigurePath,
+    },
+    /// Moves a figure and everything nested in it by `by` metres.
+    MoveFigure {
+        /// The figure.
+        at: FigurePath,
+        /// Displacement `[dx, dy]`.
+        by: Point,
+    },
+    /// Replaces a figure and everything nested in it.
+    ReplaceFigure {
+        /// The figure.
+        at: FigurePath,
+        /// The new figure.
+        figure: Figure,
+    },
+    /// Moves one vertex of a curve. For a closed curve vertex 0 is both its first and last point.
+    MovePoint {
+        /// The curve.
+        curve: CurvePath,
+        /// The vertex.
+        index: usize,
+        /// Its new position.
+        to: Point,
+    },
+    /// Inserts a vertex before vertex `index` (`index` = vertex count appends).
+    InsertPoint {
+        /// The curve.
+        curve: CurvePath,
+        /// The new vertex's index.
+        index: usize,
+        /// The vertex.
+        point: Point,
+    },
+    /// Removes one vertex.
+    DeletePoint {
+        /// The curve.
+        curve: CurvePath,
+        /// The vertex.
+        index: usize,
+    },
+    /// Sets a figure's absolute height (a pull).
+    SetHeight {
+        /// The figure.
+        at: FigurePath,
+        /// Height in metres.
+        height: f64,
+    },
+    /// Sets a figure's slope coefficient.
+    SetSlope {
+        /// The figure.
+        at: FigurePath,
+        /// Slope coefficient.
+        slope: f64,
+    },
+}
+
+/// Why an edit was refused. The document is unchanged.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum EditError {
+    /// No top-level region at that index.
+    #[error("there is no regions[{0}]")]
+    NoRegion(usize),
+    /// No figure at that path.
+    #[error("there is no {0}")]
+    NoFigure(FigurePath),
+    /// No vertex at that index.
+    #[error("{curve} has no vertex {index}")]
+    NoPoint {
+        /// The curve.
+        curve: CurvePath,
+        /// The index asked for.
+        index: usize,
+    },
+    /// The edit would make the document invalid.
+    #[error("the edit would make the document invalid: {0}")]
+    Invalid(#[from] ValidationError),
+}
+
+/// Which list of figures an edit changed: a top-level region's or a closed figure's.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum List {
+    Region(usize),
+    Figure(FigurePath),
+}
+
+impl List {
+    pub(crate) fn of(path: &FigurePath) -> List {
+        match path.parent() {
+            None => List::Region(path.region()),
+            Some(p) => List::Figure(p),
+        }
+    }
+}
+
+/// What changed in a figure list.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) enum Change {
+    Added(usize),
+    Removed(usize),
+    /// The figure and its nested figures are new.
+    Replaced(usize),
+    /// Only the figure's own points changed.
+    Outline(usize),
+}
+
+/// What part of the document an applied edit touched, for the engine to regenerate.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum Scope {
+    Height(FigurePath),
+    Slope(FigurePath),
+    Figures(List, Change),
+    RegionAdded(usize),
+    RegionRemoved(usize),
+    /// The region and its figures are new.
+    RegionReplaced(usize),
+    /// Only the region's boundary changed.
+    RegionOutline(usize),
+}
+
+/// An edit that was applied: how to undo it and what it touched.
+pub(crate) struct Applied {
+    pub inverse: Edit,
+    pub scope: Scope,
+}
+
+/// The vertices of a curve: its points without the closing repeat.
+fn vertices(points: &[Point], closed: bool) -> Vec<Point> {
+    let n = if closed {
+        points.len().saturating_sub(1)
+    } else {
+        points.len()
+    };
+    points[..n].to_vec()
+}
+
+fn close(mut v: Vec<Point>, closed: bool) -> Vec<Point> {
+    if closed && let Some(&first) = v.first() {
+        v.push(first);
+    }
+    v
+}
+
+/// Applies `edit` to `doc` and checks the touched top-level region; `masks` are the cells of the
+/// document's current top-level regions (for the overlap check of region edits).
+pub(crate) fn apply(doc: &mut Document, edit: &Edit, masks: &[&Mask]) -> Result<Applied, EditError> {
+    let figure = |doc: &Document, at: &FigurePath| at.get(doc).cloned().ok_or_else(|| EditError::NoFigure(at.clone()));
+    match edit {
+        Edit::SetHeight { at, height } => {
+            let f = at.get_mut(doc).ok_or_else(|| EditError::NoFigure(at.clone()))?;
+            if !height.is_finite() {
+                return Err(ValidationError::new(format!("{at}.height"), Problem::NotFinite).into());
+            }
+            let old = std::mem::replace(&mut f.height, *height);
+            let inverse = Edit::SetHeight {
+                at: at.clone(),
+                height: old,
+            };
+            Ok(Applied {
+                inverse,
+                scope: Scope::Height(at.clone()),
+            })
+        }
+        Edit::SetSlope { at, slope } => {
+            let f = at.get_mut(doc).ok_or_else(|| EditError::NoFigure(at.clone()))?;
+            if !slope.is_finite() {
+                return Err(ValidationError::new(format!("{at}.slope"), Problem::NotFinite).into());
+            }
+            let old = std::mem::replace(&mut f.slope, *slope);
+            let inverse = Edit::SetSlope {
+                at: at.clone(),
+                slope: old,
+            };
+            Ok(Applied {
+                inverse,
+                scope: Scope::Slope(at.clone()),
+            })
+        }
+        Edit::AddFigure { at, figure } => {
+            let list_len = at.list_mut(doc).ok_or_else(|| EditError::NoFigure(at.clone()))?.len();
+            if at.index() > list_len {
+                return Err(EditError::NoFigure(at.clone()));
+            }
+            let new = figure.clone();
+            change_region(doc, at.region(), |d| {
+                if let Some(list) = at.list_mut(d) {
+                    list.insert(at.index(), new);
+                }
+            })?;
+            Ok(Applied {
+                inverse: Edit::DeleteFigure { at: at.clone() },
+                scope: Scope::Figures(List::of(at), Change::Added(at.index())),
+            })
+        }
+        Edit::DeleteFigure { at } => {
+            let old = figure(doc, at)?;
+            change_region(doc, at.region(), |d| {
+                if let Some(list) = at.list_mut(d) {
+                    list.remove(at.index());
+                }
+            })?;
+            Ok(Applied {
+                inverse: Edit::AddFigure {
+                    at: at.clone(),
+                    figure: old,
+                },
+                scope: Scope::Figures(List::of(at), Change::Removed(at.index())),
+            })
+        }
+        Edit::MoveFigure { at, by } => {
+            let old = figure(doc, at)?;
+            let mut new = old.clone();
+            new.translate(*by);
+            replace_figure(doc, at, new, old)
+        }
+        Edit::ReplaceFigure { at, figure: new } => {
+            let old = figure(doc, at)?;
+            replace_figure(doc, at, new.clone(), old)
+        }
+        Edit::MovePoint { curve, index, to } => {
+            let (pts, closed) = curve_points(doc, curve)?;
+            let mut v = vertices(&pts, closed);
+            let old = *v.get(*index).ok_or_else(|| no_point(curve, *index))?;
+            v[*index] = *to;
+            let scope = set_curve(doc, curve, close(v, closed), masks)?;
+            Ok(Applied {
+                inverse: Edit::MovePoint {
+                    curve: curve.clone(),
+                    index: *index,
+                    to: old,
+                },
+                scope,
+            })
+        }
+        Edit::InsertPoint { curve, index, point } => {
+            let (pts, closed) = curve_points(doc, curve)?;
+            let mut v = vertices(&pts, closed);
+            if *index > v.len() {
+                return Err(no_point(curve, *index));
+            }
+            v.insert(*index, *point);
+            let scope = set_curve(doc, curve, close(v, closed), masks)?;
+            Ok(Applied {
+                inverse: Edit::DeletePoint {
+                    curve: curve.clone(),
+                    index: *index,
+                },
+                scope,
+            })
+        }
+        Edit::DeletePoint { curve, index } => {
+            let (pts, closed) = curve_points(doc, curve)?;
+            let mut v = vertices(&pts, closed);
+            if *index >= v.len() {
+                return Err(no_point(curve, *index));
+            }
+            let old = v.remove(*index);
+            let scope = set_curve(doc, curve, close(v, closed), masks)?;
+            Ok(Applied {
+                inverse: Edit::InsertPoint {
+                    curve: curve.clone(),
+                    index: *index,
+                    point: old,
+                },
+                scope,
+            })
+        }
+        Edit::AddRegion { index, region } => {
+            if *index > doc.regions.len() {
+                return Err(EditError::NoRegion(*index));
+            }
+            validate::region(&doc.grid, region, *index)?;
+            let mask = raster::closed_mask(&doc.grid, &region.boundary);
+            let shifted = masks
+                .iter()
+                .enumerate()
+                .map(|(j, m)| (if j >= *index { j + 1 } else { j }, *m));
+            validate::region_overlap(*index, &mask, shifted)?;
+            doc.regions.insert(*index, region.clone());
+            Ok(Applied {
+                inverse: Edit::DeleteRegion { index: *index },
+                scope: Scope::RegionAdded(*index),
+            })
+        }
+        Edit::DeleteRegion { index } => {
+            if *index >= doc.regions.len() {
+                return Err(EditError::NoRegion(*index));
+            }
+            let old = doc.regions.remove(*index);
+            Ok(Applied {
+                inverse: Edit::AddRegion {
+                    index: *index,
+                    region: old,
+                },
+                scope: Scope::RegionRemoved(*index),
+            })
+        }
+        Edit::MoveRegion { index, by } => {
+            let mut new = doc.regions.get(*index).ok_or(EditError::NoRegion(*index))?.clone();
+            new.translate(*by);
+            replace_region(doc, *index, new, masks, Scope::RegionReplaced(*index))
+        }
+        Edit::ReplaceRegion { index, region } => {
+            doc.regions.get(*index).ok_or(EditError::NoRegion(*index))?;
+            replace_region(doc, *index, region.clone(), masks, Scope::RegionReplaced(*index))
+        }
+    }
+}
+
+fn no_point(curve: &CurvePath, index: usize) -> EditError {
+    EditError::NoPoint {
+        curve: curve.clone(),
+        index,
+    }
+}
+
+/// Changes top-level region `index` with `f`, keeping the change only if the region stays valid.
+/// Figure edits cannot change a region's boundary, so overlap with other regions is unaffected.
+fn change_region(doc: &mut Document, index: usize, f: impl FnOnce(&mut Document)) -> Result<(), EditError> {
+    let saved = doc.regions.get(index).ok_or(EditError::NoRegion(index))?.clone();
+    f(doc);
+    if let Err(e) = validate::region(&doc.grid, &doc.regions[index], index) {
+        doc.regions[index] = saved;
+        return Err(e.into());
+    }
+    Ok(())
+}
+
+fn replace_figure(doc: &mut Document, at: &FigurePath, new: Figure, old: Figure) -> Result<Applied, EditError> {
+    change_region(doc, at.region(), |d| {
+        if let Some(f) = at.get_mut(d) {
+            *f = new;
+        }
+    })?;
+    Ok(Applied {
+        inverse: Edit::ReplaceFigure {
+            at: at.clone(),
+            figure: old,
+        },
+        scope: Scope::Figures(List::of(at), Change::Replaced(at.index())),
+    })
+}
+
+fn replace_region(
+    doc: &mut Document,
+    index: usize,
+    new: Region,
+    masks: &[&Mask],
+    scope: Scope,
+) -> Result<Applied, EditError> {
+    validate::region(&doc.grid, &new, index)?;
+    let mask = raster::closed_mask(&doc.grid, &new.boundary);
+    validate::region_overlap(index, &mask, masks.iter().enumerate().map(|(j, m)| (j, *m)))?;
+    let old = std::mem::replace(&mut doc.regions[index], new);
+    Ok(Applied {
+        inverse: Edit::ReplaceRegion { index, region: old },
+        scope,
+    })
+}
+
+fn curve_points(doc: &Document, curve: &CurvePath) -> Result<(Vec<Point>, bool), EditError> {
+    match curve {
+        CurvePath::Boundary(r) => Ok((
+            doc.regions.get(*r).ok_or(EditError::NoRegion(*r))?.boundary.clone(),
+            true,
+        )),
+        CurvePath::Figure(at) => {
+            let f = at.get(doc).ok_or_else(|| EditError::NoFigure(at.clone()))?;
+            Ok((f.points.clone(), f.kind == FigureKind::Closed))
+        }
+    }
+}
+
+/// Replaces a curve's points, checking the result.
+fn set_curve(doc: &mut Document, curve: &CurvePath, points: Vec<Point>, masks: &[&Mask]) -> Result<Scope, EditError> {
+    match curve {
+        CurvePath::Boundary(r) => {
+            let mut new = doc.regions[*r].clone();
+            new.boundary = points;
+            replace_region(doc, *r, new, masks, Scope::RegionOutline(*r)).map(|a| a.scope)
+        }
+        CurvePath::Figure(at) => {
+            change_region(doc, at.region(), |d| {
+                if let Some(f) = at.get_mut(d) {
+                    f.points = points;
+                }
+            })?;
+            Ok(Scope::Figures(List::of(at), Change::Outline(at.index())))
+        }
+    }
+}

@@ -1,0 +1,432 @@
+//! Editing a document with undo and redo, journaled so that a crash loses nothing.
+//!
+//! An [`Editor`] owns an [`Engine`] (the document and its terrain). Each edit is applied, then
+//! appended to the journal and flushed to disk, then pushed on the undo stack; if the journal
+//! cannot be written the edit is rolled back and the error returned. Opening a document replays
+//! its journal (edits, undos and redos since the last save, and the undo history saved with it);
+//! saving writes the document atomically and starts a new journal (compaction).
+//!
+//! A pull or a slope drag changes a figure many times a second; journaling every pen report would
+//! put an `fsync` in each frame. [`Editor::preview`] shows such a change without recording it;
+//! the final value is then recorded once with [`Editor::apply`], whose undo returns to the value
+//! before the preview.
+
+use std::fs;
+use std::io;
+use std::path::{Path, PathBuf};
+
+use thiserror::Error;
+
+use crate::document::{Document, LoadError, SaveError};
+use crate::edit::{Edit, EditError};
+use crate::heightmap::Heightmap;
+use crate::journal::{self, Entry, JournalError, Replay, Step, Writer};
+use crate::path::FigurePath;
+use crate::terrain::{Engine, Outcome};
+use crate::validate::ValidationError;
+
+/// The most undo steps kept; older ones are forgotten.
+pub const HISTORY_LIMIT: usize = 1000;
+
+/// Why an editor operation failed.
+#[derive(Debug, Error)]
+pub enum EditorError {
+    /// The document could not be read.
+    #[error(transparent)]
+    Load(#[from] LoadError),
+    /// The document could not be saved.
+    #[error(transparent)]
+    Save(#[from] SaveError),
+    /// The edit was refused; nothing changed.
+    #[error(transparent)]
+    Edit(#[from] EditError),
+    /// The journal could not be read or written; a failed edit was rolled back.
+    #[error(transparent)]
+    Journal(#[from] JournalError),
+    /// A journal entry does not apply to the document it was recorded for.
+    #[error("journal {} line {line}: cannot replay: {reason}", path.display())]
+    Replay {
+        /// The journal file.
+        path: PathBuf,
+        /// 1-based line number.
+        line: usize,
+        /// Why.
+        reason: String,
+    },
+    /// Only height and slope changes can be previewed.
+    #[error("only set_height and set_slope can be previewed")]
+    NotPreviewable,
+    /// The editor has no file to save to.
+    #[error("the document has no file yet: use save_as")]
+    NoFile,
+}
+
+/// What [`Editor::open`] found in the journal.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct OpenReport {
+    /// Journal entries replayed (edits, undos and redos).
+    pub replayed: usize,
+    /// Whether an incomplete last journal line (a write cut by a crash) was dropped.
+    pub dropped_torn_line: bool,
+    /// Where a journal that belonged to another version of the document was moved.
+    pub stale_journal: Option<PathBuf>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Property {
+    Height,
+    Slope,
+}
+
+#[derive(Debug)]
+struct Preview {
+    at: FigurePath,
+    property: Property,
+    original: f64,
+}
+
+/// Where the document lives on disk.
+struct Store {
+    path: PathBuf,
+    journal: Writer,
+}
+
+/// A document being edited: terrain, undo and redo, journal.
+pub struct Editor {
+    engine: Engine,
+    undo: Vec<Step>,
+    redo: Vec<Step>,
+    store: Option<Store>,
+    preview: Option<Preview>,
+}
+
+fn journal_io(path: &Path) -> impl FnOnce(io::Error) -> EditorError + '_ {
+    move |source| {
+        EditorError::Journal(JournalError::Io {
+            path: path.to_owned(),
+            source,
+        })
+    }
+}
+
+fn preview_target(edit: &Edit) -> Option<(FigurePath, Property, f64)> {
+    match edit {
+        Edit::SetHeight { at, height } => Some((at.clone(), Property::Height, *height)),
+        Edit::SetSlope { at, slope } => Some((at.clone(), Property::Slope, *slope)),
+        _ => None,
+    }
+}
+
+fn set(at: FigurePath, property: Property, value: f64) -> Edit {
+    match property {
+        Property::Height => Edit::SetHeight { at, height: value },
+        Property::Slope => Edit::SetSlope { at, slope: value },
+    }
+}
+
+impl Editor {
+    /// Edits `doc` in memory, without a file (until [`Editor::save_as`]).
+    pub fn new(doc: Document) -> Result<Editor, ValidationError> {
+        Ok(Editor {
+            engine: Engine::new(doc)?,
+            undo: Vec::new(),
+            redo: Vec::new(),
+            store: None,
+            preview: None,
+        })
+    }
+
+    /// Opens the document at `path` and replays its journal; later edits are journaled there.
+    pub fn open(path: &Path) -> Result<(Editor, OpenReport), EditorError> {
+        Editor::open_with(path, true)
+    }
+
+    /// The document at `path` with its journal replayed, without writing anything (no journal is
+    /// kept: edits to this editor are in memory only).
+    pub fn open_read_only(path: &Path) -> Result<(Editor, OpenReport), EditorError> {
+        Editor::open_with(path, false)
+    }
+
+    fn open_with(path: &Path, write: bool) -> Result<(Editor, OpenReport), EditorError> {
+        let bytes = fs::read(path).map_err(|source| LoadError::Io {
+            path: path.to_owned(),
+            source,
+        })?;
+        let text = std::str::from_utf8(&bytes).map_err(|e| LoadError::Io {
+            path: path.to_owned(),
+            source: io::Error::new(io::ErrorKind::InvalidData, e),
+        })?;
+        let doc = Document::from_json(text)?;
+        let base = journal::fingerprint(&bytes);
+        let mut editor = Editor::new(doc).map_err(LoadError::from)?;
+        let mut report = OpenReport::default();
+        let jpath = journal::path_for(path);
+        let mut valid_len = None;
+        match journal::read(&jpath, &base)? {
+            Replay::Missing => {}
+            Replay::Stale(_) => {
+                if write {
+                    let mut aside = jpath.clone().into_os_string();
+                    aside.push(".stale");
+                    let aside = PathBuf::from(aside);
+                    fs::rename(&jpath, &aside).map_err(journal_io(&jpath))?;
+                    report.stale_journal = Some(aside);
+                }
+            }
+            Replay::Entries {
+                entries,
+                valid_len: len,
+                torn,
+            } => {
+                for (i, entry) in entries.into_iter().enumerate() {
+                    // Line numbers: the open line is 1.
+                    editor.replay(entry).map_err(|reason| EditorError::Replay {
+                        path: jpath.clone(),
+                        line: i + 2,
+                        reason,
+                    })?;
+                    report.replayed += 1;
+                }
+                report.dropped_torn_line = torn;
+                valid_len = Some(len);
+            }
+        }
+        if write {
+            let writer = match valid_len {
+                Some(len) => Writer::append_to(&jpath, len),
+                None => Writer::create(&jpath, &base, &[], &[]),
+            }
+            .map_err(journal_io(&jpath))?;
+            editor.store = Some(Store {
+                path: path.to_owned(),
+                journal: writer,
+            });
+        }
+        Ok((editor, report))
+    }
+
+    fn replay(&mut self, entry: Entry) -> Result<(), String> {
+        match entry {
+            Entry::History { undo, redo } => {
+                self.undo = undo;
+                self.redo = redo;
+            }
+            Entry::Do { edit } => {
+                self.record(edit).map_err(|e| e.to_string())?;
+            }
+            Entry::Undo => {
+                self.step_back().map_err(|e| e.to_string())?.ok_or("nothing to undo")?;
+            }
+            Entry::Redo => {
+                self.step_forward()
+                    .map_err(|e| e.to_string())?
+                    .ok_or("nothing to redo")?;
+            }
+            Entry::Open { .. } => return Err("a second \"open\" entry".into()),
+        }
+        Ok(())
+    }
+
+    /// Creates the document file at `path` (atomically) with a new journal, and edits it there.
+    pub fn create(path: &Path, doc: Document) -> Result<Editor, EditorError> {
+        let mut editor = Editor::new(doc).map_err(SaveError::from)?;
+        editor.save_as(path)?;
+        Ok(editor)
+    }
+
+    /// The document.
+    pub fn document(&self) -> &Document {
+        self.engine.document()
+    }
+
+    /// The terrain.
+    pub fn heightmap(&self) -> &Heightmap {
+        self.engine.heightmap()
+    }
+
+    /// The engine (document and terrain).
+    pub fn engine(&self) -> &Engine {
+        &self.engine
+    }
+
+    /// The document's file, if it has one.
+    pub fn path(&self) -> Option<&Path> {
+        self.store.as_ref().map(|s| s.path.as_path())
+    }
+
+    /// Whether there is an edit to undo.
+    pub fn can_undo(&self) -> bool {
+        !self.undo.is_empty()
+    }
+
+    /// Whether there is an undone edit to redo.
+    pub fn can_redo(&self) -> bool {
+        !self.redo.is_empty()
+    }
+
+    fn log(&mut self, entry: &Entry) -> Result<(), EditorError> {
+        if let Some(store) = &mut self.store {
+            let path = store.journal.path().to_owned();
+            store.journal.append(entry).map_err(journal_io(&path))?;
+        }
+        Ok(())
+    }
+
+    /// Applies `edit`, journals it and makes it undoable.
+    pub fn apply(&mut self, edit: Edit) -> Result<Outcome, EditorError> {
+        // Committing the previewed property: undo returns to the value before the preview.
+        let mut original = None;
+        if let Some(p) = &self.preview {
+            match preview_target(&edit) {
+                Some((at, property, _)) if at == p.at && property == p.property => {
+                    original = Some(set(at, property, p.original));
+                }
+                _ => {
+                    self.cancel_preview()?;
+                }
+            }
+        }
+        // A refused commit leaves the preview as it was.
+        let mut outcome = self.engine.apply(&edit)?;
+        if let Some(inverse) = original {
+            outcome.inverse = inverse;
+            self.preview = None;
+        }
+        if let Err(e) = self.log(&Entry::Do { edit: edit.clone() }) {
+            // Not journaled, so not done: restore.
+            self.engine.apply(&outcome.inverse)?;
+            return Err(e);
+        }
+        self.push_undo(Step {
+            edit,
+            inverse: outcome.inverse.clone(),
+        });
+        self.redo.clear();
+        Ok(outcome)
+    }
+
+    /// Applies an edit as a journal replay does: no preview, no journal.
+    fn record(&mut self, edit: Edit) -> Result<Outcome, EditError> {
+        let outcome = self.engine.apply(&edit)?;
+        self.push_undo(Step {
+            edit,
+            inverse: outcome.inverse.clone(),
+        });
+        self.redo.clear();
+        Ok(outcome)
+    }
+
+    fn push_undo(&mut self, step: Step) {
+        if self.undo.len() == HISTORY_LIMIT {
+            self.undo.remove(0);
+        }
+        self.undo.push(step);
+    }
+
+    fn step_back(&mut self) -> Result<Option<Outcome>, EditError> {
+        let Some(step) = self.undo.pop() else { return Ok(None) };
+        match self.engine.apply(&step.inverse) {
+            Ok(outcome) => {
+                self.redo.push(step);
+                Ok(Some(outcome))
+            }
+            Err(e) => {
+                self.undo.push(step);
+                Err(e)
+            }
+        }
+    }
+
+    fn step_forward(&mut self) -> Result<Option<Outcome>, EditError> {
+        let Some(step) = self.redo.pop() else { return Ok(None) };
+        match self.engine.apply(&step.edit) {
+            Ok(outcome) => {
+                self.push_undo(step);
+                Ok(Some(outcome))
+            }
+            Err(e) => {
+                self.redo.push(step);
+                Err(e)
+            }
+        }
+    }
+
+    /// Undoes the last edit; `None` when there is none.
+    pub fn undo(&mut self) -> Result<Option<Outcome>, EditorError> {
+        self.cancel_preview()?;
+        let Some(outcome) = self.step_back()? else {
+            return Ok(None);
+        };
+        if let Err(e) = self.log(&Entry::Undo) {
+            self.step_forward()?;
+            return Err(e);
+        }
+        Ok(Some(outcome))
+    }
+
+    /// Redoes the last undone edit; `None` when there is none.
+    pub fn redo(&mut self) -> Result<Option<Outcome>, EditorError> {
+        self.cancel_preview()?;
+        let Some(outcome) = self.step_forward()? else {
+            return Ok(None);
+        };
+        if let Err(e) = self.log(&Entry::Redo) {
+            self.step_back()?;
+            return Err(e);
+        }
+        Ok(Some(outcome))
+    }
+
+    /// Shows a height or slope change at once without recording it (the frames of a pull).
+    /// [`Editor::apply`] of the same property records the final value; any other operation, or
+    /// [`Editor::cancel_preview`], first restores the value from before the preview.
+    pub fn preview(&mut self, edit: &Edit) -> Result<Outcome, EditorError> {
+        let (at, property, _) = preview_target(edit).ok_or(EditorError::NotPreviewable)?;
+        if self
+            .preview
+            .as_ref()
+            .is_some_and(|p| p.at != at || p.property != property)
+        {
+            self.cancel_preview()?;
+        }
+        let outcome = self.engine.apply(edit)?;
+        if self.preview.is_none() {
+            let original = match &outcome.inverse {
+                Edit::SetHeight { height, .. } => *height,
+                Edit::SetSlope { slope, .. } => *slope,
+                _ => return Err(EditorError::NotPreviewable),
+            };
+            self.preview = Some(Preview { at, property, original });
+        }
+        Ok(outcome)
+    }
+
+    /// Restores the value from before an unrecorded preview; `None` when there is none.
+    pub fn cancel_preview(&mut self) -> Result<Option<Outcome>, EditorError> {
+        let Some(p) = self.preview.take() else { return Ok(None) };
+        Ok(Some(self.engine.apply(&set(p.at, p.property, p.original))?))
+    }
+
+    /// Saves to the document's file (ending any preview) and compacts the journal.
+    pub fn save(&mut self) -> Result<(), EditorError> {
+        let path = self.store.as_ref().ok_or(EditorError::NoFile)?.path.clone();
+        self.save_as(&path)
+    }
+
+    /// Saves to `path` (ending any preview), which becomes the document's file, and starts its
+    /// journal afresh; the undo history carries over.
+    pub fn save_as(&mut self, path: &Path) -> Result<(), EditorError> {
+        self.cancel_preview()?;
+        // Document first: a crash between the two leaves a journal whose base no longer matches,
+        // which is then set aside rather than replayed twice.
+        let bytes = self.engine.document().save(path)?;
+        let jpath = journal::path_for(path);
+        let writer = Writer::create(&jpath, &journal::fingerprint(&bytes), &self.undo, &self.redo)
+            .map_err(journal_io(&jpath))?;
+        self.store = Some(Store {
+            path: path.to_owned(),
+            journal: writer,
+        });
+        Ok(())
+    }
+}

@@ -1,0 +1,87 @@
+//! Binary glTF 2.0 (`.glb`), written directly: a 12-byte header (`glTF`, version 2, total
+//! length), a JSON chunk (the scene: one node, one mesh, one triangle primitive with POSITION,
+//! NORMAL and 32-bit indices) padded with spaces to 4 bytes, and a BIN chunk (positions, normals,
+//! indices, each 4-byte aligned).
+
+use std::io::Write;
+
+use serde_json::json;
+
+use super::{ExportError, Mesh};
+use crate::heightmap::Heightmap;
+
+const MAGIC: u32 = 0x4654_6C67; // "glTF"
+const CHUNK_JSON: u32 = 0x4E4F_534A; // "JSON"
+const CHUNK_BIN: u32 = 0x004E_4942; // "BIN\0"
+const FLOAT: u32 = 5126;
+const UNSIGNED_INT: u32 = 5125;
+const ARRAY_BUFFER: u32 = 34962;
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+const TRIANGLES: u32 = 4;
+
+fn pad(bytes: &mut Vec<u8>, with: u8) {
+    while !bytes.len().is_multiple_of(4) {
+        bytes.push(with);
+    }
+}
+
+/// Writes the heightmap's mesh as binary glTF.
+pub fn write_glb(map: &Heightmap, mut out: impl Write) -> Result<(), ExportError> {
+    let mesh = Mesh::of(map)?;
+    let mut bin = Vec::with_capacity(mesh.positions.len() * 24 + mesh.indices.len() * 4);
+    for p in &mesh.positions {
+        p.iter().for_each(|v| bin.extend_from_slice(&v.to_le_bytes()));
+    }
+    let normals_at = bin.len();
+    for n in &mesh.normals {
+        n.iter().for_each(|v| bin.extend_from_slice(&v.to_le_bytes()));
+    }
+    let indices_at = bin.len();
+    for i in &mesh.indices {
+        bin.extend_from_slice(&i.to_le_bytes());
+    }
+    let bin_len = bin.len();
+    let (mut min, mut max) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for p in &mesh.positions {
+        for k in 0..3 {
+            min[k] = min[k].min(p[k]);
+            max[k] = max[k].max(p[k]);
+        }
+    }
+    let n = mesh.positions.len();
+    let doc = json!({
+        "asset": {"version": "2.0", "generator": "penmodel"},
+        "scene": 0,
+        "scenes": [{"nodes": [0]}],
+        "nodes": [{"mesh": 0, "name": "terrain"}],
+        "meshes": [{"name": "terrain", "primitives": [{
+            "attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2, "mode": TRIANGLES}]}],
+        "accessors": [
+            {"bufferView": 0, "componentType": FLOAT, "count": n, "type": "VEC3", "min": min, "max": max},
+            {"bufferView": 1, "componentType": FLOAT, "count": n, "type": "VEC3"},
+            {"bufferView": 2, "componentType": UNSIGNED_INT, "count": mesh.indices.len(), "type": "SCALAR"}
+        ],
+        "bufferViews": [
+            {"buffer": 0, "byteOffset": 0, "byteLength": normals_at, "target": ARRAY_BUFFER},
+            {"buffer": 0, "byteOffset": normals_at, "byteLength": indices_at - normals_at, "target": ARRAY_BUFFER},
+            {"buffer": 0, "byteOffset": indices_at, "byteLength": bin_len - indices_at, "target": ELEMENT_ARRAY_BUFFER}
+        ],
+        "buffers": [{"byteLength": bin_len}]
+    });
+    let mut json = doc.to_string().into_bytes();
+    pad(&mut json, b' ');
+    pad(&mut bin, 0);
+    let total = 12 + 8 + json.len() as u64 + 8 + bin.len() as u64;
+    let total32 = u32::try_from(total).map_err(|_| ExportError::TooLarge(total))?;
+    let mut head = Vec::with_capacity(28);
+    for v in [MAGIC, 2, total32, json.len() as u32, CHUNK_JSON] {
+        head.extend_from_slice(&v.to_le_bytes());
+    }
+    out.write_all(&head)?;
+    out.write_all(&json)?;
+    out.write_all(&(bin.len() as u32).to_le_bytes())?;
+    out.write_all(&CHUNK_BIN.to_le_bytes())?;
+    out.write_all(&bin)?;
+    out.flush()?;
+    Ok(())
+}

@@ -1,0 +1,48 @@
+//! Exports of a heightmap: 16-bit PNG, raw float32, and meshes (OBJ, binary glTF).
+//!
+//! Conventions shared by all formats:
+//! - grid row r, column c is image row r (top to bottom), column c (left to right), and raw
+//!   index `r·cols + c`;
+//! - meshes have one vertex per cell at the cell's centre, `x = (c + ½)·s`, `y = (r + ½)·s`,
+//!   and map the ground plane and height to the glTF (and de-facto OBJ) Y-up frame as
+//!   `X = x, Y = height, Z = y`, which shows the terrain from above the same way round as the
+//!   PNG; two triangles per square of four neighbouring centres, counter-clockwise seen from
+//!   above (+Y), with per-vertex normals from central differences.
+
+mod glb;
+mod mesh;
+mod obj;
+mod png;
+mod raw;
+
+use std::io;
+
+use thiserror::Error;
+
+pub use glb::write_glb;
+pub use mesh::Mesh;
+pub use obj::write_obj;
+pub use png::{HeightRange, KEY_CELL_SIZE, KEY_HEIGHT_MAX, KEY_HEIGHT_MIN, read_png_range, write_png};
+pub use raw::{read_raw, write_raw};
+
+/// Why an export failed.
+#[derive(Debug, Error)]
+pub enum ExportError {
+    /// Writing failed.
+    #[error(transparent)]
+    Io(#[from] io::Error),
+    /// The PNG encoder failed.
+    #[error("PNG encoding failed: {0}")]
+    Png(String),
+    /// A mesh needs at least 2 × 2 cells.
+    #[error("a mesh needs at least 2 × 2 cells, the grid is {cols} × {rows}")]
+    TooSmallForMesh {
+        /// Columns.
+        cols: u32,
+        /// Rows.
+        rows: u32,
+    },
+    /// The mesh does not fit the format's 32-bit sizes.
+    #[error("the mesh is too large for binary glTF ({0} bytes)")]
+    TooLarge(u64),
+}

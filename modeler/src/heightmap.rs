@@ -1,0 +1,82 @@
+//! The generated heightfield.
+
+use crate::document::Grid;
+
+/// Heights in metres over the document's grid, row-major: the height of cell `(c, r)` is at
+/// index `r·cols + c`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Heightmap {
+    cols: u32,
+    rows: u32,
+    cell_size: f64,
+    heights: Vec<f32>,
+}
+
+impl Heightmap {
+    /// A flat heightmap (all 0) over `grid`.
+    pub fn new(grid: &Grid) -> Heightmap {
+        Heightmap {
+            cols: grid.cols,
+            rows: grid.rows,
+            cell_size: grid.cell_size,
+            heights: vec![0.0; grid.cells()],
+        }
+    }
+
+    /// A heightmap from its heights (`cols × rows` of them, row-major), or `None` if the count is wrong.
+    pub fn from_heights(cols: u32, rows: u32, cell_size: f64, heights: Vec<f32>) -> Option<Heightmap> {
+        (heights.len() == cols as usize * rows as usize).then_some(Heightmap {
+            cols,
+            rows,
+            cell_size,
+            heights,
+        })
+    }
+
+    /// Columns.
+    pub fn cols(&self) -> u32 {
+        self.cols
+    }
+
+    /// Rows.
+    pub fn rows(&self) -> u32 {
+        self.rows
+    }
+
+    /// Cell size in metres.
+    pub fn cell_size(&self) -> f64 {
+        self.cell_size
+    }
+
+    /// The height of cell `(c, r)`.
+    ///
+    /// # Panics
+    /// If the cell is off the grid.
+    pub fn get(&self, c: u32, r: u32) -> f32 {
+        assert!(
+            c < self.cols && r < self.rows,
+            "cell ({c}, {r}) is off the {}×{} grid",
+            self.cols,
+            self.rows
+        );
+        self.heights[r as usize * self.cols as usize + c as usize]
+    }
+
+    /// All heights, row-major.
+    pub fn heights(&self) -> &[f32] {
+        &self.heights
+    }
+
+    pub(crate) fn heights_mut(&mut self) -> &mut [f32] {
+        &mut self.heights
+    }
+
+    /// The lowest and highest height.
+    pub fn range(&self) -> (f32, f32) {
+        self.heights
+            .iter()
+            .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &h| {
+                (lo.min(h), hi.max(h))
+            })
+    }
+}
