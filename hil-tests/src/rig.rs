@@ -71,6 +71,14 @@ impl Rig {
         }
     }
 
+    /// This rig with the display somewhere else: `rotation` and `translation_mm` map the tracker
+    /// frame to the display frame.
+    pub fn with_display_pose(mut self, rotation: DQuat, translation_mm: DVec3) -> Rig {
+        self.display_rotation = rotation;
+        self.display_translation_mm = translation_mm;
+        self
+    }
+
     /// A display-frame point (u, v on the surface, h above it) in the tracker frame.
     pub fn display_to_tracker(&self, p: DVec3) -> DVec3 {
         self.display_rotation.inverse() * (p - self.display_translation_mm)

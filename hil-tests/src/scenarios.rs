@@ -95,6 +95,17 @@ pub fn by_name(name: &str) -> Option<Scenario> {
     Some(scenario)
 }
 
+/// A calibration session: the pen touches each target (display mm) for 0.6 s, lifting in
+/// between. `rig` says where the display really is.
+pub fn calibration(targets_mm: &[DVec2], rig: Rig) -> Scenario {
+    let mut s = Script::new(home());
+    for t in targets_mm {
+        s.hover(*t).touch().hold(0.6).lift(HOVER_MM);
+    }
+    s.move_to(home());
+    Scenario::new("calibration", rig, Acoustics::clean(), s.build())
+}
+
 /// Where every scenario starts and ends: hovering over the middle of the display.
 pub fn home() -> DVec3 {
     DVec3::new(300.0, 170.0, HOVER_MM)

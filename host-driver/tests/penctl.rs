@@ -116,3 +116,89 @@ fn help_and_usage_errors() {
     assert_eq!(penctl(&["decode"]).status.code(), Some(2));
     assert_eq!(penctl(&["no-such-command"]).status.code(), Some(2));
 }
+
+#[test]
+fn monitor_prints_one_json_object_per_sample() {
+    let out = penctl(&["monitor", "--sim", "--sim-speed", "0", "--json", "--count", "5"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let lines: Vec<serde_json::Value> = String::from_utf8_lossy(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).expect("a JSON object per line"))
+        .collect();
+    assert_eq!(lines.len(), 5);
+    for (i, v) in lines.iter().enumerate() {
+        assert_eq!(v["seq"], i as u64);
+        for key in ["x_mm", "y_mm", "z_mm"] {
+            assert!(v[key].is_number(), "{key}");
+        }
+        for key in ["sw1", "sw2", "sw3", "in_range"] {
+            assert!(v[key].is_boolean(), "{key}");
+        }
+        assert!(v["quality"]["receivers_used"].is_number());
+    }
+    // The pen held still 40 mm above the middle of the display: its emitter is there.
+    let last = &lines[4];
+    assert_eq!(last["in_range"], true);
+    assert!((last["x_mm"].as_f64().unwrap_or(0.0) - 300.0).abs() < 3.0);
+}
+
+#[test]
+fn config_is_validated_before_it_is_sent() {
+    let out = penctl(&[
+        "config",
+        "set",
+        "--sim",
+        "receivers_mm=[[0,0,0],[0,0,5],[600,0,0],[0,300,0]]",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("receivers_mm[1] is degenerate"), "{err}");
+    let out = penctl(&["config", "set", "--sim", "temperature_c=\"warm\""]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("`temperature_c`: must be a number"));
+    let ok = penctl(&["config", "set", "--sim", "temperature_c=24.5", "stream_tof=true"]);
+    assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
+    let get = penctl(&["config", "get", "--sim", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&get.stdout).expect("JSON");
+    assert_eq!(v["receiver_count"], 4);
+}
+
+#[test]
+fn calibrate_with_the_simulated_pen_writes_the_file_and_plot() {
+    let dir = std::env::temp_dir().join(format!("penctl-cal-{}", std::process::id()));
+    let file = dir.join("calibration.toml");
+    let png = dir.join("residuals.png");
+    let out = penctl(&[
+        "calibrate",
+        "--sim",
+        "--sim-speed",
+        "0",
+        "--targets",
+        "9",
+        "--out",
+        file.to_str().expect("utf-8"),
+        "--plot",
+        png.to_str().expect("utf-8"),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let cal = pen_host::calibration::Calibration::load(&file).expect("a valid calibration file");
+    assert_eq!(cal.residuals.len(), 9);
+    assert!(cal.rms_mm() <= 0.5, "RMS {:.3} mm", cal.rms_mm());
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("RMS") && text.contains("saved"), "{text}");
+    assert!(std::fs::metadata(&png).expect("plot written").len() > 1000);
+    let too_few = penctl(&["calibrate", "--sim", "--targets", "3"]);
+    assert_eq!(too_few.status.code(), Some(2), "fewer than 4 targets is a usage error");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn no_device_is_a_clear_error() {
+    let out = penctl(&["info", "--serial", "/dev/does-not-exist"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("cannot attach") && err.contains("/dev/does-not-exist"),
+        "{err}"
+    );
+}

@@ -19,7 +19,8 @@ pub mod document;
 pub mod edit;
 pub mod editor;
 pub mod export;
-mod fsutil;
+// Atomic, durable writes live in the host crate, below the modeler in the dependency order.
+use pen_host::fsutil;
 pub mod geometry;
 mod heightmap;
 pub mod journal;

@@ -120,6 +120,9 @@ pub struct Engine {
     unique_id: [u8; 12],
     status: Status,
     // The latest cycle.
+    /// The latest reportable fix, smoothed, tracker frame.
+    smoothed: Option<Vec3>,
+    /// The position of the last report (repeated while out of range).
     position: Position,
     in_range: bool,
     quality: Quality,
@@ -164,6 +167,7 @@ impl Engine {
             firmware,
             unique_id,
             status: Status::ok(0),
+            smoothed: None,
             position: Position::default(),
             in_range: false,
             quality: Quality::NONE,
@@ -304,10 +308,21 @@ impl Engine {
 
     /// Smooths, constrains and transforms a fix; `None` if it cannot be reported.
     fn report_position(&mut self, t_us: u64, fix: Fix) -> Option<Vec3> {
+        let smoothed = self.smoother.filter(t_us, fix.position);
+        let p = self.presented(smoothed);
+        // A fix that cannot be carried (beyond ±3.27 m) is not reported.
+        Position::from_mm(p.to_array())?;
+        self.smoothed = Some(smoothed);
+        Some(p)
+    }
+
+    /// A smoothed fix as reported now: on the display surface while the tip switch is pressed
+    /// (so a tip_down already lies on it, though its fix came before the press), in the display
+    /// frame if the configuration asks for it.
+    fn presented(&self, smoothed: Vec3) -> Vec3 {
         let s = &self.settings;
-        let mut p = self.smoother.filter(t_us, fix.position);
+        let mut p = smoothed;
         if let Some(display) = &s.display {
-            // While the tip switch is pressed the tip is on the display surface.
             if self.debouncer.state()[0] {
                 p = display.onto_surface(p);
             }
@@ -315,9 +330,7 @@ impl Engine {
                 p = display.to_display(p);
             }
         }
-        let position = Position::from_mm(p.to_array())?;
-        self.position = position;
-        Some(p)
+        p
     }
 
     /// The next pen report, if one is due at `now_us`: after each cycle, after a switch
@@ -335,6 +348,13 @@ impl Engine {
         }
         self.fresh = false;
         self.last_report_us = Some(now_us);
+        if self.in_range
+            && let Some(p) = self
+                .smoothed
+                .and_then(|p| Position::from_mm(self.presented(p).to_array()))
+        {
+            self.position = p;
+        }
         let [sw1, sw2, sw3] = self.latch.take(self.debouncer.state());
         let report = PenReport {
             sw1,

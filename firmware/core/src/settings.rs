@@ -162,14 +162,18 @@ impl Settings {
         self.display.map_or(Vec3::Z, |d| d.normal())
     }
 
-    /// Signed distance of `p` in front of the display (or of the receivers' mean plane
-    /// perpendicular to +z without a display pose), mm.
+    /// Signed distance of `p` in front of the display, mm. Without a display pose the display
+    /// is taken to lie in the plane z = the lowest receiver's z, facing +z: receivers are mounted
+    /// on or above the display's surface.
     pub fn height(&self, p: Vec3) -> f32 {
         match &self.display {
             Some(d) => d.height(p),
             None => {
-                let mean_z = self.receivers[..self.count].iter().map(|r| r.z).sum::<f32>() / self.count as f32;
-                p.z - mean_z
+                let lowest = self.receivers[..self.count]
+                    .iter()
+                    .map(|r| r.z)
+                    .fold(f32::INFINITY, f32::min);
+                p.z - lowest
             }
         }
     }

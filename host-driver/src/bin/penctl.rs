@@ -1,20 +1,37 @@
-//! `penctl`: inspect and control the 3D pen from the command line.
+//! `penctl`: inspect, configure and calibrate the 3D pen from the command line.
 //!
-//! Exit status: 0 on success, 1 when the input is not valid (bad hex, not a report), 2 on a
-//! usage error.
+//! Exit status: 0 on success, 1 when the input, the device or a request fails (the reason on
+//! stderr), 2 on a usage error.
 
+use std::io::{IsTerminal, Write};
+use std::path::PathBuf;
 use std::process::ExitCode;
+use std::time::Duration;
 
-use anyhow::{Context, Result};
-use clap::{Parser, Subcommand};
-use pen_host::{hex, json};
-use pen_protocol::{FrameDecoder, Message, REPORT_DESCRIPTOR};
+use anyhow::{Context, Result, bail};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use glam::{DQuat, DVec3};
+use pen_host::calibrate::{self, Step};
+use pen_host::calibration::{self, DisplaySize, FitKind};
+use pen_host::device::{Device, DeviceEvent};
+use pen_host::source::Source;
+use pen_host::transport::sim::SimOptions;
+use pen_host::transport::{Transport, hid, serial};
+use pen_host::{hex, json, plot};
+use pen_protocol::{Command as DeviceCommand, Config, FrameDecoder, Message, REPORT_DESCRIPTOR, ReportId, StatusCode};
+
+/// `println!` that reports a failed write (a closed pipe) instead of panicking.
+macro_rules! outln {
+    ($($arg:tt)*) => {
+        writeln!(std::io::stdout().lock(), $($arg)*)?
+    };
+}
 
 #[derive(Parser)]
 #[command(
     name = "penctl",
     version,
-    about = "Inspect and control the 3D pen",
+    about = "Inspect, configure and calibrate the 3D pen",
     propagate_version = true
 )]
 struct Cli {
@@ -22,8 +39,81 @@ struct Cli {
     command: Command,
 }
 
+/// Which device.
+#[derive(Args, Clone)]
+struct DeviceArgs {
+    /// The serial link at PATH instead of USB HID.
+    #[arg(long, value_name = "PATH", conflicts_with_all = ["sim", "hid"])]
+    serial: Option<String>,
+    /// A hidraw device instead of the first base station found.
+    #[arg(long, value_name = "PATH", conflicts_with = "sim")]
+    hid: Option<String>,
+    /// The simulated pen in this process.
+    #[arg(long)]
+    sim: bool,
+    /// The session the simulated pen plays (`pen-sim scenarios` lists them).
+    #[arg(long, value_name = "NAME", default_value = "hold", requires = "sim")]
+    scenario: String,
+    /// Device seconds per real second for --sim (0: as fast as possible).
+    #[arg(long, default_value_t = 1.0, requires = "sim")]
+    sim_speed: f64,
+}
+
+impl DeviceArgs {
+    fn source(&self) -> Result<Source> {
+        Ok(match (&self.serial, self.sim) {
+            (Some(path), _) => Source::Serial(path.clone()),
+            (None, true) => {
+                let name = &self.scenario;
+                let scenario = pen_sim::scenarios::by_name(name)
+                    .with_context(|| format!("unknown scenario {name:?}; `pen-sim scenarios` lists them"))?;
+                Source::Sim(SimOptions {
+                    scenario,
+                    seed: 1,
+                    speed: self.sim_speed,
+                    plug: Default::default(),
+                })
+            }
+            (None, false) => Source::Hid(self.hid.clone()),
+        })
+    }
+}
+
 #[derive(Subcommand)]
 enum Command {
+    /// List the base stations attached (HID interfaces and serial links).
+    List,
+    /// Print the device's information and configuration.
+    Info {
+        #[command(flatten)]
+        device: DeviceArgs,
+        /// One JSON object.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Print samples as they arrive.
+    Monitor {
+        #[command(flatten)]
+        device: DeviceArgs,
+        /// One JSON object per sample.
+        #[arg(long)]
+        json: bool,
+        /// Stop after N samples.
+        #[arg(long, value_name = "N")]
+        count: Option<u64>,
+    },
+    /// Read or change the device's configuration.
+    Config {
+        #[command(subcommand)]
+        action: ConfigAction,
+    },
+    /// Restart the device into its ROM USB DFU bootloader (docs/flashing.md).
+    Bootloader {
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// Calibrate: touch targets on the display, fit the tracker → display transform.
+    Calibrate(CalibrateArgs),
     /// Print the USB HID report descriptor as one line of hex.
     Descriptor,
     /// Decode a report given in hex and print it as one JSON object.
@@ -41,11 +131,367 @@ enum Command {
     },
 }
 
+#[derive(Subcommand)]
+enum ConfigAction {
+    /// Print the configuration.
+    Get {
+        #[command(flatten)]
+        device: DeviceArgs,
+        /// One JSON object (the form `config set --file` reads).
+        #[arg(long)]
+        json: bool,
+    },
+    /// Change settings: KEY=VALUE (VALUE in JSON), or a whole configuration from --file.
+    #[command(after_help = "Examples:\n  penctl config set temperature_c=23.5 stream_tof=true\n  \
+                            penctl config set 'filter={\"kind\":\"off\"}'\n  penctl config get --json > c.json; penctl config set --file c.json")]
+    Set {
+        #[command(flatten)]
+        device: DeviceArgs,
+        /// Settings to change.
+        #[arg(value_name = "KEY=VALUE", required_unless_present = "file")]
+        settings: Vec<String>,
+        /// A JSON configuration (keys it lacks keep their values).
+        #[arg(long, value_name = "FILE")]
+        file: Option<PathBuf>,
+    },
+    /// Save the running configuration to the device's flash.
+    Save {
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+    /// Replace the running configuration with the firmware's defaults (not saved).
+    Defaults {
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum Fit {
+    Rigid,
+    Similarity,
+}
+
+#[derive(Args)]
+struct CalibrateArgs {
+    #[command(flatten)]
+    device: DeviceArgs,
+    /// Targets: 4 (corners), 5 (and the centre) or 9 (a 3 × 3 grid).
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u8).range(4..=9))]
+    targets: u8,
+    /// The display's active area, mm.
+    #[arg(long, value_name = "WxH", default_value = "600x340")]
+    display_mm: String,
+    /// The display's resolution.
+    #[arg(long, value_name = "WxH", default_value = "2560x1440")]
+    display_px: String,
+    /// The transform to fit.
+    #[arg(long, value_enum, default_value_t = Fit::Similarity)]
+    fit: Fit,
+    /// Where to save the calibration [default: $XDG_CONFIG_HOME/penscape/calibration.toml].
+    #[arg(long, value_name = "FILE")]
+    out: Option<PathBuf>,
+    /// Also draw the residuals into this PNG.
+    #[arg(long, value_name = "PNG")]
+    plot: Option<PathBuf>,
+    /// Also write the calibration to the device, so that it reports display coordinates.
+    #[arg(long)]
+    write_device: bool,
+    /// Seconds to wait for each touch.
+    #[arg(long, default_value_t = 60.0)]
+    patience: f64,
+}
+
+fn size<T: std::str::FromStr>(s: &str, what: &str) -> Result<(T, T)> {
+    let parsed = s
+        .split_once('x')
+        .and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
+    parsed.with_context(|| format!("{what} must be WIDTHxHEIGHT, got {s:?}"))
+}
+
+/// Opens the device, waiting a moment for it to attach.
+fn attach(args: &DeviceArgs) -> Result<Device> {
+    let mut device = Device::new(args.source()?);
+    calibrate::attach(&mut device, Duration::from_secs(2))?;
+    Ok(device)
+}
+
+fn transport(device: &mut Device) -> Result<&mut (dyn Transport + 'static)> {
+    device.transport().context("the device went away")
+}
+
+fn get_config(t: &mut dyn Transport) -> Result<Config> {
+    match t.get_feature(ReportId::Config)? {
+        Message::Config(c) => Ok(c),
+        other => bail!("the device answered with a {} report", other.id()),
+    }
+}
+
+/// Sends a configuration or command; fails unless the device accepted it.
+fn request(t: &mut dyn Transport, m: &Message) -> Result<()> {
+    let status = t.set_feature(m)?;
+    if status.code != StatusCode::Ok {
+        bail!("the device refused: {status}");
+    }
+    Ok(())
+}
+
+fn print_json(v: &serde_json::Value) -> Result<()> {
+    outln!("{v}");
+    Ok(())
+}
+
+fn info(args: &DeviceArgs, as_json: bool) -> Result<()> {
+    let mut device = attach(args)?;
+    let t = transport(&mut device)?;
+    let Message::DeviceInfo(info) = t.get_feature(ReportId::DeviceInfo)? else {
+        bail!("no device information")
+    };
+    pen_protocol::check_version(info.protocol)?;
+    let config = get_config(t)?;
+    if as_json {
+        print_json(&serde_json::json!({
+            "device": t.describe(),
+            "info": json::message_json(&Message::DeviceInfo(info)),
+            "config": json::config_value(&config),
+        }))?;
+    } else {
+        outln!("device       {}", t.describe());
+        outln!("protocol     {}", info.protocol);
+        outln!("firmware     {}", info.firmware);
+        outln!("receivers    {} of {}", info.receiver_count, info.max_receivers);
+        outln!("fix rate     {} Hz", info.fix_rate_hz);
+        outln!("unique ID    {}", hex::to_hex(&info.unique_id));
+        outln!("display pose {}", if config.display.is_some() { "set" } else { "none" });
+    }
+    Ok(())
+}
+
+fn monitor(args: &DeviceArgs, as_json: bool, count: Option<u64>) -> Result<()> {
+    let mut device = Device::new(args.source()?);
+    let mut printed = 0u64;
+    let mut out = std::io::stdout().lock();
+    while count.is_none_or(|n| printed < n) {
+        match device.next(Duration::from_millis(200)) {
+            Some(DeviceEvent::Sample(s, lost)) => {
+                if as_json {
+                    writeln!(out, "{}", json::sample_json(&s, lost))?;
+                } else {
+                    let sw = |on: bool, name: &'static str| if on { name } else { "---" };
+                    writeln!(
+                        out,
+                        "seq {:5}  t {:11.6} s  {}  x {:8.1}  y {:8.1}  z {:8.1} mm  {} {} {}  {}/{:.1} mm/{:.1}{}",
+                        s.seq,
+                        s.device_us as f64 * 1e-6,
+                        if s.in_range { "in " } else { "out" },
+                        s.position_mm.x,
+                        s.position_mm.y,
+                        s.position_mm.z,
+                        sw(s.sw[0], "SW1"),
+                        sw(s.sw[1], "SW2"),
+                        sw(s.sw[2], "SW3"),
+                        s.quality.receivers_used,
+                        s.quality.residual_mm(),
+                        s.quality.dop(),
+                        if lost > 0 {
+                            format!("  ({lost} lost)")
+                        } else {
+                            String::new()
+                        }
+                    )?;
+                }
+                printed += 1;
+            }
+            Some(DeviceEvent::Found(name)) => eprintln!("penctl: attached {name}"),
+            Some(DeviceEvent::Lost(why)) => eprintln!("penctl: device lost ({why}); waiting for it"),
+            _ => {}
+        }
+    }
+    Ok(())
+}
+
+fn config(action: ConfigAction) -> Result<()> {
+    match action {
+        ConfigAction::Get { device, json: as_json } => {
+            let mut d = attach(&device)?;
+            let c = get_config(transport(&mut d)?)?;
+            let v = json::config_value(&c);
+            if as_json {
+                print_json(&v)?;
+            } else if let Some(map) = v.as_object() {
+                for (k, v) in map {
+                    outln!("{k} = {v}");
+                }
+            }
+            Ok(())
+        }
+        ConfigAction::Set { device, settings, file } => {
+            let mut d = attach(&device)?;
+            let t = transport(&mut d)?;
+            let mut c = get_config(t)?;
+            if let Some(path) = file {
+                let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+                let v: serde_json::Value =
+                    serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
+                c = json::config_from_json(&v, &c).with_context(|| path.display().to_string())?;
+            }
+            let mut changes = serde_json::Map::new();
+            for s in &settings {
+                let (k, v) = s.split_once('=').with_context(|| format!("{s:?} is not KEY=VALUE"))?;
+                let value = serde_json::from_str(v).with_context(|| format!("{k}: {v:?} is not a JSON value"))?;
+                changes.insert(k.trim().to_string(), value);
+            }
+            c = json::config_from_json(&serde_json::Value::Object(changes), &c)?;
+            c.validate().context("not sent")?;
+            request(t, &Message::Config(c))?;
+            eprintln!("penctl: configuration applied (`penctl config save` keeps it across power cycles)");
+            Ok(())
+        }
+        ConfigAction::Save { device } => {
+            let mut d = attach(&device)?;
+            request(transport(&mut d)?, &Message::Command(DeviceCommand::SaveConfig))
+        }
+        ConfigAction::Defaults { device } => {
+            let mut d = attach(&device)?;
+            request(transport(&mut d)?, &Message::Command(DeviceCommand::LoadDefaults))
+        }
+    }
+}
+
+fn default_calibration_path() -> Result<PathBuf> {
+    let base = std::env::var_os("XDG_CONFIG_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))
+        .context("neither XDG_CONFIG_HOME nor HOME is set; give --out")?;
+    Ok(base.join("penscape/calibration.toml"))
+}
+
+fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
+    let (width_mm, height_mm) = size::<f64>(&a.display_mm, "--display-mm")?;
+    let (width_px, height_px) = size::<u32>(&a.display_px, "--display-px")?;
+    if !(width_mm > 0.0 && height_mm > 0.0 && width_px > 0 && height_px > 0) {
+        bail!("the display's size must be positive");
+    }
+    let display = DisplaySize {
+        width_mm,
+        height_mm,
+        width_px,
+        height_px,
+    };
+    let targets = display.targets(a.targets as usize);
+    let kind = match a.fit {
+        Fit::Rigid => FitKind::Rigid,
+        Fit::Similarity => FitKind::Similarity,
+    };
+    let source = match a.device.sim {
+        // The simulated user touches exactly these targets, on a display that sits rotated
+        // 1.5° and shifted from the tracker frame, as a real one would.
+        true => {
+            let rig = pen_sim::rig::Rig::reference().with_display_pose(
+                DQuat::from_axis_angle(DVec3::new(0.3, -0.2, 1.0).normalize(), 1.5f64.to_radians()),
+                DVec3::new(12.0, -7.0, 3.0),
+            );
+            let scenario = pen_sim::scenarios::calibration(&targets, rig);
+            Source::Sim(SimOptions {
+                scenario,
+                seed: 1,
+                speed: a.device.sim_speed,
+                plug: Default::default(),
+            })
+        }
+        false => a.device.source()?,
+    };
+    let mut device = Device::new(source);
+    calibrate::attach(&mut device, Duration::from_secs(2))?;
+    let original = calibrate::prepare(&mut device)?;
+    let patience = Duration::from_secs_f64(a.patience.max(1.0));
+    let tty = std::io::stderr().is_terminal();
+    let touched = calibrate::collect_touches(&mut device, &targets, patience, |step| match step {
+        Step::Touch {
+            index,
+            count,
+            target_mm,
+        } => eprintln!(
+            "target {}/{count}: touch ({:.0}, {:.0}) mm from the display's lower-left corner, and press",
+            index + 1,
+            target_mm.x,
+            target_mm.y
+        ),
+        Step::Lift => eprintln!("  lift the pen first"),
+        Step::Again { fixes } => eprintln!("  too short ({fixes} fixes): touch again and hold a moment"),
+        Step::Taken { fixes, .. } => {
+            if tty {
+                eprintln!("  taken ({fixes} fixes)")
+            }
+        }
+    });
+    let touched = match touched {
+        Ok(t) => t,
+        Err(e) => {
+            // Leave the device as it was.
+            if let Some(t) = device.transport() {
+                let _ = t.set_feature(&Message::Config(original));
+            }
+            return Err(e.into());
+        }
+    };
+    let cal = calibration::fit(&targets, &touched, kind, display)?;
+    outln!("target (u, v) mm     residual mm");
+    for r in &cal.residuals {
+        outln!(
+            "({:6.1}, {:6.1})        {:.3}",
+            r.target_mm.x,
+            r.target_mm.y,
+            r.residual_mm
+        );
+    }
+    outln!(
+        "RMS {:.3} mm, max {:.3} mm, scale {:.5}",
+        cal.rms_mm(),
+        cal.max_mm(),
+        cal.transform.scale
+    );
+    if (cal.transform.scale - 1.0).abs() > 0.005 {
+        eprintln!(
+            "penctl: the scale is {:.4}: check the configured temperature or speed of sound",
+            cal.transform.scale
+        );
+    }
+    let out = match a.out {
+        Some(p) => p,
+        None => default_calibration_path()?,
+    };
+    if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    }
+    cal.save(&out).with_context(|| format!("saving {}", out.display()))?;
+    outln!("saved {}", out.display());
+    if let Some(png) = &a.plot {
+        plot::write_residual_plot(&cal, png, 900).with_context(|| format!("writing {}", png.display()))?;
+        outln!("plot {}", png.display());
+    }
+    let t = transport(&mut device)?;
+    let restored = if a.write_device {
+        Config {
+            display: Some(cal.transform.to_device()),
+            report_display_frame: true,
+            ..original
+        }
+    } else {
+        original
+    };
+    request(t, &Message::Config(restored))?;
+    if a.write_device {
+        outln!("written to the device: it now reports display coordinates (`penctl config save` keeps them)");
+    }
+    Ok(())
+}
+
 fn decode(hex_args: &[String], frame: bool) -> Result<()> {
     let bytes = hex::parse_hex(&hex_args.join(" ")).context("not valid hex")?;
     let report = if frame { unframe(&bytes)? } else { bytes };
     let message = Message::decode(&report).context("not a valid report")?;
-    println!("{}", json::message_json(&message));
+    outln!("{}", json::message_json(&message));
     Ok(())
 }
 
@@ -63,17 +509,57 @@ fn unframe(bytes: &[u8]) -> Result<Vec<u8>> {
     payload.context("no frame in the input")
 }
 
-fn main() -> ExitCode {
-    let cli = Cli::parse();
-    let result = match cli.command {
+fn list() -> Result<()> {
+    let hids = hid::list()?;
+    let serials = serial::list();
+    if hids.is_empty() && serials.is_empty() {
+        eprintln!("penctl: no base station attached (udev rules: docs/flashing.md; the simulated pen: --sim)");
+    }
+    for h in hids {
+        outln!(
+            "hid     {}  {}{}",
+            h.path,
+            h.product,
+            h.serial.map(|s| format!(" ({s})")).unwrap_or_default()
+        );
+    }
+    for s in serials {
+        outln!("serial  {s}");
+    }
+    Ok(())
+}
+
+fn run(cli: Cli) -> Result<()> {
+    match cli.command {
+        Command::List => list(),
+        Command::Info { device, json } => info(&device, json),
+        Command::Monitor { device, json, count } => monitor(&device, json, count),
+        Command::Config { action } => config(action),
+        Command::Bootloader { device } => {
+            let mut d = attach(&device)?;
+            request(transport(&mut d)?, &Message::Command(DeviceCommand::EnterBootloader))?;
+            eprintln!("penctl: the device restarts into its DFU bootloader (dfu-util -l)");
+            Ok(())
+        }
+        Command::Calibrate(a) => calibrate_cmd(a),
         Command::Descriptor => {
-            println!("{}", hex::to_hex(&REPORT_DESCRIPTOR));
+            outln!("{}", hex::to_hex(&REPORT_DESCRIPTOR));
             Ok(())
         }
         Command::Decode { hex, frame } => decode(&hex, frame),
-    };
-    match result {
+    }
+}
+
+fn main() -> ExitCode {
+    match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader went away (`penctl monitor | head`): not an error, as for any Unix tool.
+        Err(e)
+            if e.downcast_ref::<std::io::Error>()
+                .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe) =>
+        {
+            ExitCode::SUCCESS
+        }
         Err(e) => {
             eprintln!("penctl: {e:#}");
             ExitCode::FAILURE

@@ -1,4 +1,4 @@
-//! Durable file writes: the document and the journal must survive a crash at any instant.
+//! Durable file writes: a calibration, a document, a journal must survive a crash at any instant.
 
 use std::fs::File;
 use std::io::{self, Write};
@@ -10,7 +10,7 @@ use std::path::Path;
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
     let dir = parent_dir(path);
     let mut tmp = tempfile::Builder::new()
-        .prefix(".penmodel-")
+        .prefix(".penscape-")
         .suffix(".tmp")
         .tempfile_in(dir)?;
     tmp.write_all(bytes)?;

@@ -1,0 +1,120 @@
+//! `pend`: the pen daemon. Attaches to the base station (USB HID by default, `--serial PATH`, or
+//! `--sim` for the simulated pen), applies the calibration, and serves pen events to any number
+//! of clients on a Unix domain socket as JSON lines (docs/events.md). SIGTERM and SIGINT stop it:
+//! the socket is removed and the exit status is 0.
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Duration;
+
+use anyhow::{Context, Result};
+use clap::Parser;
+use pen_host::calibration::{Calibration, DisplaySize};
+use pen_host::daemon::{self, DEFAULT_QUEUE, Hub};
+use pen_host::pipeline::Pipeline;
+use pen_host::source::Source;
+use pen_host::transport::sim::SimOptions;
+
+#[derive(Parser)]
+#[command(
+    name = "pend",
+    version,
+    about = "The 3D pen's daemon: pen events for every program, on a Unix socket"
+)]
+struct Cli {
+    /// The socket [default: $XDG_RUNTIME_DIR/penscape/pend.sock].
+    #[arg(long, value_name = "PATH")]
+    socket: Option<PathBuf>,
+    /// Use the serial link at PATH instead of USB HID.
+    #[arg(long, value_name = "PATH", conflicts_with_all = ["sim", "hid"])]
+    serial: Option<String>,
+    /// Use this hidraw device instead of the first base station found.
+    #[arg(long, value_name = "PATH", conflicts_with = "sim")]
+    hid: Option<String>,
+    /// Use the simulated pen, playing SCENARIO (default modeling-session) in real time.
+    #[arg(long, value_name = "SCENARIO", num_args = 0..=1, default_missing_value = "modeling-session")]
+    sim: Option<String>,
+    /// Device seconds per real second for --sim.
+    #[arg(long, default_value_t = 1.0, requires = "sim")]
+    sim_speed: f64,
+    /// The calibration file [default: $XDG_CONFIG_HOME/penscape/calibration.toml if it exists;
+    /// otherwise tracker coordinates are display coordinates].
+    #[arg(long, value_name = "FILE")]
+    calibration: Option<PathBuf>,
+    /// Events a client may have waiting before it misses some.
+    #[arg(long, default_value_t = DEFAULT_QUEUE)]
+    queue: usize,
+}
+
+fn default_calibration() -> Option<PathBuf> {
+    let base = std::env::var_os("XDG_CONFIG_HOME")
+        .map(PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))?;
+    let path = base.join("penscape/calibration.toml");
+    path.exists().then_some(path)
+}
+
+fn run(cli: Cli) -> Result<()> {
+    let source = match (cli.serial, cli.sim) {
+        (Some(path), _) => Source::Serial(path),
+        (None, Some(name)) => {
+            let scenario = pen_sim::scenarios::by_name(&name)
+                .with_context(|| format!("unknown scenario {name:?}; `pen-sim scenarios` lists them"))?;
+            Source::Sim(SimOptions {
+                scenario,
+                seed: 1,
+                speed: cli.sim_speed,
+                plug: Default::default(),
+            })
+        }
+        (None, None) => Source::Hid(cli.hid),
+    };
+    let calibration = match cli.calibration.or_else(default_calibration) {
+        Some(path) => {
+            let c = Calibration::load(&path)?;
+            eprintln!("pend: calibration {} (RMS {:.2} mm)", path.display(), c.rms_mm());
+            c
+        }
+        None => {
+            eprintln!("pend: no calibration; tracker coordinates are display coordinates (penctl calibrate)");
+            Calibration::identity(DisplaySize::REFERENCE)
+        }
+    };
+    let socket = cli.socket.unwrap_or_else(daemon::default_socket);
+    let listener = daemon::bind(&socket)?;
+    eprintln!("pend: serving {source} on {}", socket.display());
+
+    let stop = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
+        signal_hook::flag::register(signal, stop.clone()).context("installing signal handlers")?;
+    }
+    let hub = Arc::new(Hub::default());
+    let (h, s) = (hub.clone(), stop.clone());
+    let queue = cli.queue;
+    std::thread::spawn(move || daemon::accept(listener, h, queue, s));
+    let (h, s) = (hub.clone(), stop.clone());
+    // The transport lives on the device thread: the simulated pen is not Send.
+    std::thread::spawn(move || {
+        daemon::run_device(Pipeline::new(source, calibration), h, s, |m| eprintln!("pend: {m}"))
+    });
+
+    while !stop.load(Ordering::Relaxed) {
+        std::thread::sleep(Duration::from_millis(50));
+    }
+    let _ = std::fs::remove_file(&socket);
+    let (delivered, missed) = hub.counts();
+    eprintln!("pend: stopped; {delivered} events delivered, {missed} missed by slow clients");
+    Ok(())
+}
+
+fn main() -> ExitCode {
+    match run(Cli::parse()) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("pend: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}

@@ -1,0 +1,180 @@
+//! The calibration procedure: lead the user through the targets, take the tip's position at each
+//! press of SW1, fit.
+//!
+//! For each target the pen must first be lifted (SW1 open), then pressed on the target. While
+//! SW1 stays closed the tracker-frame positions are averaged, skipping the first 80 ms (the tip
+//! settling) and stopping after 300 ms; a touch with fewer than 10 fixes is refused and the user
+//! asked again. During the procedure the device reports raw tracker-frame positions: its
+//! display pose is removed (its tip constraint would project onto an uncalibrated plane) and put
+//! back — or replaced by the new calibration — afterwards.
+
+use std::time::{Duration, Instant};
+
+use glam::{DVec2, DVec3};
+use pen_protocol::{Config, Message, ReportId};
+use thiserror::Error;
+
+use crate::device::{Device, DeviceEvent};
+use crate::transport::TransportError;
+
+/// Fixes skipped at the start of a touch, µs of device time.
+const SETTLE_US: u64 = 80_000;
+/// Fixes averaged per touch at most, µs of device time.
+const AVERAGE_US: u64 = 300_000;
+/// Fixes a touch needs.
+const MIN_FIXES: usize = 10;
+
+/// What the procedure tells the user.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Step {
+    /// Touch target `index` (of `count`) at `target_mm` and press.
+    Touch {
+        /// From 0.
+        index: usize,
+        /// Targets in all.
+        count: usize,
+        /// Where, on the display.
+        target_mm: DVec2,
+    },
+    /// Lift the pen first.
+    Lift,
+    /// The touch was too short or unsteady: touch again.
+    Again {
+        /// Fixes taken.
+        fixes: usize,
+    },
+    /// Target taken.
+    Taken {
+        /// Where the pen was, tracker frame.
+        touched_mm: DVec3,
+        /// Fixes averaged.
+        fixes: usize,
+    },
+}
+
+/// Why the procedure stopped.
+#[derive(Debug, Error)]
+pub enum CalibrateError {
+    /// No device, or it went away.
+    #[error("{0}")]
+    Device(String),
+    /// The device refused or failed a request.
+    #[error(transparent)]
+    Transport(#[from] TransportError),
+    /// The user did not touch a target in time.
+    #[error("no touch within {0:?}")]
+    Timeout(Duration),
+}
+
+/// Attaches to the device within `timeout`.
+pub fn attach(device: &mut Device, timeout: Duration) -> Result<(), CalibrateError> {
+    let end = Instant::now() + timeout;
+    while device.transport().is_none() {
+        if Instant::now() > end {
+            let why = device.last_error().unwrap_or("no device");
+            return Err(CalibrateError::Device(format!("cannot attach: {why}")));
+        }
+        device.next(Duration::from_millis(100));
+    }
+    Ok(())
+}
+
+/// The device's configuration, and the same without its display pose (raw tracker frame).
+pub fn prepare(device: &mut Device) -> Result<Config, CalibrateError> {
+    let transport = device
+        .transport()
+        .ok_or_else(|| CalibrateError::Device("device detached".into()))?;
+    let Message::Config(config) = transport.get_feature(ReportId::Config)? else {
+        return Err(CalibrateError::Device(
+            "the device did not send its configuration".into(),
+        ));
+    };
+    let raw = Config {
+        display: None,
+        report_display_frame: false,
+        ..config
+    };
+    let status = transport.set_feature(&Message::Config(raw))?;
+    if status.code != pen_protocol::StatusCode::Ok {
+        return Err(CalibrateError::Device(format!(
+            "the device refused the calibration settings: {status}"
+        )));
+    }
+    Ok(config)
+}
+
+/// Takes one touch per target; `tell` hears each step. Gives up on a target after `patience`.
+pub fn collect_touches(
+    device: &mut Device,
+    targets: &[DVec2],
+    patience: Duration,
+    mut tell: impl FnMut(&Step),
+) -> Result<Vec<DVec3>, CalibrateError> {
+    let mut touched = Vec::new();
+    for (index, &target_mm) in targets.iter().enumerate() {
+        tell(&Step::Touch {
+            index,
+            count: targets.len(),
+            target_mm,
+        });
+        let deadline = Instant::now() + patience;
+        let mut lifted = false;
+        let mut told_lift = false;
+        let mut fixes: Vec<DVec3> = Vec::new();
+        let mut pressed_at: Option<u64> = None;
+        loop {
+            if Instant::now() > deadline {
+                return Err(CalibrateError::Timeout(patience));
+            }
+            let Some(event) = device.next(Duration::from_millis(50)) else {
+                continue;
+            };
+            let s = match event {
+                DeviceEvent::Sample(s, _) => s,
+                DeviceEvent::Lost(why) => return Err(CalibrateError::Device(format!("device lost: {why}"))),
+                _ => continue,
+            };
+            if !s.sw[0] {
+                if pressed_at.take().is_some() {
+                    if fixes.len() >= MIN_FIXES {
+                        break;
+                    }
+                    tell(&Step::Again { fixes: fixes.len() });
+                    fixes.clear();
+                }
+                lifted = true;
+                continue;
+            }
+            if !lifted {
+                if !told_lift {
+                    tell(&Step::Lift);
+                    told_lift = true;
+                }
+                continue;
+            }
+            let start = *pressed_at.get_or_insert(s.device_us);
+            let held = s.device_us.saturating_sub(start);
+            if held >= SETTLE_US && s.in_range {
+                fixes.push(s.position_mm);
+            }
+            if held >= SETTLE_US + AVERAGE_US && fixes.len() >= MIN_FIXES {
+                break;
+            }
+        }
+        let mean = fixes.iter().sum::<DVec3>() / fixes.len() as f64;
+        tell(&Step::Taken {
+            touched_mm: mean,
+            fixes: fixes.len(),
+        });
+        touched.push(mean);
+        // The next target is shown once the pen is off this one.
+        while Instant::now() < deadline {
+            match device.next(Duration::from_millis(50)) {
+                Some(DeviceEvent::Sample(s, _)) if !s.sw[0] => break,
+                Some(DeviceEvent::Lost(why)) => return Err(CalibrateError::Device(format!("device lost: {why}"))),
+                _ => {}
+            }
+        }
+    }
+    Ok(touched)
+}

@@ -1,0 +1,59 @@
+//! Transports: one interface over the ways a base station reaches the host — USB HID through
+//! hidapi ([`hid`]), the serial link through serialport ([`serial`]), and the simulated pen in
+//! this process ([`sim`]).
+
+pub mod hid;
+pub mod serial;
+pub mod sim;
+
+use std::time::Duration;
+
+use pen_protocol::{DecodeError, Message, ReportId, Status};
+use thiserror::Error;
+
+/// Why a transport call failed.
+#[derive(Debug, Error)]
+pub enum TransportError {
+    /// The device is gone (unplugged, the port closed); the caller reattaches.
+    #[error("device disconnected: {0}")]
+    Disconnected(String),
+    /// No device matched.
+    #[error("no device found: {0}")]
+    NotFound(String),
+    /// The device did not answer a request in time.
+    #[error("no answer from the device to the {0} request")]
+    Timeout(&'static str),
+    /// The device sent bytes that are not a valid report.
+    #[error("invalid report from the device: {0}")]
+    Protocol(#[from] DecodeError),
+    /// The device answered with something other than what was asked.
+    #[error("unexpected answer from the device: {0}")]
+    Unexpected(String),
+    /// The operating system refused (permissions, a busy port).
+    #[error("{0}")]
+    Os(String),
+}
+
+/// A connection to one base station.
+pub trait Transport {
+    /// Which device, for messages (`hid /dev/hidraw3`, `serial /dev/ttyACM0`, `sim`).
+    fn describe(&self) -> String;
+
+    /// The next input report (pen or time-of-flight), waiting at most `timeout`; `None` if none
+    /// came. Invalid reports are skipped and counted, not returned.
+    fn read(&mut self, timeout: Duration) -> Result<Option<Message>, TransportError>;
+
+    /// Reads a feature report.
+    fn get_feature(&mut self, id: ReportId) -> Result<Message, TransportError>;
+
+    /// Writes a feature report (a configuration or a command) and returns the device's status.
+    fn set_feature(&mut self, report: &Message) -> Result<Status, TransportError>;
+
+    /// Invalid reports or frames received and dropped so far.
+    fn dropped(&self) -> u64 {
+        0
+    }
+}
+
+/// How long a request waits for its answer.
+pub const REQUEST_TIMEOUT: Duration = Duration::from_millis(500);
