@@ -121,3 +121,60 @@ fn the_file_round_trips_and_bad_values_are_named() {
     assert!(bad("width_px = 2560", "").contains("`display.width_px` is missing"));
     assert!(bad("[display]", "[display]\ncolour = 3").contains("colour"));
 }
+
+#[test]
+fn a_calibration_written_to_the_device_makes_it_report_display_coordinates() {
+    let targets = DisplaySize::REFERENCE.targets(5);
+    let (rotation, translation) = misaligned();
+    let rig = Rig::reference().with_display_pose(rotation, translation);
+    let scenario = pen_sim::scenarios::calibration(&targets, rig);
+    let timeline = scenario.timeline.clone();
+    let mut device = Device::new(Source::Sim(SimOptions {
+        scenario,
+        seed: 5,
+        speed: 0.0,
+        plug: Default::default(),
+    }));
+    attach(&mut device, Duration::from_secs(2)).expect("attach");
+    let original = prepare(&mut device).expect("raw");
+    let touched = collect_touches(&mut device, &targets, Duration::from_secs(30), |_| {}).expect("touches");
+    let cal = fit(&targets, &touched, FitKind::Similarity, DisplaySize::REFERENCE).expect("fit");
+    let config = pen_protocol::Config {
+        display: Some(cal.transform.to_device()),
+        report_display_frame: true,
+        ..original
+    };
+    let t = device.transport().expect("attached");
+    assert_eq!(
+        t.set_feature(&pen_protocol::Message::Config(config))
+            .expect("status")
+            .code,
+        pen_protocol::StatusCode::Ok
+    );
+    // The session loops: the pen touches the first target again. The device now reports u, v on
+    // the surface, h = 0 while the tip is down, with no host calibration at all.
+    let mut checked = 0;
+    let end = std::time::Instant::now() + Duration::from_secs(30);
+    while checked < 20 && std::time::Instant::now() < end {
+        let Some(pen_host::device::DeviceEvent::Sample(s, _)) = device.next(Duration::from_millis(100)) else {
+            continue;
+        };
+        let t_s = (s.device_us as f64 * 1e-6) % timeline.duration_s();
+        if s.in_range && s.sw[0] && timeline.switches(t_s)[0] {
+            assert!(s.display_frame);
+            let tip = timeline.tip(t_s);
+            let off = DVec2::new(s.position_mm.x - tip.x, s.position_mm.y - tip.y).length();
+            assert!(
+                off < 1.5,
+                "reported ({:.1}, {:.1}) for the tip at ({:.1}, {:.1})",
+                s.position_mm.x,
+                s.position_mm.y,
+                tip.x,
+                tip.y
+            );
+            assert_eq!(s.position_mm.z, 0.0);
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 20, "touches seen after the calibration was written");
+}
