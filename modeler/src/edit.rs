@@ -108,6 +108,12 @@ pub enum Edit {
         /// Slope coefficient.
         slope: f64,
     },
+    /// Several edits made by one gesture (a pull and the slope set while pulling): applied in
+    /// order, undone together, one step of the history.
+    Group {
+        /// The edits, in order.
+        edits: Vec<Edit>,
+    },
 }
 
 /// Why an edit was refused. The document is unchanged.
@@ -130,6 +136,9 @@ pub enum EditError {
     /// The edit would make the document invalid.
     #[error("the edit would make the document invalid: {0}")]
     Invalid(#[from] ValidationError),
+    /// A group reached the single-edit code; the engine applies groups edit by edit.
+    #[error("a group of edits is applied edit by edit")]
+    Group,
 }
 
 /// Which list of figures an edit changed: a top-level region's or a closed figure's.
@@ -359,6 +368,7 @@ pub(crate) fn apply(doc: &mut Document, edit: &Edit, masks: &[&Mask]) -> Result<
             doc.regions.get(*index).ok_or(EditError::NoRegion(*index))?;
             replace_region(doc, *index, region.clone(), masks, Scope::RegionReplaced(*index))
         }
+        Edit::Group { .. } => Err(EditError::Group),
     }
 }
 

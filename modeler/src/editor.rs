@@ -8,8 +8,9 @@
 //!
 //! A pull or a slope drag changes a figure many times a second; journaling every pen report would
 //! put an `fsync` in each frame. [`Editor::preview`] shows such a change without recording it;
-//! the final value is then recorded once with [`Editor::apply`], whose undo returns to the value
-//! before the preview.
+//! the final values are then recorded once with [`Editor::commit_preview`] (height and slope
+//! of one grab are one step) or [`Editor::apply`], whose undo returns to the values before the
+//! preview.
 
 use std::fs;
 use std::io;
@@ -78,11 +79,35 @@ enum Property {
     Slope,
 }
 
+/// A figure shown with a changed height or slope, or both, not yet recorded.
 #[derive(Debug)]
 struct Preview {
     at: FigurePath,
-    property: Property,
-    original: f64,
+    /// The height before the preview, if the height is previewed.
+    height: Option<f64>,
+    /// The slope before the preview, if the slope is previewed.
+    slope: Option<f64>,
+}
+
+impl Preview {
+    fn original(&self, property: Property) -> Option<f64> {
+        match property {
+            Property::Height => self.height,
+            Property::Slope => self.slope,
+        }
+    }
+
+    /// The edits that restore the values from before the preview.
+    fn restore(&self) -> Vec<Edit> {
+        let mut edits = Vec::new();
+        if let Some(slope) = self.slope {
+            edits.push(set(self.at.clone(), Property::Slope, slope));
+        }
+        if let Some(height) = self.height {
+            edits.push(set(self.at.clone(), Property::Height, height));
+        }
+        edits
+    }
 }
 
 /// Where the document lives on disk.
@@ -275,11 +300,15 @@ impl Editor {
     /// Applies `edit`, journals it and makes it undoable.
     pub fn apply(&mut self, edit: Edit) -> Result<Outcome, EditorError> {
         // Committing the previewed property: undo returns to the value before the preview.
+        // (Only a preview of that one property: a preview of both is recorded by
+        // [`Editor::commit_preview`].)
         let mut original = None;
         if let Some(p) = &self.preview {
             match preview_target(&edit) {
-                Some((at, property, _)) if at == p.at && property == p.property => {
-                    original = Some(set(at, property, p.original));
+                Some((at, property, _))
+                    if at == p.at && p.height.is_some() != p.slope.is_some() && p.original(property).is_some() =>
+                {
+                    original = p.original(property).map(|v| set(at, property, v));
                 }
                 _ => {
                     self.cancel_preview()?;
@@ -378,33 +407,83 @@ impl Editor {
     }
 
     /// Shows a height or slope change at once without recording it (the frames of a pull).
-    /// [`Editor::apply`] of the same property records the final value; any other operation, or
-    /// [`Editor::cancel_preview`], first restores the value from before the preview.
+    /// Height and slope of the same figure can be previewed together (a pull, then the slope set
+    /// while pulling). [`Editor::commit_preview`] records the previewed values as one step, or
+    /// [`Editor::apply`] of the one previewed property records its final value; undo returns to
+    /// the values from before the preview. Any other operation, or [`Editor::cancel_preview`],
+    /// first restores them.
     pub fn preview(&mut self, edit: &Edit) -> Result<Outcome, EditorError> {
         let (at, property, _) = preview_target(edit).ok_or(EditorError::NotPreviewable)?;
-        if self
-            .preview
-            .as_ref()
-            .is_some_and(|p| p.at != at || p.property != property)
-        {
+        if self.preview.as_ref().is_some_and(|p| p.at != at) {
             self.cancel_preview()?;
         }
         let outcome = self.engine.apply(edit)?;
-        if self.preview.is_none() {
-            let original = match &outcome.inverse {
-                Edit::SetHeight { height, .. } => *height,
-                Edit::SetSlope { slope, .. } => *slope,
-                _ => return Err(EditorError::NotPreviewable),
-            };
-            self.preview = Some(Preview { at, property, original });
-        }
+        let before = match &outcome.inverse {
+            Edit::SetHeight { height, .. } => *height,
+            Edit::SetSlope { slope, .. } => *slope,
+            _ => return Err(EditorError::NotPreviewable),
+        };
+        let p = self.preview.get_or_insert(Preview {
+            at,
+            height: None,
+            slope: None,
+        });
+        let slot = match property {
+            Property::Height => &mut p.height,
+            Property::Slope => &mut p.slope,
+        };
+        slot.get_or_insert(before);
         Ok(outcome)
     }
 
-    /// Restores the value from before an unrecorded preview; `None` when there is none.
+    /// Whether a preview is showing.
+    pub fn previewing(&self) -> bool {
+        self.preview.is_some()
+    }
+
+    /// Records the previewed values as one undoable step (a `set_height`, a `set_slope`, or a
+    /// `group` of both) and returns it; `None` when nothing is previewed. If the journal cannot
+    /// be written, the preview is undone and the error returned.
+    pub fn commit_preview(&mut self) -> Result<Option<Edit>, EditorError> {
+        let Some(p) = self.preview.take() else { return Ok(None) };
+        let doc = self.engine.document();
+        let Some(figure) = p.at.get(doc) else {
+            return Ok(None);
+        };
+        let mut edits = Vec::new();
+        if p.height.is_some() {
+            edits.push(set(p.at.clone(), Property::Height, figure.height));
+        }
+        if p.slope.is_some() {
+            edits.push(set(p.at.clone(), Property::Slope, figure.slope));
+        }
+        let mut inverse = p.restore();
+        let (edit, inverse) = if edits.len() == 1 {
+            (edits.remove(0), inverse.remove(0))
+        } else {
+            (Edit::Group { edits }, Edit::Group { edits: inverse })
+        };
+        if let Err(e) = self.log(&Entry::Do { edit: edit.clone() }) {
+            self.engine.apply(&inverse)?;
+            return Err(e);
+        }
+        self.push_undo(Step {
+            edit: edit.clone(),
+            inverse,
+        });
+        self.redo.clear();
+        Ok(Some(edit))
+    }
+
+    /// Restores the values from before an unrecorded preview; `None` when there is none.
     pub fn cancel_preview(&mut self) -> Result<Option<Outcome>, EditorError> {
         let Some(p) = self.preview.take() else { return Ok(None) };
-        Ok(Some(self.engine.apply(&set(p.at, p.property, p.original))?))
+        let restore = p.restore();
+        let edit = match <[Edit; 1]>::try_from(restore) {
+            Ok([one]) => one,
+            Err(both) => Edit::Group { edits: both },
+        };
+        Ok(Some(self.engine.apply(&edit)?))
     }
 
     /// Saves to the document's file (ending any preview) and compacts the journal.

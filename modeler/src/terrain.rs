@@ -103,6 +103,14 @@ pub struct Rect {
 }
 
 impl Rect {
+    /// No cells.
+    pub const EMPTY: Rect = Rect {
+        c0: 0,
+        r0: 0,
+        width: 0,
+        height: 0,
+    };
+
     fn of(mask: &Mask) -> Rect {
         Rect {
             c0: mask.c0,
@@ -526,11 +534,40 @@ impl Engine {
 
     /// Applies an edit and regenerates the regions it touches. On error nothing changes.
     pub fn apply(&mut self, edit: &Edit) -> Result<Outcome, EditError> {
+        if let Edit::Group { edits } = edit {
+            return self.apply_group(edits);
+        }
         let masks: Vec<&Mask> = self.regions.iter().map(|n| &n.mask).collect();
         let applied = edit::apply(&mut self.doc, edit, &masks)?;
         let changed = self.regenerate(&applied.scope);
         Ok(Outcome {
             inverse: applied.inverse,
+            changed,
+        })
+    }
+
+    /// Applies `edits` in order; if one is refused, undoes those before it.
+    fn apply_group(&mut self, edits: &[Edit]) -> Result<Outcome, EditError> {
+        let mut inverses = Vec::with_capacity(edits.len());
+        let mut changed = Rect::EMPTY;
+        for edit in edits {
+            match self.apply(edit) {
+                Ok(outcome) => {
+                    inverses.push(outcome.inverse);
+                    changed = changed.union(outcome.changed);
+                }
+                Err(e) => {
+                    // Each inverse restores the document it was made from, so it applies.
+                    for inverse in inverses.iter().rev() {
+                        let _ = self.apply(inverse);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        inverses.reverse();
+        Ok(Outcome {
+            inverse: Edit::Group { edits: inverses },
             changed,
         })
     }
@@ -543,12 +580,7 @@ impl Engine {
             map,
         } = self;
         let (grid, m) = (doc.grid, *method);
-        let missing = Rect {
-            c0: 0,
-            r0: 0,
-            width: 0,
-            height: 0,
-        };
+        let missing = Rect::EMPTY;
         match scope {
             Scope::Height(at) => {
                 let Some((node, figs, base, _)) = locate(regions, doc, &List::of(at)) else {

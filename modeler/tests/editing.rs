@@ -444,3 +444,52 @@ fn an_edit_regenerates_only_its_region() {
         assert_matches_full(&engine, &format!("{edit:?}"));
     }
 }
+
+#[test]
+fn a_pull_with_a_slope_is_one_step() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("t.json");
+    let mut editor = Editor::create(&path, sample()).unwrap();
+    let at = FigurePath::new(0, 0);
+    let before = at.get(editor.document()).unwrap().clone();
+    for h in [20.0, 45.0] {
+        editor.preview(&Edit::SetHeight { at: at.clone(), height: h }).unwrap();
+    }
+    for s in [-0.5, -1.5] {
+        editor.preview(&Edit::SetSlope { at: at.clone(), slope: s }).unwrap();
+    }
+    // Previewing the slope kept the height.
+    assert_eq!(at.get(editor.document()).unwrap().height, 45.0);
+    let committed = editor.commit_preview().unwrap().expect("something to commit");
+    assert!(matches!(&committed, Edit::Group { edits } if edits.len() == 2), "{committed:?}");
+    let after = editor.document().clone();
+    assert_eq!(editor.commit_preview().unwrap(), None, "nothing left to commit");
+    // The terrain equals a fresh generation of the committed document.
+    assert_eq!(editor.heightmap(), &generate(&after).unwrap());
+    // One undo restores both.
+    editor.undo().unwrap();
+    assert_eq!(at.get(editor.document()).unwrap(), &before);
+    assert!(!editor.can_undo());
+    editor.redo().unwrap();
+    assert_eq!(editor.document(), &after);
+    // The journal holds the group, and replaying it gives the same document.
+    drop(editor);
+    let (reopened, report) = Editor::open(&path).unwrap();
+    assert!(report.replayed >= 3, "{report:?}");
+    assert_eq!(reopened.document(), &after);
+}
+
+#[test]
+fn a_refused_group_changes_nothing() {
+    let mut engine = Engine::new(sample()).unwrap();
+    let at = FigurePath::new(0, 0);
+    let group = Edit::Group {
+        edits: vec![
+            Edit::SetHeight { at: at.clone(), height: 12.0 },
+            Edit::SetSlope { at: FigurePath::new(0, 9), slope: 1.0 },
+        ],
+    };
+    assert_eq!(engine.apply(&group).unwrap_err(), EditError::NoFigure(FigurePath::new(0, 9)));
+    assert_eq!(engine.document(), &sample());
+    assert_eq!(engine.heightmap(), &generate(&sample()).unwrap());
+}
