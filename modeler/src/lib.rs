@@ -23,6 +23,7 @@ pub mod export;
 use pen_host::fsutil;
 pub mod geometry;
 mod heightmap;
+pub mod interaction;
 pub mod journal;
 mod json;
 pub mod path;

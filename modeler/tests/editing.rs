@@ -453,15 +453,28 @@ fn a_pull_with_a_slope_is_one_step() {
     let at = FigurePath::new(0, 0);
     let before = at.get(editor.document()).unwrap().clone();
     for h in [20.0, 45.0] {
-        editor.preview(&Edit::SetHeight { at: at.clone(), height: h }).unwrap();
+        editor
+            .preview(&Edit::SetHeight {
+                at: at.clone(),
+                height: h,
+            })
+            .unwrap();
     }
     for s in [-0.5, -1.5] {
-        editor.preview(&Edit::SetSlope { at: at.clone(), slope: s }).unwrap();
+        editor
+            .preview(&Edit::SetSlope {
+                at: at.clone(),
+                slope: s,
+            })
+            .unwrap();
     }
     // Previewing the slope kept the height.
     assert_eq!(at.get(editor.document()).unwrap().height, 45.0);
     let committed = editor.commit_preview().unwrap().expect("something to commit");
-    assert!(matches!(&committed, Edit::Group { edits } if edits.len() == 2), "{committed:?}");
+    assert!(
+        matches!(&committed, Edit::Group { edits } if edits.len() == 2),
+        "{committed:?}"
+    );
     let after = editor.document().clone();
     assert_eq!(editor.commit_preview().unwrap(), None, "nothing left to commit");
     // The terrain equals a fresh generation of the committed document.
@@ -485,11 +498,20 @@ fn a_refused_group_changes_nothing() {
     let at = FigurePath::new(0, 0);
     let group = Edit::Group {
         edits: vec![
-            Edit::SetHeight { at: at.clone(), height: 12.0 },
-            Edit::SetSlope { at: FigurePath::new(0, 9), slope: 1.0 },
+            Edit::SetHeight {
+                at: at.clone(),
+                height: 12.0,
+            },
+            Edit::SetSlope {
+                at: FigurePath::new(0, 9),
+                slope: 1.0,
+            },
         ],
     };
-    assert_eq!(engine.apply(&group).unwrap_err(), EditError::NoFigure(FigurePath::new(0, 9)));
+    assert_eq!(
+        engine.apply(&group).unwrap_err(),
+        EditError::NoFigure(FigurePath::new(0, 9))
+    );
     assert_eq!(engine.document(), &sample());
     assert_eq!(engine.heightmap(), &generate(&sample()).unwrap());
 }

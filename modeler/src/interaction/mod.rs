@@ -1,0 +1,925 @@
+//! The seed's pen interaction (000, section 3.2) as a state machine over calibrated pen events.
+//!
+//! | gesture | what it does |
+//! |---|---|
+//! | SW1 on the surface (SW2 up) | draws: starts a figure, or adds to the one being drawn |
+//! | SW3 while drawing | ends the figure: a point, a polyline, or a closed curve when the end came back to the start; a closed curve outside every region becomes a generation region |
+//! | pen near a figure | highlights it: a point when near it, a polyline near its line, a closed curve inside it, a region near its boundary |
+//! | SW2 + touch | grabs the highlighted figure (at a vertex, that vertex) |
+//! | grabbed, lift | pulls it up: height = pen height × the vertical scale, the terrain following live; the ground tilts towards the viewer |
+//! | grabbed, SW3 held, move left/right | sets the slope: left sharper, right bell-shaped; a slope bar shows it |
+//! | release SW2 | commits the pull and slope as one undoable edit |
+//! | grabbed, slide on the surface | moves the figure, or the grabbed vertex; dropped outside its region, deletes it |
+//! | SW3 click (nothing drawn or grabbed) | undo |
+//! | SW2 held + SW3 click (not touching) | redo |
+//! | SW3 held, move (nothing drawn or grabbed) | pans the ground with the pen; up and down zooms |
+//!
+//! [`Command`]s give the same edits to a keyboard or a script. Times come from the device clock
+//! when the event carries it (a click is timed the same at any replay speed), else the host's.
+//! A refused edit is a message and a count, never a lost document: the editor keeps it valid.
+
+pub mod pick;
+pub mod stroke;
+pub mod view;
+
+use pen_host::events::{DisplayPoint, EventKind, PenEvent};
+
+use crate::document::{Document, Figure, FigureKind, Point, Region};
+use crate::edit::Edit;
+use crate::editor::Editor;
+use crate::geometry::{Side, locate};
+use crate::path::CurvePath;
+
+pub use pick::Hit;
+pub use stroke::{Shape, Tolerances};
+pub use view::View;
+
+/// The interaction's settings; lengths are display mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Settings {
+    /// How near the tip a point or line must be to be highlighted.
+    pub pick_mm: f64,
+    /// A stroke staying this close to its start is a point figure.
+    pub point_mm: f64,
+    /// A stroke ending this close to its start is a closed curve.
+    pub close_mm: f64,
+    /// Positions of a stroke nearer than this to the last recorded one are not recorded.
+    pub step_mm: f64,
+    /// The simplification tolerance of a drawn figure.
+    pub simplify_mm: f64,
+    /// Sliding this far on the surface after a grab makes it a move.
+    pub move_mm: f64,
+    /// Lifting this high after a grab makes it a pull.
+    pub lift_mm: f64,
+    /// Slope change per mm of sideways pen motion (right is positive: bell-shaped).
+    pub slope_per_mm: f64,
+    /// The slope bar's range, ±.
+    pub slope_limit: f64,
+    /// An SW3 press shorter than this, µs, and moving less than `click_mm`, is a click.
+    pub click_us: u64,
+    /// See `click_us`.
+    pub click_mm: f64,
+    /// Raising the pen this much while panning zooms out by a factor e.
+    pub zoom_mm: f64,
+    /// The ground's tilt towards the viewer while pulling, radians.
+    pub pull_tilt: f64,
+    /// Time constant of the tilt's easing, s.
+    pub tilt_time_s: f64,
+}
+
+impl Default for Settings {
+    fn default() -> Settings {
+        Settings {
+            pick_mm: 6.0,
+            point_mm: 3.0,
+            close_mm: 10.0,
+            step_mm: 1.0,
+            simplify_mm: 1.0,
+            move_mm: 3.0,
+            lift_mm: 3.0,
+            slope_per_mm: 0.04,
+            slope_limit: 6.0,
+            click_us: 600_000,
+            click_mm: 4.0,
+            zoom_mm: 150.0,
+            pull_tilt: 20f64.to_radians(),
+            tilt_time_s: 0.3,
+        }
+    }
+}
+
+/// An operation from the keyboard or a script.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Command {
+    /// Undo the last edit.
+    Undo,
+    /// Redo the last undone edit.
+    Redo,
+    /// Delete the highlighted figure or region.
+    Delete,
+    /// Move the view by display mm (the ground follows).
+    Pan {
+        /// Rightwards.
+        du_mm: f64,
+        /// Upwards.
+        dv_mm: f64,
+    },
+    /// Magnify by `factor` about the display's centre.
+    Zoom {
+        /// > 1 magnifies.
+        factor: f64,
+    },
+    /// Show the whole grid again.
+    Fit,
+}
+
+/// What was done, for the session's summary.
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct Stats {
+    /// Figures drawn and added.
+    pub figures: u32,
+    /// Generation regions drawn and added.
+    pub regions: u32,
+    /// Grabs committed with a height change.
+    pub pulls: u32,
+    /// Grabs committed with a slope change.
+    pub slopes: u32,
+    /// Figures, regions and vertices moved.
+    pub moves: u32,
+    /// Figures and regions deleted.
+    pub deletes: u32,
+    /// Undos done.
+    pub undos: u32,
+    /// Redos done.
+    pub redos: u32,
+    /// Edits the document refused (each with a message).
+    pub refused: u32,
+    /// Pen events the source reported lost.
+    pub missed: u64,
+}
+
+/// What the grabbed figure is doing.
+#[derive(Debug, Clone, PartialEq)]
+enum Action {
+    /// Grabbed; neither lifted nor slid yet.
+    Pending,
+    /// Following the pen's height.
+    Pull,
+    /// Following the pen's sideways motion.
+    Slope { u0: f64, s0: f64 },
+    /// Following the pen along the surface, by `by` metres; `outside` when the tip is outside the
+    /// figure's region (dropping it there deletes it).
+    Move { by: Point, outside: bool },
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct Grab {
+    hit: Hit,
+    /// Where the tip touched, display mm.
+    at_mm: [f64; 2],
+    action: Action,
+    /// Whether it has been pulled (a slope returns to the pull).
+    pulled: bool,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum State {
+    Idle,
+    /// Positions of the figure being drawn (ground metres); `touching` while SW1 is down.
+    Drawing {
+        positions: Vec<Point>,
+        touching: bool,
+    },
+    /// SW2 held, nothing grabbed.
+    Armed,
+    Grabbed(Grab),
+    /// SW3 held with nothing drawn or grabbed: a click (undo) or a pan.
+    Sw3 {
+        t0: u64,
+        at_mm: [f64; 2],
+        h0: f64,
+        ground: Point,
+        scale0: f64,
+        moved: bool,
+    },
+}
+
+/// A figure being moved, as it would be dropped.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Moving {
+    /// What is moved.
+    pub curve: CurvePath,
+    /// Its points where the pen has taken them.
+    pub points: Vec<Point>,
+    /// Whether dropping it here deletes it.
+    pub deleting: bool,
+}
+
+/// The pen interaction: turns pen events into edits of an [`Editor`]'s document.
+#[derive(Debug, Clone)]
+pub struct Interaction {
+    settings: Settings,
+    view: View,
+    home: View,
+    state: State,
+    hover: Option<Hit>,
+    pen: Option<DisplayPoint>,
+    sw: [bool; 3],
+    last_t: Option<u64>,
+    stats: Stats,
+    messages: Vec<String>,
+    last_message: Option<(u64, String)>,
+}
+
+/// The event's time, µs: the device's clock if the event carries it.
+fn event_time(ev: &PenEvent) -> u64 {
+    ev.seq.map_or(ev.t_us, |(_, device_us)| device_us)
+}
+
+fn plus(a: Point, b: Point) -> Point {
+    [a[0] + b[0], a[1] + b[1]]
+}
+
+fn minus(a: Point, b: Point) -> Point {
+    [a[0] - b[0], a[1] - b[1]]
+}
+
+/// The points of a curve in the document.
+fn curve_points<'a>(doc: &'a Document, curve: &CurvePath) -> Option<(&'a [Point], bool)> {
+    match curve {
+        CurvePath::Boundary(r) => doc.regions.get(*r).map(|g| (g.boundary.as_slice(), true)),
+        CurvePath::Figure(at) => at.get(doc).map(|f| (f.points.as_slice(), f.kind == FigureKind::Closed)),
+    }
+}
+
+impl Interaction {
+    /// An interaction showing the ground through `view`.
+    pub fn new(view: View, settings: Settings) -> Interaction {
+        Interaction {
+            settings,
+            view,
+            home: view,
+            state: State::Idle,
+            hover: None,
+            pen: None,
+            sw: [false; 3],
+            last_t: None,
+            stats: Stats::default(),
+            messages: Vec::new(),
+            last_message: None,
+        }
+    }
+
+    /// The view: how the display shows the ground.
+    pub fn view(&self) -> &View {
+        &self.view
+    }
+
+    /// The settings.
+    pub fn settings(&self) -> &Settings {
+        &self.settings
+    }
+
+    /// What has been done so far.
+    pub fn stats(&self) -> &Stats {
+        &self.stats
+    }
+
+    /// The messages since the last call (refused edits, undos, the pen lost and found).
+    pub fn take_messages(&mut self) -> Vec<String> {
+        std::mem::take(&mut self.messages)
+    }
+
+    /// Where the pen is on the display, if in range.
+    pub fn pen(&self) -> Option<&DisplayPoint> {
+        self.pen.as_ref()
+    }
+
+    /// The highlighted figure or region, if nothing is grabbed.
+    pub fn hover(&self) -> Option<&Hit> {
+        match self.state {
+            State::Idle | State::Armed => self.hover.as_ref(),
+            _ => None,
+        }
+    }
+
+    /// The grabbed figure or region.
+    pub fn grabbed(&self) -> Option<&CurvePath> {
+        match &self.state {
+            State::Grabbed(g) => Some(&g.hit.curve),
+            _ => None,
+        }
+    }
+
+    /// The positions of the figure being drawn (ground metres).
+    pub fn drawing(&self) -> Option<&[Point]> {
+        match &self.state {
+            State::Drawing { positions, .. } => Some(positions),
+            _ => None,
+        }
+    }
+
+    /// The grabbed figure, region or vertex where the pen is moving it.
+    pub fn moving(&self, doc: &Document) -> Option<Moving> {
+        let State::Grabbed(g) = &self.state else { return None };
+        let Action::Move { by, outside } = g.action else {
+            return None;
+        };
+        let (points, closed) = curve_points(doc, &g.hit.curve)?;
+        let mut points = points.to_vec();
+        match g.hit.vertex {
+            Some(i) if points.len() > 1 => {
+                points[i] = plus(points[i], by);
+                if closed && i == 0 {
+                    let last = points.len() - 1;
+                    points[last] = points[0];
+                }
+            }
+            _ => points.iter_mut().for_each(|p| *p = plus(*p, by)),
+        }
+        Some(Moving {
+            curve: g.hit.curve.clone(),
+            points,
+            deleting: outside && deletes(g, doc),
+        })
+    }
+
+    /// The slope bar while setting a slope: `(value, −limit, +limit)`.
+    pub fn slope_bar(&self, doc: &Document) -> Option<(f64, f64, f64)> {
+        let State::Grabbed(g) = &self.state else { return None };
+        let Action::Slope { .. } = g.action else { return None };
+        let CurvePath::Figure(at) = &g.hit.curve else {
+            return None;
+        };
+        let s = at.get(doc)?.slope;
+        Some((s, -self.settings.slope_limit, self.settings.slope_limit))
+    }
+
+    /// Whether a pull or slope is in progress (the ground tilts).
+    pub fn pulling(&self) -> bool {
+        matches!(
+            &self.state,
+            State::Grabbed(Grab {
+                action: Action::Pull | Action::Slope { .. },
+                ..
+            })
+        )
+    }
+
+    /// One line saying what the pen is doing and what it can do next.
+    pub fn status(&self, doc: &Document) -> String {
+        let line = match &self.state {
+            State::Idle => match &self.hover {
+                Some(h) => format!("{} — SW2 + touch grabs it", describe(doc, &h.curve)),
+                None => "draw with the tip; SW3 ends a figure; SW3 click undoes".to_string(),
+            },
+            State::Drawing { positions, touching } => format!(
+                "drawing, {} positions{} — SW3 ends the figure",
+                positions.len(),
+                if *touching { "" } else { ", pen lifted" }
+            ),
+            State::Armed => match &self.hover {
+                Some(h) => format!("{} — touch to grab; SW3 redoes", describe(doc, &h.curve)),
+                None => "SW2: touch a figure to grab it; SW3 redoes".to_string(),
+            },
+            State::Grabbed(g) => {
+                let what = describe(doc, &g.hit.curve);
+                let figure = match &g.hit.curve {
+                    CurvePath::Figure(at) => at.get(doc),
+                    CurvePath::Boundary(_) => None,
+                };
+                match (&g.action, figure) {
+                    (Action::Pull, Some(f)) => format!("pull {what}: {:.0} m — release SW2 to set", f.height),
+                    (Action::Slope { .. }, Some(f)) => {
+                        format!("slope {what}: {:+.2} — left sharper, right rounder", f.slope)
+                    }
+                    (Action::Move { .. }, _) if deletes(g, doc) => {
+                        format!("{what}: release here to delete it")
+                    }
+                    (Action::Move { .. }, _) => match g.hit.vertex {
+                        Some(i) => format!("moving vertex {i} of {what}"),
+                        None => format!("moving {what}"),
+                    },
+                    _ => format!("grabbed {what}: lift to pull, slide to move, SW3 for the slope"),
+                }
+            }
+            State::Sw3 { moved: true, .. } => format!("view: 1 mm = {:.1} m", 1.0 / self.view.scale),
+            State::Sw3 { .. } => "SW3: release to undo, or move to pan (up and down zooms)".to_string(),
+        };
+        match (&self.last_message, self.last_t) {
+            (Some((t, m)), Some(now)) if now.saturating_sub(*t) < 3_000_000 => format!("{line}   · {m}"),
+            _ => line,
+        }
+    }
+
+    fn say(&mut self, message: String) {
+        if let Some(t) = self.last_t {
+            self.last_message = Some((t, message.clone()));
+        }
+        self.messages.push(message);
+    }
+
+    /// Eases the ground's tilt towards its target up to time `t_us`.
+    pub fn advance(&mut self, t_us: u64) {
+        let dt = self.last_t.map_or(0, |last| t_us.saturating_sub(last)) as f64 * 1e-6;
+        self.last_t = Some(self.last_t.map_or(t_us, |last| last.max(t_us)));
+        let target = if self.pulling() { self.settings.pull_tilt } else { 0.0 };
+        let k = 1.0 - (-dt / self.settings.tilt_time_s).exp();
+        self.view.tilt += (target - self.view.tilt) * k;
+    }
+
+    /// Handles one pen event.
+    pub fn handle(&mut self, editor: &mut Editor, ev: &PenEvent) {
+        self.advance(event_time(ev));
+        if let Some(p) = ev.point {
+            self.pen = Some(p);
+        }
+        if let Some(sw) = ev.sw {
+            self.sw = sw;
+        }
+        let t = self.last_t.unwrap_or(0);
+        match &ev.kind {
+            EventKind::ProximityIn | EventKind::Motion => self.on_motion(editor),
+            EventKind::ProximityOut => {
+                self.pen = None;
+                self.hover = None;
+            }
+            EventKind::TipDown => self.on_tip_down(editor),
+            EventKind::TipUp => self.on_tip_up(editor),
+            EventKind::ButtonDown { button: 2 } => self.on_sw2_down(),
+            EventKind::ButtonUp { button: 2 } => self.on_sw2_up(editor),
+            EventKind::ButtonDown { button: 3 } => self.on_sw3_down(editor, t),
+            EventKind::ButtonUp { button: 3 } => self.on_sw3_up(editor, t),
+            EventKind::ButtonDown { .. } | EventKind::ButtonUp { .. } => {}
+            EventKind::DeviceLost { reason } => self.on_lost(editor, reason),
+            EventKind::DeviceFound { device } => self.say(format!("pen found: {device}")),
+            EventKind::Missed { count } => {
+                self.stats.missed += count;
+                self.say(format!("{count} pen events were lost"));
+            }
+        }
+    }
+
+    /// Carries out a command.
+    pub fn command(&mut self, editor: &mut Editor, command: Command) {
+        match command {
+            Command::Undo => self.undo(editor),
+            Command::Redo => self.redo(editor),
+            Command::Delete => {
+                let Some(hit) = self.hover().cloned() else {
+                    self.say("nothing highlighted to delete".into());
+                    return;
+                };
+                let edit = match hit.curve {
+                    CurvePath::Figure(at) => Edit::DeleteFigure { at },
+                    CurvePath::Boundary(index) => Edit::DeleteRegion { index },
+                };
+                if self.commit(editor, edit, "delete") {
+                    self.stats.deletes += 1;
+                    self.hover = None;
+                }
+            }
+            Command::Pan { du_mm, dv_mm } => {
+                let c = self.view.to_display(self.view.centre);
+                let g = self.view.centre;
+                self.view.put(g, [c[0] + du_mm, c[1] + dv_mm]);
+            }
+            Command::Zoom { factor } => {
+                let (min, max) = self.scale_limits();
+                let c = [0.5 * self.view.display_mm[0], 0.5 * self.view.display_mm[1]];
+                self.view.zoom_about(factor, c, min, max);
+            }
+            Command::Fit => {
+                let tilt = self.view.tilt;
+                self.view = View { tilt, ..self.home };
+            }
+        }
+    }
+
+    fn scale_limits(&self) -> (f64, f64) {
+        (0.25 * self.home.scale, 64.0 * self.home.scale)
+    }
+
+    fn ground(&self) -> Option<(Point, DisplayPoint)> {
+        let p = self.pen?;
+        Some((self.view.to_ground(p.u_mm, p.v_mm), p))
+    }
+
+    fn on_motion(&mut self, editor: &mut Editor) {
+        let Some((g, p)) = self.ground() else { return };
+        let step = self.view.metres(self.settings.step_mm);
+        let s = self.settings;
+        match &mut self.state {
+            State::Idle | State::Armed => {
+                self.hover = pick::pick(editor.document(), g, self.view.metres(s.pick_mm));
+            }
+            State::Drawing { positions, touching } => {
+                if *touching
+                    && positions
+                        .last()
+                        .is_none_or(|&l| (l[0] - g[0]).hypot(l[1] - g[1]) >= step)
+                {
+                    positions.push(g);
+                }
+            }
+            State::Grabbed(grab) => {
+                let slid = (p.u_mm - grab.at_mm[0]).hypot(p.v_mm - grab.at_mm[1]);
+                let is_figure = matches!(grab.hit.curve, CurvePath::Figure(_));
+                if grab.action == Action::Pending {
+                    if is_figure && (!self.sw[0] || p.h_mm > s.lift_mm) {
+                        grab.action = Action::Pull;
+                        grab.pulled = true;
+                    } else if self.sw[0] && slid > s.move_mm {
+                        grab.action = Action::Move {
+                            by: [0.0, 0.0],
+                            outside: false,
+                        };
+                    }
+                }
+                let grab = grab.clone();
+                self.follow(editor, grab, g, p);
+            }
+            State::Sw3 {
+                at_mm,
+                h0,
+                ground,
+                scale0,
+                moved,
+                ..
+            } => {
+                let d = (p.u_mm - at_mm[0]).hypot(p.v_mm - at_mm[1]);
+                if d > s.click_mm || (p.h_mm - *h0).abs() > 2.0 * s.click_mm {
+                    *moved = true;
+                }
+                if *moved {
+                    // The ground point under the pen at the press stays under it; height zooms.
+                    let factor = (-(p.h_mm - *h0) / s.zoom_mm).exp();
+                    let (ground, scale0) = (*ground, *scale0);
+                    let (min, max) = self.scale_limits();
+                    self.view.scale = (scale0 * factor).clamp(min, max);
+                    self.view.put(ground, [p.u_mm, p.v_mm]);
+                }
+            }
+        }
+    }
+
+    /// A grabbed figure follows the pen: its height, its slope, or its place.
+    fn follow(&mut self, editor: &mut Editor, grab: Grab, g: Point, p: DisplayPoint) {
+        let s = self.settings;
+        let CurvePath::Figure(at) = &grab.hit.curve else {
+            if let Action::Move { .. } = grab.action {
+                self.track_move(editor, g);
+            }
+            return;
+        };
+        let edit = match grab.action {
+            Action::Pending => return,
+            Action::Pull => Edit::SetHeight {
+                at: at.clone(),
+                height: self.view.height_at(p.h_mm.max(0.0)),
+            },
+            Action::Slope { u0, s0 } => Edit::SetSlope {
+                at: at.clone(),
+                slope: (s0 + (p.u_mm - u0) * s.slope_per_mm).clamp(-s.slope_limit, s.slope_limit),
+            },
+            Action::Move { .. } => return self.track_move(editor, g),
+        };
+        if let Err(e) = editor.preview(&edit) {
+            self.stats.refused += 1;
+            self.say(format!("cannot show the change: {e}"));
+        }
+    }
+
+    fn track_move(&mut self, editor: &Editor, g: Point) {
+        let State::Grabbed(grab) = &mut self.state else { return };
+        let start = self.view.to_ground(grab.at_mm[0], grab.at_mm[1]);
+        let doc = editor.document();
+        let outside = match &grab.hit.curve {
+            CurvePath::Figure(at) => at.edge(doc).is_some_and(|edge| locate(edge, g) == Side::Outside),
+            CurvePath::Boundary(_) => {
+                !(0.0..=doc.grid.width()).contains(&g[0]) || !(0.0..=doc.grid.height()).contains(&g[1])
+            }
+        };
+        grab.action = Action::Move {
+            by: minus(g, start),
+            outside,
+        };
+    }
+
+    fn on_tip_down(&mut self, editor: &mut Editor) {
+        let Some((g, p)) = self.ground() else { return };
+        match &mut self.state {
+            State::Idle => {
+                self.state = State::Drawing {
+                    positions: vec![g],
+                    touching: true,
+                }
+            }
+            State::Drawing { positions, touching } => {
+                *touching = true;
+                positions.push(g);
+            }
+            State::Armed => {
+                let hit = self
+                    .hover
+                    .clone()
+                    .or_else(|| pick::pick(editor.document(), g, self.view.metres(self.settings.pick_mm)));
+                match hit {
+                    Some(hit) => {
+                        self.state = State::Grabbed(Grab {
+                            hit,
+                            at_mm: [p.u_mm, p.v_mm],
+                            action: Action::Pending,
+                            pulled: false,
+                        })
+                    }
+                    None => self.say("nothing here to grab".into()),
+                }
+            }
+            State::Grabbed(_) | State::Sw3 { .. } => {}
+        }
+    }
+
+    fn on_tip_up(&mut self, editor: &mut Editor) {
+        let g = self.ground().map(|(g, _)| g);
+        match &mut self.state {
+            State::Drawing { positions, touching } => {
+                *touching = false;
+                if let Some(g) = g
+                    && positions.last() != Some(&g)
+                {
+                    positions.push(g);
+                }
+            }
+            State::Grabbed(grab) => match grab.action {
+                Action::Pending if matches!(grab.hit.curve, CurvePath::Figure(_)) => {
+                    grab.action = Action::Pull;
+                    grab.pulled = true;
+                }
+                Action::Pending => {
+                    self.say("a region's boundary is moved, not pulled: pull the figures inside it".into())
+                }
+                Action::Move { .. } => {
+                    self.drop_move(editor);
+                    self.state = State::Armed;
+                }
+                _ => {}
+            },
+            _ => {}
+        }
+    }
+
+    fn on_sw2_down(&mut self) {
+        if self.state == State::Idle {
+            self.state = State::Armed;
+        }
+    }
+
+    fn on_sw2_up(&mut self, editor: &mut Editor) {
+        let State::Grabbed(grab) = &self.state else {
+            if self.state == State::Armed {
+                self.state = State::Idle;
+            }
+            return;
+        };
+        match grab.action {
+            Action::Move { .. } => self.drop_move(editor),
+            _ => self.commit_preview(editor),
+        }
+        self.state = State::Idle;
+    }
+
+    fn on_sw3_down(&mut self, editor: &mut Editor, t: u64) {
+        let at = self.pen.map(|p| ([p.u_mm, p.v_mm], p.h_mm));
+        match &mut self.state {
+            State::Drawing { positions, .. } => {
+                let positions = std::mem::take(positions);
+                self.state = State::Idle;
+                self.finish(editor, &positions);
+            }
+            State::Idle => {
+                let Some((at_mm, h0)) = at else { return };
+                self.state = State::Sw3 {
+                    t0: t,
+                    at_mm,
+                    h0,
+                    ground: self.view.to_ground(at_mm[0], at_mm[1]),
+                    scale0: self.view.scale,
+                    moved: false,
+                };
+            }
+            State::Armed => self.redo(editor),
+            State::Grabbed(grab) => {
+                let CurvePath::Figure(at_path) = &grab.hit.curve else {
+                    return;
+                };
+                if matches!(grab.action, Action::Pending | Action::Pull)
+                    && let Some((at_mm, _)) = at
+                {
+                    let s0 = at_path.get(editor.document()).map_or(0.0, |f| f.slope);
+                    grab.action = Action::Slope { u0: at_mm[0], s0 };
+                }
+            }
+            State::Sw3 { .. } => {}
+        }
+    }
+
+    fn on_sw3_up(&mut self, editor: &mut Editor, t: u64) {
+        match &mut self.state {
+            State::Grabbed(grab) => {
+                if let Action::Slope { .. } = grab.action {
+                    grab.action = if grab.pulled { Action::Pull } else { Action::Pending };
+                }
+            }
+            State::Sw3 { t0, moved, .. } => {
+                let click = !*moved && t.saturating_sub(*t0) < self.settings.click_us;
+                self.state = State::Idle;
+                if click {
+                    self.undo(editor);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    fn on_lost(&mut self, editor: &mut Editor, reason: &str) {
+        match &mut self.state {
+            State::Grabbed(_) => {
+                if let Err(e) = editor.cancel_preview() {
+                    self.say(format!("cannot restore the grabbed figure: {e}"));
+                }
+                self.say(format!("pen lost ({reason}): the grab was cancelled"));
+                self.state = State::Idle;
+            }
+            State::Drawing { touching, .. } => {
+                *touching = false;
+                self.say(format!(
+                    "pen lost ({reason}): the figure being drawn is kept; SW3 ends it"
+                ));
+            }
+            _ => {
+                self.say(format!("pen lost ({reason})"));
+                self.state = State::Idle;
+            }
+        }
+        self.pen = None;
+        self.hover = None;
+    }
+
+    /// Applies a recorded edit; a refusal is a message.
+    fn commit(&mut self, editor: &mut Editor, edit: Edit, what: &str) -> bool {
+        match editor.apply(edit) {
+            Ok(_) => true,
+            Err(e) => {
+                self.stats.refused += 1;
+                self.say(format!("{what} refused: {e}"));
+                false
+            }
+        }
+    }
+
+    fn commit_preview(&mut self, editor: &mut Editor) {
+        match editor.commit_preview() {
+            Ok(Some(edit)) => {
+                let (height, slope) = match &edit {
+                    Edit::SetHeight { .. } => (true, false),
+                    Edit::SetSlope { .. } => (false, true),
+                    _ => (true, true),
+                };
+                self.stats.pulls += u32::from(height);
+                self.stats.slopes += u32::from(slope);
+            }
+            Ok(None) => {}
+            Err(e) => {
+                self.stats.refused += 1;
+                self.say(format!("the pull was not recorded: {e}"));
+            }
+        }
+    }
+
+    fn drop_move(&mut self, editor: &mut Editor) {
+        let State::Grabbed(grab) = &self.state else { return };
+        let Action::Move { by, .. } = grab.action else { return };
+        let doc = editor.document();
+        let deletes = deletes(grab, doc);
+        if by == [0.0, 0.0] && !deletes {
+            return;
+        }
+        let vertex_to = |i: usize| {
+            curve_points(doc, &grab.hit.curve)
+                .and_then(|(pts, _)| pts.get(i))
+                .map(|p| plus(*p, by))
+        };
+        let edit = match (&grab.hit.curve, grab.hit.vertex) {
+            (CurvePath::Figure(at), _) if deletes => Edit::DeleteFigure { at: at.clone() },
+            (CurvePath::Boundary(index), None) if deletes => Edit::DeleteRegion { index: *index },
+            (CurvePath::Figure(at), Some(i)) if at.get(doc).is_some_and(|f| f.kind != FigureKind::Point) => {
+                let Some(to) = vertex_to(i) else { return };
+                Edit::MovePoint {
+                    curve: grab.hit.curve.clone(),
+                    index: i,
+                    to,
+                }
+            }
+            (CurvePath::Figure(at), _) => Edit::MoveFigure { at: at.clone(), by },
+            (CurvePath::Boundary(_), Some(i)) => {
+                let Some(to) = vertex_to(i) else { return };
+                Edit::MovePoint {
+                    curve: grab.hit.curve.clone(),
+                    index: i,
+                    to,
+                }
+            }
+            (CurvePath::Boundary(index), None) => Edit::MoveRegion { index: *index, by },
+        };
+        let delete = matches!(edit, Edit::DeleteFigure { .. } | Edit::DeleteRegion { .. });
+        if self.commit(editor, edit, if delete { "delete" } else { "move" }) {
+            if delete {
+                self.stats.deletes += 1;
+            } else {
+                self.stats.moves += 1;
+            }
+        }
+        self.hover = None;
+    }
+
+    fn undo(&mut self, editor: &mut Editor) {
+        match editor.undo() {
+            Ok(Some(_)) => {
+                self.stats.undos += 1;
+                self.say("undone".into());
+            }
+            Ok(None) => self.say("nothing to undo".into()),
+            Err(e) => self.say(format!("cannot undo: {e}")),
+        }
+        self.hover = None;
+    }
+
+    fn redo(&mut self, editor: &mut Editor) {
+        match editor.redo() {
+            Ok(Some(_)) => {
+                self.stats.redos += 1;
+                self.say("redone".into());
+            }
+            Ok(None) => self.say("nothing to redo".into()),
+            Err(e) => self.say(format!("cannot redo: {e}")),
+        }
+        self.hover = None;
+    }
+
+    /// Ends the figure being drawn: classifies it and adds it where it belongs.
+    fn finish(&mut self, editor: &mut Editor, positions: &[Point]) {
+        let v = self.view;
+        let tol = Tolerances {
+            point: v.metres(self.settings.point_mm),
+            close: v.metres(self.settings.close_mm),
+            simplify: v.metres(self.settings.simplify_mm),
+        };
+        let Some(shape) = stroke::classify(positions, &tol) else {
+            return;
+        };
+        let doc = editor.document();
+        let edit = match pick::container(doc, &shape.points) {
+            Some(at) => Edit::AddFigure {
+                figure: Figure {
+                    kind: shape.kind,
+                    points: shape.points,
+                    height: pick::base_height(doc, &at),
+                    slope: 0.0,
+                    figures: Vec::new(),
+                },
+                at,
+            },
+            None if shape.kind == FigureKind::Closed => Edit::AddRegion {
+                index: doc.regions.len(),
+                region: Region {
+                    boundary: shape.points,
+                    figures: Vec::new(),
+                },
+            },
+            None => {
+                self.stats.refused += 1;
+                self.say(format!(
+                    "the {} is outside every region: draw a closed curve around the place first",
+                    shape.kind.name()
+                ));
+                return;
+            }
+        };
+        let (name, region) = match &edit {
+            Edit::AddFigure { at, figure } => (format!("{} {at}", figure.kind.name()), false),
+            Edit::AddRegion { index, .. } => (format!("region regions[{index}]"), true),
+            _ => (String::new(), false),
+        };
+        if self.commit(editor, edit, &format!("the new {name}")) {
+            if region {
+                self.stats.regions += 1;
+            } else {
+                self.stats.figures += 1;
+            }
+            self.say(format!("added {name}"));
+        }
+    }
+}
+
+/// Whether dropping this grab deletes what it holds: a whole figure or region (not one vertex of
+/// it) moved with the tip outside its region.
+fn deletes(grab: &Grab, doc: &Document) -> bool {
+    let whole = match (&grab.hit.curve, grab.hit.vertex) {
+        (_, None) => true,
+        (CurvePath::Figure(at), Some(_)) => at.get(doc).is_some_and(|f| f.kind == FigureKind::Point),
+        (CurvePath::Boundary(_), Some(_)) => false,
+    };
+    whole && matches!(grab.action, Action::Move { outside: true, .. })
+}
+
+/// A figure or region named for the status line.
+fn describe(doc: &Document, curve: &CurvePath) -> String {
+    match curve {
+        CurvePath::Boundary(r) => format!("region {r}"),
+        CurvePath::Figure(at) => match at.get(doc) {
+            Some(f) => format!("{} {at}", f.kind.name()),
+            None => at.to_string(),
+        },
+    }
+}

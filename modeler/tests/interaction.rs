@@ -1,0 +1,366 @@
+//! The pen interaction driven by scripted pen events: each gesture of seed 000's section 3.2
+//! gives the expected document.
+//!
+//! The script moves an ideal pen (no noise) and samples it at the device's 153.8 Hz; the samples
+//! go through the host's real event detector, so the events arrive in the order and with the
+//! fields a device's do.
+
+use glam::DVec3;
+use pen_host::calibration::{Calibration, DisplaySize};
+use pen_host::events::{EventDetector, PenEvent};
+use pen_host::sample::Sample;
+use pen_protocol::Quality;
+use penmodel::interaction::{Command, Interaction, Settings, View};
+use penmodel::{Document, Editor, FigureKind, FigurePath, Grid, Point, generate};
+
+const HOVER: f64 = 40.0;
+const CYCLE_US: u64 = 6_500;
+
+/// An ideal pen on the reference display, fed straight into an interaction.
+struct Pen {
+    at: DVec3,
+    sw: [bool; 3],
+    t_us: u64,
+    seq: u16,
+    detector: EventDetector,
+    calibration: Calibration,
+    events: Vec<PenEvent>,
+    editor: Editor,
+    ui: Interaction,
+}
+
+impl Pen {
+    fn new(doc: Document) -> Pen {
+        let view = View::fit([600.0, 340.0], &doc.grid);
+        Pen {
+            at: DVec3::new(300.0, 170.0, HOVER),
+            sw: [false; 3],
+            t_us: 1_000_000,
+            seq: 0,
+            detector: EventDetector::new(),
+            calibration: Calibration::identity(DisplaySize::REFERENCE),
+            events: Vec::new(),
+            editor: Editor::new(doc).expect("valid"),
+            ui: Interaction::new(view, Settings::default()),
+        }
+    }
+
+    fn sample(&mut self) {
+        let s = Sample {
+            seq: self.seq,
+            device_us: self.t_us,
+            host_us: self.t_us,
+            sw: self.sw,
+            in_range: true,
+            display_frame: true,
+            position_mm: self.at,
+            quality: Quality::new(4, 0.5, 1.5),
+        };
+        let mut out = Vec::new();
+        self.detector.on_sample(&s, self.calibration.point(self.at), &mut out);
+        for ev in &out {
+            self.ui.handle(&mut self.editor, ev);
+        }
+        self.events.extend(out);
+        self.t_us += CYCLE_US;
+        self.seq = self.seq.wrapping_add(1);
+    }
+
+    /// Moves in a straight line at 300 mm/s, one sample per cycle.
+    fn move_to(&mut self, to: DVec3) -> &mut Self {
+        let from = self.at;
+        let n = ((to - from).length() / (300.0 * CYCLE_US as f64 * 1e-6))
+            .ceil()
+            .max(1.0) as usize;
+        for i in 1..=n {
+            self.at = from.lerp(to, i as f64 / n as f64);
+            self.sample();
+        }
+        self
+    }
+
+    fn hold(&mut self, seconds: f64) -> &mut Self {
+        for _ in 0..(seconds * 1e6 / CYCLE_US as f64) as usize {
+            self.sample();
+        }
+        self
+    }
+
+    fn set(&mut self, switch: usize, pressed: bool) -> &mut Self {
+        self.sw[switch] = pressed;
+        self.sample();
+        self
+    }
+
+    fn hover(&mut self, u: f64, v: f64) -> &mut Self {
+        self.move_to(DVec3::new(u, v, HOVER))
+    }
+
+    fn touch(&mut self) -> &mut Self {
+        let down = self.at.with_z(0.0);
+        self.move_to(down).set(0, true)
+    }
+
+    fn lift(&mut self, h: f64) -> &mut Self {
+        self.set(0, false);
+        let up = self.at.with_z(h);
+        self.move_to(up)
+    }
+
+    fn drag_to(&mut self, u: f64, v: f64) -> &mut Self {
+        self.move_to(DVec3::new(u, v, 0.0))
+    }
+
+    fn click(&mut self, switch: usize) -> &mut Self {
+        self.set(switch, true).hold(0.1).set(switch, false)
+    }
+
+    fn stroke(&mut self, points: &[(f64, f64)]) -> &mut Self {
+        let (u, v) = points[0];
+        self.hover(u, v).touch();
+        for &(u, v) in &points[1..] {
+            self.drag_to(u, v);
+        }
+        self.lift(HOVER).click(2)
+    }
+
+    fn closed(&mut self, points: &[(f64, f64)]) -> &mut Self {
+        let mut ring = points.to_vec();
+        ring.push(points[0]);
+        self.stroke(&ring)
+    }
+
+    fn grab(&mut self, u: f64, v: f64) -> &mut Self {
+        self.hover(u, v).set(1, true).touch()
+    }
+
+    fn pull_to(&mut self, h: f64) -> &mut Self {
+        if self.sw[0] {
+            self.lift(h)
+        } else {
+            let to = self.at.with_z(h);
+            self.move_to(to)
+        }
+    }
+
+    fn slope(&mut self, du: f64) -> &mut Self {
+        let to = self.at + DVec3::new(du, 0.0, 0.0);
+        self.set(2, true).move_to(to).set(2, false)
+    }
+
+    fn let_go(&mut self) -> &mut Self {
+        self.set(1, false)
+    }
+
+    fn doc(&self) -> &Document {
+        self.editor.document()
+    }
+
+    fn view(&self) -> View {
+        *self.ui.view()
+    }
+
+    /// The ground point drawn at display `(u, v)`.
+    fn ground(&self, u: f64, v: f64) -> Point {
+        self.view().to_ground(u, v)
+    }
+}
+
+/// 480 × 272 cells of 12.5 m: the reference display at 1:10 000.
+fn blank() -> Document {
+    Document::new(Grid {
+        cols: 480,
+        rows: 272,
+        cell_size: 12.5,
+    })
+}
+
+const REGION: [(f64, f64); 4] = [(60.0, 40.0), (540.0, 40.0), (540.0, 300.0), (60.0, 300.0)];
+
+fn near(a: Point, b: Point, metres: f64) -> bool {
+    (a[0] - b[0]).hypot(a[1] - b[1]) <= metres
+}
+
+#[test]
+fn drawing_makes_a_region_then_figures_inside_it() {
+    let mut pen = Pen::new(blank());
+    pen.closed(&REGION);
+    assert_eq!(pen.doc().regions.len(), 1, "{:?}", pen.ui.take_messages());
+    let boundary = &pen.doc().regions[0].boundary;
+    assert_eq!(boundary.len(), 5, "four corners and the repeat: {boundary:?}");
+    for (p, &(u, v)) in boundary.iter().zip(&REGION) {
+        assert!(near(*p, pen.ground(u, v), 10.0), "{p:?} vs {:?}", (u, v));
+    }
+
+    // A touch is a point; a stroke a polyline; a loop inside the region a closed figure.
+    pen.hover(150.0, 200.0).touch().lift(HOVER).click(2);
+    pen.stroke(&[(250.0, 90.0), (340.0, 130.0), (430.0, 110.0)]);
+    pen.closed(&[(380.0, 190.0), (480.0, 195.0), (470.0, 270.0), (390.0, 265.0)]);
+    let figures = &pen.doc().regions[0].figures;
+    let kinds: Vec<FigureKind> = figures.iter().map(|f| f.kind).collect();
+    assert_eq!(kinds, [FigureKind::Point, FigureKind::Polyline, FigureKind::Closed]);
+    assert!(near(figures[0].points[0], pen.ground(150.0, 200.0), 1e-6));
+    assert_eq!(figures[1].points.len(), 3, "{:?}", figures[1].points);
+    assert!(near(figures[1].points[1], pen.ground(340.0, 130.0), 10.0));
+    assert_eq!(figures[2].points.len(), 5);
+    assert!(figures.iter().all(|f| f.height == 0.0 && f.slope == 0.0));
+
+    // A point inside the closed figure nests in it and starts at its height.
+    pen.grab(430.0, 230.0).pull_to(40.0).let_go();
+    pen.hover(430.0, 230.0).touch().lift(HOVER).click(2);
+    let plateau = &pen.doc().regions[0].figures[2];
+    assert_eq!(plateau.figures.len(), 1);
+    assert_eq!(plateau.figures[0].height, plateau.height);
+    assert_eq!(pen.ui.stats().regions, 1);
+    assert_eq!(pen.ui.stats().figures, 4);
+    assert_eq!(pen.ui.stats().refused, 0);
+}
+
+#[test]
+fn a_figure_outside_every_region_is_refused_with_a_message() {
+    let mut pen = Pen::new(blank());
+    pen.hover(100.0, 100.0).touch().lift(HOVER).click(2);
+    assert!(pen.doc().regions.is_empty());
+    assert_eq!(pen.ui.stats().refused, 1);
+    let messages = pen.ui.take_messages();
+    assert!(
+        messages.iter().any(|m| m.contains("outside every region")),
+        "{messages:?}"
+    );
+}
+
+#[test]
+fn grab_pull_and_slope_are_one_undoable_edit() {
+    let mut pen = Pen::new(blank());
+    pen.closed(&REGION);
+    pen.hover(150.0, 200.0).touch().lift(HOVER).click(2);
+    let before = pen.doc().clone();
+
+    // Hovering over the point highlights it.
+    pen.hover(151.0, 201.0);
+    let hover = pen.ui.hover().expect("highlighted");
+    assert_eq!(hover.curve.to_string(), "regions[0].figures[0]");
+
+    pen.set(1, true).touch().pull_to(90.0);
+    assert!(pen.ui.pulling());
+    let at = FigurePath::new(0, 0);
+    let height = at.get(pen.doc()).unwrap().height;
+    assert!((height - pen.view().height_at(90.0)).abs() < 1e-9, "{height}");
+    // The terrain follows the pull live.
+    let live = pen.editor.heightmap().clone();
+    let peak = live.range().1;
+    assert!(peak > 0.99 * height as f32, "peak {peak} of {height}");
+    // The ground tilts while pulling.
+    assert!(pen.ui.view().tilt > 0.5 * Settings::default().pull_tilt);
+
+    pen.slope(-40.0);
+    let slope = at.get(pen.doc()).unwrap().slope;
+    assert!(
+        (slope - (-40.0 * Settings::default().slope_per_mm)).abs() < 1e-9,
+        "{slope}"
+    );
+    pen.let_go();
+    assert!(!pen.ui.pulling());
+    let after = pen.doc().clone();
+    assert_eq!(pen.editor.heightmap(), &generate(&after).unwrap());
+
+    // One SW3 click undoes both height and slope; SW2 + SW3 redoes.
+    pen.hover(300.0, 320.0).click(2);
+    assert_eq!(pen.doc(), &before);
+    pen.set(1, true).click(2).set(1, false);
+    assert_eq!(pen.doc(), &after);
+    assert_eq!(pen.ui.stats().pulls, 1);
+    assert_eq!(pen.ui.stats().slopes, 1);
+    assert_eq!(pen.ui.stats().undos, 1);
+    assert_eq!(pen.ui.stats().redos, 1);
+}
+
+#[test]
+fn sliding_a_grab_moves_a_vertex_or_the_figure_and_outside_deletes_it() {
+    let mut pen = Pen::new(blank());
+    pen.closed(&REGION);
+    pen.stroke(&[(250.0, 90.0), (340.0, 130.0), (430.0, 110.0)]);
+    pen.hover(150.0, 200.0).touch().lift(HOVER).click(2);
+    let ridge = FigurePath::new(0, 0);
+    let original = ridge.get(pen.doc()).unwrap().points.clone();
+
+    // At a vertex: that vertex moves, the others stay.
+    pen.grab(340.0, 130.0).drag_to(340.0, 160.0).lift(HOVER).let_go();
+    let moved = ridge.get(pen.doc()).unwrap().points.clone();
+    assert!(near(moved[1], pen.ground(340.0, 160.0), 10.0), "{:?}", moved[1]);
+    assert_eq!(moved[0], original[0]);
+    assert_eq!(moved[2], original[2]);
+
+    // On the line between vertices: the whole figure moves.
+    pen.grab(295.0, 125.0).drag_to(295.0, 105.0).lift(HOVER).let_go();
+    let shifted = ridge.get(pen.doc()).unwrap().points.clone();
+    let by = [shifted[0][0] - moved[0][0], shifted[0][1] - moved[0][1]];
+    assert!(
+        near(by, [0.0, 200.0], 10.0),
+        "moved 20 mm down the display = 200 m: {by:?}"
+    );
+
+    // Dragged out of its region and dropped: deleted.
+    pen.grab(150.0, 200.0).drag_to(30.0, 200.0);
+    let moving = pen.ui.moving(pen.editor.document()).expect("moving");
+    assert!(moving.deleting);
+    pen.lift(HOVER).let_go();
+    assert_eq!(pen.doc().regions[0].figures.len(), 1);
+    assert_eq!(pen.ui.stats().moves, 2);
+    assert_eq!(pen.ui.stats().deletes, 1);
+    // Undo brings it back.
+    pen.hover(300.0, 320.0).click(2);
+    assert_eq!(pen.doc().regions[0].figures.len(), 2);
+}
+
+#[test]
+fn sw3_held_and_moved_pans_and_zooms_without_undoing() {
+    let mut pen = Pen::new(blank());
+    pen.closed(&REGION);
+    let doc = pen.doc().clone();
+    let grabbed = pen.ground(200.0, 150.0);
+    pen.hover(200.0, 150.0)
+        .set(2, true)
+        .move_to(DVec3::new(260.0, 120.0, HOVER))
+        .set(2, false);
+    assert_eq!(pen.doc(), &doc, "a pan is not an undo");
+    // The ground point under the pen at the press is under it still.
+    assert!(near(pen.ground(260.0, 120.0), grabbed, 1e-6));
+    // Lowering the pen zooms in about it.
+    let scale = pen.view().scale;
+    pen.set(2, true).move_to(DVec3::new(260.0, 120.0, 10.0)).set(2, false);
+    assert!(pen.view().scale > 1.2 * scale, "{} vs {scale}", pen.view().scale);
+    assert!(near(pen.ground(260.0, 120.0), grabbed, 1e-6));
+    pen.ui.command(&mut pen.editor, Command::Fit);
+    assert_eq!(pen.view().scale, scale);
+    assert_eq!(pen.ui.stats().undos, 0);
+}
+
+#[test]
+fn losing_the_pen_mid_pull_cancels_the_pull_and_keeps_the_document() {
+    let mut pen = Pen::new(blank());
+    pen.closed(&REGION);
+    pen.hover(150.0, 200.0).touch().lift(HOVER).click(2);
+    let before = pen.doc().clone();
+    pen.grab(150.0, 200.0).pull_to(70.0);
+    assert!(FigurePath::new(0, 0).get(pen.doc()).unwrap().height > 0.0);
+    let mut out = Vec::new();
+    pen.detector.on_device_lost(pen.t_us, "unplugged", &mut out);
+    for ev in &out {
+        pen.ui.handle(&mut pen.editor, ev);
+    }
+    assert_eq!(pen.doc(), &before);
+    assert_eq!(pen.editor.heightmap(), &generate(&before).unwrap());
+    assert!(!pen.editor.can_redo());
+    assert!(pen.ui.take_messages().iter().any(|m| m.contains("pen lost")));
+    // The pen comes back and the session goes on.
+    let mut out = Vec::new();
+    pen.detector.on_device_found(pen.t_us, "sim", &mut out);
+    for ev in &out {
+        pen.ui.handle(&mut pen.editor, ev);
+    }
+    pen.sw = [false; 3];
+    pen.grab(150.0, 200.0).pull_to(50.0).let_go();
+    let h = FigurePath::new(0, 0).get(pen.doc()).unwrap().height;
+    assert!((h - pen.view().height_at(50.0)).abs() < 1e-9);
+}
