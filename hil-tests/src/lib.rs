@@ -3,10 +3,10 @@
 //! It models what makes ultrasonic tracking hard — receiver geometry ([`rig`]), the speed of
 //! sound and its drift, timing jitter, timer quantisation, late echoes and dropouts
 //! ([`acoustics`]), a human hand with tremor and bouncing switch contacts ([`hand`]) — plays
-//! scripted sessions of the seed's operations ([`script`], [`scenarios`]), and drives the real
-//! firmware core through its hardware traits ([`sim`]), so what comes out are the exact report
-//! bytes the device sends. Three ways out: in process ([`sim::Simulation`]), over a
-//! pseudo-terminal like a real serial device ([`pty`]), and the core itself on an emulated
+//! scripted sessions of the seed's operations ([`script`], [`scenarios`], [`session`]), and
+//! drives the real firmware core through its hardware traits ([`sim`]), so what comes out are
+//! the exact report bytes the device sends. Three ways out: in process ([`sim::Simulation`]),
+//! over a pseudo-terminal like a real serial device ([`pty`]), and the core itself on an emulated
 //! Cortex-M4F ([`qemu`]). [`accuracy`] measures it; [`trace`] records it.
 #![cfg_attr(not(test), warn(clippy::unwrap_used))]
 
@@ -18,6 +18,7 @@ pub mod qemu;
 pub mod rig;
 pub mod scenarios;
 pub mod script;
+pub mod session;
 pub mod sim;
 pub mod trace;
 

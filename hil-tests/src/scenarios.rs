@@ -28,7 +28,7 @@ pub const NAMES: &[(&str, &str)] = &[
     ),
     (
         "modeling-session",
-        "the seed's session: a region, a peak, a ridge, a plateau, grabbed, pulled and sloped",
+        "the seed's session: a region with two peaks, a ridge, a plateau with a peak, pulled and sloped; a mistake undone",
     ),
     (
         "hold",
@@ -60,7 +60,12 @@ pub fn by_name(name: &str) -> Option<Scenario> {
             hand_sweep(),
         ),
         "draw-figures" => Scenario::new(name, Rig::reference(), Acoustics::clean(), draw_figures()),
-        "modeling-session" => Scenario::new(name, Rig::reference(), Acoustics::clean(), modeling_session()),
+        "modeling-session" => Scenario::new(
+            name,
+            Rig::reference(),
+            Acoustics::clean(),
+            crate::session::timeline(&crate::session::steps(), home()),
+        ),
         "hold" => {
             let mut s = Script::new(home());
             s.hold(10.0);
@@ -168,43 +173,6 @@ fn draw_figures() -> crate::script::Timeline {
         DVec2::new(480.0, 300.0),
         DVec2::new(390.0, 290.0),
     ]);
-    s.move_to(home());
-    s.build()
-}
-
-/// A session like the seed's examples: a generation region, then control figures inside it — a
-/// peak, a ridge, a plateau with a nested peak — each grabbed, pulled up and sloped.
-fn modeling_session() -> crate::script::Timeline {
-    let mut s = Script::new(home());
-    // The generation region.
-    s.draw_closed(&[
-        DVec2::new(60.0, 40.0),
-        DVec2::new(540.0, 40.0),
-        DVec2::new(560.0, 300.0),
-        DVec2::new(300.0, 320.0),
-        DVec2::new(50.0, 290.0),
-    ]);
-    // A peak, pulled up and sharpened.
-    s.draw_point(DVec2::new(150.0, 200.0));
-    s.grab(DVec2::new(150.0, 200.0)).pull_to(90.0).slope(-40.0).let_go();
-    // A ridge, pulled up and rounded.
-    let ridge = [
-        DVec2::new(250.0, 90.0),
-        DVec2::new(340.0, 130.0),
-        DVec2::new(430.0, 110.0),
-    ];
-    s.draw_polyline(&ridge);
-    s.grab(ridge[1]).pull_to(60.0).slope(50.0).let_go();
-    // A plateau with a peak on it.
-    s.draw_closed(&[
-        DVec2::new(380.0, 190.0),
-        DVec2::new(480.0, 195.0),
-        DVec2::new(470.0, 270.0),
-        DVec2::new(390.0, 265.0),
-    ]);
-    s.grab(DVec2::new(430.0, 230.0)).pull_to(40.0).let_go();
-    s.draw_point(DVec2::new(430.0, 230.0));
-    s.grab(DVec2::new(430.0, 230.0)).pull_to(110.0).slope(-25.0).let_go();
     s.move_to(home());
     s.build()
 }

@@ -260,10 +260,10 @@ impl Script {
     }
 
     /// Adjusts the grabbed figure's slope: SW3 with SW2, moving `dx_mm` sideways (negative is
-    /// left: sharper; positive right: bell-shaped), then SW3 released.
+    /// left: sharper; positive right: bell-shaped), then, the slope bar read, SW3 released.
     pub fn slope(&mut self, dx_mm: f64) -> &mut Self {
         let to = self.at + DVec3::new(dx_mm, 0.0, 0.0);
-        self.press(SW3).move_to(to).release(SW3)
+        self.press(SW3).move_to(to).hold(0.3).release(SW3)
     }
 
     /// Lets go of the grabbed figure.

@@ -579,3 +579,13 @@ impl Calibration {
         crate::fsutil::write_atomic(path, self.to_toml().as_bytes())
     }
 }
+
+/// Where the calibration is kept by default: `$XDG_CONFIG_HOME/penscape/calibration.toml`
+/// (`~/.config/penscape/calibration.toml`); `None` when neither variable is set.
+pub fn default_path() -> Option<std::path::PathBuf> {
+    let base = std::env::var_os("XDG_CONFIG_HOME")
+        .filter(|d| !d.is_empty())
+        .map(std::path::PathBuf::from)
+        .or_else(|| std::env::var_os("HOME").map(|h| std::path::PathBuf::from(h).join(".config")))?;
+    Some(base.join("penscape/calibration.toml"))
+}

@@ -19,8 +19,13 @@ pub struct Pipeline {
 impl Pipeline {
     /// A pipeline on `source` with `calibration`.
     pub fn new(source: Source, calibration: Calibration) -> Pipeline {
+        Pipeline::with_device(Device::new(source), calibration)
+    }
+
+    /// A pipeline on a device session already under way (after a calibration, say).
+    pub fn with_device(device: Device, calibration: Calibration) -> Pipeline {
         Pipeline {
-            device: Device::new(source),
+            device,
             calibration,
             detector: EventDetector::new(),
             lost: 0,

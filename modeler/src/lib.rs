@@ -19,6 +19,7 @@ pub mod document;
 pub mod edit;
 pub mod editor;
 pub mod export;
+pub mod feed;
 // Atomic, durable writes live in the host crate, below the modeler in the dependency order.
 use pen_host::fsutil;
 pub mod geometry;
@@ -29,6 +30,7 @@ mod json;
 pub mod path;
 pub mod profile;
 pub mod raster;
+pub mod session;
 pub mod terrain;
 pub mod validate;
 

@@ -358,14 +358,6 @@ fn config(action: ConfigAction) -> Result<()> {
     }
 }
 
-fn default_calibration_path() -> Result<PathBuf> {
-    let base = std::env::var_os("XDG_CONFIG_HOME")
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))
-        .context("neither XDG_CONFIG_HOME nor HOME is set; give --out")?;
-    Ok(base.join("penscape/calibration.toml"))
-}
-
 fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
     let (width_mm, height_mm) = size::<f64>(&a.display_mm, "--display-mm")?;
     let (width_px, height_px) = size::<u32>(&a.display_px, "--display-px")?;
@@ -459,7 +451,7 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
     }
     let out = match a.out {
         Some(p) => p,
-        None => default_calibration_path()?,
+        None => pen_host::calibration::default_path().context("neither XDG_CONFIG_HOME nor HOME is set; give --out")?,
     };
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;

@@ -48,14 +48,6 @@ struct Cli {
     queue: usize,
 }
 
-fn default_calibration() -> Option<PathBuf> {
-    let base = std::env::var_os("XDG_CONFIG_HOME")
-        .map(PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| PathBuf::from(h).join(".config")))?;
-    let path = base.join("penscape/calibration.toml");
-    path.exists().then_some(path)
-}
-
 fn run(cli: Cli) -> Result<()> {
     let source = match (cli.serial, cli.sim) {
         (Some(path), _) => Source::Serial(path),
@@ -71,7 +63,10 @@ fn run(cli: Cli) -> Result<()> {
         }
         (None, None) => Source::Hid(cli.hid),
     };
-    let calibration = match cli.calibration.or_else(default_calibration) {
+    let calibration = match cli
+        .calibration
+        .or_else(|| pen_host::calibration::default_path().filter(|p| p.exists()))
+    {
         Some(path) => {
             let c = Calibration::load(&path)?;
             eprintln!("pend: calibration {} (RMS {:.2} mm)", path.display(), c.rms_mm());

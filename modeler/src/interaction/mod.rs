@@ -43,9 +43,7 @@ pub struct Settings {
     pub point_mm: f64,
     /// A stroke ending this close to its start is a closed curve.
     pub close_mm: f64,
-    /// Positions of a stroke nearer than this to the last recorded one are not recorded.
-    pub step_mm: f64,
-    /// The simplification tolerance of a drawn figure.
+    /// The simplification tolerance of a drawn figure: above the pen's noise while it moves.
     pub simplify_mm: f64,
     /// Sliding this far on the surface after a grab makes it a move.
     pub move_mm: f64,
@@ -73,8 +71,7 @@ impl Default for Settings {
             pick_mm: 6.0,
             point_mm: 3.0,
             close_mm: 10.0,
-            step_mm: 1.0,
-            simplify_mm: 1.0,
+            simplify_mm: 2.0,
             move_mm: 3.0,
             lift_mm: 3.0,
             slope_per_mm: 0.04,
@@ -487,18 +484,13 @@ impl Interaction {
 
     fn on_motion(&mut self, editor: &mut Editor) {
         let Some((g, p)) = self.ground() else { return };
-        let step = self.view.metres(self.settings.step_mm);
         let s = self.settings;
         match &mut self.state {
             State::Idle | State::Armed => {
                 self.hover = pick::pick(editor.document(), g, self.view.metres(s.pick_mm));
             }
             State::Drawing { positions, touching } => {
-                if *touching
-                    && positions
-                        .last()
-                        .is_none_or(|&l| (l[0] - g[0]).hypot(l[1] - g[1]) >= step)
-                {
+                if *touching {
                     positions.push(g);
                 }
             }

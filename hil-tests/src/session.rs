@@ -1,0 +1,113 @@
+//! The seed-like modeling session, as numbers: the figures (display mm), the pulls (pen height,
+//! mm) and the slope gestures (sideways pen travel, mm) that the `modeling-session` scenario's
+//! hand performs. The modeler's tests build the same document from these numbers directly and
+//! compare it with what the pen made through the whole chain.
+
+use glam::DVec2;
+
+use crate::script::{SW3, Script, Timeline};
+
+/// What to do with a figure once drawn.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pull {
+    /// Where the hand grabs it, display mm.
+    pub grab: DVec2,
+    /// The pen's height when it lets go, mm.
+    pub height_mm: f64,
+    /// Sideways travel with SW3 held while pulled, mm (negative: left, sharper); 0 for none.
+    pub slope_mm: f64,
+}
+
+/// A figure of the session.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Drawn {
+    /// A point at the position.
+    Point(DVec2),
+    /// A polyline through the positions.
+    Polyline(Vec<DVec2>),
+    /// A closed curve through the positions, back to the first.
+    Closed(Vec<DVec2>),
+}
+
+/// One step of the session.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Step {
+    /// The figure drawn; a closed curve outside every region becomes a generation region.
+    pub drawn: Drawn,
+    /// Its pull, if it is pulled.
+    pub pull: Option<Pull>,
+    /// SW3 clicks (undos) after the step.
+    pub undos: usize,
+}
+
+fn v(x: f64, y: f64) -> DVec2 {
+    DVec2::new(x, y)
+}
+
+/// The session, in order: a region; two peaks; a ridge; a plateau with a peak on it; and a hill
+/// drawn and pulled by mistake, then undone (pull and figure: two SW3 clicks).
+pub fn steps() -> Vec<Step> {
+    let pulled = |drawn, grab, height_mm, slope_mm| Step {
+        drawn,
+        pull: Some(Pull {
+            grab,
+            height_mm,
+            slope_mm,
+        }),
+        undos: 0,
+    };
+    let ridge = vec![v(250.0, 90.0), v(340.0, 130.0), v(430.0, 110.0)];
+    vec![
+        Step {
+            drawn: Drawn::Closed(vec![
+                v(60.0, 40.0),
+                v(540.0, 40.0),
+                v(560.0, 300.0),
+                v(300.0, 320.0),
+                v(50.0, 290.0),
+            ]),
+            pull: None,
+            undos: 0,
+        },
+        pulled(Drawn::Point(v(150.0, 200.0)), v(150.0, 200.0), 90.0, -40.0),
+        pulled(Drawn::Point(v(230.0, 260.0)), v(230.0, 260.0), 50.0, 0.0),
+        pulled(Drawn::Polyline(ridge.clone()), ridge[1], 60.0, 50.0),
+        pulled(
+            Drawn::Closed(vec![v(380.0, 190.0), v(480.0, 195.0), v(470.0, 270.0), v(390.0, 265.0)]),
+            v(430.0, 230.0),
+            40.0,
+            0.0,
+        ),
+        pulled(Drawn::Point(v(430.0, 230.0)), v(430.0, 230.0), 110.0, -25.0),
+        Step {
+            undos: 2,
+            ..pulled(Drawn::Point(v(500.0, 80.0)), v(500.0, 80.0), 70.0, 0.0)
+        },
+    ]
+}
+
+/// The hand's timeline for `steps`, from and back to `home`.
+pub fn timeline(steps: &[Step], home: glam::DVec3) -> Timeline {
+    let mut s = Script::new(home);
+    for step in steps {
+        match &step.drawn {
+            Drawn::Point(p) => s.draw_point(*p),
+            Drawn::Polyline(points) => s.draw_polyline(points),
+            Drawn::Closed(points) => s.draw_closed(points),
+        };
+        if let Some(pull) = step.pull {
+            s.grab(pull.grab).pull_to(pull.height_mm);
+            if pull.slope_mm != 0.0 {
+                s.slope(pull.slope_mm);
+            }
+            // The user looks at the result before letting go.
+            s.hold(0.3).let_go();
+        }
+        for _ in 0..step.undos {
+            // A click, then a pause so the next one is a click of its own.
+            s.click(SW3).hold(0.3);
+        }
+    }
+    s.move_to(home);
+    s.build()
+}

@@ -1,0 +1,264 @@
+//! Where the modeler's pen events come from, on a thread of their own.
+//!
+//! - [`PenSource::Demo`]: the built-in demo. The simulated pen (pen-sim: hand, acoustics, the
+//!   real firmware core) on a display that is not where the tracker thinks it is; the host's
+//!   calibration procedure touches nine targets and fits the display's pose; then the hand
+//!   performs the seed-like modeling session ([`pen_sim::session`]). Every report goes as bytes
+//!   through the host's decoding, the fitted calibration and the event detector — the chain a
+//!   real pen goes through.
+//! - [`PenSource::Daemon`]: events from `pend`'s socket.
+//! - [`PenSource::Device`]: a base station over USB HID or serial, with a calibration file.
+//!
+//! The thread sends [`Feed`] messages over a bounded channel: when the modeler is slower than
+//! the source (rendering frames of a demo that runs faster than real time), the source waits.
+//! It stops when the receiver is dropped.
+
+use std::path::PathBuf;
+use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
+use std::thread::JoinHandle;
+use std::time::Duration;
+
+use glam::{DQuat, DVec2, DVec3};
+use pen_host::calibrate::{Step, attach, collect_touches, prepare};
+use pen_host::calibration::{Calibration, DisplaySize, FitKind, fit};
+use pen_host::client::{Client, Line};
+use pen_host::device::Device;
+use pen_host::events::PenEvent;
+use pen_host::pipeline::Pipeline;
+use pen_host::source::Source;
+use pen_host::transport::sim::SimOptions;
+use pen_sim::Scenario;
+use pen_sim::acoustics::Acoustics;
+use pen_sim::rig::Rig;
+
+/// What the pen thread says.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Feed {
+    /// The display the events are calibrated to, `[width, height]` mm.
+    Display([f64; 2]),
+    /// Something to tell the user: attaching, calibrating.
+    Status(String),
+    /// A pen event in the display frame.
+    Event(PenEvent),
+    /// The source has ended normally (the demo's session is over, pend closed the socket).
+    End(String),
+    /// The source failed and cannot go on.
+    Failed(String),
+}
+
+/// A pen to model with.
+#[derive(Debug, Clone)]
+// One per session, never in a collection: a device source may carry a simulated scenario.
+#[allow(clippy::large_enum_variant)]
+pub enum PenSource {
+    /// The built-in demo through the whole chain.
+    Demo {
+        /// Device seconds per wall-clock second; 0 runs as fast as the modeler reads.
+        speed: f64,
+        /// The simulation's randomness.
+        seed: u64,
+    },
+    /// `pend`'s socket.
+    Daemon(PathBuf),
+    /// A device, and its calibration file (`None`: the default file if it exists).
+    Device {
+        /// HID, serial, or a named simulated scenario.
+        source: Source,
+        /// The calibration file.
+        calibration: Option<PathBuf>,
+    },
+}
+
+impl PenSource {
+    /// `sim` (the demo), `daemon`, `daemon:SOCKET`, `hid`, `hid:PATH`, `serial:PATH` or
+    /// `sim:SCENARIO` (a named pen-sim scenario with an identity calibration).
+    pub fn parse(s: &str, speed: f64) -> Result<PenSource, String> {
+        match s.split_once(':') {
+            None if s == "sim" => Ok(PenSource::Demo { speed, seed: 1 }),
+            None if s == "daemon" => Ok(PenSource::Daemon(pen_host::daemon::default_socket())),
+            Some(("daemon", path)) if !path.is_empty() => Ok(PenSource::Daemon(PathBuf::from(path))),
+            _ => {
+                let mut source: Source = s
+                    .parse()
+                    .map_err(|e: String| e.replace("hid, hid:PATH", "sim, daemon, daemon:SOCKET, hid, hid:PATH"))?;
+                if let Source::Sim(o) = &mut source {
+                    o.speed = speed;
+                }
+                Ok(PenSource::Device {
+                    source,
+                    calibration: None,
+                })
+            }
+        }
+    }
+}
+
+/// The demo's display pose in the tracker frame: turned 1.2° about a tilted axis and shifted by
+/// a centimetre, as a display set up by hand would be.
+fn demo_rig() -> Rig {
+    let axis = DVec3::new(0.2, -0.3, 1.0).normalize();
+    Rig::reference().with_display_pose(
+        DQuat::from_axis_angle(axis, 1.2f64.to_radians()),
+        DVec3::new(9.0, -6.0, 2.5),
+    )
+}
+
+/// The demo: nine calibration touches, then the modeling session; and the calibration targets.
+pub fn demo_scenario() -> (Scenario, Vec<DVec2>) {
+    let rig = demo_rig();
+    let targets = DisplaySize::REFERENCE.targets(9);
+    let calibration = pen_sim::scenarios::calibration(&targets, rig.clone());
+    let session = pen_sim::session::timeline(&pen_sim::session::steps(), pen_sim::scenarios::home());
+    let timeline = calibration.timeline.then(&session);
+    (Scenario::new("demo", rig, Acoustics::clean(), timeline), targets)
+}
+
+/// Starts the pen thread; `capacity` bounds the messages waiting to be read.
+pub fn spawn(source: PenSource, capacity: usize) -> (Receiver<Feed>, JoinHandle<()>) {
+    let (tx, rx) = sync_channel(capacity);
+    let handle = std::thread::Builder::new()
+        .name("pen".into())
+        .spawn(move || {
+            let result = match source {
+                PenSource::Demo { speed, seed } => run_demo(&tx, speed, seed),
+                PenSource::Daemon(path) => run_daemon(&tx, &path),
+                PenSource::Device { source, calibration } => run_device(&tx, source, calibration),
+            };
+            // A closed channel means the modeler is gone: nothing to tell.
+            if let Err(Stop::Failed(why)) = result {
+                let _ = tx.send(Feed::Failed(why));
+            }
+        })
+        .map_err(|e| e.to_string());
+    match handle {
+        Ok(h) => (rx, h),
+        Err(why) => {
+            // No thread: the receiver reports the failure at once.
+            let (tx, rx) = sync_channel(1);
+            let _ = tx.send(Feed::Failed(format!("cannot start the pen thread: {why}")));
+            (rx, std::thread::spawn(|| {}))
+        }
+    }
+}
+
+enum Stop {
+    /// The receiver is gone.
+    Closed,
+    /// The source failed.
+    Failed(String),
+}
+
+fn send(tx: &SyncSender<Feed>, feed: Feed) -> Result<(), Stop> {
+    tx.send(feed).map_err(|_| Stop::Closed)
+}
+
+fn run_demo(tx: &SyncSender<Feed>, speed: f64, seed: u64) -> Result<(), Stop> {
+    let (scenario, targets) = demo_scenario();
+    let end_us = (scenario.timeline.duration_s() * 1e6) as u64;
+    let mut device = Device::new(Source::Sim(SimOptions {
+        scenario,
+        seed,
+        speed,
+        plug: Default::default(),
+    }));
+    attach(&mut device, Duration::from_secs(5)).map_err(failed("the simulated pen"))?;
+    prepare(&mut device).map_err(failed("calibration"))?;
+    send(tx, Feed::Status("calibrating: the pen touches 9 targets".into()))?;
+    let mut closed = false;
+    let touched = collect_touches(&mut device, &targets, Duration::from_secs(60), |step| {
+        if let Step::Taken { fixes, .. } = step {
+            closed |= tx
+                .send(Feed::Status(format!("calibrating: target taken ({fixes} fixes)")))
+                .is_err();
+        }
+    })
+    .map_err(failed("calibration"))?;
+    if closed {
+        return Err(Stop::Closed);
+    }
+    let calibration = fit(&targets, &touched, FitKind::Similarity, DisplaySize::REFERENCE)
+        .map_err(|e| Stop::Failed(format!("calibration: {e}")))?;
+    send(tx, Feed::Display(display_mm(&calibration)))?;
+    send(
+        tx,
+        Feed::Status(format!(
+            "calibrated over 9 targets: RMS {:.2} mm, worst {:.2} mm",
+            calibration.rms_mm(),
+            calibration.max_mm()
+        )),
+    )?;
+    let mut pipeline = Pipeline::with_device(device, calibration);
+    let mut events = Vec::new();
+    loop {
+        let sample = pipeline.poll(Duration::from_millis(100), &mut events);
+        for e in events.drain(..) {
+            send(tx, Feed::Event(e))?;
+        }
+        if sample.is_some_and(|s| s.device_us >= end_us) {
+            let lost = pipeline.lost();
+            return send(tx, Feed::End(format!("the demo session is over ({lost} reports lost)")));
+        }
+    }
+}
+
+fn failed(what: &'static str) -> impl Fn(pen_host::calibrate::CalibrateError) -> Stop {
+    move |e| Stop::Failed(format!("{what}: {e}"))
+}
+
+fn display_mm(c: &Calibration) -> [f64; 2] {
+    [c.display.width_mm, c.display.height_mm]
+}
+
+fn run_daemon(tx: &SyncSender<Feed>, path: &std::path::Path) -> Result<(), Stop> {
+    let mut client = Client::connect(path)
+        .map_err(|e| Stop::Failed(format!("cannot connect to pend at {}: {e}", path.display())))?;
+    send(tx, Feed::Status(format!("connected to pend at {}", path.display())))?;
+    let mut bad = 0u64;
+    loop {
+        match client.next_line() {
+            None => return send(tx, Feed::End("pend closed the connection".into())),
+            Some(Ok(Line::Hello { device })) => {
+                let what = device.unwrap_or_else(|| "no pen attached yet".into());
+                send(tx, Feed::Status(format!("pend: {what}")))?;
+            }
+            Some(Ok(Line::Event(e))) => send(tx, Feed::Event(e))?,
+            Some(Err(pen_host::client::ClientError::Io(e))) => {
+                return Err(Stop::Failed(format!("pend socket: {e}")));
+            }
+            Some(Err(e)) => {
+                // A line that is not an event is dropped, counted and told.
+                bad += 1;
+                send(
+                    tx,
+                    Feed::Status(format!("dropped {bad} bad lines from pend; last: {e}")),
+                )?;
+            }
+        }
+    }
+}
+
+fn run_device(tx: &SyncSender<Feed>, source: Source, calibration: Option<PathBuf>) -> Result<(), Stop> {
+    let path = calibration.or_else(|| pen_host::calibration::default_path().filter(|p| p.exists()));
+    let calibration = match &path {
+        Some(p) => Calibration::load(p).map_err(|e| Stop::Failed(e.to_string()))?,
+        None => {
+            send(
+                tx,
+                Feed::Status(
+                    "no calibration: tracker coordinates are used as display coordinates (penctl calibrate)".into(),
+                ),
+            )?;
+            Calibration::identity(DisplaySize::REFERENCE)
+        }
+    };
+    send(tx, Feed::Display(display_mm(&calibration)))?;
+    send(tx, Feed::Status(format!("pen: {source}")))?;
+    let mut pipeline = Pipeline::new(source, calibration);
+    let mut events = Vec::new();
+    loop {
+        pipeline.poll(Duration::from_millis(100), &mut events);
+        for e in events.drain(..) {
+            send(tx, Feed::Event(e))?;
+        }
+    }
+}

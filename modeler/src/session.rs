@@ -1,0 +1,113 @@
+//! A modeling session: a document being edited by the pen, fed from a [`feed`](crate::feed).
+
+use pen_host::events::PenEvent;
+
+use crate::document::{Document, Grid};
+use crate::editor::Editor;
+use crate::feed::Feed;
+use crate::interaction::{Interaction, Settings, View};
+
+/// A new session's document: a 6 × 3.4 km map of 12.5 m cells (480 × 272), which the reference
+/// display (600 × 340 mm) shows at 1:10 000 — a millimetre on the display is 10 m, a cell 1.25 mm.
+pub fn blank_document() -> Document {
+    Document::new(Grid {
+        cols: 480,
+        rows: 272,
+        cell_size: 12.5,
+    })
+}
+
+/// How the feed stands.
+#[derive(Debug, Clone, PartialEq)]
+pub enum State {
+    /// Events are coming.
+    Running,
+    /// The source ended normally, saying this.
+    Ended(String),
+    /// The source failed, saying why.
+    Failed(String),
+}
+
+/// The editor, the pen interaction, and what the feed last said.
+pub struct Session {
+    /// The document and its terrain.
+    pub editor: Editor,
+    /// The pen's state machine and the view.
+    pub interaction: Interaction,
+    status: String,
+    state: State,
+    events: u64,
+    last_event_us: Option<u64>,
+}
+
+impl Session {
+    /// A session on `editor`, shown on a display of `display_mm` fitted to the document's grid.
+    pub fn new(editor: Editor, display_mm: [f64; 2], settings: Settings) -> Session {
+        let view = View::fit(display_mm, &editor.document().grid);
+        Session {
+            editor,
+            interaction: Interaction::new(view, settings),
+            status: String::new(),
+            state: State::Running,
+            events: 0,
+            last_event_us: None,
+        }
+    }
+
+    /// Takes one message from the feed; returns what the interaction said about it.
+    pub fn feed(&mut self, feed: Feed) -> Vec<String> {
+        match feed {
+            Feed::Display(mm) => {
+                if mm != self.interaction.view().display_mm {
+                    let settings = *self.interaction.settings();
+                    let view = View::fit(mm, &self.editor.document().grid);
+                    self.interaction = Interaction::new(view, settings);
+                }
+                Vec::new()
+            }
+            Feed::Status(s) => {
+                self.status = s.clone();
+                vec![s]
+            }
+            Feed::Event(e) => {
+                self.event(&e);
+                self.interaction.take_messages()
+            }
+            Feed::End(s) => {
+                self.state = State::Ended(s.clone());
+                vec![s]
+            }
+            Feed::Failed(s) => {
+                self.state = State::Failed(s.clone());
+                vec![s]
+            }
+        }
+    }
+
+    /// Handles one pen event.
+    pub fn event(&mut self, e: &PenEvent) {
+        self.events += 1;
+        self.last_event_us = Some(e.seq.map_or(e.t_us, |(_, d)| d));
+        self.interaction.handle(&mut self.editor, e);
+    }
+
+    /// Whether the feed is still running.
+    pub fn state(&self) -> &State {
+        &self.state
+    }
+
+    /// The feed's last status line (calibrating, connected).
+    pub fn status(&self) -> &str {
+        &self.status
+    }
+
+    /// Pen events handled.
+    pub fn events(&self) -> u64 {
+        self.events
+    }
+
+    /// The time of the last event, µs (device clock when known).
+    pub fn last_event_us(&self) -> Option<u64> {
+        self.last_event_us
+    }
+}
