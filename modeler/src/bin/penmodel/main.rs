@@ -4,6 +4,7 @@
 //! (the reason on stderr), 2 on a usage error.
 
 mod generate;
+mod render;
 
 use std::process::ExitCode;
 
@@ -25,12 +26,15 @@ struct Cli {
 enum Command {
     /// Generate a document's terrain and export it.
     Generate(generate::Args),
+    /// Render a document's terrain into a PNG.
+    Render(render::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Generate(args) => generate::run(&args),
+        Command::Render(args) => render::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

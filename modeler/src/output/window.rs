@@ -1,0 +1,1 @@
+//! The viewer window: placeholder until the window lands.
