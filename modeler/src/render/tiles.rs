@@ -62,7 +62,10 @@ impl EyePass<'_> {
                 continue;
             }
             if ch.state == ChunkState::Direct {
-                for r in ch.r0..ch.r1 {
+                for (r, span) in (ch.r0..ch.r1).zip(&ch.spans) {
+                    if span.1 <= bounds.y0 || span.0 >= bounds.y1 {
+                        continue;
+                    }
                     for a in r * cols + ch.c0..r * cols + ch.c1 {
                         // Two triangles per quad, split along b–d, clockwise on screen seen from
                         // above: (a, b, d) and (b, e, d) with b = a + 1, d = a + cols, e = d + 1.

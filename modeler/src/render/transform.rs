@@ -108,6 +108,9 @@ pub struct Chunk {
     pub state: ChunkState,
     /// Nearest depth of its vertices, for the near-to-far order.
     pub near: f32,
+    /// Per row of quads, the pixel rows its triangles may cover (first, past last), so that a
+    /// tile skips the rows of a chunk that cannot reach it.
+    pub spans: [(i32, i32); CHUNK],
 }
 
 /// The projected grid of one eye.
@@ -169,7 +172,9 @@ pub fn project_grid(map: &Heightmap, light: &[f32], affine: &Affine, near: f32, 
             let (mut x0, mut y0, mut x1, mut y1) = (i32::MAX, i32::MAX, i32::MIN, i32::MIN);
             let mut nearest = f32::INFINITY;
             let mut any_drawable = false;
-            for r in r0..=r1 {
+            // Pixel rows of each vertex row, then of each quad row (two vertex rows).
+            let mut vrows = [(i32::MAX, i32::MIN); CHUNK + 1];
+            for (r, vrow) in (r0..=r1).zip(&mut vrows) {
                 for c in c0..=c1 {
                     let k = r * cols + c;
                     match flags[k] {
@@ -177,8 +182,8 @@ pub fn project_grid(map: &Heightmap, light: &[f32], affine: &Affine, near: f32, 
                             let v = &vertices[k];
                             x0 = x0.min(v.x);
                             x1 = x1.max(v.x);
-                            y0 = y0.min(v.y);
-                            y1 = y1.max(v.y);
+                            vrow.0 = vrow.0.min(v.y);
+                            vrow.1 = vrow.1.max(v.y);
                             nearest = nearest.min(1.0 / v.invw);
                             any_drawable = true;
                         }
@@ -193,6 +198,15 @@ pub fn project_grid(map: &Heightmap, light: &[f32], affine: &Affine, near: f32, 
                             }
                         }
                     }
+                }
+                y0 = y0.min(vrow.0);
+                y1 = y1.max(vrow.1);
+            }
+            let mut spans = [(viewport.y0, viewport.y1); CHUNK];
+            if nearest > 0.0 {
+                for (span, pair) in spans.iter_mut().zip(vrows.windows(2)) {
+                    let (lo, hi) = (pair[0].0.min(pair[1].0), pair[0].1.max(pair[1].1));
+                    *span = if lo <= hi { (lo >> 8, (hi >> 8) + 1) } else { (0, 0) };
                 }
             }
             let bounds = if state == ChunkState::Mixed && nearest == 0.0 {
@@ -217,6 +231,7 @@ pub fn project_grid(map: &Heightmap, light: &[f32], affine: &Affine, near: f32, 
                 bounds,
                 state,
                 near: nearest,
+                spans,
             }
         })
         .collect();
