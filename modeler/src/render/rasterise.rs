@@ -141,6 +141,25 @@ impl Edge {
     }
 }
 
+/// Whether the bounding box of `vs` holds no pixel centre of `bounds`: then nothing made of these
+/// vertices can cover a pixel. A 512² grid's quad is under a pixel across at 1280 × 720, so one
+/// test per quad rejects most of them before either triangle is looked at.
+#[inline]
+pub fn holds_no_pixel(vs: [&Vtx; 4], bounds: &Bounds) -> bool {
+    let (mut x0, mut x1, mut y0, mut y1) = (vs[0].x, vs[0].x, vs[0].y, vs[0].y);
+    for v in &vs[1..] {
+        x0 = x0.min(v.x);
+        x1 = x1.max(v.x);
+        y0 = y0.min(v.y);
+        y1 = y1.max(v.y);
+    }
+    let px0 = ((x0 - HALF + ONE - 1) >> SUBPIXEL).max(bounds.x0);
+    let px1 = ((x1 - HALF) >> SUBPIXEL).min(bounds.x1 - 1);
+    let py0 = ((y0 - HALF + ONE - 1) >> SUBPIXEL).max(bounds.y0);
+    let py1 = ((y1 - HALF) >> SUBPIXEL).min(bounds.y1 - 1);
+    px0 > px1 || py0 > py1
+}
+
 /// Draws triangle `(a, b, c)` over the pixels of `bounds` into `sink`. Front faces are those
 /// whose vertices run clockwise on screen (the grid's triangles seen from above); others are
 /// culled, as are triangles of zero area.

@@ -69,8 +69,12 @@ impl EyePass<'_> {
                     for a in r * cols + ch.c0..r * cols + ch.c1 {
                         // Two triangles per quad, split along b–d, clockwise on screen seen from
                         // above: (a, b, d) and (b, e, d) with b = a + 1, d = a + cols, e = d + 1.
-                        rasterise::triangle(&v[a], &v[a + 1], &v[a + cols], bounds, sink);
-                        rasterise::triangle(&v[a + 1], &v[a + cols + 1], &v[a + cols], bounds, sink);
+                        let (va, vb, vd, ve) = (&v[a], &v[a + 1], &v[a + cols], &v[a + cols + 1]);
+                        if rasterise::holds_no_pixel([va, vb, vd, ve], bounds) {
+                            continue;
+                        }
+                        rasterise::triangle(va, vb, vd, bounds, sink);
+                        rasterise::triangle(vb, ve, vd, bounds, sink);
                     }
                 }
                 continue;
