@@ -26,10 +26,13 @@
 //!   physical size known. The head is tracked in the display's frame; the eyes are ± half the eye
 //!   separation along the display's x axis (the head is assumed level with the display's rows).
 //!
-//! Both honour [`Camera::tilt`]: the seed's proposal for judging heights while pulling, the ground
-//! plane rotated about a horizontal axis (the camera's right vector through the pivot) so that
-//! its far side rises towards the viewer. The light stays fixed to the terrain, so tilting changes
-//! the view, not the shading.
+//! Both honour [`Camera::tilt`]: the seed's proposal for judging heights while pulling. The ground
+//! plane turns about a horizontal axis (the camera's right vector through the pivot) so that its
+//! near edge comes towards the viewer and its far edge sinks away: heights, which point almost
+//! along the line of sight when one looks down on the display, turn towards the screen's up
+//! direction and are seen in profile (a vertical pole at the pivot, seen from elevation `e`,
+//! spans `cos(e − tilt)` of its length on screen instead of `cos e`). The light stays fixed to the
+//! terrain, so tilting changes the view, not the shading.
 //!
 //! World coordinates are those of the mesh exports: `X = x` (along columns), `Y = height`,
 //! `Z = y` (along rows), metres.
@@ -196,7 +199,8 @@ pub enum View {
 pub struct Camera {
     /// Where the eyes and the screen are.
     pub view: View,
-    /// The ground plane's rotation towards the viewer, radians (0 = none): its far side rises.
+    /// The ground plane's rotation towards the viewer, radians (0 = none): its near edge comes
+    /// towards the viewer, its far edge sinks, heights turn into profile.
     pub tilt: f64,
 }
 
@@ -354,7 +358,8 @@ impl Projection {
         let y_row = -vu * ay - vn * by;
         let w_row = -vn;
         // Model: p' = pivot + R(p − pivot); rows act on p' − E = R p + (pivot − R pivot − E).
-        let rot = DMat3::from_axis_angle(vp.axis, tilt);
+        // Negative about the right axis: the near edge (towards the eye) rises.
+        let rot = DMat3::from_axis_angle(vp.axis, -tilt);
         let offset = vp.pivot - rot * vp.pivot - e;
         let row = |v: DVec3| {
             let m = rot.transpose() * v;
