@@ -15,6 +15,7 @@ use thiserror::Error;
 
 pub use png::{encode_png, write_png};
 pub use sequence::Sequence;
+pub use window::{Viewer, ViewerEvent, WindowError};
 
 /// Why a frame could not be written.
 #[derive(Debug, Error)]

@@ -38,6 +38,9 @@ pub struct Args {
     /// Print `{"render": [...], "pull_update": [...]}` on stdout instead of a table.
     #[arg(long)]
     json: bool,
+    /// Grid sizes to measure (repeatable; default 256, 512 and 1024).
+    #[arg(long = "grid", value_name = "N", value_parser = clap::value_parser!(u32).range(2..=4096))]
+    grids: Vec<u32>,
 }
 
 fn document(n: u32) -> Result<Document> {
@@ -84,7 +87,7 @@ fn measure(n: u32, bar: &ProgressBar) -> Result<Figures> {
     let mut step = 0usize;
     let mut pull = |editor: &mut Editor| -> Result<f64> {
         step += 1;
-        let height = base + if step % 2 == 0 { 1.0 } else { 2.0 };
+        let height = base + if step.is_multiple_of(2) { 1.0 } else { 2.0 };
         let t = Instant::now();
         editor.preview(&Edit::SetHeight {
             at: peak.clone(),
@@ -139,7 +142,12 @@ fn measure(n: u32, bar: &ProgressBar) -> Result<Figures> {
 
 /// Runs the command.
 pub fn run(args: &Args) -> Result<()> {
-    let total = GRIDS.len() * (WARM_UP + FRAMES + PULLS);
+    let grids = if args.grids.is_empty() {
+        GRIDS.to_vec()
+    } else {
+        args.grids.clone()
+    };
+    let total = grids.len() * (WARM_UP + FRAMES + PULLS);
     let bar = if std::io::stderr().is_terminal() {
         let bar = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
         if let Ok(style) = ProgressStyle::with_template("{msg:>12} [{bar:30}] {pos}/{len}") {
@@ -150,7 +158,7 @@ pub fn run(args: &Args) -> Result<()> {
         ProgressBar::hidden()
     };
     let mut results = Vec::new();
-    for n in GRIDS {
+    for &n in &grids {
         bar.set_message(format!("{n}×{n}"));
         results.push(measure(n, &bar)?);
     }

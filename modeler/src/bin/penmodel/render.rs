@@ -108,6 +108,17 @@ pub struct Args {
     /// One line of text at the top left.
     #[arg(long, default_value = "")]
     mode: String,
+    /// Also show the frame in a window until it is closed (or Escape is pressed); without a
+    /// display this says so and carries on.
+    #[arg(long)]
+    window: bool,
+    /// Also write a turntable of N frames (one turn around the terrain) to the folder given by
+    /// --frames: frame_NNNNN.png and animation.png (APNG).
+    #[arg(long, value_name = "N", requires = "frames", value_parser = clap::value_parser!(u32).range(1..=3600))]
+    turntable: Option<u32>,
+    /// The folder for --turntable.
+    #[arg(long, value_name = "DIR", requires = "turntable")]
+    frames: Option<PathBuf>,
 }
 
 /// Runs the command.
@@ -168,7 +179,47 @@ pub fn run(args: &Args) -> Result<()> {
         map.rows(),
         args.png.display()
     );
+    if let (Some(n), Some(dir)) = (args.turntable, &args.frames) {
+        let mut seq = output::Sequence::create(dir, 25)?;
+        let mut renderer = Renderer::new();
+        let mut turn = frame.clone();
+        for i in 0..n {
+            let mut s = scene.clone();
+            if let View::Orbit(o) = &mut s.camera.view {
+                o.azimuth += std::f64::consts::TAU * f64::from(i) / f64::from(n);
+            }
+            renderer.render(&s, &mut turn)?;
+            seq.push(&turn)?;
+        }
+        if let Some(anim) = seq.finish()? {
+            println!("{n} frames and {} written", anim.display());
+        }
+    }
+    if args.window {
+        show(frame);
+    }
     Ok(())
+}
+
+/// Shows `frame` until the window is closed or Escape is pressed.
+fn show(frame: Frame) {
+    let mut viewer = match output::Viewer::open("penmodel render", frame.width(), frame.height()) {
+        Ok(v) => v,
+        Err(e) => {
+            eprintln!("penmodel: no window: {e}");
+            return;
+        }
+    };
+    if viewer.show(frame).is_err() {
+        return;
+    }
+    while viewer.is_open() {
+        match viewer.poll() {
+            Some(output::ViewerEvent::Key(k)) if k == "Escape" || k == "q" => break,
+            Some(_) => {}
+            None => std::thread::sleep(std::time::Duration::from_millis(20)),
+        }
+    }
 }
 
 /// The ramp's top for a terrain whose highest point is `hi` metres: snow on the highest tenth.
