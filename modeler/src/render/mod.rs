@@ -68,8 +68,10 @@ pub struct RenderStats {
     pub skipped_vertices: usize,
 }
 
-/// Rows per tile unless set otherwise ([`Renderer::with_tile_rows`]).
-pub const TILE_ROWS: usize = 16;
+/// Rows per tile unless set otherwise ([`Renderer::with_tile_rows`]). Taller tiles set up fewer
+/// triangles twice (a 512² frame: 8 rows 343M instructions, 16 rows 303M, 32 rows 294M, 48 rows
+/// 291M); 32 still gives 23 tiles to balance over two cores.
+pub const TILE_ROWS: usize = 32;
 
 #[derive(Default)]
 struct EyeBuffers {

@@ -14,9 +14,13 @@
 //!   equation, larger is nearer, and `0` marks an empty sample. Height and light are interpolated
 //!   as `h/w` and `l/w` (perspective-correct); the shade stage divides once per pixel, so hidden
 //!   samples never pay for it.
-//! - Each pixel considers the pixel centres inside the triangle's bounding box clipped to the
-//!   tile; most of the grid's triangles are a pixel or two across, so the box test rejects the
-//!   many that hold no pixel centre before any attribute is set up.
+//! - A triangle visits the pixel centres inside its bounding box clipped to the tile. Most of a
+//!   large grid's triangles are smaller than a pixel (a 512² grid at 1280 × 720 has about 0.65
+//!   covered pixels per triangle), so the box test rejects the many that hold no pixel centre
+//!   before any attribute is set up, and [`holds_no_pixel`] does it once for both triangles of
+//!   a quad (311M → 303M instructions per 512² frame; see `docs/renderer.md`). A special path that
+//!   interpolated tiny triangles from their edge functions instead of attribute planes was
+//!   measured and dropped: 344.6M → 344.3M instructions per frame, no gain.
 
 use super::frame::Rgba;
 
@@ -184,10 +188,6 @@ pub fn triangle<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut 
     }
     let sx = px0 * ONE + HALF;
     let sy = py0 * ONE + HALF;
-    if (px1 - px0 + 1) * (py1 - py0 + 1) <= SMALL {
-        small(a, b, c, area, (px0, px1, py0, py1), sink);
-        return;
-    }
     let e0 = Edge::new(b, c, sx, sy);
     let e1 = Edge::new(c, a, sx, sy);
     let e2 = Edge::new(a, b, sx, sy);
@@ -230,41 +230,6 @@ pub fn triangle<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut 
         riw += iwy;
         rh += hy;
         rl += ly;
-    }
-}
-
-/// Candidate pixels up to which a triangle takes [`small`]'s path.
-const SMALL: i32 = 4;
-
-/// A triangle with at most [`SMALL`] candidate pixels: each candidate's edge functions are
-/// evaluated directly and double as barycentric weights, so no attribute planes are set up.
-/// Most of a large grid's triangles are this small on screen (a 512² grid at 1280 × 720 has
-/// 0.65 pixels per triangle); the path took the frame's instruction count down by a third.
-#[inline]
-fn small<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, area: i64, (px0, px1, py0, py1): (i32, i32, i32, i32), sink: &mut S) {
-    let e0 = Edge::new(b, c, px0 * ONE + HALF, py0 * ONE + HALF);
-    let e1 = Edge::new(c, a, px0 * ONE + HALF, py0 * ONE + HALF);
-    let e2 = Edge::new(a, b, px0 * ONE + HALF, py0 * ONE + HALF);
-    let inv = 1.0 / area as f32;
-    for y in py0..=py1 {
-        let dy = i64::from(y - py0);
-        for x in px0..=px1 {
-            let dx = i64::from(x - px0);
-            let w0 = e0.start + dx * e0.step_x + dy * e0.step_y;
-            let w1 = e1.start + dx * e1.step_x + dy * e1.step_y;
-            let w2 = e2.start + dx * e2.step_x + dy * e2.step_y;
-            if (w0 | w1 | w2) >= 0 {
-                // The fill-rule bias (at most 1 in 2⁴⁰ of the area) is negligible as a weight.
-                let (l0, l1, l2) = (w0 as f32 * inv, w1 as f32 * inv, w2 as f32 * inv);
-                sink.pixel(
-                    x,
-                    y,
-                    l0 * a.invw + l1 * b.invw + l2 * c.invw,
-                    l0 * a.hw + l1 * b.hw + l2 * c.hw,
-                    l0 * a.lw + l1 * b.lw + l2 * c.lw,
-                );
-            }
-        }
     }
 }
 

