@@ -542,6 +542,11 @@ fn degenerate_input() {
     };
     assert!(Renderer::new().render(&Scene::new(&map, cam), &mut f).is_err());
     // Overlays without points or with non-finite points draw nothing and do not panic.
+    // A line reaching far off the grid is drawn where it crosses it, in bounded time.
+    let far = [overlay(vec![[-1e12, 4.0], [1e12, 4.5]], None)];
+    let mut s3 = Scene::new(&map, orbit([4.0, 4.0], 0.0, 60.0, 20.0));
+    s3.overlays = &far;
+    assert!(!magenta(&render(&s3, 32, 32)).is_empty());
     let odd = [
         overlay(vec![], None),
         overlay(vec![[f64::NAN, 1.0], [2.0, 2.0]], None),

@@ -46,27 +46,29 @@ pub fn surface_height(map: &Heightmap, x: f64, y: f64) -> Option<f64> {
 }
 
 /// Parameters in `(0, 1)` where segment `p → q` crosses the grid lines through cell centres and
-/// the quads' diagonals, sorted, with 0 and 1 at the ends.
+/// the quads' diagonals, sorted, with 0 and 1 at the ends. Only lines within the grid count
+/// (beyond it the surface is flat, clamped): a segment reaching far off the grid costs no more
+/// than one across it.
 fn crossings(map: &Heightmap, p: [f64; 2], q: [f64; 2]) -> Vec<f64> {
     let s = map.cell_size();
     let (u0, v0) = (p[0] / s - 0.5, p[1] / s - 0.5);
     let (u1, v1) = (q[0] / s - 0.5, q[1] / s - 0.5);
+    let (cols, rows) = (f64::from(map.cols()), f64::from(map.rows()));
     let mut ts = vec![0.0, 1.0];
-    let mut family = |a: f64, b: f64| {
-        if (b - a).abs() < 1e-12 {
+    let mut family = |a: f64, b: f64, limit: f64| {
+        if (b - a).abs() < 1e-12 || !(a.is_finite() && b.is_finite()) {
             return;
         }
-        let (lo, hi) = (a.min(b), a.max(b));
+        let (lo, hi) = (a.min(b).max(-1.0), a.max(b).min(limit + 1.0));
         let mut k = lo.floor() + 1.0;
-        // Bounded by the grid: a segment crosses at most ~2(cols + rows) lines of a family.
         while k < hi {
             ts.push((k - a) / (b - a));
             k += 1.0;
         }
     };
-    family(u0, u1);
-    family(v0, v1);
-    family(u0 + v0, u1 + v1);
+    family(u0, u1, cols);
+    family(v0, v1, rows);
+    family(u0 + v0, u1 + v1, cols + rows);
     ts.sort_by(f64::total_cmp);
     ts.dedup();
     ts
