@@ -9,6 +9,8 @@
 //! - [`Editor`]: edits ([`Edit`]) with undo and redo, and a journal that survives a crash
 //!   ([`journal`]).
 //! - [`export`]: 16-bit PNG heightmaps, raw float32, OBJ and binary glTF meshes.
+//! - [`render`]: the CPU rasteriser — camera, clipping, depth-buffered triangles, elevation
+//!   ramp with lighting, overlays, slope bar and mode text, stereo.
 //! - [`baseline`]: the seed's own repeat-until-stable distance maps, the reference for tests and
 //!   benchmarks.
 #![cfg_attr(not(test), warn(clippy::unwrap_used))]
@@ -27,9 +29,11 @@ mod heightmap;
 pub mod interaction;
 pub mod journal;
 mod json;
+pub mod output;
 pub mod path;
 pub mod profile;
 pub mod raster;
+pub mod render;
 pub mod session;
 pub mod terrain;
 pub mod validate;

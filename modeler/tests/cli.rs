@@ -90,3 +90,136 @@ fn usage_errors_exit_2() {
     assert!(help.status.success());
     assert!(String::from_utf8_lossy(&help.stdout).contains("--raw <OUT.f32>"));
 }
+
+fn png_size(path: &Path) -> (u32, u32) {
+    let reader = png::Decoder::new(std::io::BufReader::new(std::fs::File::open(path).unwrap()))
+        .read_info()
+        .unwrap();
+    (reader.info().width, reader.info().height)
+}
+
+#[test]
+fn render_writes_a_png_of_the_requested_size() {
+    let dir = tempfile::tempdir().unwrap();
+    for (stereo, size, expected) in [
+        ("none", "320x200", (320, 200)),
+        ("anaglyph", "161x97", (161, 97)),
+        ("side-by-side", "400X150", (400, 150)),
+    ] {
+        let png = dir.path().join(format!("{stereo}.png"));
+        let out = penmodel(&[
+            "render",
+            &example("02-twin-hills.json"),
+            "--png",
+            s(&png),
+            "--size",
+            size,
+            "--stereo",
+            stereo,
+            "--tilt",
+            "10",
+            "--azimuth",
+            "-40",
+        ]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        assert_eq!(png_size(&png), expected);
+    }
+    // The tracked view and a turntable.
+    let png = dir.path().join("tracked.png");
+    let frames = dir.path().join("turn");
+    let out = penmodel(&[
+        "render",
+        &example("04-volcano.json"),
+        "--png",
+        s(&png),
+        "--size",
+        "160x90",
+        "--display",
+        "1.6x0.9",
+        "--head",
+        "0.1,-0.3,0.7",
+        "--turntable",
+        "3",
+        "--frames",
+        s(&frames),
+    ]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(png_size(&png), (160, 90));
+    for name in ["frame_00000.png", "frame_00002.png", "animation.png"] {
+        assert_eq!(png_size(&frames.join(name)), (160, 90), "{name}");
+    }
+}
+
+#[test]
+fn render_usage_errors_exit_2() {
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("o.png");
+    let doc = example("02-twin-hills.json");
+    for args in [
+        vec!["render", &doc, "--png", s(&png), "--size", "0x10"],
+        vec!["render", &doc, "--png", s(&png), "--size", "10"],
+        vec!["render", &doc, "--png", s(&png), "--stereo", "3d"],
+        vec!["render", &doc],
+        vec!["render", &doc, "--png", s(&png), "--head", "0,0,1"],
+        vec!["render", &doc, "--png", s(&png), "--turntable", "3"],
+    ] {
+        let out = penmodel(&args);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(!png.exists());
+    }
+}
+
+#[test]
+fn render_of_a_bad_document_exits_1_with_the_reason() {
+    let dir = tempfile::tempdir().unwrap();
+    let doc = dir.path().join("bad.json");
+    std::fs::write(
+        &doc,
+        r#"{"version": 1, "grid": {"cols": 8, "rows": 8, "cell_size": -1.0}, "regions": []}"#,
+    )
+    .unwrap();
+    let png = dir.path().join("o.png");
+    let out = penmodel(&["render", s(&doc), "--png", s(&png)]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("grid.cell_size"), "{err}");
+    assert!(!png.exists());
+    // A camera that cannot work is a bad input too.
+    let out = penmodel(&[
+        "render",
+        &example("02-twin-hills.json"),
+        "--png",
+        s(&png),
+        "--distance",
+        "0",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("distance"));
+}
+
+#[test]
+fn bench_json_has_the_documented_shape() {
+    let out = penmodel(&["bench", "--json", "--grid", "16", "--grid", "24"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let obj = v.as_object().unwrap();
+    assert_eq!(obj.keys().collect::<Vec<_>>(), ["render", "pull_update"]);
+    let render = v["render"].as_array().unwrap();
+    let pull = v["pull_update"].as_array().unwrap();
+    for (i, n) in [16, 24].into_iter().enumerate() {
+        let r = render[i].as_object().unwrap();
+        assert_eq!(r.keys().collect::<Vec<_>>(), ["grid", "width", "height", "frame_ms"]);
+        assert_eq!(
+            (r["grid"].as_u64(), r["width"].as_u64(), r["height"].as_u64()),
+            (Some(n), Some(1280), Some(720))
+        );
+        assert!(r["frame_ms"].as_f64().unwrap() > 0.0);
+        assert_eq!(pull[i]["grid"].as_u64(), Some(n));
+        assert!(pull[i]["ms"].as_f64().unwrap() >= 0.0);
+    }
+}

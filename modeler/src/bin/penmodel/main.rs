@@ -3,7 +3,9 @@
 //! Exit status: 0 on success, 1 when the input is not valid or a file cannot be read or written
 //! (the reason on stderr), 2 on a usage error.
 
+mod bench;
 mod generate;
+mod render;
 
 use std::process::ExitCode;
 
@@ -25,12 +27,18 @@ struct Cli {
 enum Command {
     /// Generate a document's terrain and export it.
     Generate(generate::Args),
+    /// Render a document's terrain into a PNG.
+    Render(render::Args),
+    /// Measure the renderer's frame time and the terrain update while pulling.
+    Bench(bench::Args),
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
         Command::Generate(args) => generate::run(&args),
+        Command::Render(args) => render::run(&args),
+        Command::Bench(args) => bench::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -1,0 +1,197 @@
+//! `penmodel bench`: the renderer's frame time and the terrain update while pulling.
+//!
+//! - Document: the seed's example 1 (`examples/01-ridges-and-peaks.json`: one region over most of
+//!   the grid, eight control figures) on an N × N grid over the same 320 m square, N = 256, 512,
+//!   1024 — the documents of the criterion bench `benches/terrain.rs`.
+//! - Frame: 1280 × 720, mono, the orbit camera [`Camera::overview`] at azimuth 30°, elevation 35°
+//!   (45° field of view, 1.75 ground half-diagonals away), with the document's figures and
+//!   boundaries draped on the terrain, a slope bar and a mode line: what a live pull shows.
+//! - Each timed frame follows a pull step (the first figure's height changes through
+//!   [`Editor::preview`], untimed), so the renderer sees a changed terrain every frame, as it does
+//!   live.
+//! - Pull update: [`Editor::preview`] of the first figure's height, alternating between two
+//!   values after a first (untimed) step that starts the pull.
+//! - Medians over repeated runs after warm-up.
+
+use std::io::IsTerminal;
+use std::time::Instant;
+
+use anyhow::{Context, Result};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use penmodel::render::{self, Camera, Frame, Renderer, Scene, SlopeBar};
+use penmodel::{Document, Edit, Editor, FigurePath};
+
+/// Grid sizes measured.
+const GRIDS: [u32; 3] = [256, 512, 1024];
+/// The frame measured.
+const FRAME: (u32, u32) = (1280, 720);
+/// Timed frames per grid.
+const FRAMES: usize = 25;
+/// Timed pull updates per grid.
+const PULLS: usize = 60;
+/// Untimed frames first.
+const WARM_UP: usize = 3;
+
+/// Arguments of `penmodel bench`.
+#[derive(clap::Args)]
+pub struct Args {
+    /// Print `{"render": [...], "pull_update": [...]}` on stdout instead of a table.
+    #[arg(long)]
+    json: bool,
+    /// Grid sizes to measure (repeatable; default 256, 512 and 1024).
+    #[arg(long = "grid", value_name = "N", value_parser = clap::value_parser!(u32).range(2..=4096))]
+    grids: Vec<u32>,
+}
+
+fn document(n: u32) -> Result<Document> {
+    let mut doc = Document::from_json(include_str!("../../../examples/01-ridges-and-peaks.json"))
+        .context("example 1 is not valid")?;
+    let extent = doc.grid.width();
+    doc.grid.cols = n;
+    doc.grid.rows = n;
+    doc.grid.cell_size = extent / f64::from(n);
+    Ok(doc)
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    v.sort_by(f64::total_cmp);
+    let n = v.len();
+    if n == 0 {
+        return f64::NAN;
+    }
+    if n % 2 == 1 {
+        v[n / 2]
+    } else {
+        0.5 * (v[n / 2 - 1] + v[n / 2])
+    }
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+struct Figures {
+    grid: u32,
+    frame_ms: f64,
+    pull_ms: f64,
+    covered: f64,
+}
+
+fn measure(n: u32, bar: &ProgressBar) -> Result<Figures> {
+    let doc = document(n)?;
+    let extent = [doc.grid.width(), doc.grid.height()];
+    let overlays = render::document_overlays(&doc);
+    let mut editor = Editor::new(doc)?;
+    let peak = FigurePath::new(0, 0);
+    let base = editor.document().regions[0].figures[0].height;
+    let mut step = 0usize;
+    let mut pull = |editor: &mut Editor| -> Result<f64> {
+        step += 1;
+        let height = base + if step.is_multiple_of(2) { 1.0 } else { 2.0 };
+        let t = Instant::now();
+        editor.preview(&Edit::SetHeight {
+            at: peak.clone(),
+            height,
+        })?;
+        Ok(ms(t))
+    };
+    pull(&mut editor)?;
+
+    let mut renderer = Renderer::new();
+    let mut frame = Frame::new(FRAME.0, FRAME.1)?;
+    let camera = Camera::overview(extent, 30f64.to_radians(), 35f64.to_radians());
+    let mut times = Vec::with_capacity(FRAMES);
+    for i in 0..WARM_UP + FRAMES {
+        pull(&mut editor)?;
+        let mut scene = Scene::new(editor.heightmap(), camera);
+        scene.overlays = &overlays;
+        scene.selection = Some(1);
+        scene.mode = "pull  height 62.0 m";
+        scene.slope_bar = Some(SlopeBar {
+            value: -1.5,
+            min: -4.0,
+            max: 4.0,
+            label: "slope".into(),
+        });
+        scene.style.ramp_top = 70.0;
+        let t = Instant::now();
+        renderer.render(&scene, &mut frame)?;
+        if i >= WARM_UP {
+            times.push(ms(t));
+        }
+        bar.inc(1);
+    }
+    let frame_ms = median(times);
+
+    let scene = Scene::new(editor.heightmap(), camera);
+    let counts = renderer.coverage(&scene, FRAME.0, FRAME.1)?;
+    let covered = counts.iter().filter(|&&c| c > 0).count() as f64 / counts.len() as f64;
+
+    let mut pulls = Vec::with_capacity(PULLS);
+    for _ in 0..PULLS {
+        pulls.push(pull(&mut editor)?);
+        bar.inc(1);
+    }
+    Ok(Figures {
+        grid: n,
+        frame_ms,
+        pull_ms: median(pulls),
+        covered,
+    })
+}
+
+/// Runs the command.
+pub fn run(args: &Args) -> Result<()> {
+    let grids = if args.grids.is_empty() {
+        GRIDS.to_vec()
+    } else {
+        args.grids.clone()
+    };
+    let total = grids.len() * (WARM_UP + FRAMES + PULLS);
+    let bar = if std::io::stderr().is_terminal() {
+        let bar = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
+        if let Ok(style) = ProgressStyle::with_template("{msg:>12} [{bar:30}] {pos}/{len}") {
+            bar.set_style(style.progress_chars("=> "));
+        }
+        bar
+    } else {
+        ProgressBar::hidden()
+    };
+    let mut results = Vec::new();
+    for &n in &grids {
+        bar.set_message(format!("{n}×{n}"));
+        results.push(measure(n, &bar)?);
+    }
+    bar.finish_and_clear();
+    let (w, h) = FRAME;
+    if args.json {
+        let render: Vec<_> = results
+            .iter()
+            .map(|r| serde_json::json!({"grid": r.grid, "width": w, "height": h, "frame_ms": round3(r.frame_ms)}))
+            .collect();
+        let pull: Vec<_> = results
+            .iter()
+            .map(|r| serde_json::json!({"grid": r.grid, "ms": round3(r.pull_ms)}))
+            .collect();
+        println!("{}", serde_json::json!({"render": render, "pull_update": pull}));
+    } else {
+        println!("grid        frame {w}×{h}   frames/s   terrain on screen   pull update");
+        for r in &results {
+            println!(
+                "{:>4}×{:<4}   {:>8.2} ms   {:>9.1}   {:>16.0} %   {:>8.3} ms",
+                r.grid,
+                r.grid,
+                r.frame_ms,
+                1e3 / r.frame_ms,
+                r.covered * 100.0,
+                r.pull_ms
+            );
+        }
+        println!("medians of {FRAMES} frames and {PULLS} pull updates per grid; targets at 512×512: ≤ 16.7 ms, ≤ 2 ms");
+    }
+    Ok(())
+}
+
+fn round3(v: f64) -> f64 {
+    (v * 1e3).round() / 1e3
+}

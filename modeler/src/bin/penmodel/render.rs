@@ -1,0 +1,228 @@
+//! `penmodel render`: a document's terrain drawn by the CPU rasteriser into a PNG.
+
+use std::path::PathBuf;
+
+use anyhow::{Result, bail};
+use clap::ValueEnum;
+use penmodel::editor::Editor;
+use penmodel::output;
+use penmodel::render::{self, Camera, Frame, Orbit, Renderer, Scene, Stereo, Tracked, View};
+
+/// Stereo modes on the command line.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum StereoArg {
+    /// One image.
+    None,
+    /// Red–cyan anaglyph.
+    Anaglyph,
+    /// Left eye in the left half, right eye in the right half.
+    SideBySide,
+}
+
+/// `W×H` or `WxH`, positive integers.
+fn size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X', '×'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
+    let parse = |v: &str| v.trim().parse::<u32>().map_err(|e| format!("{v:?}: {e}"));
+    let (w, h) = (parse(w)?, parse(h)?);
+    if w == 0 || h == 0 || w > render::frame::MAX_SIDE || h > render::frame::MAX_SIDE {
+        return Err(format!("each side must be 1 to {}", render::frame::MAX_SIDE));
+    }
+    Ok((w, h))
+}
+
+/// `W×H` in metres.
+fn display(s: &str) -> Result<[f64; 2], String> {
+    let (w, h) = s
+        .split_once(['x', 'X', '×'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT in metres, got {s:?}"))?;
+    let parse = |v: &str| v.trim().parse::<f64>().map_err(|e| format!("{v:?}: {e}"));
+    let (w, h) = (parse(w)?, parse(h)?);
+    if !(w > 0.0 && h > 0.0 && w.is_finite() && h.is_finite()) {
+        return Err("the display's sides must be positive".into());
+    }
+    Ok([w, h])
+}
+
+/// `X,Y,Z` in metres.
+fn head(s: &str) -> Result<[f64; 3], String> {
+    let v: Vec<f64> = s
+        .split(',')
+        .map(|v| v.trim().parse::<f64>().map_err(|e| format!("{v:?}: {e}")))
+        .collect::<Result<_, _>>()?;
+    match v.as_slice() {
+        [x, y, z] if v.iter().all(|v| v.is_finite()) => Ok([*x, *y, *z]),
+        _ => Err(format!("expected X,Y,Z in metres, got {s:?}")),
+    }
+}
+
+/// Arguments of `penmodel render`.
+#[derive(clap::Args)]
+#[command(
+    after_help = "Examples:\n  penmodel render modeler/examples/04-volcano.json --png volcano.png --size 1280x720\n  \
+    penmodel render DOC.json --png a.png --size 1280x720 --stereo anaglyph --tilt 20\n  \
+    penmodel render DOC.json --png t.png --size 1920x1080 --display 1.9x1.07 --head 0,-0.4,0.8"
+)]
+pub struct Args {
+    /// The document (JSON). A pending journal beside it is replayed, read-only.
+    #[arg(value_name = "DOC.json")]
+    doc: PathBuf,
+    /// The frame as a PNG.
+    #[arg(long, value_name = "OUT.png")]
+    png: PathBuf,
+    /// Frame size in pixels.
+    #[arg(long, value_name = "WxH", value_parser = size, default_value = "1280x720")]
+    size: (u32, u32),
+    /// Stereo mode.
+    #[arg(long, value_enum, default_value = "none")]
+    stereo: StereoArg,
+    /// Orbit camera: angle around the terrain's centre, degrees (0 = from the south, 90 = east).
+    #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
+    azimuth: f64,
+    /// Orbit camera: angle above the ground, degrees.
+    #[arg(long, default_value_t = 35.0, allow_negative_numbers = true)]
+    elevation: f64,
+    /// Orbit camera: distance to the terrain's centre, metres (default: the whole ground in view).
+    #[arg(long)]
+    distance: Option<f64>,
+    /// Orbit camera: vertical field of view, degrees.
+    #[arg(long, default_value_t = 45.0)]
+    fov: f64,
+    /// Tilt of the ground plane towards the viewer, degrees.
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    tilt: f64,
+    /// Vertical exaggeration of the heights.
+    #[arg(long, default_value_t = 1.0)]
+    vertical_scale: f32,
+    /// Tracked view instead of the orbit camera: the display's size in metres; the terrain is
+    /// fitted onto it.
+    #[arg(long, value_name = "WxH", value_parser = display, requires = "head")]
+    display: Option<[f64; 2]>,
+    /// Tracked view: the head in the display's frame, metres (x right, y up the display, z out).
+    #[arg(long, value_name = "X,Y,Z", value_parser = head, allow_hyphen_values = true, requires = "display")]
+    head: Option<[f64; 3]>,
+    /// Leave out the figures and region boundaries.
+    #[arg(long)]
+    no_overlays: bool,
+    /// One line of text at the top left.
+    #[arg(long, default_value = "")]
+    mode: String,
+    /// Also show the frame in a window until it is closed (or Escape is pressed); without a
+    /// display this says so and carries on.
+    #[arg(long)]
+    window: bool,
+    /// Also write a turntable of N frames (one turn around the terrain) to the folder given by
+    /// --frames: frame_NNNNN.png and animation.png (APNG).
+    #[arg(long, value_name = "N", requires = "frames", value_parser = clap::value_parser!(u32).range(1..=3600))]
+    turntable: Option<u32>,
+    /// The folder for --turntable.
+    #[arg(long, value_name = "DIR", requires = "turntable")]
+    frames: Option<PathBuf>,
+}
+
+/// Runs the command.
+pub fn run(args: &Args) -> Result<()> {
+    let (editor, _) = Editor::open_read_only(&args.doc)?;
+    let map = editor.heightmap();
+    let grid = editor.document().grid;
+    let extent = [grid.width(), grid.height()];
+    let view = match (args.display, args.head) {
+        (Some(display), Some(head)) => {
+            let mut t = Tracked::fit(display, extent, head[2]);
+            t.head = head;
+            View::Tracked(t)
+        }
+        _ => {
+            let mut o = Orbit::overview(extent, args.azimuth.to_radians(), args.elevation.to_radians());
+            o.fov_y = args.fov.to_radians();
+            if let Some(d) = args.distance {
+                o.distance = d;
+            }
+            View::Orbit(o)
+        }
+    };
+    let overlays = if args.no_overlays {
+        Vec::new()
+    } else {
+        render::document_overlays(editor.document())
+    };
+    let (_, hi) = map.range();
+    let mut scene = Scene::new(
+        map,
+        Camera {
+            view,
+            tilt: args.tilt.to_radians(),
+        },
+    );
+    scene.overlays = &overlays;
+    scene.mode = &args.mode;
+    scene.vertical_scale = args.vertical_scale;
+    scene.style.ramp_top = ramp_top(hi);
+    scene.stereo = match args.stereo {
+        StereoArg::None => Stereo::None,
+        StereoArg::Anaglyph => Stereo::Anaglyph,
+        StereoArg::SideBySide => Stereo::SideBySide,
+    };
+    let (w, h) = args.size;
+    let mut frame = Frame::new(w, h)?;
+    let stats = Renderer::new().render(&scene, &mut frame)?;
+    if stats.skipped_vertices > 0 {
+        bail!("{} heights are not finite", stats.skipped_vertices);
+    }
+    output::write_png(&frame, &args.png)?;
+    println!(
+        "{} × {} frame of {} × {} cells written to {}",
+        w,
+        h,
+        map.cols(),
+        map.rows(),
+        args.png.display()
+    );
+    if let (Some(n), Some(dir)) = (args.turntable, &args.frames) {
+        let mut seq = output::Sequence::create(dir, 25)?;
+        let mut renderer = Renderer::new();
+        let mut turn = frame.clone();
+        for i in 0..n {
+            let mut s = scene.clone();
+            if let View::Orbit(o) = &mut s.camera.view {
+                o.azimuth += std::f64::consts::TAU * f64::from(i) / f64::from(n);
+            }
+            renderer.render(&s, &mut turn)?;
+            seq.push(&turn)?;
+        }
+        if let Some(anim) = seq.finish()? {
+            println!("{n} frames and {} written", anim.display());
+        }
+    }
+    if args.window {
+        show(frame);
+    }
+    Ok(())
+}
+
+/// Shows `frame` until the window is closed or Escape is pressed.
+fn show(frame: Frame) {
+    let mut viewer = match output::Viewer::open("penmodel render", frame.width(), frame.height()) {
+        Ok(v) => v,
+        Err(e) => {
+            eprintln!("penmodel: no window: {e}");
+            return;
+        }
+    };
+    if viewer.show(frame).is_err() {
+        return;
+    }
+    while viewer.is_open() {
+        match viewer.poll() {
+            Some(output::ViewerEvent::Key(k)) if k == "Escape" || k == "q" => break,
+            Some(_) => {}
+            None => std::thread::sleep(std::time::Duration::from_millis(20)),
+        }
+    }
+}
+
+/// The ramp's top for a terrain whose highest point is `hi` metres: snow on the highest tenth.
+pub fn ramp_top(hi: f32) -> f32 {
+    if hi > 0.0 { hi / 0.9 } else { 1.0 }
+}

@@ -1,0 +1,68 @@
+//! The output: an RGBA8 frame buffer.
+
+use super::RenderError;
+
+/// A colour: red, green, blue, alpha, 8 bits each (sRGB, alpha 255 = opaque).
+pub type Rgba = [u8; 4];
+
+/// The largest frame side the rasteriser's fixed-point coordinates allow (see [`super::rasterise`]).
+pub const MAX_SIDE: u32 = 16384;
+
+/// Refuses a zero side or one above [`MAX_SIDE`].
+pub fn check_size(width: u32, height: u32) -> Result<(), RenderError> {
+    if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
+        return Err(RenderError::FrameSize { width, height });
+    }
+    Ok(())
+}
+
+/// An RGBA8 image, row-major, top row first.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Frame {
+    width: u32,
+    height: u32,
+    pixels: Vec<Rgba>,
+}
+
+impl Frame {
+    /// A frame of `width × height` pixels, all transparent black. A zero side or one above
+    /// [`MAX_SIDE`] is refused.
+    pub fn new(width: u32, height: u32) -> Result<Frame, RenderError> {
+        check_size(width, height)?;
+        Ok(Frame {
+            width,
+            height,
+            pixels: vec![[0; 4]; width as usize * height as usize],
+        })
+    }
+
+    /// Width in pixels.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    /// Height in pixels.
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// The pixels, row-major: pixel `(x, y)` is at `y·width + x`.
+    pub fn pixels(&self) -> &[Rgba] {
+        &self.pixels
+    }
+
+    /// The pixels, mutable.
+    pub fn pixels_mut(&mut self) -> &mut [Rgba] {
+        &mut self.pixels
+    }
+
+    /// The pixel at `(x, y)`, or `None` off the frame.
+    pub fn pixel(&self, x: u32, y: u32) -> Option<Rgba> {
+        (x < self.width && y < self.height).then(|| self.pixels[y as usize * self.width as usize + x as usize])
+    }
+
+    /// The pixels as bytes, `R G B A` per pixel.
+    pub fn as_bytes(&self) -> &[u8] {
+        self.pixels.as_flattened()
+    }
+}
