@@ -204,13 +204,15 @@ impl Editor {
                 torn,
             } => {
                 for (i, entry) in entries.into_iter().enumerate() {
+                    // The undo history saved with the document is not a change to it.
+                    let change = !matches!(entry, Entry::History { .. });
                     // Line numbers: the open line is 1.
                     editor.replay(entry).map_err(|reason| EditorError::Replay {
                         path: jpath.clone(),
                         line: i + 2,
                         reason,
                     })?;
-                    report.replayed += 1;
+                    report.replayed += usize::from(change);
                 }
                 report.dropped_torn_line = torn;
                 valid_len = Some(len);

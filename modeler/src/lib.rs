@@ -31,6 +31,7 @@ pub mod journal;
 mod json;
 pub mod output;
 pub mod path;
+pub mod picture;
 pub mod profile;
 pub mod raster;
 pub mod render;

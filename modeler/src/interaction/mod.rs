@@ -347,17 +347,17 @@ impl Interaction {
     pub fn status(&self, doc: &Document) -> String {
         let line = match &self.state {
             State::Idle => match &self.hover {
-                Some(h) => format!("{} — SW2 + touch grabs it", describe(doc, &h.curve)),
-                None => "draw with the tip; SW3 ends a figure; SW3 click undoes".to_string(),
+                Some(h) => format!("{}: SW2 + touch grabs it", describe(doc, &h.curve)),
+                None => "draw with the tip | SW3 ends a figure | SW3 click: undo".to_string(),
             },
             State::Drawing { positions, touching } => format!(
-                "drawing, {} positions{} — SW3 ends the figure",
+                "drawing: {} positions{} | SW3 ends the figure",
                 positions.len(),
                 if *touching { "" } else { ", pen lifted" }
             ),
             State::Armed => match &self.hover {
-                Some(h) => format!("{} — touch to grab; SW3 redoes", describe(doc, &h.curve)),
-                None => "SW2: touch a figure to grab it; SW3 redoes".to_string(),
+                Some(h) => format!("{}: touch to grab | SW3: redo", describe(doc, &h.curve)),
+                None => "SW2: touch a figure to grab it | SW3: redo".to_string(),
             },
             State::Grabbed(g) => {
                 let what = describe(doc, &g.hit.curve);
@@ -366,25 +366,25 @@ impl Interaction {
                     CurvePath::Boundary(_) => None,
                 };
                 match (&g.action, figure) {
-                    (Action::Pull, Some(f)) => format!("pull {what}: {:.0} m — release SW2 to set", f.height),
+                    (Action::Pull, Some(f)) => format!("pull {what}: {:.0} m | release SW2 to set", f.height),
                     (Action::Slope { .. }, Some(f)) => {
-                        format!("slope {what}: {:+.2} — left sharper, right rounder", f.slope)
+                        format!("slope {what}: {:+.2} | left sharper, right rounder", f.slope)
                     }
                     (Action::Move { .. }, _) if deletes(g, doc) => {
-                        format!("{what}: release here to delete it")
+                        format!("{what}: drop here to delete it")
                     }
                     (Action::Move { .. }, _) => match g.hit.vertex {
                         Some(i) => format!("moving vertex {i} of {what}"),
                         None => format!("moving {what}"),
                     },
-                    _ => format!("grabbed {what}: lift to pull, slide to move, SW3 for the slope"),
+                    _ => format!("grabbed {what}: lift to pull, slide to move"),
                 }
             }
             State::Sw3 { moved: true, .. } => format!("view: 1 mm = {:.1} m", 1.0 / self.view.scale),
-            State::Sw3 { .. } => "SW3: release to undo, or move to pan (up and down zooms)".to_string(),
+            State::Sw3 { .. } => "SW3: release to undo, or move to pan and zoom".to_string(),
         };
         match (&self.last_message, self.last_t) {
-            (Some((t, m)), Some(now)) if now.saturating_sub(*t) < 3_000_000 => format!("{line}   · {m}"),
+            (Some((t, m)), Some(now)) if now.saturating_sub(*t) < 3_000_000 => format!("{line}  | {m}"),
             _ => line,
         }
     }
@@ -879,8 +879,8 @@ impl Interaction {
             }
         };
         let (name, region) = match &edit {
-            Edit::AddFigure { at, figure } => (format!("{} {at}", figure.kind.name()), false),
-            Edit::AddRegion { index, .. } => (format!("region regions[{index}]"), true),
+            Edit::AddFigure { at, figure } => (format!("{} {}", figure.kind.name(), short(at)), false),
+            Edit::AddRegion { index, .. } => (format!("region {index}"), true),
             _ => (String::new(), false),
         };
         if self.commit(editor, edit, &format!("the new {name}")) {
@@ -905,13 +905,23 @@ fn deletes(grab: &Grab, doc: &Document) -> bool {
     whole && matches!(grab.action, Action::Move { outside: true, .. })
 }
 
+/// A figure's path for the status line: `regions[0].figures[3].figures[1]` is `0.3.1`.
+fn short(at: &crate::path::FigurePath) -> String {
+    let mut s = at.region().to_string();
+    for i in at.indices() {
+        s.push('.');
+        s.push_str(&i.to_string());
+    }
+    s
+}
+
 /// A figure or region named for the status line.
 fn describe(doc: &Document, curve: &CurvePath) -> String {
     match curve {
         CurvePath::Boundary(r) => format!("region {r}"),
         CurvePath::Figure(at) => match at.get(doc) {
-            Some(f) => format!("{} {at}", f.kind.name()),
-            None => at.to_string(),
+            Some(f) => format!("{} {}", f.kind.name(), short(at)),
+            None => short(at),
         },
     }
 }

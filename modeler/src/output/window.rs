@@ -197,7 +197,8 @@ impl ApplicationHandler<Command> for App {
     }
 }
 
-fn has_display() -> bool {
+/// Whether a display (X11 or Wayland) is announced in the environment.
+pub fn has_display() -> bool {
     ["DISPLAY", "WAYLAND_DISPLAY"]
         .iter()
         .any(|v| std::env::var_os(v).is_some_and(|s| !s.is_empty()))

@@ -61,6 +61,17 @@ impl Frame {
         (x < self.width && y < self.height).then(|| self.pixels[y as usize * self.width as usize + x as usize])
     }
 
+    /// Copies `other` into this frame with its top-left corner at `(x, y)`, clipped to this
+    /// frame (a picture in the picture).
+    pub fn blit(&mut self, other: &Frame, x: u32, y: u32) {
+        let w = other.width.min(self.width.saturating_sub(x)) as usize;
+        for row in 0..other.height.min(self.height.saturating_sub(y)) {
+            let src = row as usize * other.width as usize;
+            let dst = (y + row) as usize * self.width as usize + x as usize;
+            self.pixels[dst..dst + w].copy_from_slice(&other.pixels[src..src + w]);
+        }
+    }
+
     /// The pixels as bytes, `R G B A` per pixel.
     pub fn as_bytes(&self) -> &[u8] {
         self.pixels.as_flattened()

@@ -40,7 +40,7 @@ use thiserror::Error;
 
 pub use camera::{Camera, Eye, Orbit, Projection, Tracked, View, Viewport};
 pub use frame::{Frame, Rgba};
-pub use scene::{Overlay, Scene, SlopeBar, Stereo, Style, document_overlays};
+pub use scene::{Overlay, Scene, SlopeBar, Stereo, Style, document_overlays, document_overlays_at};
 
 use rasterise::{Bounds, Capsule, Sample};
 use transform::{Affine, Projected};

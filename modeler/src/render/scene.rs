@@ -7,6 +7,7 @@ use super::camera::Camera;
 use super::frame::Rgba;
 use crate::document::{Document, Figure, FigureKind, Point};
 use crate::heightmap::Heightmap;
+use crate::path::{CurvePath, FigurePath};
 
 /// How the two eyes' images are combined.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -158,28 +159,40 @@ pub const FIGURE_COLOUR: Rgba = [220, 40, 40, 255];
 /// each region its boundary, then its figures depth first (a closed figure before the figures
 /// nested in it).
 pub fn document_overlays(doc: &Document) -> Vec<Overlay> {
-    fn figures(list: &[Figure], out: &mut Vec<Overlay>) {
-        for f in list {
-            out.push(Overlay {
-                points: f.points.clone(),
-                closed: f.kind == FigureKind::Closed,
-                colour: FIGURE_COLOUR,
-                width: 3.0,
-                height: None,
-            });
-            figures(&f.figures, out);
+    document_overlays_at(doc).into_iter().map(|(_, o)| o).collect()
+}
+
+/// [`document_overlays`], each with the curve it draws (to find a selection's index).
+pub fn document_overlays_at(doc: &Document) -> Vec<(CurvePath, Overlay)> {
+    fn figures(list: &[Figure], at: &dyn Fn(usize) -> FigurePath, out: &mut Vec<(CurvePath, Overlay)>) {
+        for (i, f) in list.iter().enumerate() {
+            let path = at(i);
+            out.push((
+                CurvePath::Figure(path.clone()),
+                Overlay {
+                    points: f.points.clone(),
+                    closed: f.kind == FigureKind::Closed,
+                    colour: FIGURE_COLOUR,
+                    width: 3.0,
+                    height: None,
+                },
+            ));
+            figures(&f.figures, &|j| path.child(j), out);
         }
     }
     let mut out = Vec::new();
-    for r in &doc.regions {
-        out.push(Overlay {
-            points: r.boundary.clone(),
-            closed: true,
-            colour: REGION_COLOUR,
-            width: 2.0,
-            height: None,
-        });
-        figures(&r.figures, &mut out);
+    for (r, region) in doc.regions.iter().enumerate() {
+        out.push((
+            CurvePath::Boundary(r),
+            Overlay {
+                points: region.boundary.clone(),
+                closed: true,
+                colour: REGION_COLOUR,
+                width: 2.0,
+                height: None,
+            },
+        ));
+        figures(&region.figures, &|i| FigurePath::new(r, i), &mut out);
     }
     out
 }

@@ -1,10 +1,14 @@
 //! `penmodel`: the terrain modeler from the command line.
 //!
-//! Exit status: 0 on success, 1 when the input is not valid or a file cannot be read or written
-//! (the reason on stderr), 2 on a usage error.
+//! Without a subcommand it models terrain with the pen (the built-in demo when no pen is
+//! attached); `penmodel open DOC.json` continues a saved document.
+//!
+//! Exit status: 0 on success, 1 when the input is not valid, a file cannot be read or written, or
+//! the pen fails (the reason on stderr), 2 on a usage error.
 
 mod bench;
 mod generate;
+mod live;
 mod render;
 
 use std::process::ExitCode;
@@ -16,15 +20,31 @@ use clap::{Parser, Subcommand};
     name = "penmodel",
     version,
     about = "The 3D pen's terrain modeler",
-    propagate_version = true
+    propagate_version = true,
+    args_conflicts_with_subcommands = true,
+    after_help = "Without a subcommand: model terrain with the pen (the built-in demo when no pen is attached).\n\
+    Examples:\n  penmodel                              # the demo: a window, or files in ./out without a display\n  \
+    penmodel --show headless --out run1   # the demo written to run1/\n  \
+    penmodel --source daemon              # the pen from pend\n  \
+    penmodel open out/document.json       # continue a document"
 )]
 struct Cli {
     #[command(subcommand)]
-    command: Command,
+    command: Option<Command>,
+    #[command(flatten)]
+    live: live::LiveArgs,
 }
 
 #[derive(Subcommand)]
 enum Command {
+    /// Continue modeling a saved document with the pen.
+    Open {
+        /// The document (JSON); its journal, if any, is replayed first.
+        #[arg(value_name = "DOC.json")]
+        document: std::path::PathBuf,
+        #[command(flatten)]
+        live: live::LiveArgs,
+    },
     /// Generate a document's terrain and export it.
     Generate(generate::Args),
     /// Render a document's terrain into a PNG.
@@ -36,9 +56,11 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        Command::Generate(args) => generate::run(&args),
-        Command::Render(args) => render::run(&args),
-        Command::Bench(args) => bench::run(&args),
+        None => live::run(&cli.live, None),
+        Some(Command::Open { document, live }) => live::run(&live, Some(&document)),
+        Some(Command::Generate(args)) => generate::run(&args),
+        Some(Command::Render(args)) => render::run(&args),
+        Some(Command::Bench(args)) => bench::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
@@ -46,5 +68,15 @@ fn main() -> ExitCode {
             eprintln!("penmodel: {e:#}");
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    #[test]
+    fn the_command_line_is_well_formed() {
+        super::Cli::command().debug_assert();
     }
 }

@@ -20,7 +20,7 @@ pub enum StereoArg {
 }
 
 /// `W×H` or `WxH`, positive integers.
-fn size(s: &str) -> Result<(u32, u32), String> {
+pub fn size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
         .split_once(['x', 'X', '×'])
         .ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
@@ -46,7 +46,7 @@ fn display(s: &str) -> Result<[f64; 2], String> {
 }
 
 /// `X,Y,Z` in metres.
-fn head(s: &str) -> Result<[f64; 3], String> {
+pub fn head(s: &str) -> Result<[f64; 3], String> {
     let v: Vec<f64> = s
         .split(',')
         .map(|v| v.trim().parse::<f64>().map_err(|e| format!("{v:?}: {e}")))

@@ -1,0 +1,567 @@
+//! `penmodel` without a subcommand, and `penmodel open`: model terrain with the pen.
+//!
+//! The pen comes from `--source` (default: pend's socket if pend is running, else the built-in
+//! demo); the session is shown in a window when there is a display, else written to a folder
+//! (`--out`): PNG frames and their animation, then the final terrain (16-bit PNG, float32,
+//! OBJ, glTF), a render of it, and the document (JSON), which is also journaled as it is edited.
+
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::RecvTimeoutError;
+use std::time::{Duration, Instant};
+
+use anyhow::{Context, Result, bail};
+use indicatif::{ProgressBar, ProgressStyle};
+use penmodel::editor::Editor;
+use penmodel::feed::{self, Feed, PenSource};
+use penmodel::interaction::{Command, Settings, View};
+use penmodel::output::{self, Sequence, Viewer, ViewerEvent, WindowError};
+use penmodel::picture::{Look, Picture};
+use penmodel::render::{Frame, Renderer, Stereo};
+use penmodel::session::{Session, State, blank_document};
+use penmodel::{Heightmap, export};
+use serde_json::json;
+
+use crate::render::{StereoArg, head, size};
+
+/// How the session is shown.
+#[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Show {
+    /// A window if there is a display, else files.
+    Auto,
+    /// A window.
+    Window,
+    /// Files in the --out folder.
+    Headless,
+}
+
+/// Options of a modeling session.
+#[derive(clap::Args, Clone)]
+pub struct LiveArgs {
+    /// The pen: sim (the built-in demo), daemon, daemon:SOCKET, hid, hid:PATH, serial:PATH or
+    /// sim:SCENARIO [default: daemon if pend is running, else sim].
+    #[arg(long, value_name = "SOURCE", value_parser = source)]
+    source: Option<String>,
+    /// Window, files, or a window when there is a display.
+    #[arg(long, value_enum, default_value = "auto")]
+    show: Show,
+    /// The folder for frames and results.
+    #[arg(long, value_name = "DIR", default_value = "out")]
+    out: PathBuf,
+    /// Frame size in pixels [default: 1280x720 in a window, 960x540 for files].
+    #[arg(long, value_name = "WxH", value_parser = size)]
+    size: Option<(u32, u32)>,
+    /// Leave out the overview: the terrain from an orbit camera, where heights read at a glance,
+    /// beside the display's view in the frames written to files (in a window, key `o` shows it
+    /// in a corner).
+    #[arg(long)]
+    no_overview: bool,
+    /// Frames per second of the session written to --out/frames when headless.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u16).range(1..=60))]
+    fps: u16,
+    /// The demo's speed: device seconds per second [default: 1 in a window, as fast as frames
+    /// are drawn when headless].
+    #[arg(long)]
+    speed: Option<f64>,
+    /// The demo's randomness.
+    #[arg(long, default_value_t = 1)]
+    seed: u64,
+    /// Stereo mode.
+    #[arg(long, value_enum, default_value = "none")]
+    stereo: StereoArg,
+    /// The viewer's head in the display's frame, metres (x right, y up the display, z out).
+    #[arg(long, value_name = "X,Y,Z", value_parser = head, allow_hyphen_values = true)]
+    head: Option<[f64; 3]>,
+    /// Vertical exaggeration of the terrain (a pull's height follows it: the figure stays at
+    /// the pen's tip).
+    #[arg(long, default_value_t = 1.0)]
+    exaggeration: f64,
+    /// The document's file for a new session [default: OUT/document.json].
+    #[arg(long, value_name = "DOC.json")]
+    doc: Option<PathBuf>,
+    /// Print a JSON summary on stdout at the end.
+    #[arg(long)]
+    json: bool,
+}
+
+/// A pen source's name, checked.
+fn source(s: &str) -> Result<String, String> {
+    PenSource::parse(s, 0.0).map(|_| s.to_string())
+}
+
+/// Where the results went.
+struct Written {
+    frames: usize,
+    animation: Option<PathBuf>,
+}
+
+fn default_source() -> String {
+    let socket = pen_host::daemon::default_socket();
+    if std::os::unix::net::UnixStream::connect(&socket).is_ok() {
+        "daemon".into()
+    } else {
+        "sim".into()
+    }
+}
+
+/// A new session (`doc` = None) or `penmodel open DOC`.
+pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
+    if !(args.exaggeration.is_finite() && args.exaggeration > 0.0) {
+        bail!("--exaggeration must be a positive number");
+    }
+    let window_wanted = match args.show {
+        Show::Headless => false,
+        Show::Window => true,
+        Show::Auto => output::window::has_display(),
+    };
+    let source_name = args.source.clone().unwrap_or_else(default_source);
+    let speed = args.speed.unwrap_or(if window_wanted { 1.0 } else { 0.0 });
+    let mut source = PenSource::parse(&source_name, speed).map_err(anyhow::Error::msg)?;
+    let demo = matches!(source, PenSource::Demo { .. });
+    if let PenSource::Demo { seed, .. } = &mut source {
+        *seed = args.seed;
+    }
+    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    let (editor, doc_path) = match open {
+        Some(path) => {
+            let (editor, report) = Editor::open(path)?;
+            if report.replayed > 0 {
+                eprintln!("penmodel: {} journal entries replayed", report.replayed);
+            }
+            if let Some(stale) = report.stale_journal {
+                eprintln!(
+                    "penmodel: a journal of another version was set aside: {}",
+                    stale.display()
+                );
+            }
+            (editor, path.to_owned())
+        }
+        None => {
+            let path = args.doc.clone().unwrap_or_else(|| args.out.join("document.json"));
+            // The demo's document is the demo's; a real session never overwrites work.
+            if path.exists() && !(demo && args.doc.is_none()) {
+                bail!(
+                    "{} exists: `penmodel open {}` continues it, or give another --doc",
+                    path.display(),
+                    path.display()
+                );
+            }
+            (Editor::create(&path, blank_document())?, path)
+        }
+    };
+    let settings = Settings::default();
+    let mut session = Session::new(editor, [600.0, 340.0], settings);
+    let mut look = Look::default();
+    if let Some(h) = args.head {
+        look.head_m = h;
+    }
+    look.stereo = match args.stereo {
+        StereoArg::None => Stereo::None,
+        StereoArg::Anaglyph => Stereo::Anaglyph,
+        StereoArg::SideBySide => Stereo::SideBySide,
+    };
+
+    let stop = Arc::new(AtomicBool::new(false));
+    for signal in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
+        signal_hook::flag::register(signal, stop.clone()).context("installing signal handlers")?;
+    }
+    let demo_us = demo.then(|| (feed::demo_scenario().0.timeline.duration_s() * 1e6) as u64);
+    let (rx, thread) = feed::spawn(source, 256);
+    eprintln!("penmodel: pen from {source_name}");
+
+    let viewer = if window_wanted {
+        let (w, h) = args.size.unwrap_or((1280, 720));
+        match Viewer::open("penmodel", w, h) {
+            Ok(v) => Some(v),
+            Err(e @ WindowError::NoDisplay) if args.show == Show::Auto => {
+                eprintln!("penmodel: {e}; writing files instead");
+                None
+            }
+            Err(e) => return Err(e.into()),
+        }
+    } else {
+        None
+    };
+    let (w, h) = args
+        .size
+        .unwrap_or(if viewer.is_some() { (1280, 720) } else { (960, 540) });
+    let layout = match (args.no_overview, viewer.is_some()) {
+        (true, _) | (false, true) => Overview::Off,
+        (false, false) => Overview::Beside,
+    };
+    let mut painter = Painter::new(w, h, layout)?;
+    let written = match viewer {
+        Some(v) => run_window(v, &rx, &mut session, &look, &mut painter, &stop)?,
+        None => run_headless(args, &rx, &mut session, &look, &mut painter, &stop, demo_us)?,
+    };
+    drop(rx);
+    // The pen thread notices the closed channel at its next message.
+    let _ = thread.join();
+
+    session
+        .editor
+        .save()
+        .with_context(|| format!("cannot save {}", doc_path.display()))?;
+    let results = write_results(&args.out, &session, &look, &mut painter)?;
+    let stats = session.interaction.stats().clone();
+    let state = match session.state() {
+        State::Running => "stopped".to_string(),
+        State::Ended(s) => s.clone(),
+        State::Failed(s) => format!("failed: {s}"),
+    };
+    let (lo, hi) = session.editor.heightmap().range();
+    if args.json {
+        let summary = json!({
+            "source": source_name,
+            "state": state,
+            "events": session.events(),
+            "document": doc_path,
+            "frames": written.frames,
+            "animation": written.animation,
+            "results": results,
+            "heights_m": [lo, hi],
+            "stats": {
+                "regions": stats.regions, "figures": stats.figures, "pulls": stats.pulls,
+                "slopes": stats.slopes, "moves": stats.moves, "deletes": stats.deletes,
+                "undos": stats.undos, "redos": stats.redos, "refused": stats.refused,
+                "missed": stats.missed,
+            },
+        });
+        println!("{summary}");
+    } else {
+        println!(
+            "{state}: {} pen events; {} regions, {} figures, {} pulls, {} slopes, {} undos; terrain {lo:.0} to {hi:.0} m",
+            session.events(),
+            stats.regions,
+            stats.figures,
+            stats.pulls,
+            stats.slopes,
+            stats.undos
+        );
+        let anim = written
+            .animation
+            .map(|p| format!(" and {}", p.display()))
+            .unwrap_or_default();
+        println!(
+            "wrote {} frames{anim}, the terrain, its render and the document to {}/ (document: {})",
+            written.frames,
+            args.out.display(),
+            doc_path.display()
+        );
+    }
+    if let State::Failed(why) = session.state() {
+        bail!("the pen failed: {why}");
+    }
+    Ok(())
+}
+
+fn say(messages: Vec<String>, progress: Option<&ProgressBar>) {
+    for m in messages {
+        match progress {
+            // A hidden bar (not a terminal) prints nothing.
+            Some(p) if !p.is_hidden() => p.println(format!("penmodel: {m}")),
+            _ => eprintln!("penmodel: {m}"),
+        }
+    }
+}
+
+/// Where the overview goes.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Overview {
+    /// Not drawn.
+    Off,
+    /// In the lower right corner, a quarter of each side (clear of the slope bar, which takes
+    /// the middle 40 % of the bottom).
+    Corner,
+    /// In a column half as wide as the display's view, to its right: the overview above, a map
+    /// from straight above below.
+    Beside,
+}
+
+/// Draws frames: the display's view, and the overview.
+struct Painter {
+    frame: Frame,
+    view: Frame,
+    renderer: Renderer,
+    overview: Overview,
+    inset: Frame,
+    inset_renderer: Renderer,
+}
+
+impl Painter {
+    /// Frames whose display view is `width × height`.
+    fn new(width: u32, height: u32, overview: Overview) -> Result<Painter> {
+        let mut painter = Painter {
+            frame: Frame::new(width, height)?,
+            view: Frame::new(width, height)?,
+            renderer: Renderer::new(),
+            overview: Overview::Off,
+            inset: Frame::new(1, 1)?,
+            inset_renderer: Renderer::new(),
+        };
+        painter.set_overview(overview)?;
+        Ok(painter)
+    }
+
+    fn set_overview(&mut self, overview: Overview) -> Result<()> {
+        let (w, h) = (self.view.width(), self.view.height());
+        let (frame_w, inset) = match overview {
+            Overview::Off => (w, (1, 1)),
+            Overview::Corner => (w, ((w / 4).max(1), (h / 4).max(1))),
+            Overview::Beside => (w + (w / 2).max(1), ((w / 2).max(1), (h / 2).max(1))),
+        };
+        self.frame = Frame::new(frame_w, h)?;
+        self.inset = Frame::new(inset.0, inset.1)?;
+        self.overview = overview;
+        Ok(())
+    }
+
+    fn draw(&mut self, picture: &Picture, map: &Heightmap) -> Result<&Frame> {
+        self.renderer.render(&picture.scene(map), &mut self.view)?;
+        self.frame.blit(&self.view, 0, 0);
+        if self.overview == Overview::Off {
+            return Ok(&self.frame);
+        }
+        let extent = [
+            f64::from(map.cols()) * map.cell_size(),
+            f64::from(map.rows()) * map.cell_size(),
+        ];
+        self.inset_renderer
+            .render(&picture.overview(extent).scene(map), &mut self.inset)?;
+        let (w, h) = (self.view.width(), self.view.height());
+        match self.overview {
+            Overview::Corner => {
+                let (x, y) = (w - self.inset.width() - 8, h - self.inset.height() - 8);
+                let mut border = Frame::new(self.inset.width() + 2, self.inset.height() + 2)?;
+                border.pixels_mut().fill([255, 255, 255, 255]);
+                self.frame.blit(&border, x - 1, y - 1);
+                self.frame.blit(&self.inset, x, y);
+            }
+            Overview::Beside => {
+                self.frame.blit(&self.inset, w, 0);
+                self.inset_renderer
+                    .render(&picture.map(extent).scene(map), &mut self.inset)?;
+                self.frame.blit(&self.inset, w, h - self.inset.height());
+            }
+            Overview::Off => {}
+        }
+        Ok(&self.frame)
+    }
+
+    /// `picture` alone, at the display view's size.
+    fn plain(&mut self, picture: &Picture, map: &Heightmap) -> Result<&Frame> {
+        self.renderer.render(&picture.scene(map), &mut self.view)?;
+        Ok(&self.view)
+    }
+
+    fn session(&mut self, session: &Session, look: &Look) -> Result<&Frame> {
+        let picture = Picture::of(session, look);
+        self.draw(&picture, session.editor.heightmap())
+    }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn run_headless(
+    args: &LiveArgs,
+    rx: &std::sync::mpsc::Receiver<Feed>,
+    session: &mut Session,
+    look: &Look,
+    painter: &mut Painter,
+    stop: &AtomicBool,
+    demo_us: Option<u64>,
+) -> Result<Written> {
+    let mut frames = Sequence::create(&args.out.join("frames"), args.fps)?;
+    let step_us = 1_000_000 / u64::from(args.fps);
+    let mut next_us: Option<u64> = None;
+    let progress = match demo_us {
+        Some(total) => {
+            let p = ProgressBar::new(total / 1000);
+            p.set_style(
+                ProgressStyle::with_template("{spinner} demo {bar:30} {pos}/{len} ms of the session, {msg}")
+                    .unwrap_or_else(|_| ProgressStyle::default_bar()),
+            );
+            p
+        }
+        None => ProgressBar::new_spinner(),
+    };
+    while !stop.load(Ordering::Relaxed) {
+        let feed = match rx.recv_timeout(Duration::from_millis(200)) {
+            Ok(f) => f,
+            Err(RecvTimeoutError::Timeout) => continue,
+            Err(RecvTimeoutError::Disconnected) => break,
+        };
+        let done = matches!(feed, Feed::End(_) | Feed::Failed(_));
+        let messages = session.feed(feed);
+        say(messages, Some(&progress));
+        if let Some(t) = session.last_event_us() {
+            progress.set_position(t / 1000);
+            let due = *next_us.get_or_insert(t);
+            if t >= due {
+                frames.push(painter.session(session, look)?)?;
+                next_us = Some(due + step_us);
+                progress.set_message(format!("{} frames", frames.frames().len()));
+            }
+        }
+        if done {
+            break;
+        }
+    }
+    progress.finish_and_clear();
+    let count = frames.frames().len();
+    let animation = frames.finish()?;
+    Ok(Written {
+        frames: count,
+        animation,
+    })
+}
+
+fn run_window(
+    mut viewer: Viewer,
+    rx: &std::sync::mpsc::Receiver<Feed>,
+    session: &mut Session,
+    look: &Look,
+    painter: &mut Painter,
+    stop: &AtomicBool,
+) -> Result<Written> {
+    const FRAME: Duration = Duration::from_millis(16);
+    let mut dirty = true;
+    let mut last = Instant::now() - FRAME;
+    let mut frames = 0;
+    'session: while viewer.is_open() && !stop.load(Ordering::Relaxed) {
+        while let Some(e) = viewer.poll() {
+            let command = match &e {
+                ViewerEvent::Closed => break 'session,
+                ViewerEvent::Key(k) => match k.as_str() {
+                    "Escape" | "q" => break 'session,
+                    "u" | "z" => Some(Command::Undo),
+                    "r" | "y" => Some(Command::Redo),
+                    "Delete" | "Backspace" => Some(Command::Delete),
+                    "ArrowLeft" => Some(Command::Pan {
+                        du_mm: -20.0,
+                        dv_mm: 0.0,
+                    }),
+                    "ArrowRight" => Some(Command::Pan {
+                        du_mm: 20.0,
+                        dv_mm: 0.0,
+                    }),
+                    "ArrowUp" => Some(Command::Pan {
+                        du_mm: 0.0,
+                        dv_mm: 20.0,
+                    }),
+                    "ArrowDown" => Some(Command::Pan {
+                        du_mm: 0.0,
+                        dv_mm: -20.0,
+                    }),
+                    "+" | "=" => Some(Command::Zoom { factor: 1.25 }),
+                    "-" => Some(Command::Zoom { factor: 0.8 }),
+                    "f" => Some(Command::Fit),
+                    "o" => {
+                        let next = if painter.overview == Overview::Off {
+                            Overview::Corner
+                        } else {
+                            Overview::Off
+                        };
+                        painter.set_overview(next)?;
+                        None
+                    }
+                    "s" => {
+                        match session.editor.save() {
+                            Ok(()) => eprintln!("penmodel: saved"),
+                            Err(e) => eprintln!("penmodel: cannot save: {e}"),
+                        }
+                        None
+                    }
+                    _ => None,
+                },
+                ViewerEvent::Resized { .. } => None,
+            };
+            if let Some(c) = command {
+                session.interaction.command(&mut session.editor, c);
+                say(session.interaction.take_messages(), None);
+            }
+            dirty = true;
+        }
+        // Take what the pen sent until it is time for the next frame.
+        let wait = FRAME.saturating_sub(last.elapsed());
+        match rx.recv_timeout(wait.max(Duration::from_millis(1))) {
+            Ok(feed) => {
+                let messages = session.feed(feed);
+                say(messages, None);
+                dirty = true;
+                while let Ok(more) = rx.try_recv() {
+                    say(session.feed(more), None);
+                    if last.elapsed() >= FRAME {
+                        break;
+                    }
+                }
+            }
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => {
+                // The pen has ended; the window stays until it is closed.
+                std::thread::sleep(FRAME);
+            }
+        }
+        if dirty && last.elapsed() >= FRAME {
+            if let Some(t) = session.last_event_us() {
+                session.interaction.advance(t);
+            }
+            let frame = painter.session(session, look)?.clone();
+            if viewer.show(frame).is_err() {
+                break;
+            }
+            frames += 1;
+            last = Instant::now();
+            dirty = session.interaction.pulling() || session.interaction.view().tilt > 1e-3;
+        }
+    }
+    Ok(Written {
+        frames,
+        animation: None,
+    })
+}
+
+/// Writes the final terrain, its render and the exports; returns what was written, by kind.
+fn write_results(out: &Path, session: &Session, look: &Look, painter: &mut Painter) -> Result<serde_json::Value> {
+    let map: &Heightmap = session.editor.heightmap();
+    let write = |name: &str, bytes: &[u8]| -> Result<PathBuf> {
+        let path = out.join(name);
+        pen_host::fsutil::write_atomic(&path, bytes).with_context(|| format!("cannot write {}", path.display()))?;
+        Ok(path)
+    };
+    let mut bytes = Vec::new();
+    export::write_png(map, &mut bytes)?;
+    let png = write("terrain.png", &bytes)?;
+    bytes.clear();
+    export::write_raw(map, &mut bytes)?;
+    let raw = write("terrain.f32", &bytes)?;
+    bytes.clear();
+    export::write_obj(map, &mut bytes)?;
+    let obj = write("terrain.obj", &bytes)?;
+    bytes.clear();
+    export::write_glb(map, &mut bytes)?;
+    let glb = write("terrain.glb", &bytes)?;
+    // The final state, without the pen or a highlight, the ground level: as the display shows
+    // it, and from the orbit camera of the overview.
+    let view = View {
+        tilt: 0.0,
+        ..*session.interaction.view()
+    };
+    let (lo, hi) = map.range();
+    let mode = format!("penmodel: final terrain, {lo:.0} to {hi:.0} m");
+    let picture = Picture::document(session.editor.document(), &view, mode, look);
+    bytes.clear();
+    output::encode_png(painter.plain(&picture, map)?, &mut bytes)?;
+    let display = write("display.png", &bytes)?;
+    let extent = [
+        f64::from(map.cols()) * map.cell_size(),
+        f64::from(map.rows()) * map.cell_size(),
+    ];
+    bytes.clear();
+    output::encode_png(painter.plain(&picture.overview(extent), map)?, &mut bytes)?;
+    let render = write("render.png", &bytes)?;
+    Ok(json!({
+        "heightmap_png": png, "heightmap_f32": raw, "mesh_obj": obj, "mesh_glb": glb,
+        "render": render, "display": display,
+    }))
+}

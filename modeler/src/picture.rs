@@ -1,0 +1,210 @@
+//! What a live session shows: the terrain as the seed's display showed it — the display surface
+//! is the ground, seen from the user's head with an off-axis projection, so a figure drawn at a
+//! point of the display lies exactly there — with the document's figures, the highlight, the
+//! figure being drawn or moved, the pen, the slope bar and the mode line.
+
+use crate::document::{Document, Point};
+use crate::heightmap::Heightmap;
+use crate::interaction::{Interaction, View};
+use crate::path::CurvePath;
+use crate::render::{Camera, Overlay, Rgba, Scene, SlopeBar, Stereo, Style, Tracked, document_overlays_at};
+use crate::session::Session;
+
+/// Colour of the figure being drawn.
+pub const DRAWING_COLOUR: Rgba = [64, 224, 255, 255];
+/// Colour of a figure or vertex being moved.
+pub const MOVING_COLOUR: Rgba = [255, 160, 32, 255];
+/// Colour of a figure that would be deleted where it is dropped.
+pub const DELETING_COLOUR: Rgba = [120, 120, 120, 255];
+/// Colour of the pen's tip and its foot on the ground.
+pub const PEN_COLOUR: Rgba = [255, 255, 255, 255];
+
+/// How the session is looked at.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Look {
+    /// The viewer's head in the display's frame, metres: x right, y up the display, z out of it.
+    /// The default sits 70 cm from a desk-sized display, in front of its near half.
+    pub head_m: [f64; 3],
+    /// Mono or stereo.
+    pub stereo: Stereo,
+    /// Colours and light.
+    pub style: Style,
+}
+
+impl Default for Look {
+    fn default() -> Look {
+        Look {
+            head_m: [0.0, -0.35, 0.7],
+            stereo: Stereo::None,
+            style: Style {
+                // Terrain of hundreds of metres: snow from 900 m.
+                ramp_top: 900.0,
+                ..Style::default()
+            },
+        }
+    }
+}
+
+/// The camera of a view: the display is the screen, the head looks through it.
+pub fn camera(view: &View, head_m: [f64; 3]) -> Camera {
+    Camera {
+        view: crate::render::View::Tracked(Tracked {
+            display: [view.display_mm[0] * 1e-3, view.display_mm[1] * 1e-3],
+            head: head_m,
+            eye_separation: 0.063,
+            centre: view.centre,
+            scale: view.scale * 1e-3,
+        }),
+        tilt: view.tilt,
+    }
+}
+
+/// One frame's content, owned; [`Picture::scene`] lends it to the renderer.
+#[derive(Debug, Clone)]
+pub struct Picture {
+    overlays: Vec<Overlay>,
+    selection: Option<usize>,
+    slope_bar: Option<SlopeBar>,
+    mode: String,
+    camera: Camera,
+    vertical_scale: f32,
+    look: Look,
+}
+
+fn dot(at: Point, height: Option<f64>, colour: Rgba, width: f32) -> Overlay {
+    Overlay {
+        points: vec![at],
+        closed: false,
+        colour,
+        width,
+        height,
+    }
+}
+
+impl Picture {
+    /// What `session` shows now.
+    pub fn of(session: &Session, look: &Look) -> Picture {
+        let ui = &session.interaction;
+        let doc = session.editor.document();
+        let mode = match session.state() {
+            crate::session::State::Ended(why) => format!("{why} | Esc closes"),
+            crate::session::State::Failed(why) => format!("the pen failed: {why} | Esc closes"),
+            crate::session::State::Running if session.events() == 0 && !session.status().is_empty() => {
+                session.status().to_string()
+            }
+            crate::session::State::Running => ui.status(doc),
+        };
+        Picture::from_parts(ui, doc, mode, look)
+    }
+
+    /// The document alone through `view`: no pen, no highlight, `mode` as the text line.
+    pub fn document(doc: &Document, view: &View, mode: String, look: &Look) -> Picture {
+        let overlays = crate::render::document_overlays(doc);
+        Picture {
+            overlays,
+            selection: None,
+            slope_bar: None,
+            mode,
+            camera: camera(view, look.head_m),
+            vertical_scale: view.exaggeration as f32,
+            look: look.clone(),
+        }
+    }
+
+    fn from_parts(ui: &Interaction, doc: &Document, mode: String, look: &Look) -> Picture {
+        let view = ui.view();
+        let at = document_overlays_at(doc);
+        let highlighted: Option<&CurvePath> = ui.grabbed().or(ui.hover().map(|h| &h.curve));
+        let moving = ui.moving(doc);
+        let mut selection = highlighted.and_then(|c| at.iter().position(|(p, _)| p == c));
+        let mut overlays: Vec<Overlay> = at.into_iter().map(|(_, o)| o).collect();
+        if let Some(m) = moving {
+            // The figure where the pen is taking it, in place of where it was.
+            if let Some(i) = selection.take() {
+                overlays[i].points = m.points;
+                overlays[i].colour = if m.deleting { DELETING_COLOUR } else { MOVING_COLOUR };
+            }
+        }
+        if let Some(drawn) = ui.drawing() {
+            overlays.push(Overlay {
+                points: drawn.to_vec(),
+                closed: false,
+                colour: DRAWING_COLOUR,
+                width: 3.0,
+                height: None,
+            });
+        }
+        if let Some(p) = ui.pen() {
+            let ground = view.to_ground(p.u_mm, p.v_mm);
+            overlays.push(dot(ground, None, PEN_COLOUR, 4.0));
+            if p.h_mm > 1.0 {
+                overlays.push(dot(ground, Some(view.height_at(p.h_mm)), PEN_COLOUR, 7.0));
+            }
+        }
+        let slope_bar = ui.slope_bar(doc).map(|(value, min, max)| SlopeBar {
+            value,
+            min,
+            max,
+            label: "slope".into(),
+        });
+        Picture {
+            overlays,
+            selection,
+            slope_bar,
+            mode,
+            camera: camera(view, look.head_m),
+            vertical_scale: view.exaggeration as f32,
+            look: look.clone(),
+        }
+    }
+
+    /// The same content seen from an orbit camera over the whole grid (`extent`, metres), without
+    /// the text and the slope bar: the overview shown beside the display's view, where heights
+    /// read at a glance.
+    pub fn overview(&self, extent: [f64; 2]) -> Picture {
+        self.orbit(Camera::overview(extent, 30f64.to_radians(), 35f64.to_radians()))
+    }
+
+    /// The same content from straight above, north up: a map.
+    pub fn map(&self, extent: [f64; 2]) -> Picture {
+        self.orbit(Camera::overview(extent, 0.0, 89f64.to_radians()))
+    }
+
+    fn orbit(&self, camera: Camera) -> Picture {
+        Picture {
+            mode: String::new(),
+            slope_bar: None,
+            camera,
+            look: Look {
+                stereo: Stereo::None,
+                ..self.look.clone()
+            },
+            ..self.clone()
+        }
+    }
+
+    /// The overlays drawn.
+    pub fn overlays(&self) -> &[Overlay] {
+        &self.overlays
+    }
+
+    /// The highlighted overlay's index.
+    pub fn selection(&self) -> Option<usize> {
+        self.selection
+    }
+
+    /// The scene of `terrain` with this picture's content.
+    pub fn scene<'a>(&'a self, terrain: &'a Heightmap) -> Scene<'a> {
+        Scene {
+            terrain,
+            vertical_scale: self.vertical_scale,
+            overlays: &self.overlays,
+            selection: self.selection,
+            slope_bar: self.slope_bar.clone(),
+            mode: &self.mode,
+            camera: self.camera,
+            stereo: self.look.stereo,
+            style: self.look.style.clone(),
+        }
+    }
+}

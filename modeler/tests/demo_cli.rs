@@ -1,0 +1,162 @@
+//! `penmodel` with no arguments and no display: the built-in demo, headless, writes its frames,
+//! animation, terrain and document — the README's main job, run in CI.
+
+use std::path::Path;
+use std::process::Command;
+
+use serde_json::Value;
+
+fn run(dir: &Path, extra: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_penmodel"))
+        .current_dir(dir)
+        .args(extra)
+        // No display: the session goes to files. No pend: the demo.
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env("XDG_RUNTIME_DIR", dir)
+        .output()
+        .expect("penmodel runs")
+}
+
+fn png_size(path: &Path) -> (u32, u32) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{} is a PNG", path.display());
+    let be = |i: usize| u32::from_be_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+    (be(16), be(20))
+}
+
+#[test]
+fn the_demo_runs_headless_and_writes_its_results() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // Small frames, few of them: the debug build renders slowly.
+    let out = run(dir.path(), &["--size", "320x180", "--fps", "1", "--json"]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "exit {:?}\n{stderr}", out.status);
+    assert!(
+        stderr.contains("no display") || stderr.contains("pen from sim"),
+        "{stderr}"
+    );
+    let summary: Value = serde_json::from_slice(&out.stdout).expect("one JSON object on stdout");
+    assert_eq!(summary["source"], "sim");
+    assert!(
+        summary["state"]
+            .as_str()
+            .is_some_and(|s| s.contains("over (0 reports lost)")),
+        "{summary}"
+    );
+    let stats = &summary["stats"];
+    assert_eq!(
+        (
+            &stats["regions"],
+            &stats["figures"],
+            &stats["pulls"],
+            &stats["undos"],
+            &stats["refused"]
+        ),
+        (
+            &Value::from(1),
+            &Value::from(6),
+            &Value::from(6),
+            &Value::from(2),
+            &Value::from(0)
+        ),
+        "{summary}"
+    );
+
+    let out_dir = dir.path().join("out");
+    // Frames of the display's view with the overview column beside it, and their animation.
+    let frames = summary["frames"].as_u64().expect("frame count");
+    assert!(
+        frames >= 20,
+        "{frames} frames at 1 per second of a session over 20 s long"
+    );
+    assert_eq!(png_size(&out_dir.join("frames/frame_00000.png")), (480, 180));
+    assert_eq!(png_size(&out_dir.join("frames/animation.png")), (480, 180));
+    // The terrain: 16-bit heightmap, float32, meshes, renders; the document.
+    assert_eq!(png_size(&out_dir.join("terrain.png")), (480, 272));
+    let raw = std::fs::metadata(out_dir.join("terrain.f32"))
+        .expect("terrain.f32")
+        .len();
+    assert_eq!(raw, 480 * 272 * 4);
+    for name in ["terrain.obj", "terrain.glb", "render.png", "display.png"] {
+        assert!(out_dir.join(name).exists(), "{name}");
+    }
+    let doc = penmodel::Document::load(&out_dir.join("document.json")).expect("a valid document");
+    assert_eq!(doc.regions.len(), 1);
+    assert_eq!(
+        doc.regions[0].figures.len(),
+        4,
+        "two peaks, a ridge, a plateau (the mistake undone)"
+    );
+    assert_eq!(doc.regions[0].figures[3].figures.len(), 1, "the plateau's peak");
+    let hi = summary["heights_m"][1].as_f64().expect("highest");
+    assert!(
+        (1000.0..1200.0).contains(&hi),
+        "the plateau's peak, pulled 110 mm at 1:10 000: {hi} m"
+    );
+
+    // Run again: the demo's own outputs are replaced, nothing refuses.
+    let again = run(dir.path(), &["--size", "160x90", "--fps", "1", "--no-overview"]);
+    assert!(again.status.success(), "{}", String::from_utf8_lossy(&again.stderr));
+    assert!(String::from_utf8_lossy(&again.stdout).contains("wrote"));
+    assert_eq!(png_size(&out_dir.join("frames/frame_00000.png")), (160, 90));
+
+    // Continue the document: the demo's pen draws on it. Its region overlaps the one there and
+    // is refused (counted, told); its figures land in the existing region; nothing is lost.
+    let before = penmodel::Document::load(&out_dir.join("document.json")).expect("valid");
+    let open = run(
+        dir.path(),
+        &[
+            "open",
+            "out/document.json",
+            "--out",
+            "more",
+            "--size",
+            "160x90",
+            "--fps",
+            "1",
+            "--json",
+        ],
+    );
+    let stderr = String::from_utf8_lossy(&open.stderr);
+    assert!(open.status.success(), "{stderr}");
+    assert!(stderr.contains("refused"), "{stderr}");
+    let summary: Value = serde_json::from_slice(&open.stdout).expect("JSON");
+    assert!(
+        summary["stats"]["refused"].as_u64().is_some_and(|n| n >= 1),
+        "{summary}"
+    );
+    let after = penmodel::Document::load(&out_dir.join("document.json")).expect("saved in place");
+    assert_eq!(after.regions.len(), 1);
+    assert_eq!(after.regions[0].boundary, before.regions[0].boundary);
+    assert!(
+        after.regions[0].figures.len() > before.regions[0].figures.len(),
+        "{summary}"
+    );
+}
+
+#[test]
+fn a_real_session_never_overwrites_a_document() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::create_dir(dir.path().join("out")).expect("out");
+    std::fs::write(dir.path().join("out/document.json"), "{}").expect("a file");
+    let out = run(dir.path(), &["--source", "serial:/dev/null/nothing"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("exists") && stderr.contains("penmodel open"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("out/document.json")).expect("kept"),
+        "{}"
+    );
+    // A source that is not one is a usage error with the choices.
+    let bad = run(dir.path(), &["--source", "carrier-pigeon"]);
+    assert_eq!(bad.status.code(), Some(2));
+    assert!(
+        String::from_utf8_lossy(&bad.stderr).contains("sim, daemon"),
+        "{}",
+        String::from_utf8_lossy(&bad.stderr)
+    );
+}
