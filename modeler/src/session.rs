@@ -87,7 +87,9 @@ impl Session {
     /// Handles one pen event.
     pub fn event(&mut self, e: &PenEvent) {
         self.events += 1;
-        self.last_event_us = Some(e.seq.map_or(e.t_us, |(_, d)| d));
+        if let Some((_, device_us)) = e.seq {
+            self.last_event_us = Some(device_us);
+        }
         self.interaction.handle(&mut self.editor, e);
     }
 
@@ -106,7 +108,8 @@ impl Session {
         self.events
     }
 
-    /// The time of the last event, µs (device clock when known).
+    /// The device-clock time of the last event from a report, µs (it restarts when a device
+    /// is reattached).
     pub fn last_event_us(&self) -> Option<u64> {
         self.last_event_us
     }

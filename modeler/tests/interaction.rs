@@ -353,9 +353,10 @@ fn losing_the_pen_mid_pull_cancels_the_pull_and_keeps_the_document() {
     assert_eq!(pen.editor.heightmap(), &generate(&before).unwrap());
     assert!(!pen.editor.can_redo());
     assert!(pen.ui.take_messages().iter().any(|m| m.contains("pen lost")));
-    // The pen comes back and the session goes on.
+    // The pen comes back and the session goes on. The notice carries the host's clock (µs since
+    // 1970), which must not upset the device-clock timing of what follows.
     let mut out = Vec::new();
-    pen.detector.on_device_found(pen.t_us, "sim", &mut out);
+    pen.detector.on_device_found(1_763_700_000_000_000, "sim", &mut out);
     for ev in &out {
         pen.ui.handle(&mut pen.editor, ev);
     }
@@ -363,4 +364,9 @@ fn losing_the_pen_mid_pull_cancels_the_pull_and_keeps_the_document() {
     pen.grab(150.0, 200.0).pull_to(50.0).let_go();
     let h = FigurePath::new(0, 0).get(pen.doc()).unwrap().height;
     assert!((h - pen.view().height_at(50.0)).abs() < 1e-9);
+    // A click is still a click, and the ground has tilted back.
+    pen.hover(300.0, 320.0).hold(1.5).click(2);
+    assert_eq!(pen.ui.stats().undos, 1);
+    assert_eq!(pen.doc(), &before);
+    assert!(pen.ui.view().tilt < 0.01, "tilt {}", pen.ui.view().tilt);
 }

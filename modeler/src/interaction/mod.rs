@@ -15,7 +15,8 @@
 //! | SW3 held, move (nothing drawn or grabbed) | pans the ground with the pen; up and down zooms |
 //!
 //! [`Command`]s give the same edits to a keyboard or a script. Times come from the device clock
-//! when the event carries it (a click is timed the same at any replay speed), else the host's.
+//! that reports carry (a click is timed the same at any replay speed); events that are not from
+//! a report (device found or lost) do not move it.
 //! A refused edit is a message and a count, never a lost document: the editor keeps it valid.
 
 pub mod pick;
@@ -208,9 +209,10 @@ pub struct Interaction {
     last_message: Option<(u64, String)>,
 }
 
-/// The event's time, µs: the device's clock if the event carries it.
-fn event_time(ev: &PenEvent) -> u64 {
-    ev.seq.map_or(ev.t_us, |(_, device_us)| device_us)
+/// The event's time on the device's clock, µs; `None` for events not from a report (device
+/// found or lost, missed), which carry only the host's clock.
+fn event_time(ev: &PenEvent) -> Option<u64> {
+    ev.seq.map(|(_, device_us)| device_us)
 }
 
 fn plus(a: Point, b: Point) -> Point {
@@ -397,9 +399,13 @@ impl Interaction {
     }
 
     /// Eases the ground's tilt towards its target up to time `t_us`.
+    /// A clock that goes back (a device reattached starts its own again) restarts the easing.
     pub fn advance(&mut self, t_us: u64) {
-        let dt = self.last_t.map_or(0, |last| t_us.saturating_sub(last)) as f64 * 1e-6;
-        self.last_t = Some(self.last_t.map_or(t_us, |last| last.max(t_us)));
+        let dt = match self.last_t {
+            Some(last) if t_us >= last => (t_us - last) as f64 * 1e-6,
+            _ => 0.0,
+        };
+        self.last_t = Some(t_us);
         let target = if self.pulling() { self.settings.pull_tilt } else { 0.0 };
         let k = 1.0 - (-dt / self.settings.tilt_time_s).exp();
         self.view.tilt += (target - self.view.tilt) * k;
@@ -407,7 +413,9 @@ impl Interaction {
 
     /// Handles one pen event.
     pub fn handle(&mut self, editor: &mut Editor, ev: &PenEvent) {
-        self.advance(event_time(ev));
+        if let Some(t) = event_time(ev) {
+            self.advance(t);
+        }
         if let Some(p) = ev.point {
             self.pen = Some(p);
         }

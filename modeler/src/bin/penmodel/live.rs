@@ -396,6 +396,10 @@ fn run_headless(
         say(messages, Some(&progress));
         if let Some(t) = session.last_event_us() {
             progress.set_position(t / 1000);
+            // A reattached device restarts its clock: so do the frames.
+            if next_us.is_some_and(|due| t + step_us < due) {
+                next_us = None;
+            }
             let due = *next_us.get_or_insert(t);
             if t >= due {
                 frames.push(painter.session(session, look)?)?;
