@@ -216,6 +216,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
             "source": source_name,
             "state": state,
             "events": session.events(),
+            "device_seconds": session.last_event_us().map(|t| t as f64 * 1e-6),
             "document": doc_path,
             "frames": written.frames,
             "animation": written.animation,
