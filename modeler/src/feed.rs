@@ -163,13 +163,18 @@ fn run_demo(tx: &SyncSender<Feed>, speed: f64, seed: u64) -> Result<(), Stop> {
     }));
     attach(&mut device, Duration::from_secs(5)).map_err(failed("the simulated pen"))?;
     prepare(&mut device).map_err(failed("calibration"))?;
-    send(tx, Feed::Status("calibrating: the pen touches 9 targets".into()))?;
+    send(
+        tx,
+        Feed::Status(format!("calibrating: the pen touches {} targets", targets.len())),
+    )?;
     let mut closed = false;
+    let mut taken = 0;
+    let count = targets.len();
     let touched = collect_touches(&mut device, &targets, Duration::from_secs(60), |step| {
         if let Step::Taken { fixes, .. } = step {
-            closed |= tx
-                .send(Feed::Status(format!("calibrating: target taken ({fixes} fixes)")))
-                .is_err();
+            taken += 1;
+            let line = format!("calibrating: target {taken} of {count} taken ({fixes} fixes)");
+            closed |= tx.send(Feed::Status(line)).is_err();
         }
     })
     .map_err(failed("calibration"))?;
@@ -182,7 +187,7 @@ fn run_demo(tx: &SyncSender<Feed>, speed: f64, seed: u64) -> Result<(), Stop> {
     send(
         tx,
         Feed::Status(format!(
-            "calibrated over 9 targets: RMS {:.2} mm, worst {:.2} mm",
+            "calibrated over {count} targets: RMS {:.2} mm, worst {:.2} mm",
             calibration.rms_mm(),
             calibration.max_mm()
         )),

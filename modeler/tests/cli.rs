@@ -1,4 +1,4 @@
-//! `penmodel generate` end to end: outputs, exit codes and messages.
+//! `penmodel generate`, `render` and `bench` end to end: outputs, exit codes and messages.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -85,7 +85,10 @@ fn usage_errors_exit_2() {
         Some(2)
     );
     assert_eq!(penmodel(&["frobnicate"]).status.code(), Some(2));
-    assert_eq!(penmodel(&[]).status.code(), Some(2));
+    // Without a subcommand penmodel models with the pen (tests/demo_cli.rs); its options are
+    // checked like any others.
+    assert_eq!(penmodel(&["--fps", "0"]).status.code(), Some(2));
+    assert_eq!(penmodel(&["--show", "sideways"]).status.code(), Some(2));
     let help = penmodel(&["generate", "--help"]);
     assert!(help.status.success());
     assert!(String::from_utf8_lossy(&help.stdout).contains("--raw <OUT.f32>"));
