@@ -36,6 +36,31 @@ pub fn on_segment(a: Point, b: Point, p: Point) -> bool {
     orient(a, b, p) == 0.0 && within(a, b, p)
 }
 
+/// Distance between two points.
+pub fn distance(a: Point, b: Point) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
+}
+
+/// Distance from `p` to the closed segment `a b`.
+pub fn segment_distance(a: Point, b: Point, p: Point) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let len2 = d[0] * d[0] + d[1] * d[1];
+    if len2 == 0.0 {
+        return distance(a, p);
+    }
+    let t = (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / len2).clamp(0.0, 1.0);
+    distance([a[0] + t * d[0], a[1] + t * d[1]], p)
+}
+
+/// Distance from `p` to the line through `a` and `b` (to `a` if they coincide).
+pub fn line_offset(a: Point, b: Point, p: Point) -> f64 {
+    let len = distance(a, b);
+    if len == 0.0 {
+        return distance(a, p);
+    }
+    orient(a, b, p).abs() / len
+}
+
 /// Where `p` is relative to the closed polygon `ring` (first point repeated at the end).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Side {

@@ -27,9 +27,10 @@ use pen_host::events::{DisplayPoint, EventKind, PenEvent};
 
 use crate::document::{Document, Figure, FigureKind, Point, Region};
 use crate::edit::Edit;
-use crate::editor::Editor;
+use crate::editor::{Editor, EditorError};
 use crate::geometry::{Side, locate};
 use crate::path::CurvePath;
+use crate::terrain::Outcome;
 
 pub use pick::Hit;
 pub use stroke::{Shape, Tolerances};
@@ -824,27 +825,36 @@ impl Interaction {
     }
 
     fn undo(&mut self, editor: &mut Editor) {
-        match editor.undo() {
-            Ok(Some(_)) => {
-                self.stats.undos += 1;
-                self.say("undone".into());
-            }
-            Ok(None) => self.say("nothing to undo".into()),
-            Err(e) => self.say(format!("cannot undo: {e}")),
+        let result = editor.undo();
+        if self.history(result, "undo", "undone") {
+            self.stats.undos += 1;
         }
-        self.hover = None;
     }
 
     fn redo(&mut self, editor: &mut Editor) {
-        match editor.redo() {
-            Ok(Some(_)) => {
-                self.stats.redos += 1;
-                self.say("redone".into());
-            }
-            Ok(None) => self.say("nothing to redo".into()),
-            Err(e) => self.say(format!("cannot redo: {e}")),
+        let result = editor.redo();
+        if self.history(result, "redo", "redone") {
+            self.stats.redos += 1;
         }
+    }
+
+    /// Tells what an undo or redo did; whether it did something.
+    fn history(&mut self, result: Result<Option<Outcome>, EditorError>, verb: &str, done: &str) -> bool {
         self.hover = None;
+        match result {
+            Ok(Some(_)) => {
+                self.say(done.into());
+                true
+            }
+            Ok(None) => {
+                self.say(format!("nothing to {verb}"));
+                false
+            }
+            Err(e) => {
+                self.say(format!("cannot {verb}: {e}"));
+                false
+            }
+        }
     }
 
     /// Ends the figure being drawn: classifies it and adds it where it belongs.

@@ -6,7 +6,7 @@
 //! the nearest line or point wins; failing that, the innermost closed curve around the tip.
 
 use crate::document::{Document, Figure, FigureKind, Point};
-use crate::geometry::{Side, locate};
+use crate::geometry::{Side, distance, locate, segment_distance};
 use crate::path::{CurvePath, FigurePath};
 
 /// A picked curve, and its vertex under the tip if there is one.
@@ -17,21 +17,6 @@ pub struct Hit {
     /// Its vertex within the tolerance of the tip (vertex indices leave out a closed curve's
     /// repeated last point).
     pub vertex: Option<usize>,
-}
-
-fn distance(a: Point, b: Point) -> f64 {
-    (a[0] - b[0]).hypot(a[1] - b[1])
-}
-
-/// Distance from `p` to the segment `a b`.
-fn segment_distance(a: Point, b: Point, p: Point) -> f64 {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let len2 = d[0] * d[0] + d[1] * d[1];
-    if len2 == 0.0 {
-        return distance(a, p);
-    }
-    let t = (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / len2).clamp(0.0, 1.0);
-    distance([a[0] + t * d[0], a[1] + t * d[1]], p)
 }
 
 /// Distance from `p` to a polyline (or a single point).

@@ -17,7 +17,7 @@
 //! wobbles across its start is untangled: small loops are cut off.
 
 use crate::document::{FigureKind, Point};
-use crate::geometry::segments_touch;
+use crate::geometry::{distance, line_offset, segments_touch};
 
 /// The tolerances of turning strokes into figures, in ground metres.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -37,19 +37,6 @@ pub struct Shape {
     pub kind: FigureKind,
     /// Its points; a closed curve repeats its first point at the end.
     pub points: Vec<Point>,
-}
-
-fn distance(a: Point, b: Point) -> f64 {
-    (a[0] - b[0]).hypot(a[1] - b[1])
-}
-
-/// Distance from `p` to the line through `a` and `b` (to `a` if they coincide).
-fn line_offset(a: Point, b: Point, p: Point) -> f64 {
-    let len = distance(a, b);
-    if len == 0.0 {
-        return distance(a, p);
-    }
-    ((b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0])).abs() / len
 }
 
 /// Douglas–Peucker: the indices of the points to keep so that every dropped one lies within

@@ -68,6 +68,16 @@ pub struct RenderStats {
     pub skipped_vertices: usize,
 }
 
+/// The bounds of the whole frame.
+fn whole(frame: &Frame) -> Bounds {
+    Bounds {
+        x0: 0,
+        x1: frame.width() as i32,
+        y0: 0,
+        y1: frame.height() as i32,
+    }
+}
+
 /// Rows per tile unless set otherwise ([`Renderer::with_tile_rows`]). Taller tiles set up fewer
 /// triangles twice (a 512² frame: 8 rows 343M instructions, 16 rows 303M, 32 rows 294M, 48 rows
 /// 291M); 32 still gives 23 tiles to balance over two cores.
@@ -115,12 +125,7 @@ impl Renderer {
     pub fn render(&mut self, scene: &Scene, frame: &mut Frame) -> Result<RenderStats, RenderError> {
         scene.camera.check()?;
         let stats = self.prepare(scene);
-        let full = Bounds {
-            x0: 0,
-            x1: frame.width() as i32,
-            y0: 0,
-            y1: frame.height() as i32,
-        };
+        let full = whole(frame);
         match scene.stereo {
             Stereo::None => {
                 self.eye(scene, Eye::Centre, full, frame);
@@ -158,12 +163,7 @@ impl Renderer {
     pub fn render_eye(&mut self, scene: &Scene, eye: Eye, frame: &mut Frame) -> Result<RenderStats, RenderError> {
         scene.camera.check()?;
         let stats = self.prepare(scene);
-        let full = Bounds {
-            x0: 0,
-            x1: frame.width() as i32,
-            y0: 0,
-            y1: frame.height() as i32,
-        };
+        let full = whole(frame);
         self.eye(scene, eye, full, frame);
         self.ui(scene, full, frame);
         Ok(stats)
