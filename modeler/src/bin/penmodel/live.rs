@@ -94,6 +94,8 @@ fn source(s: &str) -> Result<String, String> {
 struct Written {
     frames: usize,
     animation: Option<PathBuf>,
+    /// The frames were shown in a window, not written.
+    shown: bool,
 }
 
 fn default_source() -> String {
@@ -219,6 +221,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
             "device_seconds": session.last_event_us().map(|t| t as f64 * 1e-6),
             "document": doc_path,
             "frames": written.frames,
+            "frames_shown_in_window": written.shown,
             "animation": written.animation,
             "results": results,
             "heights_m": [lo, hi],
@@ -244,9 +247,13 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
             .animation
             .map(|p| format!(" and {}", p.display()))
             .unwrap_or_default();
+        let frames = if written.shown {
+            format!("showed {} frames; wrote", written.frames)
+        } else {
+            format!("wrote {} frames{anim},", written.frames)
+        };
         println!(
-            "wrote {} frames{anim}, the terrain, its render and the document to {}/ (document: {})",
-            written.frames,
+            "{frames} the terrain, its render and the document to {}/ (document: {})",
             args.out.display(),
             doc_path.display()
         );
@@ -418,6 +425,7 @@ fn run_headless(
     Ok(Written {
         frames: count,
         animation,
+        shown: false,
     })
 }
 
@@ -523,6 +531,7 @@ fn run_window(
     Ok(Written {
         frames,
         animation: None,
+        shown: true,
     })
 }
 
