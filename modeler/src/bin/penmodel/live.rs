@@ -169,7 +169,10 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
         signal_hook::flag::register(signal, stop.clone()).context("installing signal handlers")?;
     }
     let demo_us = demo.then(|| (feed::demo_scenario().0.timeline.duration_s() * 1e6) as u64);
-    let (rx, thread) = feed::spawn(source, 256);
+    // The pen thread is not joined: it notices the closed channel only at its next message, and
+    // a silent pen (pend without a device, a base station unplugged) sends none. It ends with
+    // the process; it holds nothing that needs closing beyond what the process's end closes.
+    let (rx, _thread) = feed::spawn(source, 256);
     eprintln!("penmodel: pen from {source_name}");
 
     let viewer = if window_wanted {
@@ -198,8 +201,6 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
         None => run_headless(args, &rx, &mut session, &look, &mut painter, &stop, demo_us)?,
     };
     drop(rx);
-    // The pen thread notices the closed channel at its next message.
-    let _ = thread.join();
 
     session
         .editor
@@ -340,7 +341,10 @@ impl Painter {
         let (w, h) = (self.view.width(), self.view.height());
         match self.overview {
             Overview::Corner => {
-                let (x, y) = (w - self.inset.width() - 8, h - self.inset.height() - 8);
+                let margin = 8.min(w / 8).min(h / 8) + 1;
+                // At least 1 from the edge, for the border; blit clips what does not fit.
+                let x = w.saturating_sub(self.inset.width() + margin).max(1);
+                let y = h.saturating_sub(self.inset.height() + margin).max(1);
                 let mut border = Frame::new(self.inset.width() + 2, self.inset.height() + 2)?;
                 border.pixels_mut().fill([255, 255, 255, 255]);
                 self.frame.blit(&border, x - 1, y - 1);
@@ -578,4 +582,29 @@ fn write_results(out: &Path, session: &Session, look: &Look, painter: &mut Paint
         "heightmap_png": png, "heightmap_f32": raw, "mesh_obj": obj, "mesh_glb": glb,
         "render": render, "display": display,
     }))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use penmodel::interaction::View;
+
+    #[test]
+    fn every_layout_draws_at_any_size() {
+        let doc = blank_document();
+        let map = penmodel::generate(&doc).expect("valid");
+        let view = View::fit([600.0, 340.0], &doc.grid);
+        let picture = Picture::document(&doc, &view, "test".into(), &Look::default());
+        for (w, h) in [(1, 1), (8, 8), (33, 20), (320, 180)] {
+            for (overview, width) in [
+                (Overview::Off, w),
+                (Overview::Corner, w),
+                (Overview::Beside, w + (w / 2).max(1)),
+            ] {
+                let mut painter = Painter::new(w, h, overview).expect("painter");
+                let frame = painter.draw(&picture, &map).expect("drawn");
+                assert_eq!((frame.width(), frame.height()), (width, h));
+            }
+        }
+    }
 }
