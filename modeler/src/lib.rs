@@ -1,4 +1,4 @@
-//! The terrain modeler driven by the 3D pen: seed 000's modeling engine.
+//! The terrain modeler driven by the 3D pen: seed 000's modeling engine and its pen interaction.
 //!
 //! - [`Document`]: the source of truth — a grid, generation regions, and control figures (points,
 //!   polylines, closed curves) with heights and slopes, nested to any depth. Saved as versioned
@@ -9,8 +9,14 @@
 //! - [`Editor`]: edits ([`Edit`]) with undo and redo, and a journal that survives a crash
 //!   ([`journal`]).
 //! - [`export`]: 16-bit PNG heightmaps, raw float32, OBJ and binary glTF meshes.
+//! - [`interaction`]: the seed's pen operations (section 3.2) as a state machine over pen
+//!   events — draw, end with SW3, highlight, grab, pull, slope, move, delete, undo, pan and zoom
+//!   (`docs/modeler.md`).
+//! - [`feed`] and [`session`]: pen events from the built-in demo, `pend` or a device, on a thread
+//!   of their own, into an editor; [`picture`]: what a frame of the session shows.
 //! - [`render`]: the CPU rasteriser — camera, clipping, depth-buffered triangles, elevation
-//!   ramp with lighting, overlays, slope bar and mode text, stereo.
+//!   ramp with lighting, overlays, slope bar and mode text, stereo; [`output`]: PNG frames, their
+//!   animation, a window.
 //! - [`baseline`]: the seed's own repeat-until-stable distance maps, the reference for tests and
 //!   benchmarks.
 #![cfg_attr(not(test), warn(clippy::unwrap_used))]
