@@ -1,7 +1,7 @@
 //! Validation of a document, with errors that name the element and the reason.
 //!
 //! A document is valid when:
-//! - its version is [`VERSION`](crate::document::VERSION), the grid has at least one cell, a
+//! - its version is [`VERSION`], the grid has at least one cell, a
 //!   positive finite cell size and at most [`MAX_CELLS`] cells;
 //! - every number is finite and every point lies on the grid (`0 ≤ x < cols·s`, `0 ≤ y < rows·s`);
 //! - a point figure has one point, a polyline at least two, and no point repeats the one before;
