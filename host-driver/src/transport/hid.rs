@@ -112,13 +112,7 @@ impl Transport for HidTransport {
         self.device
             .send_feature_report(&buf[..n])
             .map_err(|e| TransportError::Disconnected(e.to_string()))?;
-        match self.get_feature(ReportId::Status)? {
-            Message::Status(s) => Ok(s),
-            other => Err(TransportError::Unexpected(format!(
-                "{:?} report instead of the status",
-                other.id()
-            ))),
-        }
+        super::expect_status(self.get_feature(ReportId::Status)?)
     }
 
     fn dropped(&self) -> u64 {

@@ -11,6 +11,17 @@ use std::time::Duration;
 use pen_protocol::{DecodeError, Message, ReportId, Status};
 use thiserror::Error;
 
+/// The status a set-feature request is answered with; any other report is unexpected.
+pub fn expect_status(answer: Message) -> Result<Status, TransportError> {
+    match answer {
+        Message::Status(s) => Ok(s),
+        other => Err(TransportError::Unexpected(format!(
+            "{:?} report instead of the status",
+            other.id()
+        ))),
+    }
+}
+
 /// Why a transport call failed.
 #[derive(Debug, Error)]
 pub enum TransportError {

@@ -129,13 +129,7 @@ impl Transport for SerialTransport {
     fn set_feature(&mut self, report: &Message) -> Result<Status, TransportError> {
         self.answers.clear();
         self.send(report)?;
-        match self.answer("set-feature", |m| matches!(m, Message::Status(_)))? {
-            Message::Status(s) => Ok(s),
-            other => Err(TransportError::Unexpected(format!(
-                "{:?} report instead of the status",
-                other.id()
-            ))),
-        }
+        super::expect_status(self.answer("set-feature", |m| matches!(m, Message::Status(_)))?)
     }
 
     fn dropped(&self) -> u64 {

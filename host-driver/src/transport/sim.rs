@@ -140,12 +140,6 @@ impl Transport for SimTransport {
     }
 
     fn set_feature(&mut self, report: &Message) -> Result<Status, TransportError> {
-        match self.request(report)? {
-            Message::Status(s) => Ok(s),
-            other => Err(TransportError::Unexpected(format!(
-                "{:?} report instead of the status",
-                other.id()
-            ))),
-        }
+        super::expect_status(self.request(report)?)
     }
 }
