@@ -13,7 +13,7 @@ source scripts/setup.sh
 echo "firmware: firmware/target/thumbv7em-none-eabihf/release/pen-firmware"
 scripts/firmware-size.sh
 
-cargo build --release --locked -q -p penmodel -p pen-host -p pen-sim
+cargo build --release --locked -q -p penmodel -p pen-host -p pen-hil
 echo
 echo "penmodel: the built-in demo (the simulated pen, calibrated, modeling the seed's session)"
 target/release/penmodel "$@"

@@ -7,8 +7,8 @@ use pen_core::capture::{FAST_TIMER_HZ, SLOW_TIMER_HZ};
 use pen_protocol::{PenReport, Report, ReportId};
 use serde::Serialize;
 
-use crate::script::SwitchEvent;
-use crate::sim::{CycleRecord, Scenario};
+use pen_sim::script::SwitchEvent;
+use pen_sim::sim::{CycleRecord, Scenario};
 
 /// A reported switch transition matches an intended one this soon after it, s.
 pub const SWITCH_MATCH_WINDOW_S: f64 = 0.020;

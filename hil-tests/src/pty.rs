@@ -16,7 +16,7 @@ use pen_protocol::{FrameDecoder, MAX_FRAME, MAX_PAYLOAD, encode_frame};
 use serialport::{SerialPort, TTYPort};
 use thiserror::Error;
 
-use crate::sim::{MemoryStore, Scenario, Sent, Simulation};
+use pen_sim::sim::{MemoryStore, Scenario, Sent, Simulation};
 
 /// Bytes the host may leave unread before new reports are dropped rather than queued: a host
 /// that stops reading should find fresh reports when it resumes, as with real hardware.

@@ -19,7 +19,7 @@ use std::time::{Duration, Instant};
 use pen_protocol::{Config, Report};
 use thiserror::Error;
 
-use crate::sim::{CycleRecord, Sent};
+use pen_sim::sim::{CycleRecord, Sent};
 
 /// Why the emulated run failed.
 #[derive(Debug, Error)]

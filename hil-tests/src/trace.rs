@@ -4,7 +4,7 @@
 use pen_core::NoFix;
 use serde_json::{Value, json};
 
-use crate::sim::{CycleRecord, Simulation};
+use pen_sim::sim::{CycleRecord, Simulation};
 
 fn round(v: f64, decimals: i32) -> f64 {
     let f = 10f64.powi(decimals);

@@ -3,8 +3,8 @@
 //! accuracy, switch events, graceful degradation and sequence continuity.
 
 use glam::DVec3;
+use pen_hil::accuracy::{self, Metrics};
 use pen_protocol::{Message, PenReport, Report};
-use pen_sim::accuracy::{self, Metrics};
 use pen_sim::{CycleRecord, Simulation, scenarios};
 
 fn run(name: &str, seed: u64) -> (pen_sim::Scenario, Vec<CycleRecord>) {

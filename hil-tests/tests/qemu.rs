@@ -5,7 +5,8 @@
 
 use std::time::Duration;
 
-use pen_sim::{Sent, Simulation, qemu, scenarios};
+use pen_hil::qemu;
+use pen_sim::{Sent, Simulation, scenarios};
 
 #[test]
 fn the_emulated_core_sends_the_host_builds_reports() {

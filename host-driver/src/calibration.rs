@@ -574,9 +574,13 @@ impl Calibration {
         Calibration::from_toml(&text, &name)
     }
 
-    /// Writes the calibration file atomically: a temporary file beside it, synced, renamed.
+    /// Writes the calibration file atomically: a temporary file beside it, synced, renamed over
+    /// it, the directory synced; the file keeps the mode and owner of the one it replaces.
     pub fn save(&self, path: &Path) -> std::io::Result<()> {
-        crate::fsutil::write_atomic(path, self.to_toml().as_bytes())
+        use std::io::Write;
+        let mut file = atomic_write_file::AtomicWriteFile::open(path)?;
+        file.write_all(self.to_toml().as_bytes())?;
+        file.commit()
     }
 }
 

@@ -20,7 +20,6 @@ pub mod client;
 pub mod daemon;
 pub mod device;
 pub mod events;
-pub mod fsutil;
 pub mod hex;
 pub mod json;
 pub mod pipeline;

@@ -3,11 +3,12 @@
 //! point of the display lies exactly there — with the document's figures, the highlight, the
 //! figure being drawn or moved, the pen, the slope bar and the mode line.
 
-use crate::document::{Document, Point};
-use crate::heightmap::Heightmap;
+use penmodel_render::{Camera, Overlay, Rgba, Scene, SlopeBar, Stereo, Style, Tracked};
+use penmodel_terrain::Heightmap;
+use penmodel_terrain::document::{Document, Figure, FigureKind, Point};
+use penmodel_terrain::path::{CurvePath, FigurePath};
+
 use crate::interaction::{Interaction, View};
-use crate::path::CurvePath;
-use crate::render::{Camera, Overlay, Rgba, Scene, SlopeBar, Stereo, Style, Tracked, document_overlays_at};
 use crate::session::Session;
 
 /// Colour of the figure being drawn.
@@ -48,7 +49,7 @@ impl Default for Look {
 /// The camera of a view: the display is the screen, the head looks through it.
 pub fn camera(view: &View, head_m: [f64; 3]) -> Camera {
     Camera {
-        view: crate::render::View::Tracked(Tracked {
+        view: penmodel_render::View::Tracked(Tracked {
             display: [view.display_mm[0] * 1e-3, view.display_mm[1] * 1e-3],
             head: head_m,
             eye_separation: 0.063,
@@ -99,7 +100,7 @@ impl Picture {
 
     /// The document alone through `view`: no pen, no highlight, `mode` as the text line.
     pub fn document(doc: &Document, view: &View, mode: String, look: &Look) -> Picture {
-        let overlays = crate::render::document_overlays(doc);
+        let overlays = document_overlays(doc);
         Picture {
             overlays,
             selection: None,
@@ -207,4 +208,51 @@ impl Picture {
             style: self.look.style.clone(),
         }
     }
+}
+
+/// Colour of region boundaries in [`document_overlays`].
+pub const REGION_COLOUR: Rgba = [245, 245, 245, 255];
+/// Colour of control figures in [`document_overlays`].
+pub const FIGURE_COLOUR: Rgba = [220, 40, 40, 255];
+
+/// The document's region boundaries and figures as draped overlays, in document order: for
+/// each region its boundary, then its figures depth first (a closed figure before the figures
+/// nested in it).
+pub fn document_overlays(doc: &Document) -> Vec<Overlay> {
+    document_overlays_at(doc).into_iter().map(|(_, o)| o).collect()
+}
+
+/// [`document_overlays`], each with the curve it draws (to find a selection's index).
+pub fn document_overlays_at(doc: &Document) -> Vec<(CurvePath, Overlay)> {
+    fn figures(list: &[Figure], at: &dyn Fn(usize) -> FigurePath, out: &mut Vec<(CurvePath, Overlay)>) {
+        for (i, f) in list.iter().enumerate() {
+            let path = at(i);
+            out.push((
+                CurvePath::Figure(path.clone()),
+                Overlay {
+                    points: f.points.clone(),
+                    closed: f.kind == FigureKind::Closed,
+                    colour: FIGURE_COLOUR,
+                    width: 3.0,
+                    height: None,
+                },
+            ));
+            figures(&f.figures, &|j| path.child(j), out);
+        }
+    }
+    let mut out = Vec::new();
+    for (r, region) in doc.regions.iter().enumerate() {
+        out.push((
+            CurvePath::Boundary(r),
+            Overlay {
+                points: region.boundary.clone(),
+                closed: true,
+                colour: REGION_COLOUR,
+                width: 2.0,
+                height: None,
+            },
+        ));
+        figures(&region.figures, &|i| FigurePath::new(r, i), &mut out);
+    }
+    out
 }

@@ -2,10 +2,10 @@
 
 use pen_host::events::PenEvent;
 
-use crate::document::{Document, Grid};
-use crate::editor::Editor;
 use crate::feed::Feed;
 use crate::interaction::{Interaction, Settings, View};
+use penmodel_terrain::document::{Document, Grid};
+use penmodel_terrain::editor::Editor;
 
 /// A new session's document: a 6 × 3.4 km map of 12.5 m cells (480 × 272), which the reference
 /// display (600 × 340 mm) shows at 1:10 000 — a millimetre on the display is 10 m, a cell 1.25 mm.

@@ -79,7 +79,7 @@ fn the_demo_runs_headless_and_writes_its_results() {
     for name in ["terrain.obj", "terrain.glb", "render.png", "display.png"] {
         assert!(out_dir.join(name).exists(), "{name}");
     }
-    let doc = penmodel::Document::load(&out_dir.join("document.json")).expect("a valid document");
+    let doc = penmodel_terrain::Document::load(&out_dir.join("document.json")).expect("a valid document");
     assert_eq!(doc.regions.len(), 1);
     assert_eq!(
         doc.regions[0].figures.len(),
@@ -101,7 +101,7 @@ fn the_demo_runs_headless_and_writes_its_results() {
 
     // Continue the document: the demo's pen draws on it. Its region overlaps the one there and
     // is refused (counted, told); its figures land in the existing region; nothing is lost.
-    let before = penmodel::Document::load(&out_dir.join("document.json")).expect("valid");
+    let before = penmodel_terrain::Document::load(&out_dir.join("document.json")).expect("valid");
     let open = run(
         dir.path(),
         &[
@@ -124,7 +124,7 @@ fn the_demo_runs_headless_and_writes_its_results() {
         summary["stats"]["refused"].as_u64().is_some_and(|n| n >= 1),
         "{summary}"
     );
-    let after = penmodel::Document::load(&out_dir.join("document.json")).expect("saved in place");
+    let after = penmodel_terrain::Document::load(&out_dir.join("document.json")).expect("saved in place");
     assert_eq!(after.regions.len(), 1);
     assert_eq!(after.regions[0].boundary, before.regions[0].boundary);
     assert!(

@@ -11,7 +11,7 @@ use pen_host::events::{EventDetector, PenEvent};
 use pen_host::sample::Sample;
 use pen_protocol::Quality;
 use penmodel::interaction::{Command, Interaction, Settings, View};
-use penmodel::{Document, Editor, FigureKind, FigurePath, Grid, Point, generate};
+use penmodel_terrain::{Document, Editor, FigureKind, FigurePath, Grid, Point, generate};
 
 const HOVER: f64 = 40.0;
 const CYCLE_US: u64 = 6_500;

@@ -1,7 +1,7 @@
 //! The report descriptor, parsed by an independent parser (hidreport, from the hid-tools
 //! maintainers), against the report codecs: every field's offset and size, every report's length.
 
-mod common;
+use crate::common;
 
 use common::*;
 use hidreport::{Field, Report as HidReport, ReportDescriptor, VariableField};

@@ -1,7 +1,7 @@
 //! docs/protocol.md's generated sections match the code. Run with `PEN_UPDATE_DOCS=1` to rewrite
 //! them after a deliberate protocol change.
 
-mod common;
+use crate::common;
 
 use common::*;
 use hidreport::{Field, Report as HidReport, ReportDescriptor, VariableField};

@@ -1,6 +1,6 @@
 //! Truncated, oversized and corrupt input is rejected with the error that says what is wrong.
 
-mod common;
+use crate::common;
 
 use common::*;
 use pen_protocol::*;

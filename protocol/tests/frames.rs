@@ -1,7 +1,7 @@
 //! The serial framing: every intact frame survives garbage on the line; no corrupted frame is
 //! ever delivered.
 
-mod common;
+use crate::common;
 
 use common::*;
 use pen_protocol::*;

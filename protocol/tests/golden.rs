@@ -2,7 +2,7 @@
 //! docs/protocol.md (the frames' CRCs were checked with Python's zlib.crc32). A change that moves
 //! any of these bytes is a protocol change and bumps the protocol version.
 
-mod common;
+use crate::common;
 
 use common::*;
 use pen_protocol::*;

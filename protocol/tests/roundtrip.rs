@@ -1,6 +1,6 @@
 //! Round trips of every report and message, and decoding of arbitrary bytes.
 
-mod common;
+use crate::common;
 
 use common::*;
 use pen_protocol::*;

@@ -1,7 +1,5 @@
 //! The engine: cycles to reports, switches, configuration requests, serial requests.
 
-mod common;
-
 use pen_core::{Action, ConfigStore, Cycle, Engine, NoFix, StoreError, Vec3, default_config};
 use pen_protocol::*;
 

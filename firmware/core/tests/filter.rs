@@ -1,7 +1,7 @@
 //! The 1€ filter on synthetic holds, steps and ramps: how much jitter it removes and how much
 //! lag it adds, against a fixed low-pass that smooths a resting pen as much.
 
-mod common;
+use crate::common;
 
 use common::Rng;
 use pen_core::filter::{OneEuroParams, Smoother};

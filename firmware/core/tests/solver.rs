@@ -1,6 +1,6 @@
 //! The solver against known geometry.
 
-mod common;
+use crate::common;
 
 use common::*;
 use pen_core::Vec3;

@@ -9,7 +9,8 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use pen_sim::{Simulation, accuracy, pty, qemu, scenarios, trace};
+use pen_hil::{accuracy, pty, qemu, trace};
+use pen_sim::{Simulation, scenarios};
 
 #[derive(Parser)]
 #[command(

@@ -25,12 +25,12 @@ pub mod view;
 
 use pen_host::events::{DisplayPoint, EventKind, PenEvent};
 
-use crate::document::{Document, Figure, FigureKind, Point, Region};
-use crate::edit::Edit;
-use crate::editor::{Editor, EditorError};
-use crate::geometry::{Side, locate};
-use crate::path::CurvePath;
-use crate::terrain::Outcome;
+use penmodel_terrain::document::{Document, Figure, FigureKind, Point, Region};
+use penmodel_terrain::edit::Edit;
+use penmodel_terrain::editor::{Editor, EditorError};
+use penmodel_terrain::geometry::{Side, locate};
+use penmodel_terrain::path::CurvePath;
+use penmodel_terrain::terrain::Outcome;
 
 pub use pick::Hit;
 pub use stroke::{Shape, Tolerances};
@@ -924,7 +924,7 @@ fn deletes(grab: &Grab, doc: &Document) -> bool {
 }
 
 /// A figure's path for the status line: `regions[0].figures[3].figures[1]` is `0.3.1`.
-fn short(at: &crate::path::FigurePath) -> String {
+fn short(at: &penmodel_terrain::path::FigurePath) -> String {
     let mut s = at.region().to_string();
     for i in at.indices() {
         s.push('.');

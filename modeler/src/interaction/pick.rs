@@ -5,9 +5,9 @@
 //! picked only near the line: inside a region is where figures are drawn. When several qualify,
 //! the nearest line or point wins; failing that, the innermost closed curve around the tip.
 
-use crate::document::{Document, Figure, FigureKind, Point};
-use crate::geometry::{Side, distance, locate, segment_distance};
-use crate::path::{CurvePath, FigurePath};
+use penmodel_terrain::document::{Document, Figure, FigureKind, Point};
+use penmodel_terrain::geometry::{Side, distance, locate, segment_distance};
+use penmodel_terrain::path::{CurvePath, FigurePath};
 
 /// A picked curve, and its vertex under the tip if there is one.
 #[derive(Debug, Clone, PartialEq)]
@@ -138,7 +138,7 @@ pub fn base_height(doc: &Document, at: &FigurePath) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::document::{Grid, Region};
+    use penmodel_terrain::document::{Grid, Region};
 
     fn square(x0: f64, y0: f64, side: f64) -> Vec<Point> {
         vec![

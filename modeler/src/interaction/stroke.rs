@@ -16,8 +16,8 @@
 //! corners, as smoothing the positions themselves would. A closed curve whose end overshoots or
 //! wobbles across its start is untangled: small loops are cut off.
 
-use crate::document::{FigureKind, Point};
-use crate::geometry::{distance, line_offset, segments_touch};
+use penmodel_terrain::document::{FigureKind, Point};
+use penmodel_terrain::geometry::{distance, line_offset, segments_touch};
 
 /// The tolerances of turning strokes into figures, in ground metres.
 #[derive(Debug, Clone, Copy, PartialEq)]

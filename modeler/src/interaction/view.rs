@@ -2,7 +2,7 @@
 //! ground plane. A point the pen touches at `(u, v)` on the display is the ground point drawn
 //! there, and a height above the display is a height above the ground.
 
-use crate::document::{Grid, Point};
+use penmodel_terrain::document::{Grid, Point};
 
 /// The display-to-ground mapping, with pan, zoom, the vertical scale and the ground's tilt.
 #[derive(Debug, Clone, Copy, PartialEq)]

@@ -18,8 +18,8 @@ use std::time::Instant;
 
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
-use penmodel::render::{self, Camera, Frame, Renderer, Scene, SlopeBar};
-use penmodel::{Document, Edit, Editor, FigurePath};
+use penmodel_render::{Camera, Frame, Renderer, Scene, SlopeBar};
+use penmodel_terrain::{Document, Edit, Editor, FigurePath};
 
 /// Grid sizes measured.
 const GRIDS: [u32; 3] = [256, 512, 1024];
@@ -80,7 +80,7 @@ struct Figures {
 fn measure(n: u32, bar: &ProgressBar) -> Result<Figures> {
     let doc = document(n)?;
     let extent = [doc.grid.width(), doc.grid.height()];
-    let overlays = render::document_overlays(&doc);
+    let overlays = penmodel::picture::document_overlays(&doc);
     let mut editor = Editor::new(doc)?;
     let peak = FigurePath::new(0, 0);
     let base = editor.document().regions[0].figures[0].height;

@@ -3,8 +3,8 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use penmodel::editor::Editor;
-use penmodel::{Heightmap, export};
+use penmodel_terrain::editor::Editor;
+use penmodel_terrain::{Heightmap, export};
 
 /// Arguments of `penmodel generate`.
 #[derive(clap::Args)]

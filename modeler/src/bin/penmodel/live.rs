@@ -13,14 +13,14 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
-use penmodel::editor::Editor;
 use penmodel::feed::{self, Feed, PenSource};
 use penmodel::interaction::{Command, Settings, View};
-use penmodel::output::{self, Sequence, Viewer, ViewerEvent, WindowError};
 use penmodel::picture::{Look, Picture};
-use penmodel::render::{Frame, Renderer, Stereo};
 use penmodel::session::{Session, State, blank_document};
-use penmodel::{Heightmap, export};
+use penmodel_render::output::{self, Sequence, Viewer, ViewerEvent, WindowError};
+use penmodel_render::{Frame, Renderer, Stereo};
+use penmodel_terrain::editor::Editor;
+use penmodel_terrain::{Heightmap, export};
 use serde_json::json;
 
 use crate::render::{StereoArg, head, size};
@@ -544,7 +544,8 @@ fn write_results(out: &Path, session: &Session, look: &Look, painter: &mut Paint
     let map: &Heightmap = session.editor.heightmap();
     let write = |name: &str, bytes: &[u8]| -> Result<PathBuf> {
         let path = out.join(name);
-        pen_host::fsutil::write_atomic(&path, bytes).with_context(|| format!("cannot write {}", path.display()))?;
+        penmodel_terrain::persist::write_atomic(&path, bytes)
+            .with_context(|| format!("cannot write {}", path.display()))?;
         Ok(path)
     };
     let mut bytes = Vec::new();
@@ -592,7 +593,7 @@ mod tests {
     #[test]
     fn every_layout_draws_at_any_size() {
         let doc = blank_document();
-        let map = penmodel::generate(&doc).expect("valid");
+        let map = penmodel_terrain::generate(&doc).expect("valid");
         let view = View::fit([600.0, 340.0], &doc.grid);
         let picture = Picture::document(&doc, &view, "test".into(), &Look::default());
         for (w, h) in [(1, 1), (8, 8), (33, 20), (320, 180)] {

@@ -4,9 +4,9 @@ use std::path::PathBuf;
 
 use anyhow::{Result, bail};
 use clap::ValueEnum;
-use penmodel::editor::Editor;
-use penmodel::output;
-use penmodel::render::{self, Camera, Frame, Orbit, Renderer, Scene, Stereo, Tracked, View};
+use penmodel_render::output;
+use penmodel_render::{self as render, Camera, Frame, Orbit, Renderer, Scene, Stereo, Tracked, View};
+use penmodel_terrain::editor::Editor;
 
 /// Stereo modes on the command line.
 #[derive(Clone, Copy, ValueEnum)]
@@ -145,7 +145,7 @@ pub fn run(args: &Args) -> Result<()> {
     let overlays = if args.no_overlays {
         Vec::new()
     } else {
-        render::document_overlays(editor.document())
+        penmodel::picture::document_overlays(editor.document())
     };
     let (_, hi) = map.range();
     let mut scene = Scene::new(

@@ -1,0 +1,167 @@
+//! The built-in demo through the whole chain — simulated hand and acoustics, the firmware core,
+//! report bytes, host decoding, the fitted calibration, pen events, the interaction — yields the
+//! terrain of the document built directly from the session's numbers.
+//!
+//! Tolerances, and why: figure outlines within 2 mm on the display of the intended ones
+//! (Hausdorff distance; the pen's error is about 1.3 mm RMS before the fit averages it);
+//! heights within 1.5 mm of pen height (the tracker's accuracy; 15 m at 1:10 000); slopes within
+//! 0.05 (1.25 mm of sideways travel); terrain RMS difference within 2 % of the highest peak.
+//! Measured over seeds 1–8 and 11: outlines within 0.78 mm, heights 0.76 mm, slopes 0.024,
+//! terrain RMS 0.30–0.40 % of the 1100 m peak.
+
+use pen_sim::session::{Drawn, Step, steps};
+use penmodel::feed::{Feed, PenSource, spawn};
+use penmodel::interaction::pick::line_distance;
+use penmodel::interaction::{Settings, View};
+use penmodel::session::{Session, State, blank_document};
+use penmodel_terrain::{Document, Editor, Figure, FigureKind, Point, Region, generate};
+
+fn expected(view: &View, settings: &Settings) -> Document {
+    let to = |p: glam::DVec2| view.to_ground(p.x, p.y);
+    let figure = |s: &Step| {
+        let (kind, mut points) = match &s.drawn {
+            Drawn::Point(p) => (FigureKind::Point, vec![to(*p)]),
+            Drawn::Polyline(ps) => (FigureKind::Polyline, ps.iter().map(|p| to(*p)).collect()),
+            Drawn::Closed(ps) => (FigureKind::Closed, ps.iter().map(|p| to(*p)).collect()),
+        };
+        if kind == FigureKind::Closed {
+            points.push(points[0]);
+        }
+        let pull = s.pull.expect("pulled");
+        Figure {
+            kind,
+            points,
+            height: view.height_at(pull.height_mm),
+            slope: pull.slope_mm * settings.slope_per_mm,
+            figures: Vec::new(),
+        }
+    };
+    let s = steps();
+    assert_eq!(s.len(), 7, "the session this test describes");
+    assert_eq!(s[6].undos, 2, "the last figure is undone");
+    let Drawn::Closed(boundary) = &s[0].drawn else {
+        panic!("a region first")
+    };
+    let mut boundary: Vec<Point> = boundary.iter().map(|p| to(*p)).collect();
+    boundary.push(boundary[0]);
+    let mut plateau = figure(&s[4]);
+    plateau.figures.push(figure(&s[5]));
+    let mut doc = blank_document();
+    doc.regions.push(Region {
+        boundary,
+        figures: vec![figure(&s[1]), figure(&s[2]), figure(&s[3]), plateau],
+    });
+    doc
+}
+
+/// The Hausdorff distance between two polylines (for polylines it is reached at a vertex):
+/// how far the drawn figure strays from the intended one and back, metres.
+fn shape_error(actual: &[Point], expected: &[Point]) -> f64 {
+    let one_way = |from: &[Point], to: &[Point]| from.iter().map(|p| line_distance(to, *p)).fold(0.0, f64::max);
+    one_way(actual, expected).max(one_way(expected, actual))
+}
+
+fn compare(actual: &[Figure], expected: &[Figure], view: &View, worst: &mut (f64, f64, f64)) {
+    assert_eq!(actual.len(), expected.len());
+    for (a, e) in actual.iter().zip(expected) {
+        assert_eq!(a.kind, e.kind);
+        let shape_mm = shape_error(&a.points, &e.points) * view.scale;
+        // In mm of pen height.
+        let height = (a.height - e.height).abs() * view.scale * view.exaggeration;
+        let slope = (a.slope - e.slope).abs();
+        assert!(
+            shape_mm <= 2.0,
+            "{:?} off by {shape_mm:.2} mm: {:?} vs {:?}",
+            a.kind,
+            a.points,
+            e.points
+        );
+        assert!(height <= 1.5, "height {} vs {}", a.height, e.height);
+        assert!(slope <= 0.05, "slope {} vs {}", a.slope, e.slope);
+        worst.0 = worst.0.max(shape_mm);
+        worst.1 = worst.1.max(height);
+        worst.2 = worst.2.max(slope);
+        compare(&a.figures, &e.figures, view, worst);
+    }
+}
+
+#[test]
+fn the_demo_session_yields_the_terrain_of_its_document() {
+    for seed in [1, 2] {
+        demo(seed);
+    }
+}
+
+fn demo(seed: u64) {
+    let settings = Settings::default();
+    let editor = Editor::new(blank_document()).expect("valid");
+    let mut session = Session::new(editor, [600.0, 340.0], settings);
+    let (rx, thread) = spawn(PenSource::Demo { speed: 0.0, seed }, 1024);
+    let mut log = Vec::new();
+    while let Ok(feed) = rx.recv() {
+        let end = matches!(feed, Feed::End(_) | Feed::Failed(_));
+        log.extend(session.feed(feed));
+        if end {
+            break;
+        }
+    }
+    drop(rx);
+    thread.join().expect("pen thread");
+    assert!(
+        matches!(session.state(), State::Ended(s) if s.contains("0 reports lost")),
+        "{:?}\n{log:#?}",
+        session.state()
+    );
+    let stats = session.interaction.stats().clone();
+    assert_eq!((stats.regions, stats.figures), (1, 6), "{log:#?}");
+    assert_eq!(
+        (stats.pulls, stats.slopes, stats.undos, stats.refused),
+        (6, 3, 2, 0),
+        "{log:#?}"
+    );
+
+    let view = *session.interaction.view();
+    let want = expected(&view, &settings);
+    let got = session.editor.document();
+    assert_eq!(got.regions.len(), 1);
+    let mut worst = (0.0, 0.0, 0.0);
+    let boundary_mm = shape_error(&got.regions[0].boundary, &want.regions[0].boundary) * view.scale;
+    let on_display = |ps: &[Point]| {
+        ps.iter()
+            .map(|p| view.to_display(*p).map(|x| (x * 10.0).round() / 10.0))
+            .collect::<Vec<_>>()
+    };
+    assert!(
+        boundary_mm <= 2.0,
+        "the boundary is off by {boundary_mm:.2} mm: {:?}",
+        on_display(&got.regions[0].boundary)
+    );
+    compare(&got.regions[0].figures, &want.regions[0].figures, &view, &mut worst);
+
+    let a = session.editor.heightmap();
+    let b = generate(&want).expect("valid");
+    let peak = b.range().1 as f64;
+    let n = a.heights().len() as f64;
+    let rms = (a
+        .heights()
+        .iter()
+        .zip(b.heights())
+        .map(|(x, y)| ((x - y) as f64).powi(2))
+        .sum::<f64>()
+        / n)
+        .sqrt();
+    let max = a
+        .heights()
+        .iter()
+        .zip(b.heights())
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0f32, f32::max);
+    println!(
+        "outlines within {:.2} mm, heights within {:.2} mm, slopes within {:.3}; terrain RMS {rms:.2} m ({:.2} % of the {peak:.0} m peak), max {max:.1} m",
+        worst.0,
+        worst.1,
+        worst.2,
+        100.0 * rms / peak
+    );
+    assert!(rms <= 0.02 * peak, "terrain RMS {rms:.2} m against a {peak:.0} m peak");
+}

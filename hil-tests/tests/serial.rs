@@ -1,0 +1,112 @@
+//! The serial transport on a real pseudo-terminal, through serialport: garbage on the line never
+//! yields a wrong sample, and the simulated pen's pty server answers requests.
+
+use std::collections::HashMap;
+use std::io::Write;
+use std::time::{Duration, Instant};
+
+use pen_host::transport::Transport;
+use pen_host::transport::serial::SerialTransport;
+use pen_protocol::{MAX_FRAME, Message, PenReport, ReportId, StatusCode, encode_frame};
+use pen_sim::Simulation;
+use rand::{RngExt, SeedableRng};
+use serialport::{SerialPort, TTYPort};
+
+#[test]
+fn garbage_on_the_line_never_yields_a_wrong_sample() {
+    let (mut master, slave) = TTYPort::pair().expect("a pty pair");
+    let path = slave.name().expect("the pty's path");
+    drop(slave);
+    master.set_timeout(Duration::from_secs(1)).expect("timeout");
+
+    // The device side: a simulation's report bytes, framed, with garbage between the frames.
+    let scenario = pen_sim::scenarios::by_name("hand-sweep").expect("scenario");
+    let writer = std::thread::spawn(move || {
+        let mut sim = Simulation::new(&scenario, 9);
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
+        let mut sent: HashMap<u16, PenReport> = HashMap::new();
+        let mut garbage_bytes = 0;
+        // Give the reader time to open its end.
+        std::thread::sleep(Duration::from_millis(200));
+        while sent.len() < 600 {
+            for s in sim.step().sent {
+                let Ok(Message::Pen(p)) = Message::decode(&s.bytes) else {
+                    continue;
+                };
+                let mut frame = [0u8; MAX_FRAME];
+                let n = encode_frame(&s.bytes, &mut frame).expect("fits");
+                // Random bytes, zeros among them, and sometimes the tail of a frame cut short.
+                let mut junk: Vec<u8> = (0..rng.random_range(0..24)).map(|_| rng.random()).collect();
+                if rng.random_bool(0.2) {
+                    junk.extend_from_slice(&frame[1..rng.random_range(2..n)]);
+                }
+                garbage_bytes += junk.len();
+                master.write_all(&junk).expect("write");
+                master.write_all(&frame[..n]).expect("write");
+                sent.insert(p.seq, p);
+            }
+            std::thread::sleep(Duration::from_micros(500));
+        }
+        (sent, garbage_bytes)
+    });
+
+    let mut port = SerialTransport::open(&path).expect("the pty opens as a serial port");
+    let mut received = Vec::new();
+    let end = Instant::now() + Duration::from_secs(20);
+    while Instant::now() < end && received.len() < 600 {
+        if let Ok(Some(Message::Pen(p))) = port.read(Duration::from_millis(100)) {
+            received.push(p);
+        }
+    }
+    let (sent, garbage_bytes) = writer.join().expect("writer");
+    assert!(garbage_bytes > 5000, "garbage was injected ({garbage_bytes} bytes)");
+    assert!(
+        port.dropped() > 100,
+        "garbage frames were seen and dropped: {}",
+        port.dropped()
+    );
+    // Every sample is exactly a report that was sent; and every frame sent came through.
+    for p in &received {
+        assert_eq!(sent.get(&p.seq), Some(p), "a sample that was not sent");
+    }
+    assert_eq!(received.len(), 600, "every intact frame arrives");
+}
+
+#[test]
+fn the_pty_server_answers_through_the_serial_transport() {
+    let (tx, rx) = std::sync::mpsc::channel();
+    // The server runs for the rest of the test process.
+    std::thread::spawn(move || {
+        let options = pen_hil::pty::ServeOptions {
+            scenario: pen_sim::scenarios::by_name("hold").expect("scenario"),
+            seed: 1,
+            link: None,
+            speed: 1.0,
+        };
+        let _ = pen_hil::pty::serve(&options, |path| tx.send(path.to_path_buf()).unwrap_or(()), |_| {});
+    });
+    let path = rx.recv_timeout(Duration::from_secs(5)).expect("the server's path");
+    let mut port = SerialTransport::open(&path.to_string_lossy()).expect("open");
+    let info = port.get_feature(ReportId::DeviceInfo).expect("device information");
+    assert!(matches!(info, Message::DeviceInfo(i) if i.receiver_count == 4));
+    let Message::Config(mut config) = port.get_feature(ReportId::Config).expect("configuration") else {
+        panic!("not a configuration");
+    };
+    config.report_rate_hz = 1000;
+    assert_eq!(
+        port.set_feature(&Message::Config(config)).expect("status").code,
+        StatusCode::Ok
+    );
+    // Now reports come every millisecond.
+    let start = Instant::now();
+    let mut n = 0;
+    while start.elapsed() < Duration::from_millis(500) {
+        if let Ok(Some(Message::Pen(_))) = port.read(Duration::from_millis(50)) {
+            n += 1;
+        }
+    }
+    assert!((400..=560).contains(&n), "{n} reports in 0.5 s");
+    config.receiver_count = 2;
+    let refused = port.set_feature(&Message::Config(config)).expect("status");
+    assert_eq!(refused.code, StatusCode::OutOfRange);
+}

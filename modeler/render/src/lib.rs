@@ -1,0 +1,266 @@
+//! The CPU rasteriser: a [`Scene`] in, a [`Frame`] out.
+//!
+//! One module per stage, in pipeline order:
+//!
+//! 1. [`camera`]: eyes and screens — an orbit camera or a tracked head in front of a display, the
+//!    off-axis projection, stereo eyes, the ground plane's tilt.
+//! 2. [`transform`]: the grid's vertices projected and snapped once per eye; chunks of quads with
+//!    screen bounds, near to far.
+//! 3. [`clip`]: triangles and lines crossing the near plane or the guard band, cut.
+//! 4. [`rasterise`]: triangles into a depth buffer, fixed point, top-left rule.
+//! 5. [`shade`]: per-vertex light, the elevation ramp per pixel, the sky.
+//! 6. [`overlay`]: figures and boundaries draped on the surface, depth-tested with a bias.
+//! 7. [`ui`] and [`text`]: the slope bar and the mode line.
+//! 8. [`stereo`]: anaglyph and side-by-side.
+//!
+//! [`tiles`] runs stages 4–6 per band of rows in parallel (rayon). A [`Renderer`] keeps its
+//! buffers between frames, so a live session calls [`Renderer::render`] once per pen report
+//! without allocating. `docs/renderer.md` gives the maths and the measured figures behind the
+//! decisions.
+//!
+//! Input rules: a frame of zero size is refused ([`Frame::new`]); camera parameters that are not
+//! finite, or a head behind the display, are refused ([`RenderError::Camera`]); a non-finite
+//! height leaves a hole (the triangles touching it are skipped, and [`RenderStats`] counts such
+//! vertices); a grid smaller than 2 × 2 has no triangles and shows only sky, overlays and UI.
+
+pub mod camera;
+pub mod clip;
+pub mod frame;
+pub mod overlay;
+pub mod rasterise;
+pub mod scene;
+pub mod shade;
+pub mod stereo;
+pub mod text;
+pub mod tiles;
+pub mod transform;
+pub mod ui;
+
+pub mod output;
+
+use thiserror::Error;
+
+pub use camera::{Camera, Eye, Orbit, Projection, Tracked, View, Viewport};
+pub use frame::{Frame, Rgba};
+pub use scene::{Overlay, Scene, SlopeBar, Stereo, Style};
+
+use rasterise::{Bounds, Capsule, Sample};
+use transform::{Affine, Projected};
+
+/// Why a frame could not be rendered.
+#[derive(Debug, Error, PartialEq)]
+pub enum RenderError {
+    /// The frame has a zero side or one too large for the rasteriser.
+    #[error("frame size {width} × {height} is not drawable (each side 1 to {max})", max = frame::MAX_SIDE)]
+    FrameSize {
+        /// Width asked for.
+        width: u32,
+        /// Height asked for.
+        height: u32,
+    },
+    /// The camera's parameters are not usable.
+    #[error("camera: {0}")]
+    Camera(&'static str),
+}
+
+/// What a render found in its input.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct RenderStats {
+    /// Vertices whose height is not finite; their triangles were skipped.
+    pub skipped_vertices: usize,
+}
+
+/// The bounds of the whole frame.
+fn whole(frame: &Frame) -> Bounds {
+    Bounds {
+        x0: 0,
+        x1: frame.width() as i32,
+        y0: 0,
+        y1: frame.height() as i32,
+    }
+}
+
+/// Rows per tile unless set otherwise ([`Renderer::with_tile_rows`]). Taller tiles set up fewer
+/// triangles twice (a 512² frame: 8 rows 343M instructions, 16 rows 303M, 32 rows 294M, 48 rows
+/// 291M); 32 still gives 23 tiles to balance over two cores.
+pub const TILE_ROWS: usize = 32;
+
+#[derive(Default)]
+struct EyeBuffers {
+    projected: Projected,
+    capsules: Vec<Capsule>,
+}
+
+/// Renders scenes into frames, keeping its buffers from one frame to the next.
+pub struct Renderer {
+    tile_rows: usize,
+    light: Vec<f32>,
+    samples: Vec<Sample>,
+    eye: EyeBuffers,
+    left: Option<Frame>,
+}
+
+impl Default for Renderer {
+    fn default() -> Renderer {
+        Renderer::new()
+    }
+}
+
+impl Renderer {
+    /// A renderer with [`TILE_ROWS`] rows per tile.
+    pub fn new() -> Renderer {
+        Renderer::with_tile_rows(TILE_ROWS)
+    }
+
+    /// A renderer with `rows` rows per tile (at least 1). The image does not depend on it.
+    pub fn with_tile_rows(rows: usize) -> Renderer {
+        Renderer {
+            tile_rows: rows.max(1),
+            light: Vec::new(),
+            samples: Vec::new(),
+            eye: EyeBuffers::default(),
+            left: None,
+        }
+    }
+
+    /// Renders `scene` into `frame` (at the frame's size), mono or stereo as the scene asks.
+    pub fn render(&mut self, scene: &Scene, frame: &mut Frame) -> Result<RenderStats, RenderError> {
+        scene.camera.check()?;
+        let stats = self.prepare(scene);
+        let full = whole(frame);
+        match scene.stereo {
+            Stereo::None => {
+                self.eye(scene, Eye::Centre, full, frame);
+                self.ui(scene, full, frame);
+            }
+            Stereo::SideBySide => {
+                let mid = full.x1 / 2;
+                let halves = [
+                    (Eye::Left, Bounds { x1: mid, ..full }),
+                    (Eye::Right, Bounds { x0: mid, ..full }),
+                ];
+                for (eye, half) in halves {
+                    if half.x1 > half.x0 {
+                        self.eye(scene, eye, half, frame);
+                        self.ui(scene, half, frame);
+                    }
+                }
+            }
+            Stereo::Anaglyph => {
+                let mut left = match self.left.take() {
+                    Some(f) if f.width() == frame.width() && f.height() == frame.height() => f,
+                    _ => Frame::new(frame.width(), frame.height())?,
+                };
+                self.eye(scene, Eye::Left, full, &mut left);
+                self.eye(scene, Eye::Right, full, frame);
+                stereo::anaglyph(&left, frame);
+                self.left = Some(left);
+                self.ui(scene, full, frame);
+            }
+        }
+        Ok(stats)
+    }
+
+    /// Renders one eye of `scene` over the whole frame, with the UI, ignoring `scene.stereo`.
+    pub fn render_eye(&mut self, scene: &Scene, eye: Eye, frame: &mut Frame) -> Result<RenderStats, RenderError> {
+        scene.camera.check()?;
+        let stats = self.prepare(scene);
+        let full = whole(frame);
+        self.eye(scene, eye, full, frame);
+        self.ui(scene, full, frame);
+        Ok(stats)
+    }
+
+    /// How many of the terrain's triangles cover each pixel of a `width × height` frame seen by
+    /// the centre eye (row-major, no depth test): a diagnostic for the fill rule.
+    pub fn coverage(&mut self, scene: &Scene, width: u32, height: u32) -> Result<Vec<u16>, RenderError> {
+        scene.camera.check()?;
+        frame::check_size(width, height)?;
+        self.prepare(scene);
+        let full = Bounds {
+            x0: 0,
+            x1: width as i32,
+            y0: 0,
+            y1: height as i32,
+        };
+        let (affine, near) = self.project(scene, Eye::Centre, full, width, height);
+        let pass = tiles::EyePass {
+            map: scene.terrain,
+            light: &self.light,
+            affine: &affine,
+            projected: &self.eye.projected,
+            near,
+            viewport: full,
+        };
+        let mut counts = vec![0u16; width as usize * height as usize];
+        tiles::coverage(&pass, &mut counts, width as usize, self.tile_rows);
+        Ok(counts)
+    }
+
+    /// Per-frame work shared by both eyes: the light.
+    fn prepare(&mut self, scene: &Scene) -> RenderStats {
+        let skipped = shade::vertex_light(scene.terrain, scene.vertical_scale, &scene.style, &mut self.light);
+        RenderStats {
+            skipped_vertices: skipped,
+        }
+    }
+
+    /// Projects the grid for `eye` drawn into `viewport` of a `width × height` frame.
+    fn project(&mut self, scene: &Scene, eye: Eye, viewport: Bounds, width: u32, height: u32) -> (Affine, f32) {
+        let vp = scene.camera.viewpoint(eye, f64::from(width) / f64::from(height));
+        let projection = Projection::new(
+            &vp,
+            scene.camera.tilt,
+            Viewport {
+                x: f64::from(viewport.x0),
+                y: f64::from(viewport.y0),
+                width: f64::from(viewport.x1 - viewport.x0),
+                height: f64::from(viewport.y1 - viewport.y0),
+            },
+        );
+        let affine = Affine::new(&projection, scene.terrain.cell_size(), f64::from(scene.vertical_scale));
+        let near = projection.near as f32;
+        transform::project_grid(
+            scene.terrain,
+            &self.light,
+            &affine,
+            near,
+            viewport,
+            &mut self.eye.projected,
+        );
+        overlay::capsules(scene, &projection, &mut self.eye.capsules);
+        (affine, near)
+    }
+
+    fn eye(&mut self, scene: &Scene, eye: Eye, viewport: Bounds, frame: &mut Frame) {
+        let (width, height) = (frame.width(), frame.height());
+        let (affine, near) = self.project(scene, eye, viewport, width, height);
+        self.samples.resize(width as usize * height as usize, Sample::default());
+        let ramp = shade::Ramp::new(&scene.style);
+        let pass = tiles::EyePass {
+            map: scene.terrain,
+            light: &self.light,
+            affine: &affine,
+            projected: &self.eye.projected,
+            near,
+            viewport,
+        };
+        tiles::render(
+            &pass,
+            &self.eye.capsules,
+            &ramp,
+            &scene.style,
+            frame.pixels_mut(),
+            &mut self.samples,
+            width as usize,
+            self.tile_rows,
+        );
+    }
+
+    fn ui(&self, scene: &Scene, viewport: Bounds, frame: &mut Frame) {
+        if let Some(bar) = &scene.slope_bar {
+            ui::slope_bar(frame, &viewport, bar, &scene.style);
+        }
+        ui::mode_line(frame, &viewport, scene.mode, &scene.style);
+    }
+}

@@ -1,0 +1,150 @@
+//! The renderer's input: what to draw, as plain data.
+//!
+//! A [`Scene`] borrows the terrain and the overlays, so a live session builds one per frame at no
+//! cost and hands it to [`Renderer::render`](super::Renderer::render).
+
+use super::camera::Camera;
+use super::frame::Rgba;
+use penmodel_terrain::Heightmap;
+use penmodel_terrain::Point;
+
+/// How the two eyes' images are combined.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Stereo {
+    /// One image from the centre eye.
+    #[default]
+    None,
+    /// Red–cyan anaglyph: red from the left eye (its luminance), green and blue from the right.
+    Anaglyph,
+    /// The left eye's image in the left half, the right eye's in the right half, each squeezed to
+    /// half width (the "half side-by-side" format 3D displays expand).
+    SideBySide,
+}
+
+/// A line drawn on the terrain: a figure, a region boundary, or a figure being pulled.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Overlay {
+    /// Points in the ground plane, `[x, y]` in metres (the document's coordinates). One point is
+    /// drawn as a dot.
+    pub points: Vec<Point>,
+    /// Whether the last point joins the first.
+    pub closed: bool,
+    /// Line colour.
+    pub colour: Rgba,
+    /// Line width in pixels.
+    pub width: f32,
+    /// `None`: draped on the terrain surface. `Some(h)`: at the fixed height `h` metres (a figure
+    /// being pulled, drawn where the pen holds it).
+    pub height: Option<f64>,
+}
+
+/// The slope bar: a value in a range, shown with its position (seed 000: "a scroll bar behind
+/// the shape shows the value").
+#[derive(Debug, Clone, PartialEq)]
+pub struct SlopeBar {
+    /// The value shown.
+    pub value: f64,
+    /// The value at the bar's left end.
+    pub min: f64,
+    /// The value at the bar's right end.
+    pub max: f64,
+    /// Text left of the value, e.g. `"slope"`.
+    pub label: String,
+}
+
+impl SlopeBar {
+    /// Where the value sits along the bar, 0 (left end) to 1 (right end), clamped; 0.5 for an
+    /// empty or non-finite range or value.
+    pub fn position(&self) -> f64 {
+        let t = (self.value - self.min) / (self.max - self.min);
+        if t.is_finite() { t.clamp(0.0, 1.0) } else { 0.5 }
+    }
+}
+
+/// Colours, widths and lighting: everything about the look that is not the scene's content.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Style {
+    /// Heights at or above this many metres get the ramp's top colour (snow).
+    pub ramp_top: f32,
+    /// Heights at or below minus this many metres get the deepest water colour.
+    pub ramp_depth: f32,
+    /// Direction towards the light in the ground frame: `[x, y, up]` (need not be unit length).
+    pub light: [f32; 3],
+    /// Light that reaches every surface, 0 to 1; the rest is diffuse (Lambert).
+    pub ambient: f32,
+    /// Sky colour at the top of the frame.
+    pub sky_top: Rgba,
+    /// Sky colour at the bottom of the frame.
+    pub sky_bottom: Rgba,
+    /// Colour of the selected overlay.
+    pub selection_colour: Rgba,
+    /// Width of the selected overlay, pixels.
+    pub selection_width: f32,
+    /// An overlay passes the depth test where its depth is at most `1 + bias` times the
+    /// terrain's: lines on the surface stay visible, lines behind a ridge are hidden.
+    pub overlay_bias: f32,
+    /// Text colour.
+    pub text_colour: Rgba,
+    /// Text size: pixels per font pixel.
+    pub text_scale: u32,
+}
+
+impl Default for Style {
+    fn default() -> Style {
+        Style {
+            ramp_top: 100.0,
+            ramp_depth: 20.0,
+            // From the south-west, 50° up: the default views look from the south, so the slopes
+            // facing the viewer are lit and relief reads at a glance.
+            light: [-1.0, 1.0, 1.7],
+            ambient: 0.35,
+            sky_top: [96, 136, 192, 255],
+            sky_bottom: [200, 218, 235, 255],
+            selection_colour: [255, 236, 64, 255],
+            selection_width: 5.0,
+            overlay_bias: 0.01,
+            text_colour: [255, 255, 255, 255],
+            text_scale: 2,
+        }
+    }
+}
+
+/// Everything one frame shows.
+#[derive(Debug, Clone)]
+pub struct Scene<'a> {
+    /// The terrain.
+    pub terrain: &'a Heightmap,
+    /// Vertical exaggeration: heights are drawn × this (1 = true scale).
+    pub vertical_scale: f32,
+    /// Lines on the terrain.
+    pub overlays: &'a [Overlay],
+    /// The index in `overlays` of the selected one, drawn in the selection colour and width.
+    pub selection: Option<usize>,
+    /// The slope bar, when shown.
+    pub slope_bar: Option<SlopeBar>,
+    /// One line of text for the mode, top left; empty for none.
+    pub mode: &'a str,
+    /// Where the eye is.
+    pub camera: Camera,
+    /// Mono or stereo.
+    pub stereo: Stereo,
+    /// Colours and lighting.
+    pub style: Style,
+}
+
+impl<'a> Scene<'a> {
+    /// The terrain alone, seen by `camera`, with the default style.
+    pub fn new(terrain: &'a Heightmap, camera: Camera) -> Scene<'a> {
+        Scene {
+            terrain,
+            vertical_scale: 1.0,
+            overlays: &[],
+            selection: None,
+            slope_bar: None,
+            mode: "",
+            camera,
+            stereo: Stereo::None,
+            style: Style::default(),
+        }
+    }
+}

@@ -1,0 +1,173 @@
+//! Tiles: one eye's frame rendered in parallel, tile by tile.
+//!
+//! A tile is a band of whole rows, so its pixels and depth samples are contiguous slices that
+//! rayon hands to threads without locks or `unsafe`. Each tile clears its samples, draws the
+//! chunks whose screen bounds reach it (near to far), resolves colours and draws the overlays,
+//! while its samples are still in cache. A triangle that spans two tiles is set up in both and
+//! each draws only its own rows, so the image does not depend on the tile height (a test renders
+//! with one tile and with many and compares the bytes). Chunks carry the pixel rows of each row
+//! of quads, so a tile skips the quad rows of a chunk that cannot reach it: that took the
+//! triangles looked at per 512² frame from 2.2 to 1.5 times the grid's (instructions per frame
+//! 345M → 311M).
+
+use rayon::prelude::*;
+
+use super::clip;
+use super::frame::Rgba;
+use super::rasterise::{self, Bounds, Capsule, Sample, Sink, Vtx};
+use super::scene::Style;
+use super::shade::{self, Ramp};
+use super::transform::{self, Affine, ChunkState, Projected};
+use penmodel_terrain::Heightmap;
+
+/// What the tiles of one eye share.
+pub struct EyePass<'a> {
+    /// The terrain.
+    pub map: &'a Heightmap,
+    /// Per-vertex light.
+    pub light: &'a [f32],
+    /// The eye's clip-space map.
+    pub affine: &'a Affine,
+    /// The eye's projected grid and chunks.
+    pub projected: &'a Projected,
+    /// The near plane.
+    pub near: f32,
+    /// The eye's columns.
+    pub viewport: Bounds,
+}
+
+impl EyePass<'_> {
+    fn clipped<S: Sink>(&self, corners: [(usize, usize); 3], bounds: &Bounds, sink: &mut S) {
+        let cols = self.map.cols() as usize;
+        let h = self.map.heights();
+        let tri = corners.map(|(c, r)| {
+            let k = r * cols + c;
+            self.affine.clip_vertex(c, r, h[k], self.light[k])
+        });
+        let poly = clip::triangle(tri, self.near);
+        if poly.len < 3 {
+            return;
+        }
+        let v: Vec<Vtx> = poly.vertices[..poly.len].iter().map(transform::project).collect();
+        for i in 1..poly.len - 1 {
+            rasterise::triangle(&v[0], &v[i], &v[i + 1], bounds, sink);
+        }
+    }
+
+    /// Draws the terrain's triangles over `bounds` into `sink`.
+    pub fn terrain<S: Sink>(&self, bounds: &Bounds, sink: &mut S) {
+        let cols = self.map.cols() as usize;
+        let v = &self.projected.vertices;
+        let f = &self.projected.flags;
+        for ch in &self.projected.chunks {
+            let b = &ch.bounds;
+            if b.y1 <= bounds.y0 || b.y0 >= bounds.y1 || b.x1 <= bounds.x0 || b.x0 >= bounds.x1 {
+                continue;
+            }
+            if ch.state == ChunkState::Direct {
+                for (r, span) in (ch.r0..ch.r1).zip(&ch.spans) {
+                    if span.1 <= bounds.y0 || span.0 >= bounds.y1 {
+                        continue;
+                    }
+                    for a in r * cols + ch.c0..r * cols + ch.c1 {
+                        // Two triangles per quad, split along b–d, clockwise on screen seen from
+                        // above: (a, b, d) and (b, e, d) with b = a + 1, d = a + cols, e = d + 1.
+                        let (va, vb, vd, ve) = (&v[a], &v[a + 1], &v[a + cols], &v[a + cols + 1]);
+                        if rasterise::holds_no_pixel([va, vb, vd, ve], bounds) {
+                            continue;
+                        }
+                        rasterise::triangle(va, vb, vd, bounds, sink);
+                        rasterise::triangle(vb, ve, vd, bounds, sink);
+                    }
+                }
+                continue;
+            }
+            for r in ch.r0..ch.r1 {
+                for c in ch.c0..ch.c1 {
+                    let a = r * cols + c;
+                    let (bb, d, e) = (a + 1, a + cols, a + cols + 1);
+                    for (t, corners) in [
+                        ([a, bb, d], [(c, r), (c + 1, r), (c, r + 1)]),
+                        ([bb, e, d], [(c + 1, r), (c + 1, r + 1), (c, r + 1)]),
+                    ] {
+                        let flags = [f[t[0]], f[t[1]], f[t[2]]];
+                        if flags.contains(&transform::SKIP) {
+                            continue;
+                        }
+                        if flags.contains(&transform::CLIP) {
+                            self.clipped(corners, bounds, sink);
+                        } else {
+                            rasterise::triangle(&v[t[0]], &v[t[1]], &v[t[2]], bounds, sink);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Renders one eye into the `viewport` columns of `pixels` (a frame `width` wide and
+/// `frame_height` tall), with `samples` as the depth buffer, `tile_rows` rows per tile.
+#[allow(clippy::too_many_arguments)]
+pub fn render(
+    pass: &EyePass,
+    capsules: &[Capsule],
+    ramp: &Ramp,
+    style: &Style,
+    pixels: &mut [Rgba],
+    samples: &mut [Sample],
+    width: usize,
+    tile_rows: usize,
+) {
+    let frame_height = pixels.len() / width;
+    let tile = tile_rows.max(1) * width;
+    let vp = pass.viewport;
+    let (x0, x1) = (vp.x0 as usize, vp.x1 as usize);
+    pixels
+        .par_chunks_mut(tile)
+        .zip(samples.par_chunks_mut(tile))
+        .enumerate()
+        .for_each(|(i, (pix, smp))| {
+            let y0 = i * tile_rows.max(1);
+            let rows = pix.len() / width;
+            let bounds = Bounds {
+                x0: vp.x0,
+                x1: vp.x1,
+                y0: y0 as i32,
+                y1: (y0 + rows) as i32,
+            };
+            for row in smp.chunks_mut(width) {
+                row[x0..x1].fill(Sample::default());
+            }
+            let mut sink = rasterise::DepthSink {
+                samples: smp,
+                width,
+                y0: bounds.y0,
+            };
+            pass.terrain(&bounds, &mut sink);
+            shade::resolve(smp, pix, width, (x0, x1), y0, frame_height, ramp, style);
+            let (top, bottom) = (bounds.y0 as f32, bounds.y1 as f32);
+            for cap in capsules {
+                let (lo, hi) = cap.rows();
+                if hi >= top && lo < bottom {
+                    cap.draw(&bounds, width, smp, pix, style.overlay_bias);
+                }
+            }
+        });
+}
+
+/// Counts the terrain's coverage of each pixel of the viewport (no depth test).
+pub fn coverage(pass: &EyePass, counts: &mut [u16], width: usize, tile_rows: usize) {
+    let tile = tile_rows.max(1) * width;
+    counts.par_chunks_mut(tile).enumerate().for_each(|(i, cnt)| {
+        let y0 = (i * tile_rows.max(1)) as i32;
+        let bounds = Bounds {
+            x0: pass.viewport.x0,
+            x1: pass.viewport.x1,
+            y0,
+            y1: y0 + (cnt.len() / width) as i32,
+        };
+        let mut sink = rasterise::CountSink { counts: cnt, width, y0 };
+        pass.terrain(&bounds, &mut sink);
+    });
+}
