@@ -28,7 +28,7 @@ use embassy_stm32::timer::simple_pwm::PwmPin;
 use embassy_stm32::timer::{Ch1, Ch2, Ch3, Ch4, Channel};
 use embassy_stm32::{Peri, interrupt, pac};
 use pen_core::Ranging;
-use pen_core::capture::{SLOW_TIMER_HZ, ns_per_tick, ticks_to_ns};
+use pen_core::ranging::{SLOW_TIMER_HZ, ns_per_tick, ticks_to_ns};
 use pen_protocol::MAX_RECEIVERS;
 
 /// Periods of 40 kHz per burst: long enough for the transducer to ring up, short enough to end

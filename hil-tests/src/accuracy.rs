@@ -3,7 +3,7 @@
 //! switch transitions reported against those the hand made.
 
 use glam::{DMat3, DVec3};
-use pen_core::capture::{FAST_TIMER_HZ, SLOW_TIMER_HZ};
+use pen_core::ranging::{FAST_TIMER_HZ, SLOW_TIMER_HZ};
 use pen_protocol::{PenReport, Report, ReportId};
 use serde::Serialize;
 

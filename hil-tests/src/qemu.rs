@@ -7,16 +7,15 @@
 //! fusion of each cycle with SysTick under `-icount shift=0`, where virtual time counts
 //! instructions.
 //!
-//! Replay format (little-endian): `PRPL`, version u32 = 1, the configuration report (187
-//! bytes); then per cycle the burst time u64 µs, 8 × u32 capture times in ns (`0xFFFFFFFF`:
-//! none), u16 switch-sample count, and one byte per sample (SW1 = 1, SW2 = 2, SW3 = 4).
+//! The replay format is `pen_core::replay`, which both this writer and `pen-qemu`'s reader use.
 
 use std::io::Read;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use pen_protocol::{Config, Report};
+use pen_core::replay;
+use pen_protocol::Config;
 use thiserror::Error;
 
 use pen_sim::sim::{CycleRecord, Sent};
@@ -49,19 +48,10 @@ pub enum QemuError {
 /// The replay file for `records`, run with `config`.
 pub fn replay(config: &Config, records: &[CycleRecord]) -> Vec<u8> {
     let mut out = Vec::new();
-    out.extend_from_slice(b"PRPL");
-    out.extend_from_slice(&1u32.to_le_bytes());
-    let mut c = [0u8; Config::LEN];
-    // A buffer of exactly the report's length.
-    let _ = config.encode(&mut c);
-    out.extend_from_slice(&c);
+    let mut push = |bytes: &[u8]| out.extend_from_slice(bytes);
+    replay::write_header(config, &mut push);
     for r in records {
-        out.extend_from_slice(&r.t0_us.to_le_bytes());
-        for a in r.heard.arrival_ns {
-            out.extend_from_slice(&a.unwrap_or(u32::MAX).to_le_bytes());
-        }
-        out.extend_from_slice(&(r.switch_samples.len() as u16).to_le_bytes());
-        out.extend_from_slice(&r.switch_samples);
+        replay::write_cycle(r.t0_us, &r.heard.arrival_ns, &r.switch_samples, &mut push);
     }
     out
 }

@@ -1,4 +1,4 @@
-//! The integration tests of this crate, one binary: each module is one former test file.
+//! The integration tests of penmodel, in one binary: a module per area.
 mod cli;
 mod demo_cli;
 mod interaction;

@@ -5,7 +5,7 @@
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
-use pen_core::solver::{Geometry, solve};
+use pen_core::solve::{Geometry, solve};
 use pen_core::{Cycle, Engine, Vec3, default_config};
 use pen_protocol::{FirmwareVersion, MAX_RECEIVERS};
 

@@ -4,7 +4,7 @@
 use pen_protocol::{Config, ConfigError, DisplayPose, Filter, MAX_RECEIVERS};
 
 use crate::math::Vec3;
-use crate::sound::speed_of_sound_m_s;
+use crate::ranging::speed_of_sound_m_s;
 
 /// The reference build's configuration (docs/hardware.md): a display of 600 × 340 mm with its
 /// lower-left corner at the origin, x along the bottom edge, y up the surface, z out of it

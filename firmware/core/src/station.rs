@@ -12,7 +12,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::RawMutex;
 use pen_protocol::{MAX_RECEIVERS, PenReport, TofReport};
 
-use crate::engine::{Cycle, CycleResult, Engine, LISTEN_US, TICK_US};
+use crate::report::{Cycle, CycleResult, Engine, LISTEN_US, TICK_US};
 
 /// The ultrasonic front end: a burst from the pen and the receivers' first arrivals.
 pub trait Ranging {

@@ -8,7 +8,7 @@
 //! a new track, so a wrong track cannot persist.
 
 use crate::math::Vec3;
-use crate::solver::NoFix;
+use crate::solve::NoFix;
 
 /// The fastest the pen is taken to move between two fixes, mm per µs (1.5 m/s). A faster move
 /// costs a cycle: the first fix after it is held back and the next one confirms it.

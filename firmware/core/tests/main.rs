@@ -1,8 +1,9 @@
-//! The integration tests of this crate, one binary: each module is one former test file.
+//! The integration tests of pen-core, in one binary: a module per area.
 mod common;
 mod debounce;
-mod engine;
 mod filter;
-mod solver;
+mod replay;
+mod report;
+mod solve;
 mod station;
 mod store;

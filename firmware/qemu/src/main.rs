@@ -1,6 +1,6 @@
 //! The firmware core on an emulated Cortex-M4F.
 //!
-//! Reads `cycles.bin` (a replay recorded by the simulated pen, format in docs/simulator.md)
+//! Reads `cycles.bin` (a replay recorded by the simulated pen, in the format of `pen_core::replay`)
 //! through semihosting, drives pen-core's station with it — the same engine, the same station
 //! loop, compiled for `thumbv7em-none-eabihf` — and prints every report it sends as
 //! `R <device µs> <hex>` on the host's standard output. Then it replays the cycles once more
@@ -20,12 +20,10 @@ use cortex_m_semihosting::{debug, hio, syscall};
 use embassy_futures::block_on;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
+use pen_core::replay::{self, ReplayError};
 use pen_core::{Clock, Cycle, Engine, Ranging, ReportSink, SharedEngine, Station, Switches};
-use pen_protocol::{Config, FirmwareVersion, MAX_RECEIVERS, PenReport, Report, TofReport};
+use pen_protocol::{FirmwareVersion, MAX_RECEIVERS, PenReport, Report, TofReport};
 
-const MAGIC: &[u8; 4] = b"PRPL";
-const VERSION: u32 = 1;
-const NO_ARRIVAL: u32 = u32::MAX;
 /// Switch samples a cycle may have: the longest cycle, 1 s at a 1 Hz report rate, has 2000.
 const MAX_TICKS: usize = 2048;
 
@@ -57,8 +55,9 @@ impl HostFile {
         let fd = unsafe { syscall!(OPEN, path.as_ptr(), 1, name.len()) } as isize;
         (fd >= 0).then_some(HostFile(fd as usize))
     }
+}
 
-    /// Fills `buf` entirely, or returns false at the end of the file.
+impl replay::Source for HostFile {
     fn read_exact(&mut self, buf: &mut [u8]) -> bool {
         if buf.is_empty() {
             return true;
@@ -69,10 +68,7 @@ impl HostFile {
     }
 }
 
-struct Input {
-    file: HostFile,
-}
-
+/// One recorded cycle, as `pen_core::replay` reads it.
 struct CycleIn {
     t0_us: u64,
     arrival_ns: [Option<u32>; MAX_RECEIVERS],
@@ -80,38 +76,28 @@ struct CycleIn {
     switches: [u8; MAX_TICKS],
 }
 
-impl Input {
-    fn u32(&mut self) -> Option<u32> {
-        let mut b = [0u8; 4];
-        self.file.read_exact(&mut b).then(|| u32::from_le_bytes(b))
-    }
-
-    fn next_cycle(&mut self) -> Option<CycleIn> {
-        let mut b = [0u8; 8];
-        if !self.file.read_exact(&mut b) {
-            return None;
-        }
-        let t0_us = u64::from_le_bytes(b);
-        let mut arrival_ns = [None; MAX_RECEIVERS];
-        for a in arrival_ns.iter_mut() {
-            let v = self.u32()?;
-            *a = (v != NO_ARRIVAL).then_some(v);
-        }
-        let mut n = [0u8; 2];
-        if !self.file.read_exact(&mut n) {
-            return None;
-        }
-        let ticks = u16::from_le_bytes(n) as usize;
-        let mut switches = [0u8; MAX_TICKS];
-        if ticks > MAX_TICKS || !self.file.read_exact(&mut switches[..ticks]) {
-            return None;
-        }
-        Some(CycleIn {
-            t0_us,
-            arrival_ns,
-            ticks,
+/// The next cycle of the replay; `None` at its end; a damaged replay ends the run.
+fn next_cycle(file: &mut HostFile, out: &mut hio::HostStream) -> Option<CycleIn> {
+    let mut switches = [0u8; MAX_TICKS];
+    match replay::read_cycle(file, &mut switches) {
+        Ok(Some(head)) => Some(CycleIn {
+            t0_us: head.t0_us,
+            arrival_ns: head.arrival_ns,
+            ticks: head.samples as usize,
             switches,
-        })
+        }),
+        Ok(None) => None,
+        Err(e) => fail(out, replay_error(e)),
+    }
+}
+
+fn replay_error(e: ReplayError) -> &'static str {
+    match e {
+        ReplayError::NotAReplay => "cycles.bin is not a replay",
+        ReplayError::Version(_) => "cycles.bin is not a version 1 replay",
+        ReplayError::BadConfig => "bad configuration in cycles.bin",
+        ReplayError::Truncated => "cycles.bin ends inside a cycle",
+        ReplayError::TooManySamples(_) => "a cycle of cycles.bin has more switch samples than pen-qemu holds",
     }
 }
 
@@ -254,18 +240,8 @@ fn main() -> ! {
     let Some(file) = HostFile::open("cycles.bin") else {
         fail(&mut out, "cannot open cycles.bin")
     };
-    let mut input = Input { file };
-    let mut magic = [0u8; 4];
-    if !input.file.read_exact(&mut magic) || &magic != MAGIC || input.u32() != Some(VERSION) {
-        fail(&mut out, "cycles.bin is not a version 1 replay");
-    }
-    let mut config_bytes = [0u8; Config::LEN];
-    if !input.file.read_exact(&mut config_bytes) {
-        fail(&mut out, "cycles.bin ends in its configuration");
-    }
-    let Ok(config) = Config::decode(&config_bytes) else {
-        fail(&mut out, "bad configuration in cycles.bin")
-    };
+    let mut file = file;
+    let config = replay::read_header(&mut file).unwrap_or_else(|e| fail(&mut out, replay_error(e)));
     let firmware = FirmwareVersion {
         major: 0,
         minor: 1,
@@ -288,7 +264,7 @@ fn main() -> ! {
     };
     let mut station = Station::new(&engine, R(&replay), R(&replay), R(&replay), printer);
     let mut cycles = 0u32;
-    while let Some(c) = input.next_cycle() {
+    while let Some(c) = next_cycle(&mut file, &mut out) {
         {
             let mut r = replay.borrow_mut();
             r.now_us = c.t0_us;
@@ -305,15 +281,14 @@ fn main() -> ! {
     }
 
     // Pass 2: the fusion alone, cycle by cycle, timed.
-    let Some(file) = HostFile::open("cycles.bin") else {
+    let Some(mut file) = HostFile::open("cycles.bin") else {
         fail(&mut out, "cannot reopen cycles.bin")
     };
-    let mut input = Input { file };
-    let mut skip = [0u8; 8 + Config::LEN];
-    let _ = input.file.read_exact(&mut skip);
+    let mut skip = [0u8; replay::HEADER_LEN];
+    let _ = replay::Source::read_exact(&mut file, &mut skip);
     let mut engine = Engine::new(Some(config), firmware, id);
     let (mut total, mut worst, mut n) = (0u64, 0u32, 0u32);
-    while let Some(c) = input.next_cycle() {
+    while let Some(c) = next_cycle(&mut file, &mut out) {
         let cycle = Cycle {
             t0_us: c.t0_us,
             arrival_ns: c.arrival_ns,

@@ -4,8 +4,8 @@
 
 use glam::DVec3;
 use pen_core::LISTEN_US;
-use pen_core::capture::{FAST_TIMER_HZ, SLOW_TIMER_HZ, ns_per_tick, ticks_to_ns};
-use pen_core::sound::speed_of_sound_m_s;
+use pen_core::ranging::speed_of_sound_m_s;
+use pen_core::ranging::{FAST_TIMER_HZ, SLOW_TIMER_HZ, ns_per_tick, ticks_to_ns};
 use pen_protocol::MAX_RECEIVERS;
 use rand::RngExt;
 use rand_chacha::ChaCha8Rng;

@@ -1,3 +1,3 @@
-//! The integration tests of this crate, one binary: each module is one former test file.
+//! The integration tests of penmodel-render, in one binary: a module per area.
 mod outputs;
 mod render;

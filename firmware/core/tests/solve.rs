@@ -4,7 +4,7 @@ use crate::common;
 
 use common::*;
 use pen_core::Vec3;
-use pen_core::solver::{Geometry, MAX_DOP, NoFix, solve, sse_limit};
+use pen_core::solve::{Geometry, MAX_DOP, NoFix, solve, sse_limit};
 use pen_protocol::MAX_RECEIVERS;
 use proptest::prelude::*;
 

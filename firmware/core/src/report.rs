@@ -12,9 +12,9 @@ use pen_protocol::{
 use crate::debounce::Debouncer;
 use crate::filter::{OneEuroParams, Smoother};
 use crate::math::Vec3;
+use crate::ranging::{range_mm, time_of_flight_ns};
 use crate::settings::{Settings, default_config};
-use crate::solver::{self, Fix, Geometry, NoFix};
-use crate::sound::{range_mm, time_of_flight_ns};
+use crate::solve::{self, Fix, Geometry, NoFix};
 use crate::store::ConfigStore;
 use crate::track::Track;
 
@@ -255,7 +255,7 @@ impl Engine {
             front: s.front(),
         };
         let hint = self.track.hint(cycle.t0_us);
-        let raw = solver::solve(&geometry, &ranges, &|p| s.height(p), hint)
+        let raw = solve::solve(&geometry, &ranges, &|p| s.height(p), hint)
             .and_then(|fix| {
                 if fix.dop > MAX_REPORTED_DOP {
                     Err(NoFix::PoorGeometry)
