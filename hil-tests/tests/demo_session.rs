@@ -12,11 +12,11 @@
 use pen_sim::session::{Drawn, Step, steps};
 use penmodel::feed::{Feed, PenSource, spawn};
 use penmodel::interaction::pick::line_distance;
-use penmodel::interaction::{Settings, View};
+use penmodel::interaction::{Tuning, View};
 use penmodel::session::{Session, State, blank_document};
 use penmodel_terrain::{Document, Editor, Figure, FigureKind, Point, Region, generate};
 
-fn expected(view: &View, settings: &Settings) -> Document {
+fn expected(view: &View, tuning: &Tuning) -> Document {
     let to = |p: glam::DVec2| view.to_ground(p.x, p.y);
     let figure = |s: &Step| {
         let (kind, mut points) = match &s.drawn {
@@ -32,7 +32,7 @@ fn expected(view: &View, settings: &Settings) -> Document {
             kind,
             points,
             height: view.height_at(pull.height_mm),
-            slope: pull.slope_mm * settings.slope_per_mm,
+            slope: pull.slope_mm * tuning.slope_per_mm,
             figures: Vec::new(),
         }
     };
@@ -93,9 +93,9 @@ fn the_demo_session_yields_the_terrain_of_its_document() {
 }
 
 fn demo(seed: u64) {
-    let settings = Settings::default();
+    let tuning = Tuning::default();
     let editor = Editor::new(blank_document()).expect("valid");
-    let mut session = Session::new(editor, [600.0, 340.0], settings);
+    let mut session = Session::new(editor, [600.0, 340.0], tuning);
     let (rx, thread) = spawn(PenSource::Demo { speed: 0.0, seed }, 1024);
     let mut log = Vec::new();
     while let Ok(feed) = rx.recv() {
@@ -121,7 +121,7 @@ fn demo(seed: u64) {
     );
 
     let view = *session.interaction.view();
-    let want = expected(&view, &settings);
+    let want = expected(&view, &tuning);
     let got = session.editor.document();
     assert_eq!(got.regions.len(), 1);
     let mut worst = (0.0, 0.0, 0.0);

@@ -5,8 +5,8 @@
 
 use penmodel_render::{Camera, Overlay, Rgba, Scene, SlopeBar, Stereo, Style, Tracked};
 use penmodel_terrain::Heightmap;
+use penmodel_terrain::address::{CurvePath, FigurePath};
 use penmodel_terrain::document::{Document, Figure, FigureKind, Point};
-use penmodel_terrain::path::{CurvePath, FigurePath};
 
 use crate::interaction::{Interaction, View};
 use crate::session::Session;

@@ -3,7 +3,7 @@
 use pen_host::events::PenEvent;
 
 use crate::feed::Feed;
-use crate::interaction::{Interaction, Settings, View};
+use crate::interaction::{Interaction, Tuning, View};
 use penmodel_terrain::document::{Document, Grid};
 use penmodel_terrain::editor::Editor;
 
@@ -42,11 +42,11 @@ pub struct Session {
 
 impl Session {
     /// A session on `editor`, shown on a display of `display_mm` fitted to the document's grid.
-    pub fn new(editor: Editor, display_mm: [f64; 2], settings: Settings) -> Session {
+    pub fn new(editor: Editor, display_mm: [f64; 2], tuning: Tuning) -> Session {
         let view = View::fit(display_mm, &editor.document().grid);
         Session {
             editor,
-            interaction: Interaction::new(view, settings),
+            interaction: Interaction::new(view, tuning),
             status: String::new(),
             state: State::Running,
             events: 0,
@@ -59,9 +59,9 @@ impl Session {
         match feed {
             Feed::Display(mm) => {
                 if mm != self.interaction.view().display_mm {
-                    let settings = *self.interaction.settings();
+                    let tuning = *self.interaction.tuning();
                     let view = View::fit(mm, &self.editor.document().grid);
-                    self.interaction = Interaction::new(view, settings);
+                    self.interaction = Interaction::new(view, tuning);
                 }
                 Vec::new()
             }

@@ -10,7 +10,7 @@ use pen_host::calibration::{Calibration, DisplaySize};
 use pen_host::events::{EventDetector, PenEvent};
 use pen_host::sample::Sample;
 use pen_protocol::Quality;
-use penmodel::interaction::{Command, Interaction, Settings, View};
+use penmodel::interaction::{Interaction, KeyCommand, Tuning, View};
 use penmodel_terrain::{Document, Editor, FigureKind, FigurePath, Grid, Point, generate};
 
 const HOVER: f64 = 40.0;
@@ -41,7 +41,7 @@ impl Pen {
             calibration: Calibration::identity(DisplaySize::REFERENCE),
             events: Vec::new(),
             editor: Editor::new(doc).expect("valid"),
-            ui: Interaction::new(view, Settings::default()),
+            ui: Interaction::new(view, Tuning::default()),
         }
     }
 
@@ -251,12 +251,12 @@ fn grab_pull_and_slope_are_one_undoable_edit() {
     let peak = live.range().1;
     assert!(peak > 0.99 * height as f32, "peak {peak} of {height}");
     // The ground tilts while pulling.
-    assert!(pen.ui.view().tilt > 0.5 * Settings::default().pull_tilt);
+    assert!(pen.ui.view().tilt > 0.5 * Tuning::default().pull_tilt);
 
     pen.slope(-40.0);
     let slope = at.get(pen.doc()).unwrap().slope;
     assert!(
-        (slope - (-40.0 * Settings::default().slope_per_mm)).abs() < 1e-9,
+        (slope - (-40.0 * Tuning::default().slope_per_mm)).abs() < 1e-9,
         "{slope}"
     );
     pen.let_go();
@@ -331,7 +331,7 @@ fn sw3_held_and_moved_pans_and_zooms_without_undoing() {
     pen.set(2, true).move_to(DVec3::new(260.0, 120.0, 10.0)).set(2, false);
     assert!(pen.view().scale > 1.2 * scale, "{} vs {scale}", pen.view().scale);
     assert!(near(pen.ground(260.0, 120.0), grabbed, 1e-6));
-    pen.ui.command(&mut pen.editor, Command::Fit);
+    pen.ui.command(&mut pen.editor, KeyCommand::Fit);
     assert_eq!(pen.view().scale, scale);
     assert_eq!(pen.ui.stats().undos, 0);
 }

@@ -14,7 +14,7 @@
 //! | SW2 held + SW3 click (not touching) | redo |
 //! | SW3 held, move (nothing drawn or grabbed) | pans the ground with the pen; up and down zooms |
 //!
-//! [`Command`]s give the same edits to a keyboard or a script. Times come from the device clock
+//! [`KeyCommand`]s give the same edits to a keyboard or a script. Times come from the device clock
 //! that reports carry (a click is timed the same at any replay speed); events that are not from
 //! a report (device found or lost) do not move it.
 //! A refused edit is a message and a count, never a lost document: the editor keeps it valid.
@@ -25,20 +25,21 @@ pub mod view;
 
 use pen_host::events::{DisplayPoint, EventKind, PenEvent};
 
+use penmodel_terrain::address::CurvePath;
 use penmodel_terrain::document::{Document, Figure, FigureKind, Point, Region};
 use penmodel_terrain::edit::Edit;
 use penmodel_terrain::editor::{Editor, EditorError};
+use penmodel_terrain::engine::Outcome;
 use penmodel_terrain::geometry::{Side, locate};
-use penmodel_terrain::path::CurvePath;
-use penmodel_terrain::terrain::Outcome;
 
 pub use pick::Hit;
 pub use stroke::{Shape, Tolerances};
 pub use view::View;
 
-/// The interaction's settings; lengths are display mm.
+/// How the gestures are recognised and how strongly they act: distances, times and gains that
+/// tune the seed's operations to a pen's noise and a hand's reach; lengths are display mm.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Settings {
+pub struct Tuning {
     /// How near the tip a point or line must be to be highlighted.
     pub pick_mm: f64,
     /// A stroke staying this close to its start is a point figure.
@@ -67,9 +68,9 @@ pub struct Settings {
     pub tilt_time_s: f64,
 }
 
-impl Default for Settings {
-    fn default() -> Settings {
-        Settings {
+impl Default for Tuning {
+    fn default() -> Tuning {
+        Tuning {
             pick_mm: 6.0,
             point_mm: 3.0,
             close_mm: 10.0,
@@ -87,9 +88,9 @@ impl Default for Settings {
     }
 }
 
-/// An operation from the keyboard or a script.
+/// An operation given without a pen gesture: a key in the live window, or a script's step.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Command {
+pub enum KeyCommand {
     /// Undo the last edit.
     Undo,
     /// Redo the last undone edit.
@@ -197,7 +198,7 @@ pub struct Moving {
 /// The pen interaction: turns pen events into edits of an [`Editor`]'s document.
 #[derive(Debug, Clone)]
 pub struct Interaction {
-    settings: Settings,
+    tuning: Tuning,
     view: View,
     home: View,
     state: State,
@@ -234,9 +235,9 @@ fn curve_points<'a>(doc: &'a Document, curve: &CurvePath) -> Option<(&'a [Point]
 
 impl Interaction {
     /// An interaction showing the ground through `view`.
-    pub fn new(view: View, settings: Settings) -> Interaction {
+    pub fn new(view: View, tuning: Tuning) -> Interaction {
         Interaction {
-            settings,
+            tuning,
             view,
             home: view,
             state: State::Idle,
@@ -255,9 +256,9 @@ impl Interaction {
         &self.view
     }
 
-    /// The settings.
-    pub fn settings(&self) -> &Settings {
-        &self.settings
+    /// The thresholds and gains the gestures are recognised with.
+    pub fn tuning(&self) -> &Tuning {
+        &self.tuning
     }
 
     /// What has been done so far.
@@ -332,7 +333,7 @@ impl Interaction {
             return None;
         };
         let s = at.get(doc)?.slope;
-        Some((s, -self.settings.slope_limit, self.settings.slope_limit))
+        Some((s, -self.tuning.slope_limit, self.tuning.slope_limit))
     }
 
     /// Whether a pull or slope is in progress (the ground tilts).
@@ -407,8 +408,8 @@ impl Interaction {
             _ => 0.0,
         };
         self.last_t = Some(t_us);
-        let target = if self.pulling() { self.settings.pull_tilt } else { 0.0 };
-        let k = 1.0 - (-dt / self.settings.tilt_time_s).exp();
+        let target = if self.pulling() { self.tuning.pull_tilt } else { 0.0 };
+        let k = 1.0 - (-dt / self.tuning.tilt_time_s).exp();
         self.view.tilt += (target - self.view.tilt) * k;
     }
 
@@ -447,11 +448,11 @@ impl Interaction {
     }
 
     /// Carries out a command.
-    pub fn command(&mut self, editor: &mut Editor, command: Command) {
+    pub fn command(&mut self, editor: &mut Editor, command: KeyCommand) {
         match command {
-            Command::Undo => self.undo(editor),
-            Command::Redo => self.redo(editor),
-            Command::Delete => {
+            KeyCommand::Undo => self.undo(editor),
+            KeyCommand::Redo => self.redo(editor),
+            KeyCommand::Delete => {
                 let Some(hit) = self.hover().cloned() else {
                     self.say("nothing highlighted to delete".into());
                     return;
@@ -465,17 +466,17 @@ impl Interaction {
                     self.hover = None;
                 }
             }
-            Command::Pan { du_mm, dv_mm } => {
+            KeyCommand::Pan { du_mm, dv_mm } => {
                 let c = self.view.to_display(self.view.centre);
                 let g = self.view.centre;
                 self.view.put(g, [c[0] + du_mm, c[1] + dv_mm]);
             }
-            Command::Zoom { factor } => {
+            KeyCommand::Zoom { factor } => {
                 let (min, max) = self.scale_limits();
                 let c = [0.5 * self.view.display_mm[0], 0.5 * self.view.display_mm[1]];
                 self.view.zoom_about(factor, c, min, max);
             }
-            Command::Fit => {
+            KeyCommand::Fit => {
                 let tilt = self.view.tilt;
                 self.view = View { tilt, ..self.home };
             }
@@ -493,7 +494,7 @@ impl Interaction {
 
     fn on_motion(&mut self, editor: &mut Editor) {
         let Some((g, p)) = self.ground() else { return };
-        let s = self.settings;
+        let s = self.tuning;
         match &mut self.state {
             State::Idle | State::Armed => {
                 self.hover = pick::pick(editor.document(), g, self.view.metres(s.pick_mm));
@@ -546,7 +547,7 @@ impl Interaction {
 
     /// A grabbed figure follows the pen: its height, its slope, or its place.
     fn follow(&mut self, editor: &mut Editor, grab: Grab, g: Point, p: DisplayPoint) {
-        let s = self.settings;
+        let s = self.tuning;
         let CurvePath::Figure(at) = &grab.hit.curve else {
             if let Action::Move { .. } = grab.action {
                 self.track_move(editor, g);
@@ -604,7 +605,7 @@ impl Interaction {
                 let hit = self
                     .hover
                     .clone()
-                    .or_else(|| pick::pick(editor.document(), g, self.view.metres(self.settings.pick_mm)));
+                    .or_else(|| pick::pick(editor.document(), g, self.view.metres(self.tuning.pick_mm)));
                 match hit {
                     Some(hit) => {
                         self.state = State::Grabbed(Grab {
@@ -713,7 +714,7 @@ impl Interaction {
                 }
             }
             State::Sw3 { t0, moved, .. } => {
-                let click = !*moved && t.saturating_sub(*t0) < self.settings.click_us;
+                let click = !*moved && t.saturating_sub(*t0) < self.tuning.click_us;
                 self.state = State::Idle;
                 if click {
                     self.undo(editor);
@@ -861,9 +862,9 @@ impl Interaction {
     fn finish(&mut self, editor: &mut Editor, positions: &[Point]) {
         let v = self.view;
         let tol = Tolerances {
-            point: v.metres(self.settings.point_mm),
-            close: v.metres(self.settings.close_mm),
-            simplify: v.metres(self.settings.simplify_mm),
+            point: v.metres(self.tuning.point_mm),
+            close: v.metres(self.tuning.close_mm),
+            simplify: v.metres(self.tuning.simplify_mm),
         };
         let Some(shape) = stroke::classify(positions, &tol) else {
             return;
@@ -924,7 +925,7 @@ fn deletes(grab: &Grab, doc: &Document) -> bool {
 }
 
 /// A figure's path for the status line: `regions[0].figures[3].figures[1]` is `0.3.1`.
-fn short(at: &penmodel_terrain::path::FigurePath) -> String {
+fn short(at: &penmodel_terrain::address::FigurePath) -> String {
     let mut s = at.region().to_string();
     for i in at.indices() {
         s.push('.');

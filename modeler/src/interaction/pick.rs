@@ -5,9 +5,9 @@
 //! picked only near the line: inside a region is where figures are drawn. When several qualify,
 //! the nearest line or point wins; failing that, the innermost closed curve around the tip.
 
+use penmodel_terrain::address::{CurvePath, FigurePath};
 use penmodel_terrain::document::{Document, Figure, FigureKind, Point};
 use penmodel_terrain::geometry::{Side, distance, locate, segment_distance};
-use penmodel_terrain::path::{CurvePath, FigurePath};
 
 /// A picked curve, and its vertex under the tip if there is one.
 #[derive(Debug, Clone, PartialEq)]

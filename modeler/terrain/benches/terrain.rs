@@ -12,7 +12,7 @@ use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use penmodel_terrain::{CurvePath, Document, Edit, Engine, FigurePath, baseline, generate};
+use penmodel_terrain::{CurvePath, Document, Edit, FigurePath, TerrainEngine, baseline, generate};
 
 const SIZES: [u32; 3] = [256, 512, 1024];
 
@@ -39,7 +39,7 @@ fn terrain(c: &mut Criterion) {
             b.iter(|| generate(black_box(doc)))
         });
 
-        let mut engine = Engine::new(doc.clone()).expect("valid");
+        let mut engine = TerrainEngine::new(doc.clone()).expect("valid");
         let mut h = 60.0;
         g.bench_function(BenchmarkId::new("pull", n), |b| {
             b.iter(|| {

@@ -7,8 +7,8 @@
 //! is the reading under which the thesis' rules give true 4-neighbour distances (an in-place sweep
 //! would let a value travel several cells in one pass and fix it too early).
 
+use crate::cells::{Cell, Mask};
 use crate::distance::{UNREACHABLE, neighbours};
-use crate::raster::{Cell, Mask};
 
 /// `dp` by repeated sweeps: (1) the figure's cells hold 0; (2) a region cell without a value next
 /// to a cell with one takes that value + 1; (3) repeat until no cell changes.
@@ -76,7 +76,7 @@ pub fn edge_layers(mask: &Mask) -> Vec<u32> {
 /// as [`crate::generate`], the seed's cost.
 pub fn generate(doc: &crate::Document) -> Result<crate::Heightmap, crate::ValidationError> {
     Ok(
-        crate::terrain::Engine::with_method(doc.clone(), crate::terrain::Method::Sweep)?
+        crate::engine::TerrainEngine::with_method(doc.clone(), crate::engine::Method::Sweep)?
             .into_parts()
             .1,
     )

@@ -9,7 +9,7 @@
 //! Maps are laid out over the region mask's bounding box, row-major; cells outside the region
 //! hold [`UNREACHABLE`].
 
-use crate::raster::{Cell, Mask};
+use crate::cells::{Cell, Mask};
 
 /// Distance of a cell no path within the region reaches (and of cells outside the region).
 pub const UNREACHABLE: u32 = u32::MAX;

@@ -2,7 +2,7 @@
 //!
 //! The format is specified in `docs/document.md`. A [`Document`] read with [`Document::from_json`]
 //! or [`Document::load`] has been validated ([`crate::validate`]); a document built in code is
-//! checked when it is handed to the [`Engine`](crate::Engine) or saved.
+//! checked when it is handed to the [`TerrainEngine`](crate::TerrainEngine) or saved.
 
 use std::fs;
 use std::io;
@@ -209,7 +209,7 @@ impl Document {
             Some(v) if v == u64::from(VERSION) => {}
             _ => {
                 return Err(
-                    ValidationError::new("version", validate::Problem::Version(version.version.to_string())).into(),
+                    ValidationError::new("version", validate::Defect::Version(version.version.to_string())).into(),
                 );
             }
         }

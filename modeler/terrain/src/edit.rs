@@ -8,10 +8,10 @@
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use crate::address::{CurvePath, FigurePath};
+use crate::cells::{self, Mask};
 use crate::document::{Document, Figure, FigureKind, Point, Region};
-use crate::path::{CurvePath, FigurePath};
-use crate::raster::{self, Mask};
-use crate::validate::{self, Problem, ValidationError};
+use crate::validate::{self, Defect, ValidationError};
 
 /// One change to a document. Serialised (in the journal) as an object tagged by `"op"`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -213,7 +213,7 @@ pub(crate) fn apply(doc: &mut Document, edit: &Edit, masks: &[&Mask]) -> Result<
         Edit::SetHeight { at, height } => {
             let f = at.get_mut(doc).ok_or_else(|| EditError::NoFigure(at.clone()))?;
             if !height.is_finite() {
-                return Err(ValidationError::new(format!("{at}.height"), Problem::NotFinite).into());
+                return Err(ValidationError::new(format!("{at}.height"), Defect::NotFinite).into());
             }
             let old = std::mem::replace(&mut f.height, *height);
             let inverse = Edit::SetHeight {
@@ -228,7 +228,7 @@ pub(crate) fn apply(doc: &mut Document, edit: &Edit, masks: &[&Mask]) -> Result<
         Edit::SetSlope { at, slope } => {
             let f = at.get_mut(doc).ok_or_else(|| EditError::NoFigure(at.clone()))?;
             if !slope.is_finite() {
-                return Err(ValidationError::new(format!("{at}.slope"), Problem::NotFinite).into());
+                return Err(ValidationError::new(format!("{at}.slope"), Defect::NotFinite).into());
             }
             let old = std::mem::replace(&mut f.slope, *slope);
             let inverse = Edit::SetSlope {
@@ -334,7 +334,7 @@ pub(crate) fn apply(doc: &mut Document, edit: &Edit, masks: &[&Mask]) -> Result<
                 return Err(EditError::NoRegion(*index));
             }
             validate::region(&doc.grid, region, *index)?;
-            let mask = raster::closed_mask(&doc.grid, &region.boundary);
+            let mask = cells::closed_mask(&doc.grid, &region.boundary);
             let shifted = masks
                 .iter()
                 .enumerate()
@@ -414,7 +414,7 @@ fn replace_region(
     scope: Scope,
 ) -> Result<Applied, EditError> {
     validate::region(&doc.grid, &new, index)?;
-    let mask = raster::closed_mask(&doc.grid, &new.boundary);
+    let mask = cells::closed_mask(&doc.grid, &new.boundary);
     validate::region_overlap(index, &mask, masks.iter().enumerate().map(|(j, m)| (j, *m)))?;
     let old = std::mem::replace(&mut doc.regions[index], new);
     Ok(Applied {

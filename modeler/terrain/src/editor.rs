@@ -1,6 +1,6 @@
 //! Editing a document with undo and redo, journaled so that a crash loses nothing.
 //!
-//! An [`Editor`] owns an [`Engine`] (the document and its terrain). Each edit is applied, then
+//! An [`Editor`] owns an [`TerrainEngine`] (the document and its terrain). Each edit is applied, then
 //! appended to the journal and flushed to disk, then pushed on the undo stack; if the journal
 //! cannot be written the edit is rolled back and the error returned. Opening a document replays
 //! its journal (edits, undos and redos since the last save, and the undo history saved with it);
@@ -18,12 +18,12 @@ use std::path::{Path, PathBuf};
 
 use thiserror::Error;
 
+use crate::address::FigurePath;
 use crate::document::{Document, LoadError, SaveError};
 use crate::edit::{Edit, EditError};
+use crate::engine::{Outcome, TerrainEngine};
 use crate::heightmap::Heightmap;
-use crate::journal::{self, Entry, JournalError, Replay, Step, Writer};
-use crate::path::FigurePath;
-use crate::terrain::{Engine, Outcome};
+use crate::journal::{self, Entry, JournalError, Replay, UndoStep, Writer};
 use crate::validate::ValidationError;
 
 /// The most undo steps kept; older ones are forgotten.
@@ -118,9 +118,9 @@ struct Store {
 
 /// A document being edited: terrain, undo and redo, journal.
 pub struct Editor {
-    engine: Engine,
-    undo: Vec<Step>,
-    redo: Vec<Step>,
+    engine: TerrainEngine,
+    undo: Vec<UndoStep>,
+    redo: Vec<UndoStep>,
     store: Option<Store>,
     preview: Option<Preview>,
 }
@@ -153,7 +153,7 @@ impl Editor {
     /// Edits `doc` in memory, without a file (until [`Editor::save_as`]).
     pub fn new(doc: Document) -> Result<Editor, ValidationError> {
         Ok(Editor {
-            engine: Engine::new(doc)?,
+            engine: TerrainEngine::new(doc)?,
             undo: Vec::new(),
             redo: Vec::new(),
             store: None,
@@ -272,7 +272,7 @@ impl Editor {
     }
 
     /// The engine (document and terrain).
-    pub fn engine(&self) -> &Engine {
+    pub fn engine(&self) -> &TerrainEngine {
         &self.engine
     }
 
@@ -328,7 +328,7 @@ impl Editor {
             self.engine.apply(&outcome.inverse)?;
             return Err(e);
         }
-        self.push_undo(Step {
+        self.push_undo(UndoStep {
             edit,
             inverse: outcome.inverse.clone(),
         });
@@ -339,7 +339,7 @@ impl Editor {
     /// Applies an edit as a journal replay does: no preview, no journal.
     fn record(&mut self, edit: Edit) -> Result<Outcome, EditError> {
         let outcome = self.engine.apply(&edit)?;
-        self.push_undo(Step {
+        self.push_undo(UndoStep {
             edit,
             inverse: outcome.inverse.clone(),
         });
@@ -347,7 +347,7 @@ impl Editor {
         Ok(outcome)
     }
 
-    fn push_undo(&mut self, step: Step) {
+    fn push_undo(&mut self, step: UndoStep) {
         if self.undo.len() == HISTORY_LIMIT {
             self.undo.remove(0);
         }
@@ -469,7 +469,7 @@ impl Editor {
             self.engine.apply(&inverse)?;
             return Err(e);
         }
-        self.push_undo(Step {
+        self.push_undo(UndoStep {
             edit: edit.clone(),
             inverse,
         });

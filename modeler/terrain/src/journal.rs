@@ -33,7 +33,7 @@ pub const JOURNAL_VERSION: u32 = 1;
 /// An edit with its inverse: one undo (or redo) step.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub struct Step {
+pub struct UndoStep {
     /// The edit as applied.
     pub edit: Edit,
     /// The edit that undoes it.
@@ -54,9 +54,9 @@ pub enum Entry {
     /// The undo and redo stacks at the time the document was saved (oldest first).
     History {
         /// Undo stack.
-        undo: Vec<Step>,
+        undo: Vec<UndoStep>,
         /// Redo stack.
-        redo: Vec<Step>,
+        redo: Vec<UndoStep>,
     },
     /// An edit was applied.
     Do {
@@ -197,7 +197,7 @@ fn line(entry: &Entry) -> Vec<u8> {
 impl Writer {
     /// Starts a new journal at `path` for the document with fingerprint `base`, carrying the
     /// undo and redo stacks over. Atomic: a crash leaves the old journal or the new one.
-    pub fn create(path: &Path, base: &str, undo: &[Step], redo: &[Step]) -> io::Result<Writer> {
+    pub fn create(path: &Path, base: &str, undo: &[UndoStep], redo: &[UndoStep]) -> io::Result<Writer> {
         let mut bytes = line(&Entry::Open {
             journal: JOURNAL_VERSION,
             base: base.to_owned(),

@@ -4,7 +4,7 @@
 //! - [`Document`]: the source of truth — a grid, generation regions, and control figures (points,
 //!   polylines, closed curves) with heights and slopes, nested to any depth. Saved as versioned
 //!   JSON (`docs/document.md`), validated on load ([`validate`]).
-//! - [`generate`] and [`Engine`]: the terrain by the thesis' equations 1–4 ([`raster`],
+//! - [`generate`] and [`TerrainEngine`]: the terrain by the thesis' equations 1–4 ([`raster`],
 //!   [`distance`], [`profile`]), regenerated incrementally as the document is edited ([`terrain`]
 //!   explains how).
 //! - [`Editor`]: edits ([`Edit`]) with undo and redo, and a journal that survives a crash
@@ -14,27 +14,27 @@
 //!   benchmarks.
 #![cfg_attr(not(test), warn(clippy::unwrap_used))]
 
+pub mod address;
 pub mod baseline;
+pub mod cells;
 pub mod distance;
 pub mod document;
 pub mod edit;
 pub mod editor;
+pub mod engine;
 pub mod export;
 pub mod geometry;
 mod heightmap;
 pub mod journal;
 mod json;
-pub mod path;
 pub mod persist;
 pub mod profile;
-pub mod raster;
-pub mod terrain;
 pub mod validate;
 
+pub use address::{CurvePath, FigurePath};
 pub use document::{Document, Figure, FigureKind, Grid, LoadError, Point, Region, SaveError};
 pub use edit::{Edit, EditError};
 pub use editor::Editor;
+pub use engine::{Outcome, Rect, TerrainEngine, generate};
 pub use heightmap::Heightmap;
-pub use path::{CurvePath, FigurePath};
-pub use terrain::{Engine, Outcome, Rect, generate};
-pub use validate::{Problem, ValidationError};
+pub use validate::{Defect, ValidationError};

@@ -19,9 +19,9 @@
 
 use thiserror::Error;
 
+use crate::cells::{self, Cell, Mask};
 use crate::document::{Document, Figure, FigureKind, Grid, Point, Region, VERSION};
 use crate::geometry::{self, Side};
-use crate::raster::{self, Cell, Mask};
 
 /// The most cells a grid may have: 4096 × 4096. The engine keeps about 12 bytes per cell per
 /// figure of a region plus about 30 per cell, so a larger grid would not fit a workstation.
@@ -29,27 +29,27 @@ pub const MAX_CELLS: u64 = 1 << 24;
 
 /// A document element that is not valid, and why.
 #[derive(Debug, Clone, PartialEq, Error)]
-#[error("{path}: {problem}")]
+#[error("{path}: {defect}")]
 pub struct ValidationError {
     /// The element, e.g. `regions[1].figures[0].points[3]`.
     pub path: String,
     /// What is wrong with it.
-    pub problem: Problem,
+    pub defect: Defect,
 }
 
 impl ValidationError {
     /// An error at `path`.
-    pub fn new(path: impl Into<String>, problem: Problem) -> ValidationError {
+    pub fn new(path: impl Into<String>, defect: Defect) -> ValidationError {
         ValidationError {
             path: path.into(),
-            problem,
+            defect,
         }
     }
 }
 
 /// What is wrong with an element.
 #[derive(Debug, Clone, PartialEq, Error)]
-pub enum Problem {
+pub enum Defect {
     /// The version is not one this build reads.
     #[error("unsupported document version {0} (this build reads version {VERSION})")]
     Version(String),
@@ -132,7 +132,7 @@ pub fn document(doc: &Document) -> Result<(), ValidationError> {
     if doc.version != VERSION {
         return Err(ValidationError::new(
             "version",
-            Problem::Version(doc.version.to_string()),
+            Defect::Version(doc.version.to_string()),
         ));
     }
     grid(&doc.grid)?;
@@ -142,7 +142,7 @@ pub fn document(doc: &Document) -> Result<(), ValidationError> {
     let masks: Vec<Mask> = doc
         .regions
         .iter()
-        .map(|r| raster::closed_mask(&doc.grid, &r.boundary))
+        .map(|r| cells::closed_mask(&doc.grid, &r.boundary))
         .collect();
     for (i, m) in masks.iter().enumerate() {
         region_overlap(i, m, masks.iter().enumerate().take(i))?;
@@ -153,16 +153,16 @@ pub fn document(doc: &Document) -> Result<(), ValidationError> {
 /// Checks the grid.
 pub fn grid(g: &Grid) -> Result<(), ValidationError> {
     if g.cols == 0 || g.rows == 0 {
-        return Err(ValidationError::new("grid", Problem::EmptyGrid));
+        return Err(ValidationError::new("grid", Defect::EmptyGrid));
     }
     if !(g.cell_size.is_finite() && g.cell_size > 0.0 && g.width().is_finite() && g.height().is_finite()) {
-        return Err(ValidationError::new("grid.cell_size", Problem::CellSize(g.cell_size)));
+        return Err(ValidationError::new("grid.cell_size", Defect::CellSize(g.cell_size)));
     }
     let cells = u64::from(g.cols) * u64::from(g.rows);
     if cells > MAX_CELLS {
         return Err(ValidationError::new(
             "grid",
-            Problem::GridTooLarge { cells, max: MAX_CELLS },
+            Defect::GridTooLarge { cells, max: MAX_CELLS },
         ));
     }
     Ok(())
@@ -200,7 +200,7 @@ pub fn region_overlap<'a>(
         if let Some(cell) = mask.first_common(other) {
             return Err(ValidationError::new(
                 format!("regions[{index}]"),
-                Problem::Overlap {
+                Defect::Overlap {
                     other: format!("regions[{j}]"),
                     cell,
                 },
@@ -214,7 +214,7 @@ fn finite(v: f64, path: impl FnOnce() -> String) -> Result<(), ValidationError> 
     if v.is_finite() {
         Ok(())
     } else {
-        Err(ValidationError::new(path(), Problem::NotFinite))
+        Err(ValidationError::new(path(), Defect::NotFinite))
     }
 }
 
@@ -222,20 +222,20 @@ fn finite(v: f64, path: impl FnOnce() -> String) -> Result<(), ValidationError> 
 fn points(grid: &Grid, pts: &[Point], path: &impl Fn(usize) -> String) -> Result<(), ValidationError> {
     for (i, p) in pts.iter().enumerate() {
         if !(p[0].is_finite() && p[1].is_finite()) {
-            return Err(ValidationError::new(path(i), Problem::NotFinite));
+            return Err(ValidationError::new(path(i), Defect::NotFinite));
         }
         let (w, h) = (grid.width(), grid.height());
         if !(p[0] >= 0.0 && p[0] < w && p[1] >= 0.0 && p[1] < h) {
-            let problem = Problem::OutsideGrid {
+            let defect = Defect::OutsideGrid {
                 x: p[0],
                 y: p[1],
                 width: w,
                 height: h,
             };
-            return Err(ValidationError::new(path(i), problem));
+            return Err(ValidationError::new(path(i), defect));
         }
         if i > 0 && pts[i - 1] == *p {
-            return Err(ValidationError::new(path(i), Problem::RepeatedPoint));
+            return Err(ValidationError::new(path(i), Defect::RepeatedPoint));
         }
     }
     Ok(())
@@ -245,14 +245,14 @@ fn points(grid: &Grid, pts: &[Point], path: &impl Fn(usize) -> String) -> Result
 fn ring(grid: &Grid, pts: &[Point], path: impl Fn(usize) -> String, whole: &str) -> Result<(), ValidationError> {
     points(grid, pts, &path)?;
     let (Some(&first), Some(&last)) = (pts.first(), pts.last()) else {
-        return Err(ValidationError::new(whole, Problem::CurveTooShort(0)));
+        return Err(ValidationError::new(whole, Defect::CurveTooShort(0)));
     };
     if first != last {
-        return Err(ValidationError::new(whole, Problem::OpenCurve { first, last }));
+        return Err(ValidationError::new(whole, Defect::OpenCurve { first, last }));
     }
     let n = pts.len() - 1; // segments, = distinct vertices
     if n < 3 {
-        return Err(ValidationError::new(whole, Problem::CurveTooShort(n)));
+        return Err(ValidationError::new(whole, Defect::CurveTooShort(n)));
     }
     let seg = |i: usize| (pts[i], pts[i + 1]);
     for j in 1..n {
@@ -271,7 +271,7 @@ fn ring(grid: &Grid, pts: &[Point], path: impl Fn(usize) -> String, whole: &str)
                 geometry::segments_touch(a, b, c, d)
             };
             if meets {
-                return Err(ValidationError::new(path(j), Problem::SelfIntersecting(i)));
+                return Err(ValidationError::new(path(j), Defect::SelfIntersecting(i)));
             }
         }
     }
@@ -288,14 +288,14 @@ fn figures(grid: &Grid, figs: &[Figure], edge: &[Point], edge_path: &str, parent
         .iter()
         .enumerate()
         .filter(|(_, f)| f.kind == FigureKind::Closed)
-        .map(|(k, f)| (k, raster::closed_mask(grid, &f.points)))
+        .map(|(k, f)| (k, cells::closed_mask(grid, &f.points)))
         .collect();
     for (a, (ka, ma)) in closed.iter().enumerate() {
         for (kb, mb) in &closed[..a] {
             if let Some(cell) = ma.first_common(mb) {
                 return Err(ValidationError::new(
                     format!("{parent}.figures[{ka}]"),
-                    Problem::Overlap {
+                    Defect::Overlap {
                         other: format!("{parent}.figures[{kb}]"),
                         cell,
                     },
@@ -316,15 +316,15 @@ fn figure(grid: &Grid, f: &Figure, edge: &[Point], edge_path: &str, path: &str) 
             if f.points.len() != 1 {
                 return Err(ValidationError::new(
                     format!("{path}.points"),
-                    Problem::PointCount(f.points.len()),
+                    Defect::PointCount(f.points.len()),
                 ));
             }
         }
         FigureKind::Polyline => {
             points(grid, &f.points, &point_path)?;
             if f.points.len() < 2 {
-                let problem = Problem::PolylineTooShort(f.points.len());
-                return Err(ValidationError::new(format!("{path}.points"), problem));
+                let defect = Defect::PolylineTooShort(f.points.len());
+                return Err(ValidationError::new(format!("{path}.points"), defect));
             }
         }
         FigureKind::Closed => ring(grid, &f.points, point_path, &format!("{path}.points"))?,
@@ -335,13 +335,13 @@ fn figure(grid: &Grid, f: &Figure, edge: &[Point], edge_path: &str, path: &str) 
             Side::On => {
                 return Err(ValidationError::new(
                     point_path(i),
-                    Problem::OnRegionEdge(edge_path.into()),
+                    Defect::OnRegionEdge(edge_path.into()),
                 ));
             }
             Side::Outside => {
                 return Err(ValidationError::new(
                     point_path(i),
-                    Problem::OutsideRegion(edge_path.into()),
+                    Defect::OutsideRegion(edge_path.into()),
                 ));
             }
         }
@@ -350,7 +350,7 @@ fn figure(grid: &Grid, f: &Figure, edge: &[Point], edge_path: &str, path: &str) 
             if edge.windows(2).any(|e| geometry::segments_touch(a, b, e[0], e[1])) {
                 return Err(ValidationError::new(
                     point_path(i),
-                    Problem::CrossesRegionEdge(edge_path.into()),
+                    Defect::CrossesRegionEdge(edge_path.into()),
                 ));
             }
         }
@@ -359,7 +359,7 @@ fn figure(grid: &Grid, f: &Figure, edge: &[Point], edge_path: &str, path: &str) 
         if f.kind != FigureKind::Closed {
             return Err(ValidationError::new(
                 format!("{path}.figures"),
-                Problem::NestedInOpenFigure(f.kind.name()),
+                Defect::NestedInOpenFigure(f.kind.name()),
             ));
         }
         figures(grid, &f.figures, &f.points, &format!("{path}.points"), path)?;

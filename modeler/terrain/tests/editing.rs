@@ -7,7 +7,9 @@ use std::fs;
 
 use common::*;
 use penmodel_terrain::editor::{Editor, OpenReport};
-use penmodel_terrain::{CurvePath, Document, Edit, EditError, Engine, Figure, FigurePath, Problem, generate, journal};
+use penmodel_terrain::{
+    CurvePath, Defect, Document, Edit, EditError, Figure, FigurePath, TerrainEngine, generate, journal,
+};
 use proptest::prelude::*;
 
 /// Every figure path of the document, depth first.
@@ -136,7 +138,7 @@ fn edit_for(doc: &Document, op: &Op) -> Option<Edit> {
 }
 
 #[track_caller]
-fn assert_matches_full(engine: &Engine, context: &str) {
+fn assert_matches_full(engine: &TerrainEngine, context: &str) {
     let full = generate(engine.document()).unwrap();
     let tol = tolerance(engine.document());
     if let Some((c, r, a, b)) = first_difference(engine.heightmap(), &full, tol) {
@@ -152,7 +154,7 @@ proptest! {
     /// refused edit leaves the document and terrain exactly as they were.
     #[test]
     fn incremental_equals_full(doc in nested_document(), ops in prop::collection::vec(op(), 1..14)) {
-        let mut engine = Engine::new(doc).unwrap();
+        let mut engine = TerrainEngine::new(doc).unwrap();
         for (n, op) in ops.iter().enumerate() {
             let Some(edit) = edit_for(engine.document(), op) else { continue };
             let (before_doc, before_map) = (engine.document().clone(), engine.heightmap().clone());
@@ -243,7 +245,7 @@ fn sample() -> Document {
 
 #[test]
 fn refused_edits_name_the_problem() {
-    let mut engine = Engine::new(sample()).unwrap();
+    let mut engine = TerrainEngine::new(sample()).unwrap();
     let outside = engine.apply(&Edit::MoveFigure {
         at: FigurePath::new(0, 0),
         by: [30.0, 0.0],
@@ -252,7 +254,7 @@ fn refused_edits_name_the_problem() {
         panic!("{outside:?}")
     };
     assert_eq!(e.path, "regions[0].figures[0].points[0]");
-    assert!(matches!(e.problem, Problem::OutsideGrid { .. }), "{e}");
+    assert!(matches!(e.defect, Defect::OutsideGrid { .. }), "{e}");
     let nan = engine.apply(&Edit::SetHeight {
         at: FigurePath::new(0, 1).child(0),
         height: f64::NAN,
@@ -261,8 +263,8 @@ fn refused_edits_name_the_problem() {
         panic!("{nan:?}")
     };
     assert_eq!(
-        (e.path.as_str(), e.problem),
-        ("regions[0].figures[1].figures[0].height", Problem::NotFinite)
+        (e.path.as_str(), e.defect),
+        ("regions[0].figures[1].figures[0].height", Defect::NotFinite)
     );
     let missing = engine.apply(&Edit::DeleteFigure {
         at: FigurePath::new(0, 5),
@@ -409,9 +411,8 @@ fn an_edit_regenerates_only_its_region() {
         boundary: polygon([31.0, 20.0], 7.0, 8, 0.1),
         figures: vec![point([31.0, 21.0], 20.0, 0.0)],
     });
-    let mut engine = Engine::new(doc).unwrap();
-    let region1 =
-        penmodel_terrain::raster::closed_mask(&engine.document().grid, &engine.document().regions[1].boundary);
+    let mut engine = TerrainEngine::new(doc).unwrap();
+    let region1 = penmodel_terrain::cells::closed_mask(&engine.document().grid, &engine.document().regions[1].boundary);
     let before = engine.heightmap().clone();
     for edit in [
         Edit::SetHeight {
@@ -495,7 +496,7 @@ fn a_pull_with_a_slope_is_one_step() {
 
 #[test]
 fn a_refused_group_changes_nothing() {
-    let mut engine = Engine::new(sample()).unwrap();
+    let mut engine = TerrainEngine::new(sample()).unwrap();
     let at = FigurePath::new(0, 0);
     let group = Edit::Group {
         edits: vec![

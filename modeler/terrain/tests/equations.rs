@@ -2,8 +2,8 @@
 //!
 //! Every expected number is worked out in the comments from the rules, not taken from the code.
 
+use penmodel_terrain::cells::{self, Mask};
 use penmodel_terrain::distance::{self, UNREACHABLE};
-use penmodel_terrain::raster::{self, Mask};
 use penmodel_terrain::{Document, Figure, FigureKind, Grid, Region, generate, profile};
 
 const EPS: f32 = 1e-5;
@@ -65,9 +65,9 @@ fn point_is_its_cell() {
         cell_size: 2.0,
     };
     // x/s = 1.5 → column 1; y/s = 4.0 lies on the line between rows 3 and 4 → row 4 (half-open).
-    assert_eq!(raster::point_cell(&g, [3.0, 8.0]), (1, 4));
-    assert_eq!(raster::point_cell(&g, [0.0, 0.0]), (0, 0));
-    assert_eq!(raster::point_cell(&g, [19.99, 0.1]), (9, 0));
+    assert_eq!(cells::point_cell(&g, [3.0, 8.0]), (1, 4));
+    assert_eq!(cells::point_cell(&g, [0.0, 0.0]), (0, 0));
+    assert_eq!(cells::point_cell(&g, [19.99, 0.1]), (9, 0));
 }
 
 #[test]
@@ -77,11 +77,11 @@ fn segment_is_four_connected_supercover() {
     // exactly — the grid corner (2, 1), with x and y both increasing: tie → step x first, so
     // (1,0) → (2,0) → (2,1), then x = 3 at y = 1.33 → (3,1).
     let mut cells = Vec::new();
-    raster::segment_cells(&g, [0.5, 0.5], [3.5, 1.5], &mut cells);
+    cells::segment_cells(&g, [0.5, 0.5], [3.5, 1.5], &mut cells);
     assert_eq!(cells, vec![(0, 0), (1, 0), (2, 0), (2, 1), (3, 1)]);
     // Drawn the other way round: the same cells.
     let mut back = Vec::new();
-    raster::segment_cells(&g, [3.5, 1.5], [0.5, 0.5], &mut back);
+    cells::segment_cells(&g, [3.5, 1.5], [0.5, 0.5], &mut back);
     back.reverse();
     assert_eq!(back, cells);
 }
@@ -92,17 +92,17 @@ fn diagonal_through_corners_tie_rule() {
     // Exactly through corners (1, 1) and (2, 2): each corner adds the corner's column, row above
     // it in cell terms (X, Y−1): (1, 0) and (2, 1).
     let mut cells = Vec::new();
-    raster::segment_cells(&g, [0.5, 0.5], [2.5, 2.5], &mut cells);
+    cells::segment_cells(&g, [0.5, 0.5], [2.5, 2.5], &mut cells);
     assert_eq!(cells, vec![(0, 0), (1, 0), (1, 1), (2, 1), (2, 2)]);
     let mut back = Vec::new();
-    raster::segment_cells(&g, [2.5, 2.5], [0.5, 0.5], &mut back);
+    cells::segment_cells(&g, [2.5, 2.5], [0.5, 0.5], &mut back);
     back.sort();
     cells.sort();
     assert_eq!(back, cells);
     // x increasing, y decreasing through corner (1, 2): the half-open corner point (1, 2) lies
     // in cell (1, 2), so the walk is (0,2) → (1,2) → (1,1): 4-connected without a tie cell.
     let mut anti = Vec::new();
-    raster::segment_cells(&g, [0.5, 2.5], [1.5, 1.5], &mut anti);
+    cells::segment_cells(&g, [0.5, 2.5], [1.5, 1.5], &mut anti);
     assert_eq!(anti, vec![(0, 2), (1, 2), (1, 1)]);
 }
 
@@ -116,7 +116,7 @@ fn closed_curve_is_boundary_plus_centres_inside() {
     // (3,3) (2,3) (2,4) (1,4) (1,5) (0,5): the cells with c + r = 5 and those with c + r = 6,
     // 1 ≤ c ≤ 5. Inside: centres (c + ½, r + ½) with c + r + 1 < 6, i.e. c + r ≤ 4.
     // Together: every (c, r) with c, r ≤ 5 and c + r ≤ 6.
-    let m = raster::closed_mask(&g, &[[0.5, 0.5], [5.5, 0.5], [0.5, 5.5], [0.5, 0.5]]);
+    let m = cells::closed_mask(&g, &[[0.5, 0.5], [5.5, 0.5], [0.5, 5.5], [0.5, 0.5]]);
     let mut expected = Vec::new();
     for r in 0..=5u32 {
         for c in 0..=5u32 {

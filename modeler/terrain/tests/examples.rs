@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use penmodel_terrain::{Document, Figure, FigureKind, generate, raster};
+use penmodel_terrain::{Document, Figure, FigureKind, cells, generate};
 
 fn examples() -> Vec<(String, Document)> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples");
@@ -53,7 +53,7 @@ fn examples_generate() {
         doc.regions.iter().for_each(|r| walk(&r.figures, &mut figs));
         // Every point figure stands at its height (no two figures share a cell in the examples).
         for f in figs.iter().filter(|f| f.kind == FigureKind::Point) {
-            let (c, r) = raster::point_cell(&doc.grid, f.points[0]);
+            let (c, r) = cells::point_cell(&doc.grid, f.points[0]);
             assert_eq!(map.get(c, r), f.height as f32, "{name}: point at {:?}", f.points[0]);
         }
         // The terrain spans from 0 (outside the regions) to the highest figure; heights are

@@ -3,9 +3,9 @@
 use crate::common;
 
 use common::*;
+use penmodel_terrain::cells::{self, Mask};
 use penmodel_terrain::distance::{self, UNREACHABLE};
-use penmodel_terrain::raster::{self, Mask};
-use penmodel_terrain::{Engine, FigureKind, Region, baseline, generate, profile};
+use penmodel_terrain::{FigureKind, Region, TerrainEngine, baseline, generate, profile};
 use proptest::prelude::*;
 
 /// A random set of cells in a w × h box, and some sources among them.
@@ -94,7 +94,7 @@ proptest! {
             prop_assert!(v >= lo && v <= hi, "height {} outside [{}, {}]", v, lo, hi);
         }
         // And the figure's own cells are at H.
-        for (c, r) in raster::figure_cells(&doc.grid, &doc.regions[0].figures[0]) {
+        for (c, r) in cells::figure_cells(&doc.grid, &doc.regions[0].figures[0]) {
             prop_assert_eq!(map.get(c, r), h);
         }
     }
@@ -115,13 +115,13 @@ proptest! {
     fn continuous_across_nested_edge(mut doc in nested_document()) {
         // The closed figure alone in the parent, for the bound on the parent's side.
         doc.regions[0].figures.retain(|f| f.kind == FigureKind::Closed);
-        let engine = Engine::new(doc.clone()).unwrap();
+        let engine = TerrainEngine::new(doc.clone()).unwrap();
         let map = engine.heightmap();
         let k = &doc.regions[0].figures[0];
-        let nested = raster::closed_mask(&doc.grid, &k.points);
-        let region = raster::closed_mask(&doc.grid, &doc.regions[0].boundary);
+        let nested = cells::closed_mask(&doc.grid, &k.points);
+        let region = cells::closed_mask(&doc.grid, &doc.regions[0].boundary);
         let df = distance::edge_layers(&region);
-        let on_inner: Vec<(u32, u32)> = k.figures.iter().flat_map(|f| raster::figure_cells(&doc.grid, f)).collect();
+        let on_inner: Vec<(u32, u32)> = k.figures.iter().flat_map(|f| cells::figure_cells(&doc.grid, f)).collect();
         let h_k = k.height as f32;
         let bound_factor = 1f64.max(1.0 - k.slope);
         for q in nested.cells() {

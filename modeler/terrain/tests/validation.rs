@@ -3,7 +3,7 @@
 use crate::common;
 
 use common::*;
-use penmodel_terrain::{Document, LoadError, Problem, Region, validate};
+use penmodel_terrain::{Defect, Document, LoadError, Region, validate};
 
 fn base() -> Document {
     document(
@@ -25,17 +25,17 @@ fn base() -> Document {
 }
 
 #[track_caller]
-fn rejects(doc: &Document, path: &str, problem: impl Fn(&Problem) -> bool) {
+fn rejects(doc: &Document, path: &str, problem: impl Fn(&Defect) -> bool) {
     match validate::document(doc) {
         Ok(()) => panic!("accepted, expected an error at {path}"),
         Err(e) => {
             assert_eq!(e.path, path, "{e}");
-            assert!(problem(&e.problem), "{e}");
+            assert!(problem(&e.defect), "{e}");
             // The JSON loader reports the same error. JSON has no NaN or infinity: serde_json
             // writes them as null, which the loader refuses at the same element.
             match Document::from_json(&doc.to_json()) {
                 Err(LoadError::Invalid(le)) => assert_eq!(le, e),
-                Err(LoadError::Parse { path: p, message, .. }) if !doc_is_finite(&e.problem) => {
+                Err(LoadError::Parse { path: p, message, .. }) if !doc_is_finite(&e.defect) => {
                     assert!(p.starts_with(&e.path), "{p} vs {}", e.path);
                     assert!(message.contains("null"), "{message}");
                 }
@@ -45,8 +45,8 @@ fn rejects(doc: &Document, path: &str, problem: impl Fn(&Problem) -> bool) {
     }
 }
 
-fn doc_is_finite(problem: &Problem) -> bool {
-    !matches!(problem, Problem::NotFinite | Problem::CellSize(_))
+fn doc_is_finite(problem: &Defect) -> bool {
+    !matches!(problem, Defect::NotFinite | Defect::CellSize(_))
 }
 
 #[test]
@@ -58,11 +58,11 @@ fn the_base_document_is_valid() {
 fn open_curves() {
     let mut d = base();
     d.regions[0].boundary.pop();
-    rejects(&d, "regions[0].boundary", |p| matches!(p, Problem::OpenCurve { .. }));
+    rejects(&d, "regions[0].boundary", |p| matches!(p, Defect::OpenCurve { .. }));
     let mut d = base();
     d.regions[0].figures[2].points.pop();
     rejects(&d, "regions[0].figures[2].points", |p| {
-        matches!(p, Problem::OpenCurve { .. })
+        matches!(p, Defect::OpenCurve { .. })
     });
 }
 
@@ -73,12 +73,12 @@ fn self_intersecting_curves() {
     d.regions[0].figures[2].points = vec![[21.0, 11.0], [27.0, 17.0], [27.0, 11.0], [21.0, 17.0], [21.0, 11.0]];
     d.regions[0].figures[2].figures.clear();
     rejects(&d, "regions[0].figures[2].points[2]", |p| {
-        *p == Problem::SelfIntersecting(0)
+        *p == Defect::SelfIntersecting(0)
     });
     // A boundary doubling back on itself along a line.
     let mut d = base();
     d.regions[0].boundary = vec![[5.0, 5.0], [35.0, 5.0], [20.0, 5.0], [20.0, 35.0], [5.0, 5.0]];
-    rejects(&d, "regions[0].boundary[1]", |p| *p == Problem::SelfIntersecting(0));
+    rejects(&d, "regions[0].boundary[1]", |p| *p == Defect::SelfIntersecting(0));
 }
 
 #[test]
@@ -86,13 +86,13 @@ fn figures_outside_their_region() {
     let mut d = base();
     d.regions[0].figures[0].points[0] = [2.0, 2.0];
     rejects(&d, "regions[0].figures[0].points[0]", |p| {
-        *p == Problem::OutsideRegion("regions[0].boundary".into())
+        *p == Defect::OutsideRegion("regions[0].boundary".into())
     });
     // A nested figure outside its closed figure (but inside the region).
     let mut d = base();
     d.regions[0].figures[2].figures[0].points[0] = [20.0, 25.0];
     rejects(&d, "regions[0].figures[2].figures[0].points[0]", |p| {
-        *p == Problem::OutsideRegion("regions[0].figures[2].points".into())
+        *p == Defect::OutsideRegion("regions[0].figures[2].points".into())
     });
     // A polyline whose points are inside but whose segment leaves the region: a square region
     // with a notch, the segment jumping across the notch.
@@ -109,7 +109,7 @@ fn figures_outside_their_region() {
     ];
     d.regions[0].figures = vec![polyline(vec![[10.0, 30.0], [30.0, 30.0]], 5.0, 0.0)];
     rejects(&d, "regions[0].figures[0].points[1]", |p| {
-        *p == Problem::CrossesRegionEdge("regions[0].boundary".into())
+        *p == Defect::CrossesRegionEdge("regions[0].boundary".into())
     });
 }
 
@@ -123,7 +123,7 @@ fn overlapping_regions() {
     rejects(
         &d,
         "regions[1]",
-        |p| matches!(p, Problem::Overlap { other, .. } if other == "regions[0]"),
+        |p| matches!(p, Defect::Overlap { other, .. } if other == "regions[0]"),
     );
     // Closer than a cell without touching still overlaps on the grid: x = 35.1 and x = 35.4
     // both fall in column 35.
@@ -137,7 +137,7 @@ fn overlapping_regions() {
         figures: vec![],
     });
     rejects(&d, "regions[1]", |p| {
-        *p == Problem::Overlap {
+        *p == Defect::Overlap {
             other: "regions[0]".into(),
             cell: (35, 1),
         }
@@ -150,7 +150,7 @@ fn overlapping_regions() {
     rejects(
         &d,
         "regions[0].figures[3]",
-        |p| matches!(p, Problem::Overlap { other, .. } if other == "regions[0].figures[2]"),
+        |p| matches!(p, Defect::Overlap { other, .. } if other == "regions[0].figures[2]"),
     );
 }
 
@@ -158,18 +158,18 @@ fn overlapping_regions() {
 fn non_finite_numbers() {
     let mut d = base();
     d.regions[0].figures[1].slope = f64::INFINITY;
-    rejects(&d, "regions[0].figures[1].slope", |p| *p == Problem::NotFinite);
+    rejects(&d, "regions[0].figures[1].slope", |p| *p == Defect::NotFinite);
     let mut d = base();
     d.regions[0].figures[2].figures[0].height = f64::NAN;
     rejects(&d, "regions[0].figures[2].figures[0].height", |p| {
-        *p == Problem::NotFinite
+        *p == Defect::NotFinite
     });
     let mut d = base();
     d.regions[0].figures[1].points[2] = [f64::NAN, 3.0];
-    rejects(&d, "regions[0].figures[1].points[2]", |p| *p == Problem::NotFinite);
+    rejects(&d, "regions[0].figures[1].points[2]", |p| *p == Defect::NotFinite);
     let mut d = base();
     d.grid.cell_size = f64::NAN;
-    rejects(&d, "grid.cell_size", |p| matches!(p, Problem::CellSize(_)));
+    rejects(&d, "grid.cell_size", |p| matches!(p, Defect::CellSize(_)));
 }
 
 #[test]
@@ -178,18 +178,18 @@ fn grids() {
     d.grid.cols = 100_000;
     d.grid.rows = 100_000;
     rejects(&d, "grid", |p| {
-        *p == Problem::GridTooLarge {
+        *p == Defect::GridTooLarge {
             cells: 10_000_000_000,
             max: validate::MAX_CELLS,
         }
     });
     let mut d = base();
     d.grid.rows = 0;
-    rejects(&d, "grid", |p| *p == Problem::EmptyGrid);
+    rejects(&d, "grid", |p| *p == Defect::EmptyGrid);
     let mut d = base();
     d.grid.cols = 30; // the region reaches x = 35
     rejects(&d, "regions[0].boundary[0]", |p| {
-        matches!(p, Problem::OutsideGrid { .. })
+        matches!(p, Defect::OutsideGrid { .. })
     });
 }
 
@@ -197,23 +197,23 @@ fn grids() {
 fn figure_shapes() {
     let mut d = base();
     d.regions[0].figures[0].points.push([15.0, 18.0]);
-    rejects(&d, "regions[0].figures[0].points", |p| *p == Problem::PointCount(2));
+    rejects(&d, "regions[0].figures[0].points", |p| *p == Defect::PointCount(2));
     let mut d = base();
     d.regions[0].figures[1].points.truncate(1);
     rejects(&d, "regions[0].figures[1].points", |p| {
-        *p == Problem::PolylineTooShort(1)
+        *p == Defect::PolylineTooShort(1)
     });
     let mut d = base();
     d.regions[0].figures[1].points[1] = d.regions[0].figures[1].points[0];
-    rejects(&d, "regions[0].figures[1].points[1]", |p| *p == Problem::RepeatedPoint);
+    rejects(&d, "regions[0].figures[1].points[1]", |p| *p == Defect::RepeatedPoint);
     let mut d = base();
     d.regions[0].figures[2].points = vec![[22.0, 12.0], [25.0, 12.0], [22.0, 12.0]];
     d.regions[0].figures[2].figures.clear();
-    rejects(&d, "regions[0].figures[2].points", |p| *p == Problem::CurveTooShort(2));
+    rejects(&d, "regions[0].figures[2].points", |p| *p == Defect::CurveTooShort(2));
     let mut d = base();
     d.regions[0].figures[1].figures.push(point([20.0, 20.0], 1.0, 0.0));
     rejects(&d, "regions[0].figures[1].figures", |p| {
-        *p == Problem::NestedInOpenFigure("polyline")
+        *p == Defect::NestedInOpenFigure("polyline")
     });
 }
 
@@ -243,7 +243,7 @@ fn json_errors_name_the_element() {
     let text = base().to_json().replacen("\"version\": 1", "\"version\": 2", 1);
     match Document::from_json(&text) {
         Err(LoadError::Invalid(e)) => {
-            assert_eq!((e.path.as_str(), e.problem), ("version", Problem::Version("2".into())))
+            assert_eq!((e.path.as_str(), e.defect), ("version", Defect::Version("2".into())))
         }
         other => panic!("{other:?}"),
     }

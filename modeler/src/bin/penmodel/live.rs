@@ -14,7 +14,7 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use penmodel::feed::{self, Feed, PenSource};
-use penmodel::interaction::{Command, Settings, View};
+use penmodel::interaction::{KeyCommand, Tuning, View};
 use penmodel::picture::{Look, Picture};
 use penmodel::session::{Session, State, blank_document};
 use penmodel_render::output::{self, Sequence, Viewer, ViewerEvent, WindowError};
@@ -152,8 +152,8 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
             (Editor::create(&path, blank_document())?, path)
         }
     };
-    let settings = Settings::default();
-    let mut session = Session::new(editor, [600.0, 340.0], settings);
+    let tuning = Tuning::default();
+    let mut session = Session::new(editor, [600.0, 340.0], tuning);
     let mut look = Look::default();
     if let Some(h) = args.head {
         look.head_m = h;
@@ -451,28 +451,28 @@ fn run_window(
                 ViewerEvent::Closed => break 'session,
                 ViewerEvent::Key(k) => match k.as_str() {
                     "Escape" | "q" => break 'session,
-                    "u" | "z" => Some(Command::Undo),
-                    "r" | "y" => Some(Command::Redo),
-                    "Delete" | "Backspace" => Some(Command::Delete),
-                    "ArrowLeft" => Some(Command::Pan {
+                    "u" | "z" => Some(KeyCommand::Undo),
+                    "r" | "y" => Some(KeyCommand::Redo),
+                    "Delete" | "Backspace" => Some(KeyCommand::Delete),
+                    "ArrowLeft" => Some(KeyCommand::Pan {
                         du_mm: -20.0,
                         dv_mm: 0.0,
                     }),
-                    "ArrowRight" => Some(Command::Pan {
+                    "ArrowRight" => Some(KeyCommand::Pan {
                         du_mm: 20.0,
                         dv_mm: 0.0,
                     }),
-                    "ArrowUp" => Some(Command::Pan {
+                    "ArrowUp" => Some(KeyCommand::Pan {
                         du_mm: 0.0,
                         dv_mm: 20.0,
                     }),
-                    "ArrowDown" => Some(Command::Pan {
+                    "ArrowDown" => Some(KeyCommand::Pan {
                         du_mm: 0.0,
                         dv_mm: -20.0,
                     }),
-                    "+" | "=" => Some(Command::Zoom { factor: 1.25 }),
-                    "-" => Some(Command::Zoom { factor: 0.8 }),
-                    "f" => Some(Command::Fit),
+                    "+" | "=" => Some(KeyCommand::Zoom { factor: 1.25 }),
+                    "-" => Some(KeyCommand::Zoom { factor: 0.8 }),
+                    "f" => Some(KeyCommand::Fit),
                     "o" => {
                         let next = if painter.overview == Overview::Off {
                             Overview::Corner

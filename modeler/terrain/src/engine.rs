@@ -49,19 +49,19 @@
 //! per cell, whatever the number of edits (nothing accumulates: each update recomputes a cell
 //! from cached terms). The `editing` tests check exactly this bound.
 
+use crate::address::FigurePath;
 use crate::baseline;
+use crate::cells::{self, Cell, Mask};
 use crate::distance;
 use crate::document::{Document, Figure, FigureKind, Grid};
 use crate::edit::{self, Change, Edit, EditError, List, Scope};
 use crate::heightmap::Heightmap;
-use crate::path::FigurePath;
 use crate::profile;
-use crate::raster::{self, Cell, Mask};
 use crate::validate::{self, ValidationError};
 
 /// Generates the terrain of a document (validating it first).
 pub fn generate(doc: &Document) -> Result<Heightmap, ValidationError> {
-    Ok(Engine::new(doc.clone())?.into_parts().1)
+    Ok(TerrainEngine::new(doc.clone())?.into_parts().1)
 }
 
 /// How distance maps are computed.
@@ -175,14 +175,14 @@ struct RegionNode {
 /// inside its region, which puts its cells inside the region's; the intersection only guards
 /// against a rounding tie at a cell border, so that no region paints outside its parent.
 fn nested_mask(grid: &Grid, points: &[crate::document::Point], parent: &Mask) -> Mask {
-    raster::closed_mask(grid, points).intersect(parent)
+    cells::closed_mask(grid, points).intersect(parent)
 }
 
 /// The cells a figure stands on; a closed figure's are its nested region's.
 fn sources(grid: &Grid, f: &Figure, child: Option<&RegionNode>) -> Vec<Cell> {
     match child {
         Some(c) if f.kind == FigureKind::Closed => c.mask.cells().collect(),
-        _ => raster::figure_cells(grid, f),
+        _ => cells::figure_cells(grid, f),
     }
 }
 
@@ -455,7 +455,7 @@ pub struct Outcome {
 
 /// The terrain generator: holds a document and its heightmap, and keeps the heightmap up to date
 /// through edits by regenerating only the regions they touch.
-pub struct Engine {
+pub struct TerrainEngine {
     doc: Document,
     method: Method,
     regions: Vec<RegionNode>,
@@ -481,25 +481,25 @@ fn locate<'a, 'd>(
     }
 }
 
-impl Engine {
+impl TerrainEngine {
     /// Validates `doc` and generates its terrain.
-    pub fn new(doc: Document) -> Result<Engine, ValidationError> {
-        Engine::with_method(doc, Method::Bfs)
+    pub fn new(doc: Document) -> Result<TerrainEngine, ValidationError> {
+        TerrainEngine::with_method(doc, Method::Bfs)
     }
 
-    pub(crate) fn with_method(doc: Document, method: Method) -> Result<Engine, ValidationError> {
+    pub(crate) fn with_method(doc: Document, method: Method) -> Result<TerrainEngine, ValidationError> {
         validate::document(&doc)?;
         let grid = doc.grid;
         let regions: Vec<RegionNode> = doc
             .regions
             .iter()
-            .map(|r| RegionNode::build(&grid, raster::closed_mask(&grid, &r.boundary), &r.figures, None, method))
+            .map(|r| RegionNode::build(&grid, cells::closed_mask(&grid, &r.boundary), &r.figures, None, method))
             .collect();
         let mut map = Heightmap::new(&grid);
         for (node, r) in regions.iter().zip(&doc.regions) {
             node.paint_all(&r.figures, 0.0, &mut map);
         }
-        Ok(Engine {
+        Ok(TerrainEngine {
             doc,
             method,
             regions,
@@ -573,7 +573,7 @@ impl Engine {
     }
 
     fn regenerate(&mut self, scope: &Scope) -> Rect {
-        let Engine {
+        let TerrainEngine {
             doc,
             method,
             regions,
@@ -638,7 +638,7 @@ impl Engine {
             }
             Scope::RegionAdded(i) => {
                 let r = &doc.regions[*i];
-                let node = RegionNode::build(&grid, raster::closed_mask(&grid, &r.boundary), &r.figures, None, m);
+                let node = RegionNode::build(&grid, cells::closed_mask(&grid, &r.boundary), &r.figures, None, m);
                 node.paint_all(&r.figures, 0.0, map);
                 let rect = Rect::of(&node.mask);
                 regions.insert(*i, node);
@@ -651,7 +651,7 @@ impl Engine {
             }
             Scope::RegionReplaced(i) => {
                 let r = &doc.regions[*i];
-                let node = RegionNode::build(&grid, raster::closed_mask(&grid, &r.boundary), &r.figures, None, m);
+                let node = RegionNode::build(&grid, cells::closed_mask(&grid, &r.boundary), &r.figures, None, m);
                 let old = std::mem::replace(&mut regions[*i], node);
                 old.clear(map);
                 regions[*i].paint_all(&r.figures, 0.0, map);
@@ -662,7 +662,7 @@ impl Engine {
                 let node = &mut regions[*i];
                 node.clear(map);
                 let old = Rect::of(&node.mask);
-                node.reshape(&grid, raster::closed_mask(&grid, &r.boundary), &r.figures, None, m);
+                node.reshape(&grid, cells::closed_mask(&grid, &r.boundary), &r.figures, None, m);
                 node.paint_all(&r.figures, 0.0, map);
                 old.union(Rect::of(&node.mask))
             }
