@@ -7,7 +7,6 @@
 //! the device reader or the other clients, each of which has its own writer thread.
 
 use std::io::{BufWriter, Write};
-use std::os::unix::fs::{DirBuilderExt, PermissionsExt};
 use std::os::unix::net::{UnixListener, UnixStream};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
@@ -20,23 +19,14 @@ use serde_json::json;
 use crate::events::{EventKind, PenEvent};
 use crate::pipeline::Pipeline;
 use crate::sample::now_us;
+use crate::socket::{self, SocketError};
 
 /// Events a client may have queued before it starts missing them: about a second at 1 kHz.
 pub const DEFAULT_QUEUE: usize = 1024;
 
 /// The default socket: `$XDG_RUNTIME_DIR/penscape/pend.sock`, or `/tmp/penscape-UID/pend.sock`.
 pub fn default_socket() -> PathBuf {
-    match std::env::var_os("XDG_RUNTIME_DIR") {
-        Some(dir) if !dir.is_empty() => PathBuf::from(dir).join("penscape/pend.sock"),
-        _ => PathBuf::from(format!("/tmp/penscape-{}/pend.sock", uid())),
-    }
-}
-
-fn uid() -> u32 {
-    // The owner of /proc/self is this process's user, without an unsafe libc call.
-    std::fs::metadata("/proc/self")
-        .map(|m| std::os::unix::fs::MetadataExt::uid(&m))
-        .unwrap_or(0)
+    socket::default_path()
 }
 
 struct Client {
@@ -139,45 +129,11 @@ fn write_client(stream: UnixStream, rx: Receiver<Arc<str>>, missed: Arc<AtomicU6
     }
 }
 
-/// Why the server could not start.
-#[derive(Debug, thiserror::Error)]
-pub enum ServeError {
-    /// The socket could not be made.
-    #[error("cannot listen on {path}: {source}")]
-    Socket {
-        /// The socket path.
-        path: PathBuf,
-        /// Why.
-        source: std::io::Error,
-    },
-    /// Another pend is already serving there.
-    #[error("{0} is in use by another pend")]
-    InUse(PathBuf),
-}
-
-/// Binds the socket at `path` (mode 0600, its directory 0700), replacing a stale one.
-pub fn bind(path: &Path) -> Result<UnixListener, ServeError> {
-    let err = |source| ServeError::Socket {
-        path: path.to_path_buf(),
-        source,
-    };
-    if let Some(dir) = path.parent().filter(|d| !d.as_os_str().is_empty()) {
-        std::fs::DirBuilder::new()
-            .recursive(true)
-            .mode(0o700)
-            .create(dir)
-            .map_err(err)?;
-    }
-    if path.exists() {
-        // A socket nobody answers on is left over from a crash; one that answers is in use.
-        if UnixStream::connect(path).is_ok() {
-            return Err(ServeError::InUse(path.to_path_buf()));
-        }
-        std::fs::remove_file(path).map_err(err)?;
-    }
-    let listener = UnixListener::bind(path).map_err(err)?;
-    std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o600)).map_err(err)?;
-    Ok(listener)
+/// Binds the socket at `path`, owner-only from the start, replacing only a dead socket
+/// (`socket` says what is checked). At the default path the directory is pend's own and must be
+/// private to this user.
+pub fn bind(path: &Path) -> Result<UnixListener, SocketError> {
+    socket::bind(path, path == default_socket())
 }
 
 /// Accepts clients until `stop` is set.

@@ -3,3 +3,4 @@ mod calibration;
 mod daemon;
 mod events;
 mod penctl;
+mod socket;

@@ -1,0 +1,366 @@
+//! Where pend listens, made safe against other users of the machine.
+//!
+//! The socket carries every pen event, and whoever can replace it sees the user's pen. So:
+//!
+//! - The default directory (`$XDG_RUNTIME_DIR/penscape`, or `/tmp/penscape-UID` without one) is
+//!   created by pend with mode 0700. One that already exists is used only if it is a real
+//!   directory (not a symlink: checked with `lstat`), owned by this user, and closed to group and
+//!   others; anything else is refused with what is wrong, never repaired in place — it may be
+//!   another user's trap.
+//! - For a socket path given on the command line, its directory is created 0700 if missing; an
+//!   existing one must not be a symlink, and must be owned by this user or root and not writable
+//!   by others unless sticky (like `/tmp`), so nobody else can rename or replace the socket.
+//! - The socket is bound under a umask of 0177, so it is owner-only from the moment it exists
+//!   (no window between `bind` and `chmod`).
+//! - Only a *socket* nobody answers on is removed as stale (a crashed pend left it); a regular
+//!   file, a folder or a symlink at the path is an error naming it, and a socket that answers is
+//!   another pend.
+
+use std::ffi::OsString;
+use std::fs::{DirBuilder, Metadata};
+use std::io;
+use std::os::unix::fs::{DirBuilderExt, FileTypeExt, MetadataExt, PermissionsExt};
+use std::os::unix::net::{UnixListener, UnixStream};
+use std::path::{Path, PathBuf};
+
+use nix::sys::stat::{Mode, umask};
+
+/// Why pend cannot listen where it was asked to.
+#[derive(Debug, thiserror::Error)]
+pub enum SocketError {
+    /// The directory, or the path itself, is a symbolic link.
+    #[error("{0} is a symbolic link; pend does not follow links for its socket (remove it, or choose --socket)")]
+    Symlink(PathBuf),
+    /// Something that is not a directory stands where the socket's directory should be.
+    #[error("{0} is not a directory")]
+    NotADirectory(PathBuf),
+    /// The directory belongs to someone else.
+    #[error(
+        "{path} belongs to user {owner}, not to you (user {uid}); another user may control it — remove it or choose --socket"
+    )]
+    NotOwned {
+        /// The directory.
+        path: PathBuf,
+        /// Its owner's uid.
+        owner: u32,
+        /// This process's uid.
+        uid: u32,
+    },
+    /// The directory is open to other users.
+    #[error("{path} has mode {mode:04o}; it must be closed to other users (chmod 700 {path}) or removed")]
+    OpenToOthers {
+        /// The directory.
+        path: PathBuf,
+        /// Its permission bits.
+        mode: u32,
+    },
+    /// Something that is not a socket stands at the socket's path.
+    #[error("{0} exists and is not a socket; pend will not remove it (choose another --socket)")]
+    NotASocket(PathBuf),
+    /// Another pend answers on the socket.
+    #[error("{0} is in use by another pend")]
+    InUse(PathBuf),
+    /// The system refused an operation.
+    #[error("cannot {what} {path}: {cause}")]
+    Io {
+        /// What was being done.
+        what: &'static str,
+        /// On what.
+        path: PathBuf,
+        /// The system's reason (not a `source`, so a chain of errors prints it once).
+        cause: io::Error,
+    },
+}
+
+/// This process's user id.
+pub fn uid() -> u32 {
+    nix::unistd::getuid().as_raw()
+}
+
+/// The default socket: `$XDG_RUNTIME_DIR/penscape/pend.sock`, or `/tmp/penscape-UID/pend.sock`
+/// when `XDG_RUNTIME_DIR` is unset or empty.
+pub fn default_path() -> PathBuf {
+    default_path_from(std::env::var_os("XDG_RUNTIME_DIR"), uid())
+}
+
+fn default_path_from(runtime_dir: Option<OsString>, uid: u32) -> PathBuf {
+    match runtime_dir {
+        Some(dir) if !dir.is_empty() => PathBuf::from(dir).join("penscape/pend.sock"),
+        _ => PathBuf::from(format!("/tmp/penscape-{uid}/pend.sock")),
+    }
+}
+
+/// Binds pend's socket at `path`. `private_dir`: the directory is pend's own (the default
+/// location) and is held to the strict rule — owned by this user, mode 0700 or tighter.
+pub fn bind(path: &Path, private_dir: bool) -> Result<UnixListener, SocketError> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
+        _ => PathBuf::from("."),
+    };
+    prepare_dir(&dir, private_dir)?;
+    clear_stale(path)?;
+    // Owner-only from creation: the umask is the process's, so restore it at once.
+    let old = umask(Mode::from_bits_truncate(0o177));
+    let bound = UnixListener::bind(path);
+    umask(old);
+    bound.map_err(|cause| SocketError::Io {
+        what: "listen on",
+        path: path.to_path_buf(),
+        cause,
+    })
+}
+
+/// Makes `dir` (0700) if it is missing, and checks an existing one.
+fn prepare_dir(dir: &Path, private_dir: bool) -> Result<(), SocketError> {
+    match std::fs::symlink_metadata(dir) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            // Parents as the system makes them; the last level is ours and private.
+            if let Some(parent) = dir.parent().filter(|p| !p.as_os_str().is_empty()) {
+                std::fs::create_dir_all(parent).map_err(|cause| SocketError::Io {
+                    what: "create the folder",
+                    path: parent.to_path_buf(),
+                    cause,
+                })?;
+            }
+            match DirBuilder::new().mode(0o700).create(dir) {
+                Ok(()) => {}
+                // Made by someone else between our look and our mkdir: check theirs below.
+                Err(e) if e.kind() == io::ErrorKind::AlreadyExists => {}
+                Err(cause) => {
+                    return Err(SocketError::Io {
+                        what: "create the folder",
+                        path: dir.to_path_buf(),
+                        cause,
+                    });
+                }
+            }
+            let meta = lstat(dir)?;
+            check_dir(dir, &meta, private_dir)
+        }
+        Err(cause) => Err(SocketError::Io {
+            what: "inspect",
+            path: dir.to_path_buf(),
+            cause,
+        }),
+        Ok(meta) => check_dir(dir, &meta, private_dir),
+    }
+}
+
+fn lstat(path: &Path) -> Result<Metadata, SocketError> {
+    std::fs::symlink_metadata(path).map_err(|cause| SocketError::Io {
+        what: "inspect",
+        path: path.to_path_buf(),
+        cause,
+    })
+}
+
+fn check_dir(dir: &Path, meta: &Metadata, private_dir: bool) -> Result<(), SocketError> {
+    if meta.file_type().is_symlink() {
+        return Err(SocketError::Symlink(dir.to_path_buf()));
+    }
+    if !meta.is_dir() {
+        return Err(SocketError::NotADirectory(dir.to_path_buf()));
+    }
+    let me = uid();
+    let mode = meta.permissions().mode() & 0o7777;
+    if private_dir {
+        if meta.uid() != me {
+            return Err(SocketError::NotOwned {
+                path: dir.to_path_buf(),
+                owner: meta.uid(),
+                uid: me,
+            });
+        }
+        if mode & 0o077 != 0 {
+            return Err(SocketError::OpenToOthers {
+                path: dir.to_path_buf(),
+                mode,
+            });
+        }
+    } else {
+        if meta.uid() != me && meta.uid() != 0 {
+            return Err(SocketError::NotOwned {
+                path: dir.to_path_buf(),
+                owner: meta.uid(),
+                uid: me,
+            });
+        }
+        // Writable by group or others without the sticky bit: they could rename our socket.
+        let sticky = mode & 0o1000 != 0;
+        if mode & 0o022 != 0 && !sticky {
+            return Err(SocketError::OpenToOthers {
+                path: dir.to_path_buf(),
+                mode,
+            });
+        }
+    }
+    Ok(())
+}
+
+/// Removes a socket at `path` that nobody answers on; refuses anything else.
+fn clear_stale(path: &Path) -> Result<(), SocketError> {
+    let meta = match std::fs::symlink_metadata(path) {
+        Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(()),
+        Err(cause) => {
+            return Err(SocketError::Io {
+                what: "inspect",
+                path: path.to_path_buf(),
+                cause,
+            });
+        }
+        Ok(m) => m,
+    };
+    if meta.file_type().is_symlink() {
+        return Err(SocketError::Symlink(path.to_path_buf()));
+    }
+    if !meta.file_type().is_socket() {
+        return Err(SocketError::NotASocket(path.to_path_buf()));
+    }
+    match UnixStream::connect(path) {
+        Ok(_) => Err(SocketError::InUse(path.to_path_buf())),
+        // Refused: a socket left by a crashed pend.
+        Err(e) if e.kind() == io::ErrorKind::ConnectionRefused => {
+            std::fs::remove_file(path).map_err(|cause| SocketError::Io {
+                what: "remove the stale socket",
+                path: path.to_path_buf(),
+                cause,
+            })
+        }
+        Err(cause) => Err(SocketError::Io {
+            what: "connect to",
+            path: path.to_path_buf(),
+            cause,
+        }),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn mode_of(p: &Path) -> u32 {
+        std::fs::symlink_metadata(p).expect("exists").permissions().mode() & 0o7777
+    }
+
+    #[test]
+    fn the_default_path_follows_the_runtime_dir() {
+        assert_eq!(
+            default_path_from(Some("/run/user/1000".into()), 1000),
+            PathBuf::from("/run/user/1000/penscape/pend.sock")
+        );
+        assert_eq!(
+            default_path_from(None, 1000),
+            PathBuf::from("/tmp/penscape-1000/pend.sock")
+        );
+        assert_eq!(
+            default_path_from(Some("".into()), 7),
+            PathBuf::from("/tmp/penscape-7/pend.sock")
+        );
+    }
+
+    #[test]
+    fn a_new_private_dir_and_socket_are_owner_only() {
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let dir = tmp.path().join("penscape");
+        let path = dir.join("pend.sock");
+        let listener = bind(&path, true).expect("binds");
+        assert_eq!(mode_of(&dir), 0o700);
+        assert_eq!(mode_of(&path) & 0o777, 0o600, "no access for others from the start");
+        drop(listener);
+    }
+
+    #[test]
+    fn a_private_dir_open_to_others_is_refused_not_repaired() {
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let dir = tmp.path().join("penscape");
+        std::fs::create_dir(&dir).expect("mkdir");
+        std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o777)).expect("chmod");
+        let e = bind(&dir.join("pend.sock"), true).expect_err("refused");
+        assert!(matches!(e, SocketError::OpenToOthers { mode: 0o777, .. }), "{e}");
+        assert!(e.to_string().contains("chmod 700"), "{e}");
+        assert_eq!(mode_of(&dir), 0o777, "left as found");
+        assert!(!dir.join("pend.sock").exists());
+    }
+
+    #[test]
+    fn a_symlinked_dir_is_refused() {
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let elsewhere = tmp.path().join("elsewhere");
+        std::fs::create_dir(&elsewhere).expect("mkdir");
+        std::fs::set_permissions(&elsewhere, std::fs::Permissions::from_mode(0o700)).expect("chmod");
+        let link = tmp.path().join("penscape");
+        std::os::unix::fs::symlink(&elsewhere, &link).expect("symlink");
+        let e = bind(&link.join("pend.sock"), true).expect_err("refused");
+        assert!(matches!(e, SocketError::Symlink(_)), "{e}");
+        let e = bind(&link.join("pend.sock"), false).expect_err("refused for a chosen path too");
+        assert!(matches!(e, SocketError::Symlink(_)), "{e}");
+    }
+
+    #[test]
+    fn a_dir_of_another_user_is_refused() {
+        // Only root can give a folder away; elsewhere this case cannot be made.
+        if uid() != 0 {
+            eprintln!("skipped: giving a folder to another user needs root");
+            return;
+        }
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let dir = tmp.path().join("penscape");
+        DirBuilder::new().mode(0o700).create(&dir).expect("mkdir");
+        nix::unistd::chown(&dir, Some(nix::unistd::Uid::from_raw(65534)), None).expect("chown");
+        let e = bind(&dir.join("pend.sock"), true).expect_err("refused");
+        assert!(matches!(e, SocketError::NotOwned { owner: 65534, .. }), "{e}");
+        let e = bind(&dir.join("pend.sock"), false).expect_err("refused for a chosen path too");
+        assert!(matches!(e, SocketError::NotOwned { owner: 65534, .. }), "{e}");
+    }
+
+    #[test]
+    fn a_chosen_path_in_a_shared_sticky_dir_is_allowed_and_in_an_open_one_refused() {
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let sticky = tmp.path().join("sticky");
+        std::fs::create_dir(&sticky).expect("mkdir");
+        std::fs::set_permissions(&sticky, std::fs::Permissions::from_mode(0o1777)).expect("chmod");
+        bind(&sticky.join("pend.sock"), false).expect("like /tmp: others cannot rename our socket");
+        let open = tmp.path().join("open");
+        std::fs::create_dir(&open).expect("mkdir");
+        std::fs::set_permissions(&open, std::fs::Permissions::from_mode(0o777)).expect("chmod");
+        let e = bind(&open.join("pend.sock"), false).expect_err("refused");
+        assert!(matches!(e, SocketError::OpenToOthers { .. }), "{e}");
+    }
+
+    #[test]
+    fn only_a_dead_socket_is_replaced() {
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let path = tmp.path().join("pend.sock");
+
+        std::fs::write(&path, "my notes").expect("write");
+        let e = bind(&path, false).expect_err("a regular file is not stale");
+        assert!(matches!(e, SocketError::NotASocket(_)), "{e}");
+        assert_eq!(std::fs::read_to_string(&path).expect("kept"), "my notes");
+        std::fs::remove_file(&path).expect("rm");
+
+        let live = bind(&path, false).expect("binds");
+        let e = bind(&path, false).expect_err("in use");
+        assert!(matches!(e, SocketError::InUse(_)), "{e}");
+        drop(live);
+        // The listener is gone, its file remains and refuses connections: stale.
+        assert!(path.exists());
+        bind(&path, false).expect("a stale socket is replaced");
+    }
+
+    #[test]
+    fn messages_name_the_path_and_say_the_reason_once() {
+        let e = SocketError::Io {
+            what: "listen on",
+            path: PathBuf::from("/nowhere/pend.sock"),
+            cause: io::Error::from(io::ErrorKind::NotFound),
+        };
+        assert!(
+            std::error::Error::source(&e).is_none(),
+            "the reason is in the message, not repeated"
+        );
+        assert!(
+            e.to_string().starts_with("cannot listen on /nowhere/pend.sock: "),
+            "{e}"
+        );
+    }
+}
