@@ -5,6 +5,7 @@ use std::time::{SystemTime, UNIX_EPOCH};
 
 use glam::DVec3;
 use pen_protocol::{PenReport, Quality};
+use serde::Serialize;
 
 /// One pen report, decoded and timed.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -25,6 +26,46 @@ pub struct Sample {
     pub position_mm: DVec3,
     /// How far to trust the fix.
     pub quality: Quality,
+}
+
+impl Sample {
+    /// The sample as `penctl monitor --json` prints it, with the reports lost just before it
+    /// (docs/penctl.md): positions rounded to the reports' 0.1 mm.
+    pub fn json(&self, lost: u64) -> impl Serialize + '_ {
+        let r = |v: f64| (v * 10.0).round() / 10.0;
+        SampleJson {
+            seq: self.seq,
+            device_us: self.device_us,
+            host_us: self.host_us,
+            in_range: self.in_range,
+            display_frame: self.display_frame,
+            x_mm: r(self.position_mm.x),
+            y_mm: r(self.position_mm.y),
+            z_mm: r(self.position_mm.z),
+            sw1: self.sw[0],
+            sw2: self.sw[1],
+            sw3: self.sw[2],
+            quality: &self.quality,
+            lost,
+        }
+    }
+}
+
+#[derive(Serialize)]
+struct SampleJson<'a> {
+    seq: u16,
+    device_us: u64,
+    host_us: u64,
+    in_range: bool,
+    display_frame: bool,
+    x_mm: f64,
+    y_mm: f64,
+    z_mm: f64,
+    sw1: bool,
+    sw2: bool,
+    sw3: bool,
+    quality: &'a Quality,
+    lost: u64,
 }
 
 /// Microseconds since the Unix epoch, now.

@@ -155,7 +155,9 @@ fn config_is_validated_before_it_is_sent() {
     assert!(err.contains("receivers_mm[1] is degenerate"), "{err}");
     let out = penctl(&["config", "set", "--sim", "temperature_c=\"warm\""]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("`temperature_c`: must be a number"));
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("`temperature_c`: invalid type: string \"warm\", expected f32")
+    );
     let ok = penctl(&["config", "set", "--sim", "temperature_c=24.5", "stream_tof=true"]);
     assert!(ok.status.success(), "{}", String::from_utf8_lossy(&ok.stderr));
     let get = penctl(&["config", "get", "--sim", "--json"]);

@@ -12,8 +12,16 @@ use crate::error::DecodeError;
 use crate::pen::MAX_RECEIVERS;
 
 /// Position smoothing.
+///
+/// JSON (feature `serde`): `{"kind": "off"}` or `{"kind": "one_euro", "min_cutoff_hz", "beta",
+/// "d_cutoff_hz"}`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(tag = "kind", rename_all = "snake_case", try_from = "crate::json::FilterJson")
+)]
 pub enum Filter {
     /// Report raw fixes.
     Off,
@@ -21,10 +29,13 @@ pub enum Filter {
     /// still pen is steady and a moving one lags little.
     OneEuro {
         /// Cutoff at rest, Hz.
+        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json::wide"))]
         min_cutoff_hz: f32,
         /// Cutoff increase per mm/s of speed, Hz·s/mm.
+        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json::wide"))]
         beta: f32,
         /// Cutoff of the speed estimate, Hz.
+        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json::wide"))]
         d_cutoff_hz: f32,
     },
 }
@@ -37,14 +48,27 @@ impl Filter {
 /// The similarity transform from the tracker frame to the display frame:
 /// `p_display = scale · R(rotation) · p_tracker + translation`, where the display frame has u, v
 /// in the display surface and h along its normal, towards the user.
+///
+/// JSON (feature `serde`): `{"rotation_wxyz", "translation_mm", "scale"}`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(
+    feature = "serde",
+    derive(serde::Serialize, serde::Deserialize),
+    serde(deny_unknown_fields)
+)]
 pub struct DisplayPose {
     /// Unit quaternion `[w, x, y, z]`.
+    #[cfg_attr(
+        feature = "serde",
+        serde(rename = "rotation_wxyz", serialize_with = "crate::json::wide_array")
+    )]
     pub rotation: [f32; 4],
     /// Translation, mm.
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json::wide_array"))]
     pub translation_mm: [f32; 3],
     /// Scale (1 for a rigid transform).
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json::wide"))]
     pub scale: f32,
 }
 

@@ -8,6 +8,8 @@ mod descriptor;
 mod error;
 mod frame;
 mod info;
+#[cfg(feature = "serde")]
+mod json;
 mod pen;
 mod status;
 mod tof;
@@ -21,6 +23,8 @@ pub use error::{DecodeError, EncodeError};
 pub use frame::{CRC, CRC_LEN, FrameDecoder, FrameError, MAX_FRAME, MAX_PAYLOAD, encode_frame, encode_report_frame};
 pub use info::SUPPORTED_MAJOR_VERSIONS;
 pub use info::{DeviceInfo, FirmwareVersion, PROTOCOL_VERSION, UnsupportedVersion, Version, check_version};
+#[cfg(feature = "serde")]
+pub use json::{ConfigChanges, PerReceiver};
 pub use pen::{MAX_RECEIVERS, POSITION_LOGICAL_MAX, PenReport, Position, Quality, UNITS_PER_MM};
 pub use status::{Command, GetFeature, Status, StatusCode};
 pub use tof::{NO_ARRIVAL, TofReport};

@@ -56,14 +56,22 @@ impl Position {
 
 /// How much to trust a fix: the receivers it used, how well their ranges agree, and how the
 /// geometry amplifies range errors.
+///
+/// JSON (feature `serde`): `receivers_used`, `residual_mm` and `dop` as decimal numbers.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub struct Quality {
     /// Receivers whose ranges the fix used (0 = no fix, at most [`MAX_RECEIVERS`]).
     pub receivers_used: u8,
     /// RMS range residual of the fix in 0.1 mm; 255 means 25.5 mm or more, or unknown.
+    #[cfg_attr(
+        feature = "serde",
+        serde(rename = "residual_mm", serialize_with = "crate::json::tenths")
+    )]
     pub residual: u8,
     /// Position dilution of precision ×10; 255 means 25.5 or more, or unknown.
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json::tenths"))]
     pub dop: u8,
 }
 

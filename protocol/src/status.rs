@@ -8,9 +8,11 @@ use crate::codec::{Reader, Report, Writer};
 use crate::config::{ConfigError, ConfigField, Problem};
 use crate::error::DecodeError;
 
-/// The outcome of the last request (a set-feature or a command).
+/// The outcome of the last request (a set-feature or a command). JSON (feature `serde`): the
+/// variant's name, e.g. `"OutOfRange"`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum StatusCode {
     /// Applied.
     Ok = 0,
@@ -154,9 +156,11 @@ impl Report for Status {
     }
 }
 
-/// An action the device performs when this report is written.
+/// An action the device performs when this report is written. JSON (feature `serde`): the
+/// variant's name, e.g. `"SaveConfig"`.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[cfg_attr(feature = "serde", derive(serde::Serialize))]
 pub enum Command {
     /// Save the running configuration to flash, so it survives a power cycle.
     SaveConfig = 1,

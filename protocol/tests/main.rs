@@ -5,4 +5,6 @@ mod docs;
 mod errors;
 mod frames;
 mod golden;
+#[cfg(feature = "serde")]
+mod json;
 mod roundtrip;

@@ -17,8 +17,11 @@ use pen_host::device::{Device, DeviceEvent};
 use pen_host::source::Source;
 use pen_host::transport::sim::SimOptions;
 use pen_host::transport::{Transport, hid, serial};
-use pen_host::{hex, json, plot};
-use pen_protocol::{Command as DeviceCommand, Config, FrameDecoder, Message, REPORT_DESCRIPTOR, ReportId, StatusCode};
+use pen_host::{hex, plot};
+use pen_protocol::{
+    Command as DeviceCommand, Config, ConfigChanges, FrameDecoder, Message, REPORT_DESCRIPTOR, ReportId, StatusCode,
+};
+use serde::Serialize;
 
 /// `println!` that reports a failed write (a closed pipe) instead of panicking.
 macro_rules! outln {
@@ -236,9 +239,34 @@ fn request(t: &mut dyn Transport, m: &Message) -> Result<()> {
     Ok(())
 }
 
-fn print_json(v: &serde_json::Value) -> Result<()> {
-    outln!("{v}");
+fn print_json(v: &impl Serialize) -> Result<()> {
+    outln!("{}", serde_json::to_string(v)?);
     Ok(())
+}
+
+/// `penctl info --json`.
+#[derive(Serialize)]
+struct InfoJson<'a> {
+    device: String,
+    /// The device information report, tagged like `penctl decode` prints it.
+    info: &'a Message,
+    config: &'a Config,
+}
+
+/// Reads configuration changes in JSON (the form `config get --json` prints); errors name the
+/// key at fault.
+fn config_changes(v: serde_json::Value) -> Result<ConfigChanges> {
+    // serde would also read a struct from a list of its values: only an object is one here.
+    anyhow::ensure!(v.is_object(), "`(top level)`: must be a JSON object");
+    serde_path_to_error::deserialize(v).map_err(|e| {
+        let path = e.path().to_string();
+        let inner = e.into_inner();
+        if path == "." {
+            anyhow::anyhow!("{inner}")
+        } else {
+            anyhow::anyhow!("`{path}`: {inner}")
+        }
+    })
 }
 
 fn info(args: &DeviceArgs, as_json: bool) -> Result<()> {
@@ -250,11 +278,11 @@ fn info(args: &DeviceArgs, as_json: bool) -> Result<()> {
     pen_protocol::check_version(info.protocol)?;
     let config = get_config(t)?;
     if as_json {
-        print_json(&serde_json::json!({
-            "device": t.describe(),
-            "info": json::message_json(&Message::DeviceInfo(info)),
-            "config": json::config_value(&config),
-        }))?;
+        print_json(&InfoJson {
+            device: t.describe(),
+            info: &Message::DeviceInfo(info),
+            config: &config,
+        })?;
     } else {
         outln!("device       {}", t.describe());
         outln!("protocol     {}", info.protocol);
@@ -275,7 +303,7 @@ fn monitor(args: &DeviceArgs, as_json: bool, count: Option<u64>) -> Result<()> {
         match device.next(Duration::from_millis(200)) {
             Some(DeviceEvent::Sample(s, lost)) => {
                 if as_json {
-                    writeln!(out, "{}", json::sample_json(&s, lost))?;
+                    writeln!(out, "{}", serde_json::to_string(&s.json(lost))?)?;
                 } else {
                     let sw = |on: bool, name: &'static str| if on { name } else { "---" };
                     writeln!(
@@ -315,10 +343,9 @@ fn config(action: ConfigAction) -> Result<()> {
         ConfigAction::Get { device, json: as_json } => {
             let mut d = attach(&device)?;
             let c = get_config(transport(&mut d)?)?;
-            let v = json::config_value(&c);
             if as_json {
-                print_json(&v)?;
-            } else if let Some(map) = v.as_object() {
+                print_json(&c)?;
+            } else if let serde_json::Value::Object(map) = serde_json::to_value(c)? {
                 for (k, v) in map {
                     outln!("{k} = {v}");
                 }
@@ -333,7 +360,7 @@ fn config(action: ConfigAction) -> Result<()> {
                 let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
                 let v: serde_json::Value =
                     serde_json::from_str(&text).with_context(|| format!("{} is not JSON", path.display()))?;
-                c = json::config_from_json(&v, &c).with_context(|| path.display().to_string())?;
+                c = config_changes(v).with_context(|| path.display().to_string())?.apply(&c);
             }
             let mut changes = serde_json::Map::new();
             for s in &settings {
@@ -341,7 +368,7 @@ fn config(action: ConfigAction) -> Result<()> {
                 let value = serde_json::from_str(v).with_context(|| format!("{k}: {v:?} is not a JSON value"))?;
                 changes.insert(k.trim().to_string(), value);
             }
-            c = json::config_from_json(&serde_json::Value::Object(changes), &c)?;
+            c = config_changes(serde_json::Value::Object(changes))?.apply(&c);
             c.validate().context("not sent")?;
             request(t, &Message::Config(c))?;
             eprintln!("penctl: configuration applied (`penctl config save` keeps it across power cycles)");
@@ -483,7 +510,7 @@ fn decode(hex_args: &[String], frame: bool) -> Result<()> {
     let bytes = hex::parse_hex(&hex_args.join(" ")).context("not valid hex")?;
     let report = if frame { unframe(&bytes)? } else { bytes };
     let message = Message::decode(&report).context("not a valid report")?;
-    outln!("{}", json::message_json(&message));
+    print_json(&message)?;
     Ok(())
 }
 
