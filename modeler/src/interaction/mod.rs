@@ -28,8 +28,8 @@ use pen_host::events::{DisplayPoint, EventKind, PenEvent};
 use penmodel_terrain::address::CurvePath;
 use penmodel_terrain::document::{Document, Figure, FigureKind, Point, Region};
 use penmodel_terrain::edit::Edit;
+use penmodel_terrain::editor::Outcome;
 use penmodel_terrain::editor::{Editor, EditorError};
-use penmodel_terrain::engine::Outcome;
 use penmodel_terrain::geometry::{Side, locate};
 
 pub use pick::Hit;

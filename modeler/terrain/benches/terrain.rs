@@ -1,18 +1,23 @@
 //! Terrain generation figures (issue 6): full regeneration, a pull (one figure's height changes),
 //! the start of a pull (first height change of another figure), a slope change and a moved
 //! point, at 256², 512² and 1024² cells; beside the seed's repeat-until-stable method (full
-//! regeneration with the sweeps of `penmodel_terrain::baseline`) on the same documents.
+//! regeneration with the sweeps of `tests/baseline.rs`) on the same documents. Each update is an
+//! edit applied to the document and the terrain engine brought up to date with its scope, as the
+//! editor does, without the editor's history.
 //!
 //! The document is example 1 (`examples/01-ridges-and-peaks.json`: one region over most of the
 //! grid, eight control figures) on an N × N grid over the same 320 m square.
 //!
-//! Run: `cargo bench -p penmodel --bench terrain` (filter with e.g. `-- pull/512`).
+//! Run: `cargo bench -p penmodel-terrain --bench terrain` (filter with e.g. `-- pull/512`).
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
-use penmodel_terrain::{CurvePath, Document, Edit, FigurePath, TerrainEngine, baseline, generate};
+use penmodel_terrain::{CurvePath, Document, Edit, FigurePath, Rect, TerrainEngine, generate};
+
+#[path = "../tests/baseline.rs"]
+mod baseline;
 
 const SIZES: [u32; 3] = [256, 512, 1024];
 
@@ -24,6 +29,19 @@ fn document(n: u32) -> Document {
     doc.grid.rows = n;
     doc.grid.cell_size = extent / f64::from(n);
     doc
+}
+
+/// A document and its terrain, edited as the editor does.
+struct Model {
+    doc: Document,
+    terrain: TerrainEngine,
+}
+
+impl Model {
+    fn edit(&mut self, edit: Edit) -> Rect {
+        let applied = edit.apply_to(&mut self.doc).expect("the bench's edits are valid");
+        self.terrain.update(&self.doc, &applied.scope)
+    }
 }
 
 fn terrain(c: &mut Criterion) {
@@ -39,12 +57,18 @@ fn terrain(c: &mut Criterion) {
             b.iter(|| generate(black_box(doc)))
         });
 
-        let mut engine = TerrainEngine::new(doc.clone()).expect("valid");
+        let mut model = Model {
+            terrain: TerrainEngine::new(&doc).expect("valid"),
+            doc: doc.clone(),
+        };
         let mut h = 60.0;
         g.bench_function(BenchmarkId::new("pull", n), |b| {
             b.iter(|| {
                 h = if h == 60.0 { 61.0 } else { 60.0 };
-                engine.set_height(black_box(&peak), h)
+                model.edit(Edit::SetHeight {
+                    at: black_box(peak.clone()),
+                    height: h,
+                })
             })
         });
 
@@ -54,7 +78,10 @@ fn terrain(c: &mut Criterion) {
                 // Alternating figures: each height change starts a new pull (rebuilds rest_k).
                 flip = !flip;
                 let (at, h) = if flip { (&peak, 60.5) } else { (&other, 45.5) };
-                engine.set_height(black_box(at), h)
+                model.edit(Edit::SetHeight {
+                    at: black_box(at.clone()),
+                    height: h,
+                })
             })
         });
 
@@ -62,7 +89,10 @@ fn terrain(c: &mut Criterion) {
         g.bench_function(BenchmarkId::new("slope", n), |b| {
             b.iter(|| {
                 s = if s == -1.5 { -1.4 } else { -1.5 };
-                engine.set_slope(black_box(&peak), s)
+                model.edit(Edit::SetSlope {
+                    at: black_box(peak.clone()),
+                    slope: s,
+                })
             })
         });
 
@@ -71,7 +101,7 @@ fn terrain(c: &mut Criterion) {
         g.bench_function(BenchmarkId::new("move_point", n), |b| {
             b.iter(|| {
                 x = if x == 110.0 { 112.0 } else { 110.0 };
-                engine.apply(&Edit::MovePoint {
+                model.edit(Edit::MovePoint {
                     curve: curve.clone(),
                     index: 1,
                     to: [x, 170.0],

@@ -1,19 +1,11 @@
-//! The document: the modeler's source of truth, saved and loaded as versioned JSON.
+//! The document: the modeler's source of truth, plain data that serialises as versioned JSON.
 //!
-//! The format is specified in `docs/document.md`. A [`Document`] read with [`Document::from_json`]
-//! or [`Document::load`] has been validated ([`crate::validate`]); a document built in code is
+//! The format is specified in `docs/document.md`. This module only holds the types; reading and
+//! writing them is [`crate::persist`]'s ([`Document::from_json`], [`Document::load`],
+//! [`Document::save`]), which validates ([`crate::validate`]). A document built in code is
 //! checked when it is handed to the [`TerrainEngine`](crate::TerrainEngine) or saved.
 
-use std::fs;
-use std::io;
-use std::path::{Path, PathBuf};
-
 use serde::{Deserialize, Serialize};
-use thiserror::Error;
-
-use crate::json;
-use crate::persist::write_atomic;
-use crate::validate::{self, ValidationError};
 
 /// The format version this build reads and writes.
 pub const VERSION: u32 = 1;
@@ -141,55 +133,6 @@ impl Region {
     }
 }
 
-/// Why a document could not be read.
-#[derive(Debug, Error)]
-pub enum LoadError {
-    /// The file could not be read.
-    #[error("cannot read {}: {source}", path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The reason.
-        source: io::Error,
-    },
-    /// The text is not JSON of the document's shape.
-    #[error("{}: {message} (line {line}, column {column})", if path.is_empty() { "document" } else { path })]
-    Parse {
-        /// The element that failed, e.g. `regions[0].figures[1].height` (empty for the top level).
-        path: String,
-        /// What was wrong.
-        message: String,
-        /// 1-based line of the error.
-        line: usize,
-        /// 1-based column of the error.
-        column: usize,
-    },
-    /// The document is well formed but not valid.
-    #[error(transparent)]
-    Invalid(#[from] ValidationError),
-}
-
-/// Why a document could not be saved.
-#[derive(Debug, Error)]
-pub enum SaveError {
-    /// The document is not valid; nothing was written.
-    #[error(transparent)]
-    Invalid(#[from] ValidationError),
-    /// Writing failed; the previous file, if any, is intact.
-    #[error("cannot write {}: {source}", path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The reason.
-        source: io::Error,
-    },
-}
-
-#[derive(Deserialize)]
-struct VersionOnly {
-    version: serde_json::Value,
-}
-
 impl Document {
     /// An empty document on `grid`.
     pub fn new(grid: Grid) -> Document {
@@ -199,72 +142,5 @@ impl Document {
             grid,
             regions: Vec::new(),
         }
-    }
-
-    /// Parses and validates a document.
-    pub fn from_json(text: &str) -> Result<Document, LoadError> {
-        // The version decides how to read the rest, so it is checked before the shape.
-        let version: VersionOnly = parse(text)?;
-        match version.version.as_u64() {
-            Some(v) if v == u64::from(VERSION) => {}
-            _ => {
-                return Err(
-                    ValidationError::new("version", validate::Defect::Version(version.version.to_string())).into(),
-                );
-            }
-        }
-        let doc: Document = parse(text)?;
-        validate::document(&doc)?;
-        Ok(doc)
-    }
-
-    /// The document as JSON text, in the layout of `docs/document.md` (short arrays on one line).
-    pub fn to_json(&self) -> String {
-        json::pretty(self)
-    }
-
-    /// Reads and validates the document at `path`.
-    pub fn load(path: &Path) -> Result<Document, LoadError> {
-        let text = fs::read_to_string(path).map_err(|source| LoadError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
-        Document::from_json(&text)
-    }
-
-    /// Validates the document and writes it to `path` atomically: a temporary file in the same
-    /// directory is written and flushed to disk, renamed over `path`, and the directory flushed.
-    /// Returns the bytes written.
-    pub fn save(&self, path: &Path) -> Result<Vec<u8>, SaveError> {
-        validate::document(self)?;
-        let bytes = self.to_json().into_bytes();
-        write_atomic(path, &bytes).map_err(|source| SaveError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
-        Ok(bytes)
-    }
-}
-
-fn parse<'de, T: Deserialize<'de>>(text: &'de str) -> Result<T, LoadError> {
-    let de = &mut serde_json::Deserializer::from_str(text);
-    let value = serde_path_to_error::deserialize(de).map_err(|e| {
-        let path = e.path().to_string();
-        let inner = e.into_inner();
-        LoadError::Parse {
-            path: if path == "." { String::new() } else { path },
-            message: strip_position(&inner.to_string()),
-            line: inner.line(),
-            column: inner.column(),
-        }
-    })?;
-    Ok(value)
-}
-
-/// serde_json's message without its " at line L column C" suffix (reported separately).
-fn strip_position(message: &str) -> String {
-    match message.rfind(" at line ") {
-        Some(i) => message[..i].to_owned(),
-        None => message.to_owned(),
     }
 }

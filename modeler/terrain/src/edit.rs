@@ -10,6 +10,7 @@ use thiserror::Error;
 
 use crate::address::{CurvePath, FigurePath};
 use crate::cells::{self, Mask};
+use crate::change::{FigureList, ListChange, Scope};
 use crate::document::{Document, Figure, FigureKind, Point, Region};
 use crate::validate::{self, Defect, ValidationError};
 
@@ -136,55 +137,17 @@ pub enum EditError {
     /// The edit would make the document invalid.
     #[error("the edit would make the document invalid: {0}")]
     Invalid(#[from] ValidationError),
-    /// A group reached the single-edit code; the engine applies groups edit by edit.
+    /// [`Edit::apply_to`] was given a group, whose edits are applied one at a time.
     #[error("a group of edits is applied edit by edit")]
     Group,
 }
 
-/// Which list of figures an edit changed: a top-level region's or a closed figure's.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum List {
-    Region(usize),
-    Figure(FigurePath),
-}
-
-impl List {
-    pub(crate) fn of(path: &FigurePath) -> List {
-        match path.parent() {
-            None => List::Region(path.region()),
-            Some(p) => List::Figure(p),
-        }
-    }
-}
-
-/// What changed in a figure list.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub(crate) enum Change {
-    Added(usize),
-    Removed(usize),
-    /// The figure and its nested figures are new.
-    Replaced(usize),
-    /// Only the figure's own points changed.
-    Outline(usize),
-}
-
-/// What part of the document an applied edit touched, for the engine to regenerate.
-#[derive(Debug, Clone, PartialEq)]
-pub(crate) enum Scope {
-    Height(FigurePath),
-    Slope(FigurePath),
-    Figures(List, Change),
-    RegionAdded(usize),
-    RegionRemoved(usize),
-    /// The region and its figures are new.
-    RegionReplaced(usize),
-    /// Only the region's boundary changed.
-    RegionOutline(usize),
-}
-
 /// An edit that was applied: how to undo it and what it touched.
-pub(crate) struct Applied {
+#[derive(Debug, Clone, PartialEq)]
+pub struct Applied {
+    /// The edit that restores the document exactly.
     pub inverse: Edit,
+    /// The part of the document that changed, for [`crate::engine::TerrainEngine::update`].
     pub scope: Scope,
 }
 
@@ -205,9 +168,25 @@ fn close(mut v: Vec<Point>, closed: bool) -> Vec<Point> {
     v
 }
 
-/// Applies `edit` to `doc` and checks the touched top-level region; `masks` are the cells of the
-/// document's current top-level regions (for the overlap check of region edits).
-pub(crate) fn apply(doc: &mut Document, edit: &Edit, masks: &[&Mask]) -> Result<Applied, EditError> {
+impl Edit {
+    /// Applies the edit to `doc`, checking the touched top-level region, and returns its inverse
+    /// and scope. A refused edit leaves `doc` unchanged. A [`Edit::Group`] is refused
+    /// ([`EditError::Group`]): its edits are applied one by one, each followed by its terrain
+    /// update, which the [`Editor`](crate::Editor) does.
+    pub fn apply_to(&self, doc: &mut Document) -> Result<Applied, EditError> {
+        apply(doc, self)
+    }
+}
+
+/// The cells of every top-level region, for the overlap check of region edits.
+fn region_masks(doc: &Document) -> Vec<Mask> {
+    doc.regions
+        .iter()
+        .map(|r| cells::closed_mask(&doc.grid, &r.boundary))
+        .collect()
+}
+
+fn apply(doc: &mut Document, edit: &Edit) -> Result<Applied, EditError> {
     let figure = |doc: &Document, at: &FigurePath| at.get(doc).cloned().ok_or_else(|| EditError::NoFigure(at.clone()));
     match edit {
         Edit::SetHeight { at, height } => {
@@ -253,7 +232,7 @@ pub(crate) fn apply(doc: &mut Document, edit: &Edit, masks: &[&Mask]) -> Result<
             })?;
             Ok(Applied {
                 inverse: Edit::DeleteFigure { at: at.clone() },
-                scope: Scope::Figures(List::of(at), Change::Added(at.index())),
+                scope: Scope::Figures(FigureList::of(at), ListChange::Added(at.index())),
             })
         }
         Edit::DeleteFigure { at } => {
@@ -268,7 +247,7 @@ pub(crate) fn apply(doc: &mut Document, edit: &Edit, masks: &[&Mask]) -> Result<
                     at: at.clone(),
                     figure: old,
                 },
-                scope: Scope::Figures(List::of(at), Change::Removed(at.index())),
+                scope: Scope::Figures(FigureList::of(at), ListChange::Removed(at.index())),
             })
         }
         Edit::MoveFigure { at, by } => {
@@ -286,7 +265,7 @@ pub(crate) fn apply(doc: &mut Document, edit: &Edit, masks: &[&Mask]) -> Result<
             let mut v = vertices(&pts, closed);
             let old = *v.get(*index).ok_or_else(|| no_point(curve, *index))?;
             v[*index] = *to;
-            let scope = set_curve(doc, curve, close(v, closed), masks)?;
+            let scope = set_curve(doc, curve, close(v, closed))?;
             Ok(Applied {
                 inverse: Edit::MovePoint {
                     curve: curve.clone(),
@@ -303,7 +282,7 @@ pub(crate) fn apply(doc: &mut Document, edit: &Edit, masks: &[&Mask]) -> Result<
                 return Err(no_point(curve, *index));
             }
             v.insert(*index, *point);
-            let scope = set_curve(doc, curve, close(v, closed), masks)?;
+            let scope = set_curve(doc, curve, close(v, closed))?;
             Ok(Applied {
                 inverse: Edit::DeletePoint {
                     curve: curve.clone(),
@@ -319,7 +298,7 @@ pub(crate) fn apply(doc: &mut Document, edit: &Edit, masks: &[&Mask]) -> Result<
                 return Err(no_point(curve, *index));
             }
             let old = v.remove(*index);
-            let scope = set_curve(doc, curve, close(v, closed), masks)?;
+            let scope = set_curve(doc, curve, close(v, closed))?;
             Ok(Applied {
                 inverse: Edit::InsertPoint {
                     curve: curve.clone(),
@@ -335,10 +314,11 @@ pub(crate) fn apply(doc: &mut Document, edit: &Edit, masks: &[&Mask]) -> Result<
             }
             validate::region(&doc.grid, region, *index)?;
             let mask = cells::closed_mask(&doc.grid, &region.boundary);
+            let masks = region_masks(doc);
             let shifted = masks
                 .iter()
                 .enumerate()
-                .map(|(j, m)| (if j >= *index { j + 1 } else { j }, *m));
+                .map(|(j, m)| (if j >= *index { j + 1 } else { j }, m));
             validate::region_overlap(*index, &mask, shifted)?;
             doc.regions.insert(*index, region.clone());
             Ok(Applied {
@@ -362,11 +342,11 @@ pub(crate) fn apply(doc: &mut Document, edit: &Edit, masks: &[&Mask]) -> Result<
         Edit::MoveRegion { index, by } => {
             let mut new = doc.regions.get(*index).ok_or(EditError::NoRegion(*index))?.clone();
             new.translate(*by);
-            replace_region(doc, *index, new, masks, Scope::RegionReplaced(*index))
+            replace_region(doc, *index, new, Scope::RegionReplaced(*index))
         }
         Edit::ReplaceRegion { index, region } => {
             doc.regions.get(*index).ok_or(EditError::NoRegion(*index))?;
-            replace_region(doc, *index, region.clone(), masks, Scope::RegionReplaced(*index))
+            replace_region(doc, *index, region.clone(), Scope::RegionReplaced(*index))
         }
         Edit::Group { .. } => Err(EditError::Group),
     }
@@ -402,20 +382,14 @@ fn replace_figure(doc: &mut Document, at: &FigurePath, new: Figure, old: Figure)
             at: at.clone(),
             figure: old,
         },
-        scope: Scope::Figures(List::of(at), Change::Replaced(at.index())),
+        scope: Scope::Figures(FigureList::of(at), ListChange::Replaced(at.index())),
     })
 }
 
-fn replace_region(
-    doc: &mut Document,
-    index: usize,
-    new: Region,
-    masks: &[&Mask],
-    scope: Scope,
-) -> Result<Applied, EditError> {
+fn replace_region(doc: &mut Document, index: usize, new: Region, scope: Scope) -> Result<Applied, EditError> {
     validate::region(&doc.grid, &new, index)?;
     let mask = cells::closed_mask(&doc.grid, &new.boundary);
-    validate::region_overlap(index, &mask, masks.iter().enumerate().map(|(j, m)| (j, *m)))?;
+    validate::region_overlap(index, &mask, region_masks(doc).iter().enumerate())?;
     let old = std::mem::replace(&mut doc.regions[index], new);
     Ok(Applied {
         inverse: Edit::ReplaceRegion { index, region: old },
@@ -437,12 +411,12 @@ fn curve_points(doc: &Document, curve: &CurvePath) -> Result<(Vec<Point>, bool),
 }
 
 /// Replaces a curve's points, checking the result.
-fn set_curve(doc: &mut Document, curve: &CurvePath, points: Vec<Point>, masks: &[&Mask]) -> Result<Scope, EditError> {
+fn set_curve(doc: &mut Document, curve: &CurvePath, points: Vec<Point>) -> Result<Scope, EditError> {
     match curve {
         CurvePath::Boundary(r) => {
             let mut new = doc.regions[*r].clone();
             new.boundary = points;
-            replace_region(doc, *r, new, masks, Scope::RegionOutline(*r)).map(|a| a.scope)
+            replace_region(doc, *r, new, Scope::RegionOutline(*r)).map(|a| a.scope)
         }
         CurvePath::Figure(at) => {
             change_region(doc, at.region(), |d| {
@@ -450,7 +424,7 @@ fn set_curve(doc: &mut Document, curve: &CurvePath, points: Vec<Point>, masks: &
                     f.points = points;
                 }
             })?;
-            Ok(Scope::Figures(List::of(at), Change::Outline(at.index())))
+            Ok(Scope::Figures(FigureList::of(at), ListChange::Outline(at.index())))
         }
     }
 }

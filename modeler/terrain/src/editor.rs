@@ -1,6 +1,8 @@
 //! Editing a document with undo and redo, journaled so that a crash loses nothing.
 //!
-//! An [`Editor`] owns an [`TerrainEngine`] (the document and its terrain). Each edit is applied, then
+//! An [`Editor`] owns the document and its [`TerrainEngine`]. Each edit is applied to the
+//! document ([`Edit::apply_to`], which says what changed), the terrain brought up to date with
+//! that scope, then
 //! appended to the journal and flushed to disk, then pushed on the undo stack; if the journal
 //! cannot be written the edit is rolled back and the error returned. Opening a document replays
 //! its journal (edits, undos and redos since the last save, and the undo history saved with it);
@@ -19,11 +21,12 @@ use std::path::{Path, PathBuf};
 use thiserror::Error;
 
 use crate::address::FigurePath;
-use crate::document::{Document, LoadError, SaveError};
+use crate::document::Document;
 use crate::edit::{Edit, EditError};
-use crate::engine::{Outcome, TerrainEngine};
+use crate::engine::{Rect, TerrainEngine};
 use crate::heightmap::Heightmap;
 use crate::journal::{self, Entry, JournalError, Replay, UndoStep, Writer};
+use crate::persist::{self, LoadError, SaveError};
 use crate::validate::ValidationError;
 
 /// The most undo steps kept; older ones are forgotten.
@@ -110,6 +113,15 @@ impl Preview {
     }
 }
 
+/// The result of an applied edit.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Outcome {
+    /// The edit that undoes it exactly.
+    pub inverse: Edit,
+    /// The cells whose height may have changed.
+    pub changed: Rect,
+}
+
 /// Where the document lives on disk.
 struct Store {
     path: PathBuf,
@@ -118,7 +130,8 @@ struct Store {
 
 /// A document being edited: terrain, undo and redo, journal.
 pub struct Editor {
-    engine: TerrainEngine,
+    doc: Document,
+    terrain: TerrainEngine,
     undo: Vec<UndoStep>,
     redo: Vec<UndoStep>,
     store: Option<Store>,
@@ -153,7 +166,8 @@ impl Editor {
     /// Edits `doc` in memory, without a file (until [`Editor::save_as`]).
     pub fn new(doc: Document) -> Result<Editor, ValidationError> {
         Ok(Editor {
-            engine: TerrainEngine::new(doc)?,
+            terrain: TerrainEngine::new(&doc)?,
+            doc,
             undo: Vec::new(),
             redo: Vec::new(),
             store: None,
@@ -173,15 +187,7 @@ impl Editor {
     }
 
     fn open_with(path: &Path, write: bool) -> Result<(Editor, OpenReport), EditorError> {
-        let bytes = fs::read(path).map_err(|source| LoadError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
-        let text = std::str::from_utf8(&bytes).map_err(|e| LoadError::Io {
-            path: path.to_owned(),
-            source: io::Error::new(io::ErrorKind::InvalidData, e),
-        })?;
-        let doc = Document::from_json(text)?;
+        let (doc, bytes) = persist::read_document(path)?;
         let base = journal::fingerprint(&bytes);
         let mut editor = Editor::new(doc).map_err(LoadError::from)?;
         let mut report = OpenReport::default();
@@ -263,17 +269,52 @@ impl Editor {
 
     /// The document.
     pub fn document(&self) -> &Document {
-        self.engine.document()
+        &self.doc
     }
 
     /// The terrain.
     pub fn heightmap(&self) -> &Heightmap {
-        self.engine.heightmap()
+        self.terrain.heightmap()
     }
 
-    /// The engine (document and terrain).
-    pub fn engine(&self) -> &TerrainEngine {
-        &self.engine
+    /// Applies `edit` to the document and the terrain, with no history or journal. On error
+    /// nothing changes.
+    fn change(&mut self, edit: &Edit) -> Result<Outcome, EditError> {
+        if let Edit::Group { edits } = edit {
+            return self.change_group(edits);
+        }
+        let applied = edit.apply_to(&mut self.doc)?;
+        let changed = self.terrain.update(&self.doc, &applied.scope);
+        Ok(Outcome {
+            inverse: applied.inverse,
+            changed,
+        })
+    }
+
+    /// Applies `edits` in order; if one is refused, undoes those before it.
+    fn change_group(&mut self, edits: &[Edit]) -> Result<Outcome, EditError> {
+        let mut inverses = Vec::with_capacity(edits.len());
+        let mut changed = Rect::EMPTY;
+        for edit in edits {
+            match self.change(edit) {
+                Ok(outcome) => {
+                    inverses.push(outcome.inverse);
+                    changed = changed.union(outcome.changed);
+                }
+                Err(e) => {
+                    // Each inverse restores the document it was made from, so it applies.
+                    for inverse in inverses.iter().rev() {
+                        let _ = self.change(inverse);
+                    }
+                    return Err(e);
+                }
+            }
+        }
+        inverses.reverse();
+        Ok(Outcome {
+            inverse: Edit::Group { edits: inverses },
+            changed,
+        })
     }
 
     /// The document's file, if it has one.
@@ -318,14 +359,14 @@ impl Editor {
             }
         }
         // A refused commit leaves the preview as it was.
-        let mut outcome = self.engine.apply(&edit)?;
+        let mut outcome = self.change(&edit)?;
         if let Some(inverse) = original {
             outcome.inverse = inverse;
             self.preview = None;
         }
         if let Err(e) = self.log(&Entry::Do { edit: edit.clone() }) {
             // Not journaled, so not done: restore.
-            self.engine.apply(&outcome.inverse)?;
+            self.change(&outcome.inverse)?;
             return Err(e);
         }
         self.push_undo(UndoStep {
@@ -338,7 +379,7 @@ impl Editor {
 
     /// Applies an edit as a journal replay does: no preview, no journal.
     fn record(&mut self, edit: Edit) -> Result<Outcome, EditError> {
-        let outcome = self.engine.apply(&edit)?;
+        let outcome = self.change(&edit)?;
         self.push_undo(UndoStep {
             edit,
             inverse: outcome.inverse.clone(),
@@ -356,7 +397,7 @@ impl Editor {
 
     fn step_back(&mut self) -> Result<Option<Outcome>, EditError> {
         let Some(step) = self.undo.pop() else { return Ok(None) };
-        match self.engine.apply(&step.inverse) {
+        match self.change(&step.inverse) {
             Ok(outcome) => {
                 self.redo.push(step);
                 Ok(Some(outcome))
@@ -370,7 +411,7 @@ impl Editor {
 
     fn step_forward(&mut self) -> Result<Option<Outcome>, EditError> {
         let Some(step) = self.redo.pop() else { return Ok(None) };
-        match self.engine.apply(&step.edit) {
+        match self.change(&step.edit) {
             Ok(outcome) => {
                 self.push_undo(step);
                 Ok(Some(outcome))
@@ -419,7 +460,7 @@ impl Editor {
         if self.preview.as_ref().is_some_and(|p| p.at != at) {
             self.cancel_preview()?;
         }
-        let outcome = self.engine.apply(edit)?;
+        let outcome = self.change(edit)?;
         let before = match &outcome.inverse {
             Edit::SetHeight { height, .. } => *height,
             Edit::SetSlope { slope, .. } => *slope,
@@ -448,7 +489,7 @@ impl Editor {
     /// be written, the preview is undone and the error returned.
     pub fn commit_preview(&mut self) -> Result<Option<Edit>, EditorError> {
         let Some(p) = self.preview.take() else { return Ok(None) };
-        let doc = self.engine.document();
+        let doc = &self.doc;
         let Some(figure) = p.at.get(doc) else {
             return Ok(None);
         };
@@ -466,7 +507,7 @@ impl Editor {
             (Edit::Group { edits }, Edit::Group { edits: inverse })
         };
         if let Err(e) = self.log(&Entry::Do { edit: edit.clone() }) {
-            self.engine.apply(&inverse)?;
+            self.change(&inverse)?;
             return Err(e);
         }
         self.push_undo(UndoStep {
@@ -485,7 +526,7 @@ impl Editor {
             Ok([one]) => one,
             Err(both) => Edit::Group { edits: both },
         };
-        Ok(Some(self.engine.apply(&edit)?))
+        Ok(Some(self.change(&edit)?))
     }
 
     /// Saves to the document's file (ending any preview) and compacts the journal.
@@ -500,7 +541,7 @@ impl Editor {
         self.cancel_preview()?;
         // Document first: a crash between the two leaves a journal whose base no longer matches,
         // which is then set aside rather than replayed twice.
-        let bytes = self.engine.document().save(path)?;
+        let bytes = self.doc.save(path)?;
         let jpath = journal::path_for(path);
         let writer = Writer::create(&jpath, &journal::fingerprint(&bytes), &self.undo, &self.redo)
             .map_err(journal_io(&jpath))?;

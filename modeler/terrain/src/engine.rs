@@ -40,6 +40,11 @@
 //!   breadth-first search, then the region's shares and coefficients; the other figures' `dp` are
 //!   kept. A moved closed figure rebuilds its nested regions; a changed boundary the region's maps.
 //!
+//! The engine is told what changed, not how: [`TerrainEngine::update`] takes the document after
+//! a change and its [`Scope`] (which figure's height or slope, which figure list, which region),
+//! and regenerates that part from the document. Turning an edit into a document change and a
+//! scope is the editor's ([`crate::edit`], [`crate::editor`]).
+//!
 //! Other regions are not touched. Coefficients are a deterministic function of the geometry, so
 //! a rebuilt region equals a freshly generated one to the bit. Heights after a pull are the same
 //! `f32` terms (base and `relief_k·coef_k`) summed in another order, or the algebraically equal
@@ -49,44 +54,17 @@
 //! per cell, whatever the number of edits (nothing accumulates: each update recomputes a cell
 //! from cached terms). The `editing` tests check exactly this bound.
 
-use crate::address::FigurePath;
-use crate::baseline;
 use crate::cells::{self, Cell, Mask};
+use crate::change::{FigureList, ListChange, Scope};
 use crate::distance;
-use crate::document::{Document, Figure, FigureKind, Grid};
-use crate::edit::{self, Change, Edit, EditError, List, Scope};
+use crate::document::{Document, Figure, FigureKind, Grid, Point, Region};
 use crate::heightmap::Heightmap;
 use crate::profile;
 use crate::validate::{self, ValidationError};
 
 /// Generates the terrain of a document (validating it first).
 pub fn generate(doc: &Document) -> Result<Heightmap, ValidationError> {
-    Ok(TerrainEngine::new(doc.clone())?.into_parts().1)
-}
-
-/// How distance maps are computed.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Method {
-    /// Breadth-first search, linear time.
-    Bfs,
-    /// The seed's repeat-until-stable sweeps ([`baseline`]).
-    Sweep,
-}
-
-impl Method {
-    fn figure_distance(self, mask: &Mask, cells: &[Cell]) -> Vec<u32> {
-        match self {
-            Method::Bfs => distance::from_sources(mask, cells),
-            Method::Sweep => baseline::from_sources(mask, cells),
-        }
-    }
-
-    fn edge_layers(self, mask: &Mask) -> Vec<u32> {
-        match self {
-            Method::Bfs => distance::edge_layers(mask),
-            Method::Sweep => baseline::edge_layers(mask),
-        }
-    }
+    Ok(TerrainEngine::new(doc)?.into_heightmap())
 }
 
 /// A rectangle of cells.
@@ -174,7 +152,7 @@ struct RegionNode {
 /// The cells of the nested region a closed curve bounds. Validation keeps a closed figure strictly
 /// inside its region, which puts its cells inside the region's; the intersection only guards
 /// against a rounding tie at a cell border, so that no region paints outside its parent.
-fn nested_mask(grid: &Grid, points: &[crate::document::Point], parent: &Mask) -> Mask {
+fn nested_mask(grid: &Grid, points: &[Point], parent: &Mask) -> Mask {
     cells::closed_mask(grid, points).intersect(parent)
 }
 
@@ -187,13 +165,13 @@ fn sources(grid: &Grid, f: &Figure, child: Option<&RegionNode>) -> Vec<Cell> {
 }
 
 impl FigureNode {
-    fn build(grid: &Grid, region: &Mask, f: &Figure, m: Method) -> FigureNode {
+    fn build(grid: &Grid, region: &Mask, f: &Figure) -> FigureNode {
         let child = (f.kind == FigureKind::Closed).then(|| {
             let mask = nested_mask(grid, &f.points, region);
-            Box::new(RegionNode::build(grid, mask, &f.figures, Some(f.slope), m))
+            Box::new(RegionNode::build(grid, mask, &f.figures, Some(f.slope)))
         });
         FigureNode {
-            dp: m.figure_distance(region, &sources(grid, f, child.as_deref())),
+            dp: distance::from_sources(region, &sources(grid, f, child.as_deref())),
             share: Vec::new(),
             coef: Vec::new(),
             child,
@@ -202,9 +180,9 @@ impl FigureNode {
 }
 
 impl RegionNode {
-    fn build(grid: &Grid, mask: Mask, figs: &[Figure], outer: Option<f64>, m: Method) -> RegionNode {
-        let df = m.edge_layers(&mask);
-        let figures = figs.iter().map(|f| FigureNode::build(grid, &mask, f, m)).collect();
+    fn build(grid: &Grid, mask: Mask, figs: &[Figure], outer: Option<f64>) -> RegionNode {
+        let df = distance::edge_layers(&mask);
+        let figures = figs.iter().map(|f| FigureNode::build(grid, &mask, f)).collect();
         let mut node = RegionNode {
             mask,
             df,
@@ -218,17 +196,17 @@ impl RegionNode {
     }
 
     /// New cells for the region; its figures' nested regions are kept.
-    fn reshape(&mut self, grid: &Grid, mask: Mask, figs: &[Figure], outer: Option<f64>, m: Method) {
+    fn reshape(&mut self, grid: &Grid, mask: Mask, figs: &[Figure], outer: Option<f64>) {
         self.mask = mask;
-        self.df = m.edge_layers(&self.mask);
+        self.df = distance::edge_layers(&self.mask);
         for (f, node) in figs.iter().zip(&mut self.figures) {
-            node.dp = m.figure_distance(&self.mask, &sources(grid, f, node.child.as_deref()));
+            node.dp = distance::from_sources(&self.mask, &sources(grid, f, node.child.as_deref()));
         }
         self.settle(figs, outer);
     }
 
     /// Figure k's points changed (its nested figures did not).
-    fn outline(&mut self, grid: &Grid, k: usize, figs: &[Figure], m: Method) {
+    fn outline(&mut self, grid: &Grid, k: usize, figs: &[Figure]) {
         let f = &figs[k];
         if let Some(child) = self.figures[k].child.as_deref_mut() {
             child.reshape(
@@ -236,11 +214,10 @@ impl RegionNode {
                 nested_mask(grid, &f.points, &self.mask),
                 &f.figures,
                 Some(f.slope),
-                m,
             );
         }
         let node = &mut self.figures[k];
-        node.dp = m.figure_distance(&self.mask, &sources(grid, f, node.child.as_deref()));
+        node.dp = distance::from_sources(&self.mask, &sources(grid, f, node.child.as_deref()));
     }
 
     /// Recomputes what depends on the set of figures: owned cells, shares, coefficients.
@@ -444,33 +421,23 @@ impl RegionNode {
     }
 }
 
-/// The result of an applied edit.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Outcome {
-    /// The edit that undoes it exactly.
-    pub inverse: Edit,
-    /// The cells whose height may have changed.
-    pub changed: Rect,
-}
-
-/// The terrain generator: holds a document and its heightmap, and keeps the heightmap up to date
-/// through edits by regenerating only the regions they touch.
+/// A document's terrain with the caches that let it follow the document's changes: per region
+/// its distance maps and per figure its eq. 1–3 coefficients. Regenerates only what a change
+/// touches.
 pub struct TerrainEngine {
-    doc: Document,
-    method: Method,
     regions: Vec<RegionNode>,
     map: Heightmap,
 }
 
-/// The node that owns list `list` of `regions`, and that list's figures, base and outer slope.
+/// The node that owns figure list `list`, with that list's figures, base and outer slope.
 fn locate<'a, 'd>(
     regions: &'a mut [RegionNode],
     doc: &'d Document,
-    list: &List,
+    list: &FigureList,
 ) -> Option<(&'a mut RegionNode, &'d [Figure], f64, Option<f64>)> {
     match list {
-        List::Region(i) => Some((regions.get_mut(*i)?, &doc.regions.get(*i)?.figures, 0.0, None)),
-        List::Figure(p) => {
+        FigureList::Region(i) => Some((regions.get_mut(*i)?, &doc.regions.get(*i)?.figures, 0.0, None)),
+        FigureList::Nested(p) => {
             let f = p.get(doc)?;
             let mut node = regions.get_mut(p.region())?;
             for &i in p.indices() {
@@ -481,35 +448,26 @@ fn locate<'a, 'd>(
     }
 }
 
+fn region_node(grid: &Grid, r: &Region) -> RegionNode {
+    RegionNode::build(grid, cells::closed_mask(grid, &r.boundary), &r.figures, None)
+}
+
 impl TerrainEngine {
     /// Validates `doc` and generates its terrain.
-    pub fn new(doc: Document) -> Result<TerrainEngine, ValidationError> {
-        TerrainEngine::with_method(doc, Method::Bfs)
+    pub fn new(doc: &Document) -> Result<TerrainEngine, ValidationError> {
+        validate::document(doc)?;
+        Ok(TerrainEngine::build(doc))
     }
 
-    pub(crate) fn with_method(doc: Document, method: Method) -> Result<TerrainEngine, ValidationError> {
-        validate::document(&doc)?;
+    /// Generates the terrain of a valid document.
+    fn build(doc: &Document) -> TerrainEngine {
         let grid = doc.grid;
-        let regions: Vec<RegionNode> = doc
-            .regions
-            .iter()
-            .map(|r| RegionNode::build(&grid, cells::closed_mask(&grid, &r.boundary), &r.figures, None, method))
-            .collect();
+        let regions: Vec<RegionNode> = doc.regions.iter().map(|r| region_node(&grid, r)).collect();
         let mut map = Heightmap::new(&grid);
         for (node, r) in regions.iter().zip(&doc.regions) {
             node.paint_all(&r.figures, 0.0, &mut map);
         }
-        Ok(TerrainEngine {
-            doc,
-            method,
-            regions,
-            map,
-        })
-    }
-
-    /// The document.
-    pub fn document(&self) -> &Document {
-        &self.doc
+        TerrainEngine { regions, map }
     }
 
     /// The terrain.
@@ -517,97 +475,72 @@ impl TerrainEngine {
         &self.map
     }
 
-    /// The document and its terrain.
-    pub fn into_parts(self) -> (Document, Heightmap) {
-        (self.doc, self.map)
+    /// The terrain, without the caches.
+    pub fn into_heightmap(self) -> Heightmap {
+        self.map
     }
 
-    /// Sets a figure's height (a pull) and updates the terrain.
-    pub fn set_height(&mut self, at: &FigurePath, height: f64) -> Result<Outcome, EditError> {
-        self.apply(&Edit::SetHeight { at: at.clone(), height })
-    }
-
-    /// Sets a figure's slope and updates the terrain.
-    pub fn set_slope(&mut self, at: &FigurePath, slope: f64) -> Result<Outcome, EditError> {
-        self.apply(&Edit::SetSlope { at: at.clone(), slope })
-    }
-
-    /// Applies an edit and regenerates the regions it touches. On error nothing changes.
-    pub fn apply(&mut self, edit: &Edit) -> Result<Outcome, EditError> {
-        if let Edit::Group { edits } = edit {
-            return self.apply_group(edits);
-        }
-        let masks: Vec<&Mask> = self.regions.iter().map(|n| &n.mask).collect();
-        let applied = edit::apply(&mut self.doc, edit, &masks)?;
-        let changed = self.regenerate(&applied.scope);
-        Ok(Outcome {
-            inverse: applied.inverse,
-            changed,
-        })
-    }
-
-    /// Applies `edits` in order; if one is refused, undoes those before it.
-    fn apply_group(&mut self, edits: &[Edit]) -> Result<Outcome, EditError> {
-        let mut inverses = Vec::with_capacity(edits.len());
-        let mut changed = Rect::EMPTY;
-        for edit in edits {
-            match self.apply(edit) {
-                Ok(outcome) => {
-                    inverses.push(outcome.inverse);
-                    changed = changed.union(outcome.changed);
-                }
-                Err(e) => {
-                    // Each inverse restores the document it was made from, so it applies.
-                    for inverse in inverses.iter().rev() {
-                        let _ = self.apply(inverse);
-                    }
-                    return Err(e);
+    /// Brings the terrain up to date with `doc` after the change `scope` describes, regenerating
+    /// only that part, and returns the cells whose height may have changed.
+    ///
+    /// `doc` is the document this engine last saw (at [`TerrainEngine::new`] or the last update)
+    /// with that one change made, and valid. A scope that does not fit the engine's regions and
+    /// figures (an index out of range, a list of another length) regenerates everything; any
+    /// other mismatch leaves a terrain that does not match the document.
+    pub fn update(&mut self, doc: &Document, scope: &Scope) -> Rect {
+        match self.regenerate(doc, scope) {
+            Some(rect) => rect,
+            None => {
+                *self = TerrainEngine::build(doc);
+                Rect {
+                    c0: 0,
+                    r0: 0,
+                    width: doc.grid.cols,
+                    height: doc.grid.rows,
                 }
             }
         }
-        inverses.reverse();
-        Ok(Outcome {
-            inverse: Edit::Group { edits: inverses },
-            changed,
-        })
     }
 
-    fn regenerate(&mut self, scope: &Scope) -> Rect {
-        let TerrainEngine {
-            doc,
-            method,
-            regions,
-            map,
-        } = self;
-        let (grid, m) = (doc.grid, *method);
-        let missing = Rect::EMPTY;
-        match scope {
+    /// The part of [`TerrainEngine::update`] that regenerates by scope; `None` when the scope
+    /// does not fit.
+    fn regenerate(&mut self, doc: &Document, scope: &Scope) -> Option<Rect> {
+        let TerrainEngine { regions, map } = self;
+        let grid = doc.grid;
+        let before = match scope {
+            Scope::RegionAdded(_) => doc.regions.len().checked_sub(1)?,
+            Scope::RegionRemoved(_) => doc.regions.len() + 1,
+            _ => doc.regions.len(),
+        };
+        if regions.len() != before {
+            return None;
+        }
+        let rect = match scope {
             Scope::Height(at) => {
-                let Some((node, figs, base, _)) = locate(regions, doc, &List::of(at)) else {
-                    return missing;
-                };
+                let (node, figs, base, _) = locate(regions, doc, &FigureList::of(at))?;
                 let k = at.index();
+                let f = figs.get(k)?;
+                node.figures.get(k)?;
                 node.plateau = None;
                 node.paint_pull(k, figs, base, map);
                 let mut rect = Rect::of(&node.mask);
                 if let Some(child) = node.figures[k].child.as_deref_mut() {
                     child.rest = None;
-                    child.paint_plateau(&figs[k].figures, figs[k].height, map);
+                    child.paint_plateau(&f.figures, f.height, map);
                     rect = rect.union(Rect::of(&child.mask));
                 }
                 rect
             }
             Scope::Slope(at) => {
-                let Some((node, figs, base, outer)) = locate(regions, doc, &List::of(at)) else {
-                    return missing;
-                };
+                let (node, figs, base, outer) = locate(regions, doc, &FigureList::of(at))?;
                 let k = at.index();
+                let f = figs.get(k)?;
+                node.figures.get(k)?;
                 node.coefficients(k, figs, outer);
                 node.plateau = None;
                 node.paint_pull(k, figs, base, map);
                 let mut rect = Rect::of(&node.mask);
                 if let Some(child) = node.figures[k].child.as_deref_mut() {
-                    let f = &figs[k];
                     for j in 0..f.figures.len() {
                         child.coefficients(j, &f.figures, Some(f.slope));
                     }
@@ -619,53 +552,66 @@ impl TerrainEngine {
                 rect
             }
             Scope::Figures(list, change) => {
-                let Some((node, figs, base, outer)) = locate(regions, doc, list) else {
-                    return missing;
+                let (node, figs, base, outer) = locate(regions, doc, list)?;
+                let fits = match *change {
+                    ListChange::Added(k) => k < figs.len() && k <= node.figures.len(),
+                    ListChange::Removed(k) => k < node.figures.len(),
+                    ListChange::Replaced(k) | ListChange::Outline(k) => k < figs.len() && k < node.figures.len(),
                 };
+                if !fits {
+                    return None;
+                }
                 match *change {
-                    Change::Added(k) => node
-                        .figures
-                        .insert(k, FigureNode::build(&grid, &node.mask, &figs[k], m)),
-                    Change::Removed(k) => {
+                    ListChange::Added(k) => node.figures.insert(k, FigureNode::build(&grid, &node.mask, &figs[k])),
+                    ListChange::Removed(k) => {
                         node.figures.remove(k);
                     }
-                    Change::Replaced(k) => node.figures[k] = FigureNode::build(&grid, &node.mask, &figs[k], m),
-                    Change::Outline(k) => node.outline(&grid, k, figs, m),
+                    ListChange::Replaced(k) => node.figures[k] = FigureNode::build(&grid, &node.mask, &figs[k]),
+                    ListChange::Outline(k) => node.outline(&grid, k, figs),
+                }
+                if node.figures.len() != figs.len() {
+                    return None;
                 }
                 node.settle(figs, outer);
                 node.paint_all(figs, base, map);
                 Rect::of(&node.mask)
             }
             Scope::RegionAdded(i) => {
-                let r = &doc.regions[*i];
-                let node = RegionNode::build(&grid, cells::closed_mask(&grid, &r.boundary), &r.figures, None, m);
+                let r = doc.regions.get(*i)?;
+                let node = region_node(&grid, r);
                 node.paint_all(&r.figures, 0.0, map);
                 let rect = Rect::of(&node.mask);
                 regions.insert(*i, node);
                 rect
             }
             Scope::RegionRemoved(i) => {
+                if *i >= regions.len() {
+                    return None;
+                }
                 let node = regions.remove(*i);
                 node.clear(map);
                 Rect::of(&node.mask)
             }
             Scope::RegionReplaced(i) => {
-                let r = &doc.regions[*i];
-                let node = RegionNode::build(&grid, cells::closed_mask(&grid, &r.boundary), &r.figures, None, m);
-                let old = std::mem::replace(&mut regions[*i], node);
+                let r = doc.regions.get(*i)?;
+                let old = std::mem::replace(regions.get_mut(*i)?, region_node(&grid, r));
                 old.clear(map);
                 regions[*i].paint_all(&r.figures, 0.0, map);
                 Rect::of(&old.mask).union(Rect::of(&regions[*i].mask))
             }
             Scope::RegionOutline(i) => {
-                let r = &doc.regions[*i];
-                let node = &mut regions[*i];
+                let r = doc.regions.get(*i)?;
+                let node = regions.get_mut(*i)?;
+                if node.figures.len() != r.figures.len() {
+                    return None;
+                }
                 node.clear(map);
                 let old = Rect::of(&node.mask);
-                node.reshape(&grid, cells::closed_mask(&grid, &r.boundary), &r.figures, None, m);
+                node.reshape(&grid, cells::closed_mask(&grid, &r.boundary), &r.figures, None);
                 node.paint_all(&r.figures, 0.0, map);
                 old.union(Rect::of(&node.mask))
             }
-        }
+        };
+        Some(rect)
     }
 }

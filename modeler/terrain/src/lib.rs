@@ -15,8 +15,8 @@
 #![cfg_attr(not(test), warn(clippy::unwrap_used))]
 
 pub mod address;
-pub mod baseline;
 pub mod cells;
+pub mod change;
 pub mod distance;
 pub mod document;
 pub mod edit;
@@ -32,9 +32,10 @@ pub mod profile;
 pub mod validate;
 
 pub use address::{CurvePath, FigurePath};
-pub use document::{Document, Figure, FigureKind, Grid, LoadError, Point, Region, SaveError};
+pub use document::{Document, Figure, FigureKind, Grid, Point, Region};
 pub use edit::{Edit, EditError};
-pub use editor::Editor;
-pub use engine::{Outcome, Rect, TerrainEngine, generate};
+pub use editor::{Editor, Outcome};
+pub use engine::{Rect, TerrainEngine, generate};
 pub use heightmap::Heightmap;
+pub use persist::{LoadError, SaveError};
 pub use validate::{Defect, ValidationError};

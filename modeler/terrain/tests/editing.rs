@@ -6,7 +6,8 @@ use crate::common;
 use std::fs;
 
 use common::*;
-use penmodel_terrain::editor::{Editor, OpenReport};
+use penmodel_terrain::change::Scope;
+use penmodel_terrain::editor::{Editor, EditorError, OpenReport};
 use penmodel_terrain::{
     CurvePath, Defect, Document, Edit, EditError, Figure, FigurePath, TerrainEngine, generate, journal,
 };
@@ -138,10 +139,10 @@ fn edit_for(doc: &Document, op: &Op) -> Option<Edit> {
 }
 
 #[track_caller]
-fn assert_matches_full(engine: &TerrainEngine, context: &str) {
-    let full = generate(engine.document()).unwrap();
-    let tol = tolerance(engine.document());
-    if let Some((c, r, a, b)) = first_difference(engine.heightmap(), &full, tol) {
+fn assert_matches_full(editor: &Editor, context: &str) {
+    let full = generate(editor.document()).unwrap();
+    let tol = tolerance(editor.document());
+    if let Some((c, r, a, b)) = first_difference(editor.heightmap(), &full, tol) {
         panic!("{context}: incremental {a} vs full {b} at ({c}, {r}), tolerance {tol}");
     }
 }
@@ -154,15 +155,15 @@ proptest! {
     /// refused edit leaves the document and terrain exactly as they were.
     #[test]
     fn incremental_equals_full(doc in nested_document(), ops in prop::collection::vec(op(), 1..14)) {
-        let mut engine = TerrainEngine::new(doc).unwrap();
+        let mut editor = Editor::new(doc).unwrap();
         for (n, op) in ops.iter().enumerate() {
-            let Some(edit) = edit_for(engine.document(), op) else { continue };
-            let (before_doc, before_map) = (engine.document().clone(), engine.heightmap().clone());
-            match engine.apply(&edit) {
-                Ok(_) => assert_matches_full(&engine, &format!("after op {n} {edit:?}")),
+            let Some(edit) = edit_for(editor.document(), op) else { continue };
+            let (before_doc, before_map) = (editor.document().clone(), editor.heightmap().clone());
+            match editor.apply(edit.clone()) {
+                Ok(_) => assert_matches_full(&editor, &format!("after op {n} {edit:?}")),
                 Err(_) => {
-                    prop_assert_eq!(engine.document(), &before_doc);
-                    prop_assert_eq!(engine.heightmap(), &before_map);
+                    prop_assert_eq!(editor.document(), &before_doc);
+                    prop_assert_eq!(editor.heightmap(), &before_map);
                 }
             }
         }
@@ -183,13 +184,13 @@ proptest! {
         for expected in docs.iter().rev().skip(1) {
             prop_assert!(editor.undo().unwrap().is_some());
             prop_assert_eq!(editor.document(), expected);
-            assert_matches_full(editor.engine(), "after undo");
+            assert_matches_full(&editor, "after undo");
         }
         prop_assert!(editor.undo().unwrap().is_none());
         prop_assert_eq!(editor.document(), &doc);
         while editor.redo().unwrap().is_some() {}
         prop_assert_eq!(editor.document(), &last);
-        assert_matches_full(editor.engine(), "after redo");
+        assert_matches_full(&editor, "after redo");
     }
 
     /// A crash (the editor dropped without saving) loses nothing: reopening replays the journal
@@ -245,32 +246,35 @@ fn sample() -> Document {
 
 #[test]
 fn refused_edits_name_the_problem() {
-    let mut engine = TerrainEngine::new(sample()).unwrap();
-    let outside = engine.apply(&Edit::MoveFigure {
+    let mut editor = Editor::new(sample()).unwrap();
+    let outside = editor.apply(Edit::MoveFigure {
         at: FigurePath::new(0, 0),
         by: [30.0, 0.0],
     });
-    let Err(EditError::Invalid(e)) = outside else {
+    let Err(EditorError::Edit(EditError::Invalid(e))) = outside else {
         panic!("{outside:?}")
     };
     assert_eq!(e.path, "regions[0].figures[0].points[0]");
     assert!(matches!(e.defect, Defect::OutsideGrid { .. }), "{e}");
-    let nan = engine.apply(&Edit::SetHeight {
+    let nan = editor.apply(Edit::SetHeight {
         at: FigurePath::new(0, 1).child(0),
         height: f64::NAN,
     });
-    let Err(EditError::Invalid(e)) = nan else {
+    let Err(EditorError::Edit(EditError::Invalid(e))) = nan else {
         panic!("{nan:?}")
     };
     assert_eq!(
         (e.path.as_str(), e.defect),
         ("regions[0].figures[1].figures[0].height", Defect::NotFinite)
     );
-    let missing = engine.apply(&Edit::DeleteFigure {
+    let missing = editor.apply(Edit::DeleteFigure {
         at: FigurePath::new(0, 5),
     });
-    assert_eq!(missing, Err(EditError::NoFigure(FigurePath::new(0, 5))));
-    assert_eq!(engine.document(), &sample());
+    assert!(
+        matches!(&missing, Err(EditorError::Edit(EditError::NoFigure(at))) if *at == FigurePath::new(0, 5)),
+        "{missing:?}"
+    );
+    assert_eq!(editor.document(), &sample());
 }
 
 #[test]
@@ -411,9 +415,9 @@ fn an_edit_regenerates_only_its_region() {
         boundary: polygon([31.0, 20.0], 7.0, 8, 0.1),
         figures: vec![point([31.0, 21.0], 20.0, 0.0)],
     });
-    let mut engine = TerrainEngine::new(doc).unwrap();
-    let region1 = penmodel_terrain::cells::closed_mask(&engine.document().grid, &engine.document().regions[1].boundary);
-    let before = engine.heightmap().clone();
+    let mut editor = Editor::new(doc).unwrap();
+    let region1 = penmodel_terrain::cells::closed_mask(&editor.document().grid, &editor.document().regions[1].boundary);
+    let before = editor.heightmap().clone();
     for edit in [
         Edit::SetHeight {
             at: FigurePath::new(0, 0),
@@ -433,7 +437,7 @@ fn an_edit_regenerates_only_its_region() {
             to: [14.0, 27.5],
         },
     ] {
-        let out = engine.apply(&edit).unwrap();
+        let out = editor.apply(edit.clone()).unwrap();
         // The changed rectangle lies left of region 1's box, and region 1's heights are untouched.
         assert!(
             out.changed.c0 + out.changed.width <= region1.c0,
@@ -441,9 +445,9 @@ fn an_edit_regenerates_only_its_region() {
             out.changed
         );
         for (c, r) in region1.cells() {
-            assert_eq!(engine.heightmap().get(c, r).to_bits(), before.get(c, r).to_bits());
+            assert_eq!(editor.heightmap().get(c, r).to_bits(), before.get(c, r).to_bits());
         }
-        assert_matches_full(&engine, &format!("{edit:?}"));
+        assert_matches_full(&editor, &format!("{edit:?}"));
     }
 }
 
@@ -496,7 +500,7 @@ fn a_pull_with_a_slope_is_one_step() {
 
 #[test]
 fn a_refused_group_changes_nothing() {
-    let mut engine = TerrainEngine::new(sample()).unwrap();
+    let mut editor = Editor::new(sample()).unwrap();
     let at = FigurePath::new(0, 0);
     let group = Edit::Group {
         edits: vec![
@@ -510,10 +514,39 @@ fn a_refused_group_changes_nothing() {
             },
         ],
     };
-    assert_eq!(
-        engine.apply(&group).unwrap_err(),
-        EditError::NoFigure(FigurePath::new(0, 9))
+    let refused = editor.apply(group);
+    assert!(
+        matches!(&refused, Err(EditorError::Edit(EditError::NoFigure(at))) if *at == FigurePath::new(0, 9)),
+        "{refused:?}"
     );
-    assert_eq!(engine.document(), &sample());
-    assert_eq!(engine.heightmap(), &generate(&sample()).unwrap());
+    assert_eq!(editor.document(), &sample());
+    assert_eq!(editor.heightmap(), &generate(&sample()).unwrap());
+    assert!(!editor.can_undo());
+}
+
+/// The engine follows the document it is given: the document after an edit, and the scope the
+/// edit reports. A scope that does not fit the engine's regions regenerates everything.
+#[test]
+fn the_engine_updates_from_the_document_and_a_scope() {
+    let mut doc = sample();
+    let mut terrain = TerrainEngine::new(&doc).unwrap();
+    let at = FigurePath::new(0, 1).child(0);
+    let applied = Edit::SetHeight { at, height: 44.0 }.apply_to(&mut doc).unwrap();
+    assert_eq!(applied.scope, Scope::Height(FigurePath::new(0, 1).child(0)));
+    let changed = terrain.update(&doc, &applied.scope);
+    assert!(changed.width > 0 && changed.height > 0);
+    let tol = tolerance(&doc);
+    assert_eq!(
+        first_difference(terrain.heightmap(), &generate(&doc).unwrap(), tol),
+        None
+    );
+
+    Edit::DeleteFigure {
+        at: FigurePath::new(0, 0),
+    }
+    .apply_to(&mut doc)
+    .unwrap();
+    let changed = terrain.update(&doc, &Scope::RegionRemoved(3));
+    assert_eq!((changed.width, changed.height), (doc.grid.cols, doc.grid.rows));
+    assert_eq!(terrain.heightmap(), &generate(&doc).unwrap());
 }

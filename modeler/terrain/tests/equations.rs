@@ -164,7 +164,7 @@ fn dp_goes_around_obstacles() {
     let d = distance::from_sources(&m, &[(0, 0)]);
     assert_eq!(render(&m, &d), vec!["0...8", "1...7", "23456"]);
     assert_eq!(
-        render(&m, &penmodel_terrain::baseline::from_sources(&m, &[(0, 0)])),
+        render(&m, &crate::baseline::from_sources(&m, &[(0, 0)])),
         render(&m, &d)
     );
 }
@@ -179,7 +179,7 @@ fn df_counts_layers_from_the_edge() {
         render(&m, &d),
         vec!["000.000", "0110110", "0121210", "0111110", "0000000"]
     );
-    assert_eq!(render(&m, &penmodel_terrain::baseline::edge_layers(&m)), render(&m, &d));
+    assert_eq!(render(&m, &crate::baseline::edge_layers(&m)), render(&m, &d));
 }
 
 // ---- eq. 1 and eq. 2 ----

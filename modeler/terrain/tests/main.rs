@@ -1,4 +1,5 @@
 //! The integration tests of penmodel-terrain, in one binary: a module per area.
+mod baseline;
 mod common;
 mod docs;
 mod editing;

@@ -1,11 +1,12 @@
 //! Properties of the terrain rules on random documents and grids.
 
+use crate::baseline;
 use crate::common;
 
 use common::*;
 use penmodel_terrain::cells::{self, Mask};
 use penmodel_terrain::distance::{self, UNREACHABLE};
-use penmodel_terrain::{FigureKind, Region, TerrainEngine, baseline, generate, profile};
+use penmodel_terrain::{FigureKind, Region, generate, profile};
 use proptest::prelude::*;
 
 /// A random set of cells in a w × h box, and some sources among them.
@@ -115,8 +116,7 @@ proptest! {
     fn continuous_across_nested_edge(mut doc in nested_document()) {
         // The closed figure alone in the parent, for the bound on the parent's side.
         doc.regions[0].figures.retain(|f| f.kind == FigureKind::Closed);
-        let engine = TerrainEngine::new(doc.clone()).unwrap();
-        let map = engine.heightmap();
+        let map = generate(&doc).unwrap();
         let k = &doc.regions[0].figures[0];
         let nested = cells::closed_mask(&doc.grid, &k.points);
         let region = cells::closed_mask(&doc.grid, &doc.regions[0].boundary);
