@@ -1,6 +1,6 @@
-//! The output: an RGBA8 frame buffer.
+//! The output: an RGBA8 frame buffer, and why a frame could not be rendered.
 
-use super::RenderError;
+use thiserror::Error;
 
 /// A colour: red, green, blue, alpha, 8 bits each (sRGB, alpha 255 = opaque).
 pub type Rgba = [u8; 4];
@@ -14,6 +14,22 @@ pub fn check_size(width: u32, height: u32) -> Result<(), RenderError> {
         return Err(RenderError::FrameSize { width, height });
     }
     Ok(())
+}
+
+/// Why a frame could not be rendered.
+#[derive(Debug, Error, PartialEq)]
+pub enum RenderError {
+    /// The frame has a zero side or one too large for the rasteriser.
+    #[error("frame size {width} × {height} is not drawable (each side 1 to {max})", max = MAX_SIDE)]
+    FrameSize {
+        /// Width asked for.
+        width: u32,
+        /// Height asked for.
+        height: u32,
+    },
+    /// The camera's parameters are not usable.
+    #[error("camera: {0}")]
+    Camera(&'static str),
 }
 
 /// An RGBA8 image, row-major, top row first.

@@ -38,30 +38,12 @@ pub mod ui;
 
 pub mod output;
 
-use thiserror::Error;
-
 pub use camera::{Camera, Eye, Orbit, Projection, Tracked, View, Viewport};
-pub use frame::{Frame, Rgba};
+pub use frame::{Frame, RenderError, Rgba};
 pub use scene::{Overlay, Scene, SlopeBar, Stereo, Style};
 
 use rasterise::{Bounds, Capsule, Sample};
 use transform::{Affine, Projected};
-
-/// Why a frame could not be rendered.
-#[derive(Debug, Error, PartialEq)]
-pub enum RenderError {
-    /// The frame has a zero side or one too large for the rasteriser.
-    #[error("frame size {width} × {height} is not drawable (each side 1 to {max})", max = frame::MAX_SIDE)]
-    FrameSize {
-        /// Width asked for.
-        width: u32,
-        /// Height asked for.
-        height: u32,
-    },
-    /// The camera's parameters are not usable.
-    #[error("camera: {0}")]
-    Camera(&'static str),
-}
 
 /// What a render found in its input.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
