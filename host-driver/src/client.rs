@@ -4,9 +4,8 @@ use std::io::{BufRead, BufReader};
 use std::os::unix::net::UnixStream;
 use std::path::Path;
 
-use serde_json::Value;
-
-use crate::events::{DisplayPoint, EventKind, PenEvent};
+use crate::events::PenEvent;
+use crate::wire::SocketLine;
 
 /// Why an event line could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -36,72 +35,24 @@ pub enum Line {
     Event(PenEvent),
 }
 
-/// Parses one JSON line (docs/events.md).
+/// Parses one JSON line (docs/events.md): a line that is not JSON, lacks a key its `type`
+/// needs, or has one of the wrong type or range is an error saying which.
 pub fn parse_line(line: &str) -> Result<Line, ClientError> {
-    let bad = |why: &str| ClientError::Bad {
+    let bad = |why: String| ClientError::Bad {
         line: line.to_string(),
-        why: why.to_string(),
+        why,
     };
-    let v: Value = serde_json::from_str(line).map_err(|e| bad(&e.to_string()))?;
-    let kind = v.get("type").and_then(Value::as_str).ok_or_else(|| bad("no type"))?;
-    let t = v.get("t").and_then(Value::as_f64).ok_or_else(|| bad("no t"))?;
-    let t_us = (t * 1e6).round() as u64;
-    let num = |k: &str| v.get(k).and_then(Value::as_f64);
-    let button = || {
-        v.get("button")
-            .and_then(Value::as_u64)
-            .map(|b| b as u8)
-            .ok_or_else(|| bad("no button"))
+    let wire: SocketLine = serde_json::from_str(line).map_err(|e| bad(e.to_string()))?;
+    let device = match &wire {
+        SocketLine::Hello(h) => Some(h.device.clone()),
+        _ => None,
     };
-    let text = |k: &str| v.get(k).and_then(Value::as_str).unwrap_or("").to_string();
-    let kind = match kind {
-        "hello" => {
-            return Ok(Line::Hello {
-                device: v.get("device").and_then(Value::as_str).map(str::to_string),
-            });
-        }
-        "proximity_in" => EventKind::ProximityIn,
-        "proximity_out" => EventKind::ProximityOut,
-        "tip_down" => EventKind::TipDown,
-        "tip_up" => EventKind::TipUp,
-        "button_down" => EventKind::ButtonDown { button: button()? },
-        "button_up" => EventKind::ButtonUp { button: button()? },
-        "motion" => EventKind::Motion,
-        "device_lost" => EventKind::DeviceLost { reason: text("reason") },
-        "device_found" => EventKind::DeviceFound { device: text("device") },
-        "missed" => EventKind::Missed {
-            count: v.get("count").and_then(Value::as_u64).ok_or_else(|| bad("no count"))?,
-        },
-        other => return Err(bad(&format!("unknown type {other:?}"))),
-    };
-    let point = match (num("u_mm"), num("v_mm"), num("h_mm")) {
-        (Some(u_mm), Some(v_mm), Some(h_mm)) => Some(DisplayPoint {
-            u_mm,
-            v_mm,
-            h_mm,
-            u_px: num("u_px").unwrap_or(0.0),
-            v_px: num("v_px").unwrap_or(0.0),
+    match wire.into_event().map_err(|e| bad(e.to_string()))? {
+        Some(event) => Ok(Line::Event(event)),
+        None => Ok(Line::Hello {
+            device: device.flatten(),
         }),
-        _ => None,
-    };
-    let sw = v.get("sw").and_then(Value::as_array).and_then(|a| {
-        let b: Vec<bool> = a.iter().filter_map(Value::as_bool).collect();
-        <[bool; 3]>::try_from(b).ok()
-    });
-    let seq = match (
-        v.get("seq").and_then(Value::as_u64),
-        v.get("device_us").and_then(Value::as_u64),
-    ) {
-        (Some(s), Some(d)) => Some((s as u16, d)),
-        _ => None,
-    };
-    Ok(Line::Event(PenEvent {
-        kind,
-        t_us,
-        point,
-        sw,
-        seq,
-    }))
+    }
 }
 
 /// A connection to pend.
@@ -126,6 +77,62 @@ impl Client {
             Ok(0) => None,
             Ok(_) => Some(parse_line(self.line.trim_end())),
             Err(e) => Some(Err(e.into())),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::events::EventKind;
+
+    fn why(line: &str) -> String {
+        match parse_line(line) {
+            Err(ClientError::Bad { why, .. }) => why,
+            other => panic!("{line}: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn good_lines_read() {
+        let hello = parse_line(r#"{"type":"hello","t":1.5,"events":1,"connected":false,"device":null}"#);
+        assert_eq!(hello.ok(), Some(Line::Hello { device: None }));
+        let Ok(Line::Event(e)) = parse_line(
+            r#"{"type":"button_up","t":2.000001,"u_mm":1,"v_mm":2,"h_mm":3,"u_px":4,"v_px":5,"button":3,"sw":[true,false,false],"seq":7,"device_us":9,"later":"ignored"}"#,
+        ) else {
+            panic!("a button event")
+        };
+        assert_eq!(e.kind, EventKind::ButtonUp { button: 3 });
+        assert_eq!(
+            (e.t_us, e.seq, e.sw),
+            (2_000_001, Some((7, 9)), Some([true, false, false]))
+        );
+        assert_eq!(e.point.map(|p| p.v_px), Some(5.0));
+    }
+
+    #[test]
+    fn malformed_lines_are_errors_not_defaults() {
+        let cases = [
+            ("not json", "expected ident"),
+            (r#"{"t":1}"#, "missing field `type`"),
+            (r#"{"type":"wobble","t":1}"#, "unknown variant `wobble`"),
+            (r#"{"type":"motion"}"#, "missing field `t`"),
+            (r#"{"type":"motion","t":"now"}"#, "invalid type"),
+            (r#"{"type":"motion","t":-1}"#, "not a time"),
+            (r#"{"type":"motion","t":1,"u_mm":1,"v_mm":2,"h_mm":3}"#, "u_px"),
+            (r#"{"type":"motion","t":1,"seq":70000,"device_us":1}"#, "70000"),
+            (r#"{"type":"motion","t":1,"seq":7}"#, "seq and device_us"),
+            (r#"{"type":"motion","t":1,"sw":[true,false]}"#, "invalid length 2"),
+            (r#"{"type":"button_down","t":1}"#, "missing field `button`"),
+            (r#"{"type":"button_down","t":1,"button":1}"#, "button 1 is not 2 or 3"),
+            (r#"{"type":"button_down","t":1,"button":258}"#, "258"),
+            (r#"{"type":"device_lost","t":1}"#, "missing field `reason`"),
+            (r#"{"type":"missed","t":1,"count":-2}"#, "-2"),
+            (r#"{"type":"hello","t":1,"events":1}"#, "missing field `connected`"),
+        ];
+        for (line, expected) in cases {
+            let why = why(line);
+            assert!(why.contains(expected), "{line}: {why}");
         }
     }
 }

@@ -14,12 +14,11 @@ use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
-use serde_json::json;
-
 use crate::events::{EventKind, PenEvent};
 use crate::pipeline::Pipeline;
 use crate::sample::now_us;
 use crate::socket::{self, SocketError};
+use crate::wire::{Hello, SocketLine};
 
 /// Events a client may have queued before it starts missing them: about a second at 1 kHz.
 pub const DEFAULT_QUEUE: usize = 1024;
@@ -51,7 +50,7 @@ impl Hub {
             EventKind::DeviceLost { .. } => *lock(&self.device) = None,
             _ => {}
         }
-        let line: Arc<str> = Arc::from(format!("{}\n", event.to_json()));
+        let line: Arc<str> = Arc::from(event.to_line());
         let mut clients = lock(&self.clients);
         clients.retain(|c| match c.queue.try_send(line.clone()) {
             Ok(()) => {
@@ -86,15 +85,9 @@ impl Hub {
         let (tx, rx) = sync_channel(queue_len.max(1));
         let missed = Arc::new(AtomicU64::new(0));
         let device = lock(&self.device).clone();
-        let hello = json!({
-            "type": "hello",
-            "t": now_us() as f64 * 1e-6,
-            "events": 1,
-            "connected": device.is_some(),
-            "device": device,
-        });
+        let hello = SocketLine::Hello(Hello::new(now_us(), device)).to_text();
         let client_missed = missed.clone();
-        std::thread::spawn(move || write_client(stream, rx, client_missed, &format!("{hello}\n")));
+        std::thread::spawn(move || write_client(stream, rx, client_missed, &hello));
         lock(&self.clients).push(Client { queue: tx, missed });
     }
 }
@@ -113,7 +106,7 @@ fn write_client(stream: UnixStream, rx: Receiver<Arc<str>>, missed: Arc<AtomicU6
     while let Ok(line) = rx.recv() {
         let lost = missed.swap(0, Ordering::Relaxed);
         if lost > 0 {
-            let notice = format!("{}\n", PenEvent::missed(lost, now_us()).to_json());
+            let notice = PenEvent::missed(lost, now_us()).to_line();
             if out.write_all(notice.as_bytes()).is_err() {
                 return;
             }

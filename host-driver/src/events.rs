@@ -8,8 +8,6 @@
 //! come; when it returns, `device_found` starts from nothing pressed and out of range. The JSON
 //! form is in docs/events.md.
 
-use serde_json::{Map, Value, json};
-
 use crate::sample::Sample;
 
 /// A point in the display frame.
@@ -116,42 +114,9 @@ impl PenEvent {
         PenEvent::bare(EventKind::Missed { count }, t_us)
     }
 
-    /// The event as one JSON object (docs/events.md).
-    pub fn to_json(&self) -> Value {
-        let mut m = Map::new();
-        m.insert("type".into(), json!(self.kind.name()));
-        m.insert("t".into(), json!(self.t_us as f64 * 1e-6));
-        if let Some(p) = self.point {
-            let r = |v: f64| (v * 1000.0).round() / 1000.0;
-            m.insert("u_mm".into(), json!(r(p.u_mm)));
-            m.insert("v_mm".into(), json!(r(p.v_mm)));
-            m.insert("h_mm".into(), json!(r(p.h_mm)));
-            m.insert("u_px".into(), json!(r(p.u_px)));
-            m.insert("v_px".into(), json!(r(p.v_px)));
-        }
-        match &self.kind {
-            EventKind::ButtonDown { button } | EventKind::ButtonUp { button } => {
-                m.insert("button".into(), json!(button));
-            }
-            EventKind::DeviceLost { reason } => {
-                m.insert("reason".into(), json!(reason));
-            }
-            EventKind::DeviceFound { device } => {
-                m.insert("device".into(), json!(device));
-            }
-            EventKind::Missed { count } => {
-                m.insert("count".into(), json!(count));
-            }
-            _ => {}
-        }
-        if let Some(sw) = self.sw {
-            m.insert("sw".into(), json!(sw));
-        }
-        if let Some((seq, device_us)) = self.seq {
-            m.insert("seq".into(), json!(seq));
-            m.insert("device_us".into(), json!(device_us));
-        }
-        Value::Object(m)
+    /// The event as one line on pend's socket: JSON and a newline (docs/events.md).
+    pub fn to_line(&self) -> String {
+        crate::wire::SocketLine::from(self).to_text()
     }
 }
 
@@ -348,8 +313,8 @@ mod tests {
         d.on_sample(&sample(7, true, [false, false, true]), point(12.5), &mut out);
         out.push(PenEvent::missed(3, 42));
         for e in &out {
-            let line = e.to_json().to_string();
-            match crate::client::parse_line(&line) {
+            let line = e.to_line();
+            match crate::client::parse_line(line.trim_end()) {
                 Ok(crate::client::Line::Event(back)) => assert_eq!(&back, e, "{line}"),
                 other => panic!("{line}: {other:?}"),
             }

@@ -27,3 +27,4 @@ pub mod sample;
 pub mod socket;
 pub mod source;
 pub mod transport;
+pub mod wire;
