@@ -228,7 +228,7 @@ pub enum Eye {
 /// A screen rectangle in the world and the eye looking through it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Viewpoint {
-    /// The eye.
+    /// The eye's position, world metres.
     pub eye: DVec3,
     /// The screen's lower-left corner.
     pub lower_left: DVec3,
@@ -236,7 +236,7 @@ pub struct Viewpoint {
     pub lower_right: DVec3,
     /// The screen's upper-left corner.
     pub upper_left: DVec3,
-    /// The tilt's pivot.
+    /// The point the ground tilts about.
     pub pivot: DVec3,
     /// The tilt's axis (unit).
     pub axis: DVec3,

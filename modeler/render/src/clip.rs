@@ -79,11 +79,11 @@ fn planes(near: f32) -> [Plane; 5] {
 pub const MAX_POLYGON: usize = 8;
 
 /// A convex polygon of up to [`MAX_POLYGON`] vertices.
+#[allow(missing_docs)] // `len` counts the vertices used.
 #[derive(Debug, Clone, Copy)]
 pub struct Polygon {
     /// The vertices; the first `len` are used.
     pub vertices: [ClipVertex; MAX_POLYGON],
-    /// How many.
     pub len: usize,
 }
 

@@ -235,6 +235,7 @@ pub fn triangle<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut 
 
 /// A thick line segment on screen: a capsule of `radius` around `a → b`, depth interpolated
 /// along it; drawn where it passes the depth test against `samples` with `bias`.
+#[allow(missing_docs)] // `colour` is the fill.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Capsule {
     /// Start: pixel x, y and `1/w`.
@@ -243,7 +244,6 @@ pub struct Capsule {
     pub b: [f32; 3],
     /// Half the line width, pixels.
     pub radius: f32,
-    /// Colour.
     pub colour: Rgba,
 }
 

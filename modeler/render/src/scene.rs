@@ -22,6 +22,7 @@ pub enum Stereo {
 }
 
 /// A line drawn on the terrain: a figure, a region boundary, or a figure being pulled.
+#[allow(missing_docs)] // `colour` is the line's.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Overlay {
     /// Points in the ground plane, `[x, y]` in metres (the document's coordinates). One point is
@@ -29,7 +30,6 @@ pub struct Overlay {
     pub points: Vec<Point>,
     /// Whether the last point joins the first.
     pub closed: bool,
-    /// Line colour.
     pub colour: Rgba,
     /// Line width in pixels.
     pub width: f32,
@@ -40,9 +40,9 @@ pub struct Overlay {
 
 /// The slope bar: a value in a range, shown with its position (seed 000: "a scroll bar behind
 /// the shape shows the value").
+#[allow(missing_docs)] // fields named for what they hold.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SlopeBar {
-    /// The value shown.
     pub value: f64,
     /// The value at the bar's left end.
     pub min: f64,
@@ -110,9 +110,9 @@ impl Default for Style {
 }
 
 /// Everything one frame shows.
+#[allow(missing_docs)] // fields named for what they hold.
 #[derive(Debug, Clone)]
 pub struct Scene<'a> {
-    /// The terrain.
     pub terrain: &'a Heightmap,
     /// Vertical exaggeration: heights are drawn × this (1 = true scale).
     pub vertical_scale: f32,

@@ -21,8 +21,8 @@ use super::transform::{self, Affine, ChunkState, Projected};
 use penmodel_terrain::Heightmap;
 
 /// What the tiles of one eye share.
+#[allow(missing_docs)] // fields named for what they hold.
 pub struct EyePass<'a> {
-    /// The terrain.
     pub map: &'a Heightmap,
     /// Per-vertex light.
     pub light: &'a [f32],

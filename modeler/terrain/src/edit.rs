@@ -15,109 +15,59 @@ use crate::document::{Document, Figure, FigureKind, Point, Region};
 use crate::validate::{self, Defect, ValidationError};
 
 /// One change to a document. Serialised (in the journal) as an object tagged by `"op"`.
+#[allow(missing_docs)] // fields named for what they hold; each variant says what it does with them.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "op", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Edit {
     /// Inserts a top-level region at `index`.
-    AddRegion {
-        /// Its index once inserted.
-        index: usize,
-        /// The region, with its figures.
-        region: Region,
-    },
+    AddRegion { index: usize, region: Region },
     /// Removes top-level region `index` and its figures.
-    DeleteRegion {
-        /// The region.
-        index: usize,
-    },
+    DeleteRegion { index: usize },
     /// Moves a region and its figures by `by` metres.
     MoveRegion {
-        /// The region.
         index: usize,
         /// Displacement `[dx, dy]`.
         by: Point,
     },
     /// Replaces a region and its figures.
-    ReplaceRegion {
-        /// The region.
-        index: usize,
-        /// The new region.
-        region: Region,
-    },
+    ReplaceRegion { index: usize, region: Region },
     /// Inserts a figure so that it ends up at `at`.
-    AddFigure {
-        /// The new figure's path.
-        at: FigurePath,
-        /// The figure, with any nested figures.
-        figure: Figure,
-    },
+    AddFigure { at: FigurePath, figure: Figure },
     /// Removes a figure and everything nested in it.
-    DeleteFigure {
-        /// The figure.
-        at: FigurePath,
-    },
+    DeleteFigure { at: FigurePath },
     /// Moves a figure and everything nested in it by `by` metres.
     MoveFigure {
-        /// The figure.
         at: FigurePath,
         /// Displacement `[dx, dy]`.
         by: Point,
     },
     /// Replaces a figure and everything nested in it.
-    ReplaceFigure {
-        /// The figure.
-        at: FigurePath,
-        /// The new figure.
-        figure: Figure,
-    },
+    ReplaceFigure { at: FigurePath, figure: Figure },
     /// Moves one vertex of a curve. For a closed curve vertex 0 is both its first and last point.
-    MovePoint {
-        /// The curve.
-        curve: CurvePath,
-        /// The vertex.
-        index: usize,
-        /// Its new position.
-        to: Point,
-    },
+    MovePoint { curve: CurvePath, index: usize, to: Point },
     /// Inserts a vertex before vertex `index` (`index` = vertex count appends).
     InsertPoint {
-        /// The curve.
         curve: CurvePath,
-        /// The new vertex's index.
         index: usize,
-        /// The vertex.
         point: Point,
     },
     /// Removes one vertex.
-    DeletePoint {
-        /// The curve.
-        curve: CurvePath,
-        /// The vertex.
-        index: usize,
-    },
+    DeletePoint { curve: CurvePath, index: usize },
     /// Sets a figure's absolute height (a pull).
     SetHeight {
-        /// The figure.
         at: FigurePath,
         /// Height in metres.
         height: f64,
     },
     /// Sets a figure's slope coefficient.
-    SetSlope {
-        /// The figure.
-        at: FigurePath,
-        /// Slope coefficient.
-        slope: f64,
-    },
+    SetSlope { at: FigurePath, slope: f64 },
     /// Several edits made by one gesture (a pull and the slope set while pulling): applied in
     /// order, undone together, one step of the history.
-    Group {
-        /// The edits, in order.
-        edits: Vec<Edit>,
-    },
+    Group { edits: Vec<Edit> },
 }
 
 /// Why an edit was refused. The document is unchanged.
+#[allow(missing_docs)] // the fields name the missing vertex.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum EditError {
     /// No top-level region at that index.
@@ -128,12 +78,7 @@ pub enum EditError {
     NoFigure(FigurePath),
     /// No vertex at that index.
     #[error("{curve} has no vertex {index}")]
-    NoPoint {
-        /// The curve.
-        curve: CurvePath,
-        /// The index asked for.
-        index: usize,
-    },
+    NoPoint { curve: CurvePath, index: usize },
     /// The edit would make the document invalid.
     #[error("the edit would make the document invalid: {0}")]
     Invalid(#[from] ValidationError),

@@ -33,6 +33,7 @@ use crate::validate::ValidationError;
 pub const HISTORY_LIMIT: usize = 1000;
 
 /// Why an editor operation failed.
+#[allow(missing_docs)] // the fields say which file, where and why.
 #[derive(Debug, Error)]
 pub enum EditorError {
     /// The document could not be read.
@@ -50,11 +51,9 @@ pub enum EditorError {
     /// A journal entry does not apply to the document it was recorded for.
     #[error("journal {} line {line}: cannot replay: {reason}", path.display())]
     Replay {
-        /// The journal file.
         path: PathBuf,
         /// 1-based line number.
         line: usize,
-        /// Why.
         reason: String,
     },
     /// Only height and slope changes can be previewed.
@@ -267,12 +266,12 @@ impl Editor {
         Ok(editor)
     }
 
-    /// The document.
+    /// The document as edited so far (a preview included).
     pub fn document(&self) -> &Document {
         &self.doc
     }
 
-    /// The terrain.
+    /// The terrain of [`Editor::document`].
     pub fn heightmap(&self) -> &Heightmap {
         self.terrain.heightmap()
     }

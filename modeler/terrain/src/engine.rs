@@ -67,21 +67,18 @@ pub fn generate(doc: &Document) -> Result<Heightmap, ValidationError> {
     Ok(TerrainEngine::new(doc)?.into_heightmap())
 }
 
-/// A rectangle of cells.
+/// A rectangle of cells: columns `c0..c0 + width`, rows `r0..r0 + height`.
+#[allow(missing_docs)] // the fields are the ranges above.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Rect {
-    /// First column.
     pub c0: u32,
-    /// First row.
     pub r0: u32,
-    /// Columns.
     pub width: u32,
-    /// Rows.
     pub height: u32,
 }
 
 impl Rect {
-    /// No cells.
+    /// No cells; the identity of [`Rect::union`].
     pub const EMPTY: Rect = Rect {
         c0: 0,
         r0: 0,
@@ -470,7 +467,7 @@ impl TerrainEngine {
         TerrainEngine { regions, map }
     }
 
-    /// The terrain.
+    /// The terrain as of the last update.
     pub fn heightmap(&self) -> &Heightmap {
         &self.map
     }

@@ -1,23 +1,32 @@
 //! Plane geometry on the document's points: orientation, segment intersection, point in polygon.
 //!
+//! The computations are on [`DVec2`]; every function takes anything that converts into one, so
+//! the document's `[x, y]` points ([`Point`](crate::document::Point), which keep the file format and its parse
+//! errors as they are) and glam vectors both go in as they are. The formulas are written out by
+//! component where glam's own would round differently (a distance is `hypot`, not
+//! `sqrt(x² + y²)`), so the results are the same bits as on plain arrays.
+//!
 //! Plain `f64` predicates. They decide validation (a curve crossing itself, a figure leaving its
 //! region); inputs that sit within rounding of a tie are decided either way, consistently for the
 //! same input.
 
-use crate::document::Point;
+use glam::DVec2;
 
 /// Twice the signed area of the triangle `a b c`: positive when `c` is to the left of `a → b`.
-pub fn orient(a: Point, b: Point, c: Point) -> f64 {
-    (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0])
+pub fn orient(a: impl Into<DVec2>, b: impl Into<DVec2>, c: impl Into<DVec2>) -> f64 {
+    let a = a.into();
+    let (ab, ac) = (b.into() - a, c.into() - a);
+    ab.x * ac.y - ab.y * ac.x
 }
 
 /// Whether `p`, known to be collinear with `a b`, lies within the segment's bounding box.
-fn within(a: Point, b: Point, p: Point) -> bool {
-    p[0] >= a[0].min(b[0]) && p[0] <= a[0].max(b[0]) && p[1] >= a[1].min(b[1]) && p[1] <= a[1].max(b[1])
+fn within(a: DVec2, b: DVec2, p: DVec2) -> bool {
+    p.x >= a.x.min(b.x) && p.x <= a.x.max(b.x) && p.y >= a.y.min(b.y) && p.y <= a.y.max(b.y)
 }
 
 /// Whether the closed segments `a b` and `c d` share at least one point (touching counts).
-pub fn segments_touch(a: Point, b: Point, c: Point, d: Point) -> bool {
+pub fn segments_touch(a: impl Into<DVec2>, b: impl Into<DVec2>, c: impl Into<DVec2>, d: impl Into<DVec2>) -> bool {
+    let (a, b, c, d) = (a.into(), b.into(), c.into(), d.into());
     let o1 = orient(a, b, c);
     let o2 = orient(a, b, d);
     let o3 = orient(c, d, a);
@@ -32,28 +41,32 @@ pub fn segments_touch(a: Point, b: Point, c: Point, d: Point) -> bool {
 }
 
 /// Whether `p` lies on the closed segment `a b`.
-pub fn on_segment(a: Point, b: Point, p: Point) -> bool {
+pub fn on_segment(a: impl Into<DVec2>, b: impl Into<DVec2>, p: impl Into<DVec2>) -> bool {
+    let (a, b, p) = (a.into(), b.into(), p.into());
     orient(a, b, p) == 0.0 && within(a, b, p)
 }
 
 /// Distance between two points.
-pub fn distance(a: Point, b: Point) -> f64 {
-    (a[0] - b[0]).hypot(a[1] - b[1])
+pub fn distance(a: impl Into<DVec2>, b: impl Into<DVec2>) -> f64 {
+    let d = a.into() - b.into();
+    d.x.hypot(d.y)
 }
 
 /// Distance from `p` to the closed segment `a b`.
-pub fn segment_distance(a: Point, b: Point, p: Point) -> f64 {
-    let d = [b[0] - a[0], b[1] - a[1]];
-    let len2 = d[0] * d[0] + d[1] * d[1];
+pub fn segment_distance(a: impl Into<DVec2>, b: impl Into<DVec2>, p: impl Into<DVec2>) -> f64 {
+    let (a, b, p) = (a.into(), b.into(), p.into());
+    let d = b - a;
+    let len2 = d.length_squared();
     if len2 == 0.0 {
         return distance(a, p);
     }
-    let t = (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / len2).clamp(0.0, 1.0);
-    distance([a[0] + t * d[0], a[1] + t * d[1]], p)
+    let t = ((p - a).dot(d) / len2).clamp(0.0, 1.0);
+    distance(a + d * t, p)
 }
 
 /// Distance from `p` to the line through `a` and `b` (to `a` if they coincide).
-pub fn line_offset(a: Point, b: Point, p: Point) -> f64 {
+pub fn line_offset(a: impl Into<DVec2>, b: impl Into<DVec2>, p: impl Into<DVec2>) -> f64 {
+    let (a, b, p) = (a.into(), b.into(), p.into());
     let len = distance(a, b);
     if len == 0.0 {
         return distance(a, p);
@@ -73,17 +86,18 @@ pub enum Side {
 }
 
 /// Locates `p` against the simple polygon `ring` (even-odd rule; its last point equals its first).
-pub fn locate(ring: &[Point], p: Point) -> Side {
+pub fn locate<P: Copy + Into<DVec2>>(ring: &[P], p: impl Into<DVec2>) -> Side {
+    let p = p.into();
     let mut inside = false;
     for e in ring.windows(2) {
-        let (a, b) = (e[0], e[1]);
+        let (a, b) = (e[0].into(), e[1].into());
         if on_segment(a, b, p) {
             return Side::On;
         }
         // Half-open in y so a vertex on the ray is counted once.
-        if (a[1] > p[1]) != (b[1] > p[1]) {
-            let x = a[0] + (p[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]);
-            if p[0] < x {
+        if (a.y > p.y) != (b.y > p.y) {
+            let x = a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y);
+            if p.x < x {
                 inside = !inside;
             }
         }
@@ -94,6 +108,7 @@ pub fn locate(ring: &[Point], p: Point) -> Side {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::document::Point;
 
     const SQUARE: [Point; 5] = [[0.0, 0.0], [4.0, 0.0], [4.0, 4.0], [0.0, 4.0], [0.0, 0.0]];
 

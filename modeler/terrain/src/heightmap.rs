@@ -33,12 +33,12 @@ impl Heightmap {
         })
     }
 
-    /// Columns.
+    /// Columns: cells along x.
     pub fn cols(&self) -> u32 {
         self.cols
     }
 
-    /// Rows.
+    /// Rows: cells along y.
     pub fn rows(&self) -> u32 {
         self.rows
     }

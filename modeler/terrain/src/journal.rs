@@ -41,6 +41,7 @@ pub struct UndoStep {
 }
 
 /// One line of the journal.
+#[allow(missing_docs)] // fields named for what they hold; each variant says what the line records.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "op", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Entry {
@@ -52,17 +53,9 @@ pub enum Entry {
         base: String,
     },
     /// The undo and redo stacks at the time the document was saved (oldest first).
-    History {
-        /// Undo stack.
-        undo: Vec<UndoStep>,
-        /// Redo stack.
-        redo: Vec<UndoStep>,
-    },
+    History { undo: Vec<UndoStep>, redo: Vec<UndoStep> },
     /// An edit was applied.
-    Do {
-        /// The edit.
-        edit: Edit,
-    },
+    Do { edit: Edit },
     /// The last edit was undone.
     Undo,
     /// The last undone edit was redone.
@@ -87,6 +80,7 @@ pub fn fingerprint(bytes: &[u8]) -> String {
 }
 
 /// What reading a journal found.
+#[allow(missing_docs)] // named for what they hold.
 #[derive(Debug)]
 pub enum Replay {
     /// No journal file.
@@ -96,7 +90,6 @@ pub enum Replay {
     /// The entries after the `open` line, and the byte length of the complete lines (a torn last
     /// line is left out; `torn` says whether there was one).
     Entries {
-        /// Entries in order.
         entries: Vec<Entry>,
         /// Length of the complete lines.
         valid_len: u64,
@@ -106,24 +99,18 @@ pub enum Replay {
 }
 
 /// A journal that cannot be read.
+#[allow(missing_docs)] // the fields say which file, where and why.
 #[derive(Debug, thiserror::Error)]
 pub enum JournalError {
     /// Reading or writing failed.
     #[error("journal {}: {source}", path.display())]
-    Io {
-        /// The journal file.
-        path: PathBuf,
-        /// The reason.
-        source: io::Error,
-    },
+    Io { path: PathBuf, source: io::Error },
     /// A complete line is not a journal entry.
     #[error("journal {} line {line}: {message}", path.display())]
     Corrupt {
-        /// The journal file.
         path: PathBuf,
         /// 1-based line number.
         line: usize,
-        /// What is wrong.
         message: String,
     },
 }

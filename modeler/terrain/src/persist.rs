@@ -26,22 +26,17 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
 }
 
 /// Why a document could not be read.
+#[allow(missing_docs)] // the fields say which file and why.
 #[derive(Debug, Error)]
 pub enum LoadError {
     /// The file could not be read.
     #[error("cannot read {}: {source}", path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The reason.
-        source: io::Error,
-    },
+    Io { path: PathBuf, source: io::Error },
     /// The text is not JSON of the document's shape.
     #[error("{}: {message} (line {line}, column {column})", if path.is_empty() { "document" } else { path })]
     Parse {
         /// The element that failed, e.g. `regions[0].figures[1].height` (empty for the top level).
         path: String,
-        /// What was wrong.
         message: String,
         /// 1-based line of the error.
         line: usize,
@@ -54,6 +49,7 @@ pub enum LoadError {
 }
 
 /// Why a document could not be saved.
+#[allow(missing_docs)] // the fields say which file and why.
 #[derive(Debug, Error)]
 pub enum SaveError {
     /// The document is not valid; nothing was written.
@@ -61,12 +57,7 @@ pub enum SaveError {
     Invalid(#[from] ValidationError),
     /// Writing failed; the previous file, if any, is intact.
     #[error("cannot write {}: {source}", path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The reason.
-        source: io::Error,
-    },
+    Io { path: PathBuf, source: io::Error },
 }
 
 #[derive(Deserialize)]

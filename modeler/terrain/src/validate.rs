@@ -17,6 +17,7 @@
 //!
 //! Errors stop at the first problem, in document order.
 
+use glam::DVec2;
 use thiserror::Error;
 
 use crate::cells::{self, Cell, Mask};
@@ -48,6 +49,7 @@ impl ValidationError {
 }
 
 /// What is wrong with an element.
+#[allow(missing_docs)] // fields named for what they hold; the message shows them.
 #[derive(Debug, Clone, PartialEq, Error)]
 pub enum Defect {
     /// The version is not one this build reads.
@@ -61,21 +63,14 @@ pub enum Defect {
     CellSize(f64),
     /// The grid has more cells than [`MAX_CELLS`].
     #[error("{cells} cells is more than the {max} this build can hold in memory")]
-    GridTooLarge {
-        /// Cells asked for.
-        cells: u64,
-        /// The limit.
-        max: u64,
-    },
+    GridTooLarge { cells: u64, max: u64 },
     /// A number is NaN or infinite.
     #[error("not a finite number")]
     NotFinite,
     /// A point lies off the grid.
     #[error("({x}, {y}) lies outside the grid [0, {width}) × [0, {height}) m")]
     OutsideGrid {
-        /// The point's x.
         x: f64,
-        /// The point's y.
         y: f64,
         /// The grid's extent along x.
         width: f64,
@@ -96,12 +91,7 @@ pub enum Defect {
     RepeatedPoint,
     /// A closed curve whose last point is not its first.
     #[error("the curve is open: its last point ({}, {}) is not its first ({}, {})", last[0], last[1], first[0], first[1])]
-    OpenCurve {
-        /// The first point.
-        first: Point,
-        /// The last point.
-        last: Point,
-    },
+    OpenCurve { first: Point, last: Point },
     /// A closed curve that crosses or touches itself.
     #[error("the curve crosses itself: the segment from this point meets the segment from points[{0}]")]
     SelfIntersecting(usize),
@@ -265,7 +255,8 @@ fn ring(grid: &Grid, pts: &[Point], path: impl Fn(usize) -> String, whole: &str)
                 } else {
                     (pts[j], pts[0], pts[1])
                 };
-                geometry::orient(p, q, r) == 0.0 && (p[0] - q[0]) * (r[0] - q[0]) + (p[1] - q[1]) * (r[1] - q[1]) > 0.0
+                let (p, q, r) = (DVec2::from(p), DVec2::from(q), DVec2::from(r));
+                geometry::orient(p, q, r) == 0.0 && (p - q).dot(r - q) > 0.0
             } else {
                 let ((a, b), (c, d)) = (seg(i), seg(j));
                 geometry::segments_touch(a, b, c, d)

@@ -20,16 +20,12 @@ pub use sequence::Sequence;
 pub use window::{Viewer, ViewerEvent, WindowError};
 
 /// Why a frame could not be written.
+#[allow(missing_docs)] // the fields say which file or frame and why.
 #[derive(Debug, Error)]
 pub enum OutputError {
     /// A file could not be created or written.
     #[error("cannot write {}: {source}", path.display())]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The reason.
-        source: io::Error,
-    },
+    Io { path: PathBuf, source: io::Error },
     /// The PNG encoder failed.
     #[error("PNG encoding failed: {0}")]
     Png(String),
@@ -38,7 +34,6 @@ pub enum OutputError {
     FrameSize {
         /// The frame's index.
         index: usize,
-        /// Its size.
         got: (u32, u32),
         /// The first frame's size.
         expected: (u32, u32),

@@ -41,15 +41,11 @@ pub enum WindowError {
 }
 
 /// What the viewer reports.
+#[allow(missing_docs)] // fields named for what they hold.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum ViewerEvent {
     /// The window's drawable area is now this many pixels.
-    Resized {
-        /// Width.
-        width: u32,
-        /// Height.
-        height: u32,
-    },
+    Resized { width: u32, height: u32 },
     /// A key was pressed: its text (`"u"`, `"+"`) or name (`"Escape"`, `"ArrowLeft"`).
     Key(String),
     /// The user closed the window.

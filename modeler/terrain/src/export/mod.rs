@@ -26,6 +26,7 @@ pub use png::{HeightRange, KEY_CELL_SIZE, KEY_HEIGHT_MAX, KEY_HEIGHT_MIN, read_p
 pub use raw::{read_raw, write_raw};
 
 /// Why an export failed.
+#[allow(missing_docs)] // fields named for what they hold.
 #[derive(Debug, Error)]
 pub enum ExportError {
     /// Writing failed.
@@ -36,12 +37,7 @@ pub enum ExportError {
     Png(String),
     /// A mesh needs at least 2 × 2 cells.
     #[error("a mesh needs at least 2 × 2 cells, the grid is {cols} × {rows}")]
-    TooSmallForMesh {
-        /// Columns.
-        cols: u32,
-        /// Rows.
-        rows: u32,
-    },
+    TooSmallForMesh { cols: u32, rows: u32 },
     /// The mesh does not fit the format's 32-bit sizes.
     #[error("the mesh is too large for binary glTF ({0} bytes)")]
     TooLarge(u64),
