@@ -9,7 +9,7 @@
 //! Measured over seeds 1–8 and 11: outlines within 0.78 mm, heights 0.76 mm, slopes 0.024,
 //! terrain RMS 0.30–0.40 % of the 1100 m peak.
 
-use pen_sim::session::{Drawn, Step, steps};
+use pen_sim::session::{Drawn, ModelingStep, steps};
 use penmodel::feed::{Feed, PenSource, spawn};
 use penmodel::interaction::pick::line_distance;
 use penmodel::interaction::{Tuning, View};
@@ -18,7 +18,7 @@ use penmodel_terrain::{Document, Editor, Figure, FigureKind, Point, Region, gene
 
 fn expected(view: &View, tuning: &Tuning) -> Document {
     let to = |p: glam::DVec2| view.to_ground(p.x, p.y);
-    let figure = |s: &Step| {
+    let figure = |s: &ModelingStep| {
         let (kind, mut points) = match &s.drawn {
             Drawn::Point(p) => (FigureKind::Point, vec![to(*p)]),
             Drawn::Polyline(ps) => (FigureKind::Polyline, ps.iter().map(|p| to(*p)).collect()),

@@ -3,7 +3,7 @@
 use std::time::Duration;
 
 use glam::{DQuat, DVec2, DVec3};
-use pen_host::calibrate::{Step, attach, collect_touches, prepare};
+use pen_host::calibration::procedure::{Prompt, attach, collect_touches, prepare};
 use pen_host::calibration::{Calibration, CalibrationError, DisplaySize, FitKind, fit};
 use pen_host::device::Device;
 use pen_host::source::Source;
@@ -34,7 +34,7 @@ fn run(targets: &[DVec2], seed: u64) -> Calibration {
     let touched = collect_touches(&mut device, targets, Duration::from_secs(30), |s| steps.push(s.clone()))
         .expect("every target touched");
     assert_eq!(
-        steps.iter().filter(|s| matches!(s, Step::Taken { .. })).count(),
+        steps.iter().filter(|s| matches!(s, Prompt::Taken { .. })).count(),
         targets.len()
     );
     fit(targets, &touched, FitKind::Similarity, DisplaySize::REFERENCE).expect("fit")

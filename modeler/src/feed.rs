@@ -18,14 +18,14 @@ use std::sync::mpsc::{Receiver, SyncSender, sync_channel};
 use std::thread::JoinHandle;
 use std::time::Duration;
 
-use glam::{DQuat, DVec2, DVec3};
-use pen_host::calibrate::{Step, attach, collect_touches, prepare};
+use glam::DVec2;
+use pen_host::calibration::procedure::{CalibrateError, Prompt, attach, collect_touches, prepare};
 use pen_host::calibration::{Calibration, DisplaySize, FitKind, fit};
 use pen_host::client::{Client, Line};
 use pen_host::device::Device;
 use pen_host::events::PenEvent;
 use pen_host::pipeline::Pipeline;
-use pen_host::source::Source;
+use pen_host::source::{Source, SourceError};
 use pen_host::transport::sim::SimOptions;
 use pen_sim::Scenario;
 use pen_sim::acoustics::Acoustics;
@@ -78,9 +78,15 @@ impl PenSource {
             None if s == "daemon" => Ok(PenSource::Daemon(pen_host::daemon::default_socket())),
             Some(("daemon", path)) if !path.is_empty() => Ok(PenSource::Daemon(PathBuf::from(path))),
             _ => {
-                let mut source: Source = s
-                    .parse()
-                    .map_err(|e: String| e.replace("hid, hid:PATH", "sim, daemon, daemon:SOCKET, hid, hid:PATH"))?;
+                let mut source: Source = s.parse().map_err(|e| match e {
+                    SourceError::UnknownKind { given } => {
+                        format!(
+                            "unknown source {given:?}: sim, daemon, daemon:SOCKET, {}",
+                            Source::FORMS
+                        )
+                    }
+                    other => other.to_string(),
+                })?;
                 if let Source::Sim(o) = &mut source {
                     o.speed = speed;
                 }
@@ -93,19 +99,9 @@ impl PenSource {
     }
 }
 
-/// The demo's display pose in the tracker frame: turned 1.2° about a tilted axis and shifted by
-/// a centimetre, as a display set up by hand would be.
-fn demo_rig() -> Rig {
-    let axis = DVec3::new(0.2, -0.3, 1.0).normalize();
-    Rig::reference().with_display_pose(
-        DQuat::from_axis_angle(axis, 1.2f64.to_radians()),
-        DVec3::new(9.0, -6.0, 2.5),
-    )
-}
-
 /// The demo: nine calibration touches, then the modeling session; and the calibration targets.
 pub fn demo_scenario() -> (Scenario, Vec<DVec2>) {
-    let rig = demo_rig();
+    let rig = Rig::hand_placed_display();
     let targets = DisplaySize::REFERENCE.targets(9);
     let calibration = pen_sim::scenarios::calibration(&targets, rig.clone());
     let session = pen_sim::session::timeline(&pen_sim::session::steps(), pen_sim::scenarios::home());
@@ -171,7 +167,7 @@ fn run_demo(tx: &SyncSender<Feed>, speed: f64, seed: u64) -> Result<(), Stop> {
     let mut taken = 0;
     let count = targets.len();
     let touched = collect_touches(&mut device, &targets, Duration::from_secs(60), |step| {
-        if let Step::Taken { fixes, .. } = step {
+        if let Prompt::Taken { fixes, .. } = step {
             taken += 1;
             let line = format!("calibrating: target {taken} of {count} taken ({fixes} fixes)");
             closed |= tx.send(Feed::Status(line)).is_err();
@@ -206,7 +202,7 @@ fn run_demo(tx: &SyncSender<Feed>, speed: f64, seed: u64) -> Result<(), Stop> {
     }
 }
 
-fn failed(what: &'static str) -> impl Fn(pen_host::calibrate::CalibrateError) -> Stop {
+fn failed(what: &'static str) -> impl Fn(CalibrateError) -> Stop {
     move |e| Stop::Failed(format!("{what}: {e}"))
 }
 

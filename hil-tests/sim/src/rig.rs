@@ -79,6 +79,17 @@ impl Rig {
         self
     }
 
+    /// The reference build with its display set up by hand, a little off where the tracker
+    /// frame puts it: turned 1.2° about a tilted axis and shifted by about a centimetre. What a
+    /// calibration has to find (the modeler's demo, `penctl calibrate --sim`).
+    pub fn hand_placed_display() -> Rig {
+        let axis = DVec3::new(0.2, -0.3, 1.0).normalize();
+        Rig::reference().with_display_pose(
+            DQuat::from_axis_angle(axis, 1.2f64.to_radians()),
+            DVec3::new(9.0, -6.0, 2.5),
+        )
+    }
+
     /// A display-frame point (u, v on the surface, h above it) in the tracker frame.
     pub fn display_to_tracker(&self, p: DVec3) -> DVec3 {
         self.display_rotation.inverse() * (p - self.display_translation_mm)

@@ -29,9 +29,9 @@ pub enum Drawn {
     Closed(Vec<DVec2>),
 }
 
-/// One step of the session.
+/// One step of the modeling session: a figure drawn, maybe pulled and sloped, maybe undone.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Step {
+pub struct ModelingStep {
     /// The figure drawn; a closed curve outside every region becomes a generation region.
     pub drawn: Drawn,
     /// Its pull, if it is pulled.
@@ -46,8 +46,8 @@ fn v(x: f64, y: f64) -> DVec2 {
 
 /// The session, in order: a region; two peaks; a ridge; a plateau with a peak on it; and a hill
 /// drawn and pulled by mistake, then undone (pull and figure: two SW3 clicks).
-pub fn steps() -> Vec<Step> {
-    let pulled = |drawn, grab, height_mm, slope_mm| Step {
+pub fn steps() -> Vec<ModelingStep> {
+    let pulled = |drawn, grab, height_mm, slope_mm| ModelingStep {
         drawn,
         pull: Some(Pull {
             grab,
@@ -58,7 +58,7 @@ pub fn steps() -> Vec<Step> {
     };
     let ridge = vec![v(250.0, 90.0), v(340.0, 130.0), v(430.0, 110.0)];
     vec![
-        Step {
+        ModelingStep {
             drawn: Drawn::Closed(vec![
                 v(60.0, 40.0),
                 v(540.0, 40.0),
@@ -79,7 +79,7 @@ pub fn steps() -> Vec<Step> {
             0.0,
         ),
         pulled(Drawn::Point(v(430.0, 230.0)), v(430.0, 230.0), 110.0, -25.0),
-        Step {
+        ModelingStep {
             undos: 2,
             ..pulled(Drawn::Point(v(500.0, 80.0)), v(500.0, 80.0), 70.0, 0.0)
         },
@@ -87,7 +87,7 @@ pub fn steps() -> Vec<Step> {
 }
 
 /// The hand's timeline for `steps`, from and back to `home`.
-pub fn timeline(steps: &[Step], home: glam::DVec3) -> Timeline {
+pub fn timeline(steps: &[ModelingStep], home: glam::DVec3) -> Timeline {
     let mut s = Script::new(home);
     for step in steps {
         match &step.drawn {

@@ -10,14 +10,12 @@ use std::time::Duration;
 
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
-use glam::{DQuat, DVec3};
-use pen_host::calibrate::{self, Step};
-use pen_host::calibration::{self, DisplaySize, FitKind};
+use pen_host::calibration::procedure::{self as calibrate, Prompt};
+use pen_host::calibration::{self, DisplaySize, FitKind, plot};
 use pen_host::device::{Device, DeviceEvent};
-use pen_host::source::Source;
-use pen_host::transport::sim::SimOptions;
+use pen_host::hex;
+use pen_host::source::{self, SimSwitch, Source};
 use pen_host::transport::{Transport, hid, serial};
-use pen_host::{hex, plot};
 use pen_protocol::{
     Command as DeviceCommand, Config, ConfigChanges, FrameDecoder, Message, REPORT_DESCRIPTOR, ReportId, StatusCode,
 };
@@ -42,45 +40,8 @@ struct Cli {
     command: Command,
 }
 
-/// Which device.
-#[derive(Args, Clone)]
-struct DeviceArgs {
-    /// The serial link at PATH instead of USB HID.
-    #[arg(long, value_name = "PATH", conflicts_with_all = ["sim", "hid"])]
-    serial: Option<String>,
-    /// A hidraw device instead of the first base station found.
-    #[arg(long, value_name = "PATH", conflicts_with = "sim")]
-    hid: Option<String>,
-    /// The simulated pen in this process.
-    #[arg(long)]
-    sim: bool,
-    /// The session the simulated pen plays (`pen-sim scenarios` lists them).
-    #[arg(long, value_name = "NAME", default_value = "hold", requires = "sim")]
-    scenario: String,
-    /// Device seconds per real second for --sim (0: as fast as possible).
-    #[arg(long, default_value_t = 1.0, requires = "sim")]
-    sim_speed: f64,
-}
-
-impl DeviceArgs {
-    fn source(&self) -> Result<Source> {
-        Ok(match (&self.serial, self.sim) {
-            (Some(path), _) => Source::Serial(path.clone()),
-            (None, true) => {
-                let name = &self.scenario;
-                let scenario = pen_sim::scenarios::by_name(name)
-                    .with_context(|| format!("unknown scenario {name:?}; `pen-sim scenarios` lists them"))?;
-                Source::Sim(SimOptions {
-                    scenario,
-                    seed: 1,
-                    speed: self.sim_speed,
-                    plug: Default::default(),
-                })
-            }
-            (None, false) => Source::Hid(self.hid.clone()),
-        })
-    }
-}
+/// Which device: `--serial PATH`, `--hid PATH`, or `--sim` with `--scenario NAME`.
+type DeviceArgs = source::DeviceArgs<SimSwitch>;
 
 #[derive(Subcommand)]
 enum Command {
@@ -385,6 +346,28 @@ fn config(action: ConfigAction) -> Result<()> {
     }
 }
 
+/// The device to calibrate; the simulated user touches exactly the targets, on a display set up
+/// by hand a little off the tracker frame, as a real one would be.
+#[cfg(feature = "sim")]
+fn calibration_source(device: &DeviceArgs, targets: &[glam::DVec2]) -> Result<Source> {
+    if !device.is_sim() {
+        return Ok(device.source()?);
+    }
+    let rig = pen_sim::rig::Rig::hand_placed_display();
+    Ok(Source::Sim(pen_host::transport::sim::SimOptions {
+        scenario: pen_sim::scenarios::calibration(targets, rig),
+        seed: 1,
+        speed: device.sim_speed,
+        plug: Default::default(),
+    }))
+}
+
+/// The device to calibrate.
+#[cfg(not(feature = "sim"))]
+fn calibration_source(device: &DeviceArgs, _targets: &[glam::DVec2]) -> Result<Source> {
+    Ok(device.source()?)
+}
+
 fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
     let (width_mm, height_mm) = size::<f64>(&a.display_mm, "--display-mm")?;
     let (width_px, height_px) = size::<u32>(&a.display_px, "--display-px")?;
@@ -402,31 +385,14 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
         Fit::Rigid => FitKind::Rigid,
         Fit::Similarity => FitKind::Similarity,
     };
-    let source = match a.device.sim {
-        // The simulated user touches exactly these targets, on a display that sits rotated
-        // 1.5° and shifted from the tracker frame, as a real one would.
-        true => {
-            let rig = pen_sim::rig::Rig::reference().with_display_pose(
-                DQuat::from_axis_angle(DVec3::new(0.3, -0.2, 1.0).normalize(), 1.5f64.to_radians()),
-                DVec3::new(12.0, -7.0, 3.0),
-            );
-            let scenario = pen_sim::scenarios::calibration(&targets, rig);
-            Source::Sim(SimOptions {
-                scenario,
-                seed: 1,
-                speed: a.device.sim_speed,
-                plug: Default::default(),
-            })
-        }
-        false => a.device.source()?,
-    };
+    let source = calibration_source(&a.device, &targets)?;
     let mut device = Device::new(source);
     calibrate::attach(&mut device, Duration::from_secs(2))?;
     let original = calibrate::prepare(&mut device)?;
     let patience = Duration::from_secs_f64(a.patience.max(1.0));
     let tty = std::io::stderr().is_terminal();
     let touched = calibrate::collect_touches(&mut device, &targets, patience, |step| match step {
-        Step::Touch {
+        Prompt::Touch {
             index,
             count,
             target_mm,
@@ -436,9 +402,9 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
             target_mm.x,
             target_mm.y
         ),
-        Step::Lift => eprintln!("  lift the pen first"),
-        Step::Again { fixes } => eprintln!("  too short ({fixes} fixes): touch again and hold a moment"),
-        Step::Taken { fixes, .. } => {
+        Prompt::Lift => eprintln!("  lift the pen first"),
+        Prompt::Again { fixes } => eprintln!("  too short ({fixes} fixes): touch again and hold a moment"),
+        Prompt::Taken { fixes, .. } => {
             if tty {
                 eprintln!("  taken ({fixes} fixes)")
             }
@@ -532,7 +498,12 @@ fn list() -> Result<()> {
     let hids = hid::list()?;
     let serials = serial::list();
     if hids.is_empty() && serials.is_empty() {
-        eprintln!("penctl: no base station attached (udev rules: docs/flashing.md; the simulated pen: --sim)");
+        let hint = if cfg!(feature = "sim") {
+            "; the simulated pen: --sim"
+        } else {
+            ""
+        };
+        eprintln!("penctl: no base station attached (udev rules: docs/flashing.md{hint})");
     }
     for h in hids {
         outln!(

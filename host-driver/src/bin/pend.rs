@@ -14,8 +14,7 @@ use clap::Parser;
 use pen_host::calibration::{Calibration, DisplaySize};
 use pen_host::daemon::{self, DEFAULT_QUEUE, Hub};
 use pen_host::pipeline::Pipeline;
-use pen_host::source::Source;
-use pen_host::transport::sim::SimOptions;
+use pen_host::source::{DeviceArgs, SimScenario};
 
 #[derive(Parser)]
 #[command(
@@ -27,18 +26,8 @@ struct Cli {
     /// The socket [default: $XDG_RUNTIME_DIR/penscape/pend.sock].
     #[arg(long, value_name = "PATH")]
     socket: Option<PathBuf>,
-    /// Use the serial link at PATH instead of USB HID.
-    #[arg(long, value_name = "PATH", conflicts_with_all = ["sim", "hid"])]
-    serial: Option<String>,
-    /// Use this hidraw device instead of the first base station found.
-    #[arg(long, value_name = "PATH", conflicts_with = "sim")]
-    hid: Option<String>,
-    /// Use the simulated pen, playing SCENARIO (default modeling-session) in real time.
-    #[arg(long, value_name = "SCENARIO", num_args = 0..=1, default_missing_value = "modeling-session")]
-    sim: Option<String>,
-    /// Device seconds per real second for --sim.
-    #[arg(long, default_value_t = 1.0, requires = "sim")]
-    sim_speed: f64,
+    #[command(flatten)]
+    device: DeviceArgs<SimScenario>,
     /// The calibration file [default: $XDG_CONFIG_HOME/penscape/calibration.toml if it exists;
     /// otherwise tracker coordinates are display coordinates].
     #[arg(long, value_name = "FILE")]
@@ -49,20 +38,7 @@ struct Cli {
 }
 
 fn run(cli: Cli) -> Result<()> {
-    let source = match (cli.serial, cli.sim) {
-        (Some(path), _) => Source::Serial(path),
-        (None, Some(name)) => {
-            let scenario = pen_sim::scenarios::by_name(&name)
-                .with_context(|| format!("unknown scenario {name:?}; `pen-sim scenarios` lists them"))?;
-            Source::Sim(SimOptions {
-                scenario,
-                seed: 1,
-                speed: cli.sim_speed,
-                plug: Default::default(),
-            })
-        }
-        (None, None) => Source::Hid(cli.hid),
-    };
+    let source = cli.device.source()?;
     let calibration = match cli
         .calibration
         .or_else(|| pen_host::calibration::default_path().filter(|p| p.exists()))

@@ -1,9 +1,10 @@
 //! Transports: one interface over the ways a base station reaches the host — USB HID through
-//! hidapi ([`hid`]), the serial link through serialport ([`serial`]), and the simulated pen in
-//! this process ([`sim`]).
+//! hidapi ([`hid`]), the serial link through serialport ([`serial`]), and, with the cargo
+//! feature `sim`, the simulated pen in this process (`sim`).
 
 pub mod hid;
 pub mod serial;
+#[cfg(feature = "sim")]
 pub mod sim;
 
 use std::time::Duration;

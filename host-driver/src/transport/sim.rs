@@ -42,11 +42,11 @@ impl SimPlug {
 pub struct SimOptions {
     /// The session, repeated.
     pub scenario: Scenario,
-    /// Randomness.
+    /// Seeds the hand's tremor, the acoustics' noise and the switches' bounce.
     pub seed: u64,
     /// Device seconds per wall-clock second; 0 runs as fast as it is read.
     pub speed: f64,
-    /// The plug.
+    /// Keep a clone to unplug the device from another thread.
     pub plug: SimPlug,
 }
 

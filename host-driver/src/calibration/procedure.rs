@@ -24,9 +24,9 @@ const AVERAGE_US: u64 = 300_000;
 /// Fixes a touch needs.
 const MIN_FIXES: usize = 10;
 
-/// What the procedure tells the user.
+/// What the procedure tells the user, as it goes.
 #[derive(Debug, Clone, PartialEq)]
-pub enum Step {
+pub enum Prompt {
     /// Touch target `index` (of `count`) at `target_mm` and press.
     Touch {
         /// From 0.
@@ -103,16 +103,16 @@ pub fn prepare(device: &mut Device) -> Result<Config, CalibrateError> {
     Ok(config)
 }
 
-/// Takes one touch per target; `tell` hears each step. Gives up on a target after `patience`.
+/// Takes one touch per target; `tell` hears each prompt. Gives up on a target after `patience`.
 pub fn collect_touches(
     device: &mut Device,
     targets: &[DVec2],
     patience: Duration,
-    mut tell: impl FnMut(&Step),
+    mut tell: impl FnMut(&Prompt),
 ) -> Result<Vec<DVec3>, CalibrateError> {
     let mut touched = Vec::new();
     for (index, &target_mm) in targets.iter().enumerate() {
-        tell(&Step::Touch {
+        tell(&Prompt::Touch {
             index,
             count: targets.len(),
             target_mm,
@@ -139,7 +139,7 @@ pub fn collect_touches(
                     if fixes.len() >= MIN_FIXES {
                         break;
                     }
-                    tell(&Step::Again { fixes: fixes.len() });
+                    tell(&Prompt::Again { fixes: fixes.len() });
                     fixes.clear();
                 }
                 lifted = true;
@@ -147,7 +147,7 @@ pub fn collect_touches(
             }
             if !lifted {
                 if !told_lift {
-                    tell(&Step::Lift);
+                    tell(&Prompt::Lift);
                     told_lift = true;
                 }
                 continue;
@@ -162,7 +162,7 @@ pub fn collect_touches(
             }
         }
         let mean = fixes.iter().sum::<DVec3>() / fixes.len() as f64;
-        tell(&Step::Taken {
+        tell(&Prompt::Taken {
             touched_mm: mean,
             fixes: fixes.len(),
         });
