@@ -184,7 +184,8 @@ impl Picture {
         }
     }
 
-    /// The overlays drawn.
+    /// The lines drawn on the terrain: the document's figures and boundaries in document order,
+    /// then the stroke being drawn and the pen's dots.
     pub fn overlays(&self) -> &[Overlay] {
         &self.overlays
     }

@@ -128,9 +128,9 @@ pub struct Stats {
     pub moves: u32,
     /// Figures and regions deleted.
     pub deletes: u32,
-    /// Undos done.
+    /// Undos that changed the document (not those with nothing to undo, or refused).
     pub undos: u32,
-    /// Redos done.
+    /// Redos that changed the document (not those with nothing to redo, or refused).
     pub redos: u32,
     /// Edits the document refused (each with a message).
     pub refused: u32,

@@ -3,8 +3,8 @@
 //! Both maps are breadth-first searches from a set of sources, moving only through the region's
 //! cells: every cell is queued once and looks at its four neighbours once, so a map costs
 //! O(cells of the region's box). The seed's method (repeat sweeps over the grid until nothing
-//! changes) computes the same numbers in O(cells × largest distance); it is kept in
-//! [`crate::baseline`] as the reference and benchmark baseline.
+//! changes) computes the same numbers in O(cells × largest distance); it is kept in the crate's
+//! tests (`tests/baseline.rs`) as the reference and benchmark baseline.
 //!
 //! Maps are laid out over the region mask's bounding box, row-major; cells outside the region
 //! hold [`UNREACHABLE`].

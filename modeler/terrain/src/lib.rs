@@ -1,17 +1,19 @@
 //! The terrain model of seed 000: a document of regions and control figures, and the terrain as a
 //! pure function of it, with nothing of the pen or the screen.
 //!
-//! - [`Document`]: the source of truth — a grid, generation regions, and control figures (points,
-//!   polylines, closed curves) with heights and slopes, nested to any depth. Saved as versioned
-//!   JSON (`docs/document.md`), validated on load ([`validate`]).
-//! - [`generate`] and [`TerrainEngine`]: the terrain by the thesis' equations 1–4 ([`raster`],
-//!   [`distance`], [`profile`]), regenerated incrementally as the document is edited ([`terrain`]
-//!   explains how).
-//! - [`Editor`]: edits ([`Edit`]) with undo and redo, and a journal that survives a crash
-//!   ([`journal`], [`persist`]).
+//! - [`Document`] ([`document`]): the source of truth — a grid, generation regions, and control
+//!   figures (points, polylines, closed curves) with heights and slopes, nested to any depth.
+//!   Plain data; read and written as versioned JSON by [`persist`] (`docs/document.md`),
+//!   validated ([`validate`]), addressed by [`FigurePath`] and [`CurvePath`] ([`address`]).
+//! - [`generate`] and [`TerrainEngine`] ([`engine`]): the terrain by the thesis' equations 1–4
+//!   ([`cells`], [`distance`], [`profile`]), updated from the document and a change [`change::Scope`]
+//!   by regenerating only what changed ([`engine`] explains how).
+//! - [`Editor`]: edits ([`Edit`], which turn into a document change and its scope) with undo and
+//!   redo, and a journal that survives a crash ([`journal`], [`persist`]).
 //! - [`export`]: 16-bit PNG heightmaps, raw float32, OBJ and binary glTF meshes.
-//! - [`baseline`]: the seed's own repeat-until-stable distance maps, the reference for tests and
-//!   benchmarks.
+//!
+//! The seed's own repeat-until-stable distance maps are not here: they are the reference in
+//! `tests/baseline.rs`, which the tests compare the engine with and the bench times.
 #![cfg_attr(not(test), warn(clippy::unwrap_used))]
 
 pub mod address;
