@@ -31,13 +31,17 @@ fn serve(args: &[&str]) -> (Server, String) {
     (Server(child), line.trim().to_string())
 }
 
-/// Reads frames for `duration`, returning the decoded messages and the count of bad frames.
-fn read_messages(port: &mut Box<dyn serialport::SerialPort>, duration: Duration) -> (Vec<Message>, usize) {
+/// A hang guard only: on a loaded machine the server may be slow, never this slow.
+const GUARD: Duration = Duration::from_secs(30);
+
+/// Reads frames until the decoded messages satisfy `done` (or [`GUARD`] passes), returning them
+/// and the count of bad frames.
+fn read_until(port: &mut Box<dyn serialport::SerialPort>, done: impl Fn(&[Message]) -> bool) -> (Vec<Message>, usize) {
     let mut decoder = FrameDecoder::new();
     let (mut messages, mut bad) = (Vec::new(), 0);
-    let end = Instant::now() + duration;
+    let end = Instant::now() + GUARD;
     let mut buf = [0u8; 1024];
-    while Instant::now() < end {
+    while !done(&messages) && Instant::now() < end {
         match port.read(&mut buf) {
             Ok(n) => {
                 for &b in &buf[..n] {
@@ -53,6 +57,10 @@ fn read_messages(port: &mut Box<dyn serialport::SerialPort>, duration: Duration)
         }
     }
     (messages, bad)
+}
+
+fn pens_in(messages: &[Message]) -> usize {
+    messages.iter().filter(|m| matches!(m, Message::Pen(_))).count()
 }
 
 fn send(port: &mut Box<dyn serialport::SerialPort>, m: &Message) {
@@ -78,9 +86,7 @@ fn reports_stream_in_real_time_over_the_pty() {
         "first line is the device path, got {path:?}"
     );
     let mut port = open(&path);
-    let start = Instant::now();
-    let (messages, bad) = read_messages(&mut port, Duration::from_millis(1500));
-    let elapsed = start.elapsed().as_secs_f64();
+    let (messages, bad) = read_until(&mut port, |m| pens_in(m) >= 200);
     let pens: Vec<PenReport> = messages
         .iter()
         .filter_map(|m| match m {
@@ -89,12 +95,13 @@ fn reports_stream_in_real_time_over_the_pty() {
         })
         .collect();
     assert_eq!(bad, 0, "no corrupted frames");
-    // Real time: about 154 reports a second (a frame may have been cut by opening mid-stream).
-    let rate = pens.len() as f64 / elapsed;
-    assert!((120.0..170.0).contains(&rate), "{rate:.1} reports/s");
-    // Consecutive, in range, with a quality figure.
+    assert!(pens.len() >= 200, "{} pen reports within {GUARD:?}", pens.len());
+    // Consecutive, one fix cycle (6.5 ms, about 154 a second) apart on the device clock, in
+    // range, with a quality figure. (The wall-clock rate is not asserted: a loaded machine may
+    // deliver late. `pen-sim serve --pty` paces the stream; docs/simulator.md has its figure.)
     for pair in pens.windows(2) {
         assert_eq!(pair[1].seq, pair[0].seq.wrapping_add(1));
+        assert_eq!(pair[1].timestamp_us.wrapping_sub(pair[0].timestamp_us), 6500);
     }
     assert!(pens.iter().filter(|p| p.in_range).count() > pens.len() * 9 / 10);
     assert!(pens.iter().all(|p| !p.in_range || p.quality.receivers_used == 4));
@@ -110,7 +117,7 @@ fn requests_are_answered_over_the_pty() {
             report: ReportId::DeviceInfo,
         }),
     );
-    let (messages, _) = read_messages(&mut port, Duration::from_millis(300));
+    let (messages, _) = read_until(&mut port, |m| m.iter().any(|m| matches!(m, Message::DeviceInfo(_))));
     let info = messages
         .iter()
         .find_map(|m| match m {
@@ -129,7 +136,7 @@ fn requests_are_answered_over_the_pty() {
     let mut frame = [0u8; MAX_FRAME];
     let len = encode_frame(&bytes, &mut frame).expect("fits");
     port.write_all(&frame[..len]).expect("write");
-    let (messages, _) = read_messages(&mut port, Duration::from_millis(300));
+    let (messages, _) = read_until(&mut port, |m| m.iter().any(|m| matches!(m, Message::Status(_))));
     let status = messages
         .iter()
         .find_map(|m| match m {
@@ -144,7 +151,7 @@ fn requests_are_answered_over_the_pty() {
 
     // Garbage on the line is not answered and does not disturb the stream.
     port.write_all(&[0x13, 0x37, 0x00, 0xff, 0xfe, 0x00]).expect("write");
-    let (messages, bad) = read_messages(&mut port, Duration::from_millis(200));
+    let (messages, bad) = read_until(&mut port, |m| pens_in(m) >= 20);
     assert_eq!(bad, 0);
     assert!(messages.iter().any(|m| matches!(m, Message::Pen(_))));
 }

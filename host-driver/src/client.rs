@@ -9,29 +9,25 @@ use crate::wire::SocketLine;
 
 /// Why an event line could not be read.
 #[derive(Debug, thiserror::Error)]
+#[allow(missing_docs)]
 pub enum ClientError {
     /// The socket failed.
     #[error("pend socket: {0}")]
     Io(#[from] std::io::Error),
     /// A line is not an event.
     #[error("bad event line {line:?}: {why}")]
-    Bad {
-        /// The line.
-        line: String,
-        /// What is wrong.
-        why: String,
-    },
+    Bad { line: String, why: String },
 }
 
 /// A line from pend: the greeting, or an event.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)]
 pub enum Line {
     /// The first line: whether a device is attached, and which.
     Hello {
         /// The device, if attached.
         device: Option<String>,
     },
-    /// An event.
     Event(PenEvent),
 }
 

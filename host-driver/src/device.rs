@@ -47,7 +47,7 @@ impl Device {
         }
     }
 
-    /// The source.
+    #[allow(missing_docs)]
     pub fn source(&self) -> &Source {
         &self.source
     }

@@ -27,6 +27,7 @@ pub struct DisplayPoint {
 
 /// What happened.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)]
 pub enum EventKind {
     /// The pen came into range.
     ProximityIn,
@@ -54,15 +55,9 @@ pub enum EventKind {
         reason: String,
     },
     /// A device was attached (or reattached).
-    DeviceFound {
-        /// Which.
-        device: String,
-    },
+    DeviceFound { device: String },
     /// This client lost `count` events because it did not read them fast enough.
-    Missed {
-        /// How many.
-        count: u64,
-    },
+    Missed { count: u64 },
 }
 
 impl EventKind {
@@ -85,8 +80,8 @@ impl EventKind {
 
 /// An event with its time and, for positional events, where.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)]
 pub struct PenEvent {
-    /// What.
     pub kind: EventKind,
     /// Host time, µs since the Unix epoch.
     pub t_us: u64,

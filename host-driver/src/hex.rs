@@ -4,6 +4,7 @@ use thiserror::Error;
 
 /// Why text is not a byte string in hex.
 #[derive(Debug, Error, PartialEq, Eq)]
+#[allow(missing_docs)]
 pub enum HexError {
     /// Nothing but separators.
     #[error("no hex digits")]
@@ -11,7 +12,6 @@ pub enum HexError {
     /// A character that is neither a hex digit nor a separator.
     #[error("'{ch}' at position {position} is not a hex digit")]
     BadDigit {
-        /// The character.
         ch: char,
         /// Its position in the input, counting characters from 0.
         position: usize,

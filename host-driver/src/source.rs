@@ -32,13 +32,11 @@ pub enum Source {
 
 /// Why a source cannot be had.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[allow(missing_docs)]
 pub enum SourceError {
     /// The string names no kind of source.
     #[error("unknown source {given:?}: {}", Source::FORMS)]
-    UnknownKind {
-        /// The string.
-        given: String,
-    },
+    UnknownKind { given: String },
     /// `serial` without a path.
     #[error("serial needs a path: serial:/dev/ttyACM0")]
     SerialWithoutPath,

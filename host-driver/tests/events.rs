@@ -80,7 +80,7 @@ fn unplugging_mid_stroke_is_announced_and_the_device_comes_back() {
     let plug = SimPlug::default();
     let events: Arc<Mutex<Vec<(Instant, PenEvent)>>> = Arc::default();
     let (src_plug, out) = (plug.clone(), events.clone());
-    // Real time: the reattachment is measured on the wall clock.
+    // Real time: the device is unplugged while the pen is mid-stroke.
     std::thread::spawn(move || {
         let mut p = Pipeline::new(
             sim("draw-figures", 1.0, src_plug),
@@ -119,28 +119,36 @@ fn unplugging_mid_stroke_is_announced_and_the_device_comes_back() {
         Duration::from_secs(2),
     )
     .expect("device_lost");
+    let founds = || {
+        let log = events.lock().unwrap_or_else(|e| e.into_inner());
+        log.iter()
+            .filter(|(_, e)| matches!(e.kind, EventKind::DeviceFound { .. }))
+            .count()
+    };
+    // Unplugged, nothing is found however long it stays out (a few retries' worth here).
     std::thread::sleep(Duration::from_millis(500));
-    let replugged = Instant::now();
+    assert_eq!(founds(), 1, "no reattach while unplugged");
     plug.set(true);
-    let found = wait_for(
-        &|e| matches!(&e.kind, EventKind::DeviceFound { .. }),
-        Duration::from_secs(3),
-    );
-    // The first device_found is the initial attach; the reattach is the second.
-    std::thread::sleep(Duration::from_millis(1200));
+    // The first device_found is the initial attach; the reattach is the second, and the pen's
+    // events resume after it. Counted, not timed: the retry interval (200 ms) is a design
+    // figure, and a loaded machine may be late; the guard only catches a hang.
+    let end = Instant::now() + Duration::from_secs(30);
+    while founds() < 2 && Instant::now() < end {
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    assert_eq!(founds(), 2, "attached, then reattached");
+    let motions_after = |log: &[(Instant, PenEvent)]| {
+        let found = log
+            .iter()
+            .rposition(|(_, e)| matches!(e.kind, EventKind::DeviceFound { .. }))
+            .unwrap_or(log.len());
+        log[found..].iter().filter(|(_, e)| e.kind == EventKind::Motion).count()
+    };
+    while motions_after(&events.lock().unwrap_or_else(|e| e.into_inner())) < 10 && Instant::now() < end {
+        std::thread::sleep(Duration::from_millis(10));
+    }
     let log = events.lock().unwrap_or_else(|e| e.into_inner()).clone();
-    let founds: Vec<Instant> = log
-        .iter()
-        .filter(|(_, e)| matches!(e.kind, EventKind::DeviceFound { .. }))
-        .map(|(t, _)| *t)
-        .collect();
-    assert!(
-        found.is_some() && founds.len() == 2,
-        "attached, then reattached: {}",
-        founds.len()
-    );
-    let reattach = founds[1].duration_since(replugged);
-    assert!(reattach < Duration::from_secs(1), "reattached after {reattach:?}");
+    assert!(motions_after(&log) >= 10, "events resume after the reattach");
     // The stroke in progress is ended when the device goes: lost, tip_up, proximity_out.
     let kinds: Vec<&str> = log
         .iter()

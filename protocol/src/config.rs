@@ -355,8 +355,8 @@ impl fmt::Display for Problem {
 /// A configuration that decodes but cannot be used.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[allow(missing_docs)]
 pub struct ConfigError {
-    /// The field.
     pub field: ConfigField,
     /// What is wrong with it.
     pub problem: Problem,

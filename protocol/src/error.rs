@@ -8,6 +8,7 @@ use crate::ReportId;
 /// Why bytes are not a valid report.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[allow(missing_docs)]
 pub enum DecodeError {
     /// No bytes at all.
     Empty,
@@ -31,7 +32,6 @@ pub enum DecodeError {
     },
     /// Bits that this version reserves (padding, unused flags) are set.
     ReservedBits {
-        /// The report.
         report: ReportId,
         /// Byte offset within the report (report ID at 0).
         offset: usize,
@@ -40,28 +40,16 @@ pub enum DecodeError {
     },
     /// A slot that must be zero in this configuration (an unused receiver, a disabled option) is not.
     UnusedNotZero {
-        /// The report.
         report: ReportId,
         /// Byte offset within the report (report ID at 0).
         offset: usize,
-        /// The field.
         field: &'static str,
     },
     /// A field holds a value outside its defined range (e.g. a position of -32768, the reserved
     /// logical value, or more receivers than exist).
-    OutOfRange {
-        /// The report.
-        report: ReportId,
-        /// The field.
-        field: &'static str,
-    },
+    OutOfRange { report: ReportId, field: &'static str },
     /// A floating-point field is NaN or infinite.
-    NotFinite {
-        /// The report.
-        report: ReportId,
-        /// The field.
-        field: &'static str,
-    },
+    NotFinite { report: ReportId, field: &'static str },
 }
 
 impl fmt::Display for DecodeError {

@@ -63,12 +63,10 @@ pub fn check_version(device: Version) -> Result<(), UnsupportedVersion> {
 /// A firmware version (semantic versioning).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[allow(missing_docs)]
 pub struct FirmwareVersion {
-    /// Major.
     pub major: u8,
-    /// Minor.
     pub minor: u8,
-    /// Patch.
     pub patch: u8,
 }
 

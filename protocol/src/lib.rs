@@ -104,20 +104,14 @@ impl fmt::Display for ReportId {
 /// Any report or message, decoded by its report ID.
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[allow(missing_docs)]
 pub enum Message {
-    /// A pen report.
     Pen(PenReport),
-    /// A time-of-flight diagnostics report.
     Tof(TofReport),
-    /// A device information report.
     DeviceInfo(DeviceInfo),
-    /// A configuration report.
     Config(Config),
-    /// A status report.
     Status(Status),
-    /// A command.
     Command(Command),
-    /// A get-feature request.
     GetFeature(GetFeature),
 }
 

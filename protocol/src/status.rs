@@ -56,10 +56,10 @@ impl StatusCode {
 /// The answer to a request: which request, its outcome, and the field at fault.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[allow(missing_docs)]
 pub struct Status {
     /// The report ID of the request answered (0 before any request).
     pub request: u8,
-    /// The outcome.
     pub code: StatusCode,
     /// The configuration field at fault (a [`ConfigField`] code), or 0.
     pub field: u8,

@@ -24,16 +24,14 @@ pub const MIN_TARGETS: usize = 4;
 
 /// Why a fit or a calibration file is refused.
 #[derive(Debug, Error, PartialEq)]
+#[allow(missing_docs)]
 pub enum CalibrationError {
     /// Fewer than [`MIN_TARGETS`] points, or unequal lists.
     #[error("calibration needs at least {MIN_TARGETS} touched targets, got {0}")]
     TooFewPoints(usize),
     /// A coordinate is NaN or infinite.
     #[error("point {index} is not finite")]
-    NotFinite {
-        /// Which point.
-        index: usize,
-    },
+    NotFinite { index: usize },
     /// The points lie (nearly) on one line: the rotation about it is undetermined.
     #[error(
         "the {which} points lie on one line (at most {spread_mm:.1} mm off it); spread the targets over the display"
@@ -49,16 +47,10 @@ pub enum CalibrationError {
     Degenerate,
     /// A calibration file could not be read or parsed.
     #[error("{path}: {message}")]
-    File {
-        /// The file.
-        path: String,
-        /// What is wrong.
-        message: String,
-    },
+    File { path: String, message: String },
     /// A calibration file has a bad value.
     #[error("{path}: `{key}` {problem}")]
     BadValue {
-        /// The file.
         path: String,
         /// The key, e.g. `transform.scale`.
         key: String,
@@ -117,12 +109,11 @@ impl DisplaySize {
 
 /// A fitted transform, tracker frame → display frame: `p_d = scale · R · p_t + translation`.
 #[derive(Debug, Clone, Copy, PartialEq)]
+#[allow(missing_docs)]
 pub struct Transform {
-    /// The rotation.
     pub rotation: DQuat,
     /// The translation, mm.
     pub translation_mm: DVec3,
-    /// The scale.
     pub scale: f64,
 }
 
@@ -164,12 +155,12 @@ pub struct TargetResidual {
 
 /// A calibration: the transform, the display's size, and the fit it came from.
 #[derive(Debug, Clone, PartialEq)]
+#[allow(missing_docs)]
 pub struct Calibration {
     /// Tracker → display.
     pub transform: Transform,
     /// Rigid or similarity.
     pub kind: FitKind,
-    /// The display.
     pub display: DisplaySize,
     /// Per target.
     pub residuals: Vec<TargetResidual>,
