@@ -1,4 +1,5 @@
 //! The integration tests of pen-hil, in one binary: a module per area.
+mod architecture;
 mod demo_session;
 mod hil;
 mod pty;

@@ -72,7 +72,7 @@ fn bench(c: &mut Criterion) {
         EventDetector::new().on_sample(&s, calibration.to_display(s.position_mm), &mut out);
         out.pop().expect("a motion event")
     };
-    c.bench_function("event → JSON line", |b| b.iter(|| motion.to_line()));
+    c.bench_function("event → JSON line", |b| b.iter(|| pen_host::wire::line(&motion)));
 
     // 32 clients connected through socket pairs, each drained by a thread: at this rate the
     // writers cannot keep up, so this is the saturated throughput, not the per-report cost.

@@ -18,7 +18,8 @@ use crate::events::{EventKind, PenEvent};
 use crate::pipeline::Pipeline;
 use crate::sample::now_us;
 use crate::socket::{self, SocketError};
-use crate::wire::{Hello, SocketLine};
+
+use crate::wire::{self, Hello, SocketLine};
 
 /// Events a client may have queued before it starts missing them: about a second at 1 kHz.
 pub const DEFAULT_QUEUE: usize = 1024;
@@ -50,7 +51,7 @@ impl Hub {
             EventKind::DeviceLost { .. } => *lock(&self.device) = None,
             _ => {}
         }
-        let line: Arc<str> = Arc::from(event.to_line());
+        let line: Arc<str> = Arc::from(wire::line(event));
         let mut clients = lock(&self.clients);
         clients.retain(|c| match c.queue.try_send(line.clone()) {
             Ok(()) => {
@@ -106,7 +107,7 @@ fn write_client(stream: UnixStream, rx: Receiver<Arc<str>>, missed: Arc<AtomicU6
     while let Ok(line) = rx.recv() {
         let lost = missed.swap(0, Ordering::Relaxed);
         if lost > 0 {
-            let notice = PenEvent::missed(lost, now_us()).to_line();
+            let notice = wire::line(&PenEvent::missed(lost, now_us()));
             if out.write_all(notice.as_bytes()).is_err() {
                 return;
             }

@@ -108,11 +108,6 @@ impl PenEvent {
     pub fn missed(count: u64, t_us: u64) -> PenEvent {
         PenEvent::bare(EventKind::Missed { count }, t_us)
     }
-
-    /// The event as one line on pend's socket: JSON and a newline (docs/events.md).
-    pub fn to_line(&self) -> String {
-        crate::wire::SocketLine::from(self).to_text()
-    }
 }
 
 /// Derives events from samples; keeps the pen's last known state.
@@ -308,7 +303,7 @@ mod tests {
         d.on_sample(&sample(7, true, [false, false, true]), point(12.5), &mut out);
         out.push(PenEvent::missed(3, 42));
         for e in &out {
-            let line = e.to_line();
+            let line = crate::wire::line(e);
             match crate::client::parse_line(line.trim_end()) {
                 Ok(crate::client::Line::Event(back)) => assert_eq!(&back, e, "{line}"),
                 other => panic!("{line}: {other:?}"),

@@ -215,6 +215,11 @@ impl Report {
     }
 }
 
+/// An event as one line on pend's socket: JSON and a newline (docs/events.md).
+pub fn line(event: &PenEvent) -> String {
+    SocketLine::from(event).to_text()
+}
+
 impl From<&PenEvent> for SocketLine {
     fn from(e: &PenEvent) -> SocketLine {
         let t = seconds(e.t_us);

@@ -20,7 +20,7 @@ use crate::pen::MAX_RECEIVERS;
 #[cfg_attr(
     feature = "serde",
     derive(serde::Serialize, serde::Deserialize),
-    serde(tag = "kind", rename_all = "snake_case", try_from = "crate::json::FilterJson")
+    serde(tag = "kind", rename_all = "snake_case", try_from = "crate::config::FilterJson")
 )]
 pub enum Filter {
     /// Report raw fixes.
@@ -29,13 +29,13 @@ pub enum Filter {
     /// still pen is steady and a moving one lags little.
     OneEuro {
         /// Cutoff at rest, Hz.
-        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json::wide"))]
+        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::wide::wide"))]
         min_cutoff_hz: f32,
         /// Cutoff increase per mm/s of speed, Hz·s/mm.
-        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json::wide"))]
+        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::wide::wide"))]
         beta: f32,
         /// Cutoff of the speed estimate, Hz.
-        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json::wide"))]
+        #[cfg_attr(feature = "serde", serde(serialize_with = "crate::wide::wide"))]
         d_cutoff_hz: f32,
     },
 }
@@ -61,14 +61,14 @@ pub struct DisplayPose {
     /// Unit quaternion `[w, x, y, z]`.
     #[cfg_attr(
         feature = "serde",
-        serde(rename = "rotation_wxyz", serialize_with = "crate::json::wide_array")
+        serde(rename = "rotation_wxyz", serialize_with = "crate::wide::wide_array")
     )]
     pub rotation: [f32; 4],
     /// Translation, mm.
-    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json::wide_array"))]
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::wide::wide_array"))]
     pub translation_mm: [f32; 3],
     /// Scale (1 for a rigid transform).
-    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json::wide"))]
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::wide::wide"))]
     pub scale: f32,
 }
 
@@ -507,5 +507,60 @@ impl Config {
             return fail(ConfigField::ReportDisplayFrame, Problem::Missing);
         }
         Ok(())
+    }
+}
+
+/// `filter` as read: a `kind` and, for the 1€ filter, its three parameters.
+#[cfg(feature = "serde")]
+#[derive(serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct FilterJson {
+    kind: FilterKind,
+    min_cutoff_hz: Option<f32>,
+    beta: Option<f32>,
+    d_cutoff_hz: Option<f32>,
+}
+
+#[cfg(feature = "serde")]
+#[derive(serde::Deserialize)]
+#[serde(rename_all = "snake_case")]
+enum FilterKind {
+    Off,
+    OneEuro,
+}
+
+/// Why a `filter` object is not one.
+#[cfg(feature = "serde")]
+#[derive(Debug)]
+pub struct FilterJsonError(&'static str);
+
+#[cfg(feature = "serde")]
+impl core::fmt::Display for FilterJsonError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.0)
+    }
+}
+
+#[cfg(feature = "serde")]
+impl TryFrom<FilterJson> for Filter {
+    type Error = FilterJsonError;
+
+    fn try_from(j: FilterJson) -> Result<Filter, FilterJsonError> {
+        match j.kind {
+            FilterKind::Off => match (j.min_cutoff_hz, j.beta, j.d_cutoff_hz) {
+                (None, None, None) => Ok(Filter::Off),
+                _ => Err(FilterJsonError("the filter \"off\" takes no parameters")),
+            },
+            FilterKind::OneEuro => match (j.min_cutoff_hz, j.beta, j.d_cutoff_hz) {
+                (Some(min_cutoff_hz), Some(beta), Some(d_cutoff_hz)) => Ok(Filter::OneEuro {
+                    min_cutoff_hz,
+                    beta,
+                    d_cutoff_hz,
+                }),
+                _ => Err(FilterJsonError(
+                    "the filter \"one_euro\" needs min_cutoff_hz, beta and d_cutoff_hz",
+                )),
+            },
+        }
     }
 }

@@ -13,7 +13,7 @@
 use core::fmt;
 
 use serde::de::{self, Deserializer, SeqAccess, Visitor};
-use serde::ser::{SerializeSeq, Serializer};
+use serde::ser::Serializer;
 use serde::{Deserialize, Serialize};
 
 use crate::config::{Config, ConfigField, DisplayPose, Filter};
@@ -21,63 +21,8 @@ use crate::info::DeviceInfo;
 use crate::pen::{MAX_RECEIVERS, PenReport, Quality};
 use crate::status::{Command, GetFeature, Status};
 use crate::tof::{NO_ARRIVAL, TofReport};
+use crate::wide::{tenths, wide, wide_list, wide_opt};
 use crate::{Message, ReportId};
-
-/// Tenths (logical position units, quality steps) as a decimal number: 123 → 12.3.
-pub(crate) fn tenths<S: Serializer, T: Copy + Into<f64>>(v: &T, s: S) -> Result<S::Ok, S::Error> {
-    s.serialize_f64((*v).into() / 10.0)
-}
-
-/// An `f32` as the `f64` it widens to.
-pub(crate) fn wide<S: Serializer>(v: &f32, s: S) -> Result<S::Ok, S::Error> {
-    s.serialize_f64(f64::from(*v))
-}
-
-fn wide_opt<S: Serializer>(v: &Option<f32>, s: S) -> Result<S::Ok, S::Error> {
-    match v {
-        Some(v) => s.serialize_f64(f64::from(*v)),
-        None => s.serialize_none(),
-    }
-}
-
-/// A list of `f32` (or of `[f32; N]`) as `f64`s.
-pub(crate) fn wide_list<S: Serializer, T: Wide>(v: &&[T], s: S) -> Result<S::Ok, S::Error> {
-    let mut seq = s.serialize_seq(Some(v.len()))?;
-    for x in v.iter() {
-        x.put(&mut seq)?;
-    }
-    seq.end()
-}
-
-/// What [`wide_list`] lists.
-pub(crate) trait Wide {
-    fn put<S: SerializeSeq>(&self, seq: &mut S) -> Result<(), S::Error>;
-}
-
-impl Wide for f32 {
-    fn put<S: SerializeSeq>(&self, seq: &mut S) -> Result<(), S::Error> {
-        seq.serialize_element(&f64::from(*self))
-    }
-}
-
-impl<const N: usize> Wide for [f32; N] {
-    fn put<S: SerializeSeq>(&self, seq: &mut S) -> Result<(), S::Error> {
-        seq.serialize_element(&WideSlice(self))
-    }
-}
-
-/// `f32`s as `f64`s.
-struct WideSlice<'a>(&'a [f32]);
-
-impl Serialize for WideSlice<'_> {
-    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.collect_seq(self.0.iter().map(|&v| f64::from(v)))
-    }
-}
-
-pub(crate) fn wide_array<S: Serializer, const N: usize>(v: &[f32; N], s: S) -> Result<S::Ok, S::Error> {
-    WideSlice(v).serialize(s)
-}
 
 /// A value by its `Display` form.
 fn display<S: Serializer, T: fmt::Display>(v: &T, s: S) -> Result<S::Ok, S::Error> {
@@ -457,56 +402,6 @@ impl<'de, T: Deserialize<'de> + Copy + Default> Deserialize<'de> for PerReceiver
             }
         }
         d.deserialize_seq(List(core::marker::PhantomData))
-    }
-}
-
-/// `filter` as read: a `kind` and, for the 1€ filter, its three parameters.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct FilterJson {
-    kind: FilterKind,
-    min_cutoff_hz: Option<f32>,
-    beta: Option<f32>,
-    d_cutoff_hz: Option<f32>,
-}
-
-#[derive(Deserialize)]
-#[serde(rename_all = "snake_case")]
-enum FilterKind {
-    Off,
-    OneEuro,
-}
-
-/// Why a `filter` object is not one.
-#[derive(Debug)]
-pub struct FilterJsonError(&'static str);
-
-impl fmt::Display for FilterJsonError {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        f.write_str(self.0)
-    }
-}
-
-impl TryFrom<FilterJson> for Filter {
-    type Error = FilterJsonError;
-
-    fn try_from(j: FilterJson) -> Result<Filter, FilterJsonError> {
-        match j.kind {
-            FilterKind::Off => match (j.min_cutoff_hz, j.beta, j.d_cutoff_hz) {
-                (None, None, None) => Ok(Filter::Off),
-                _ => Err(FilterJsonError("the filter \"off\" takes no parameters")),
-            },
-            FilterKind::OneEuro => match (j.min_cutoff_hz, j.beta, j.d_cutoff_hz) {
-                (Some(min_cutoff_hz), Some(beta), Some(d_cutoff_hz)) => Ok(Filter::OneEuro {
-                    min_cutoff_hz,
-                    beta,
-                    d_cutoff_hz,
-                }),
-                _ => Err(FilterJsonError(
-                    "the filter \"one_euro\" needs min_cutoff_hz, beta and d_cutoff_hz",
-                )),
-            },
-        }
     }
 }
 

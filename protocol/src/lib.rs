@@ -13,6 +13,8 @@ mod json;
 mod pen;
 mod status;
 mod tof;
+#[cfg(feature = "serde")]
+mod wide;
 
 use core::fmt;
 

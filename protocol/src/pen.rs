@@ -67,11 +67,11 @@ pub struct Quality {
     /// RMS range residual of the fix in 0.1 mm; 255 means 25.5 mm or more, or unknown.
     #[cfg_attr(
         feature = "serde",
-        serde(rename = "residual_mm", serialize_with = "crate::json::tenths")
+        serde(rename = "residual_mm", serialize_with = "crate::wide::tenths")
     )]
     pub residual: u8,
     /// Position dilution of precision ×10; 255 means 25.5 or more, or unknown.
-    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::json::tenths"))]
+    #[cfg_attr(feature = "serde", serde(serialize_with = "crate::wide::tenths"))]
     pub dop: u8,
 }
 

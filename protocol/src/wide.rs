@@ -1,0 +1,63 @@
+//! Number forms of the JSON output (feature `serde`): numbers the device holds as `f32` written
+//! as the `f64` they widen to (`0.1f32` prints as `0.10000000149011612`, the exact value the
+//! device holds), and tenths as decimals. A leaf: the report types name these helpers in their
+//! serde attributes, and the JSON module uses them too.
+
+use serde::Serialize;
+use serde::ser::{SerializeSeq, Serializer};
+
+/// Tenths (logical position units, quality steps) as a decimal number: 123 → 12.3.
+pub(crate) fn tenths<S: Serializer, T: Copy + Into<f64>>(v: &T, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64((*v).into() / 10.0)
+}
+
+/// An `f32` as the `f64` it widens to.
+pub(crate) fn wide<S: Serializer>(v: &f32, s: S) -> Result<S::Ok, S::Error> {
+    s.serialize_f64(f64::from(*v))
+}
+
+pub(crate) fn wide_opt<S: Serializer>(v: &Option<f32>, s: S) -> Result<S::Ok, S::Error> {
+    match v {
+        Some(v) => s.serialize_f64(f64::from(*v)),
+        None => s.serialize_none(),
+    }
+}
+
+/// A list of `f32` (or of `[f32; N]`) as `f64`s.
+pub(crate) fn wide_list<S: Serializer, T: Wide>(v: &&[T], s: S) -> Result<S::Ok, S::Error> {
+    let mut seq = s.serialize_seq(Some(v.len()))?;
+    for x in v.iter() {
+        x.put(&mut seq)?;
+    }
+    seq.end()
+}
+
+/// What [`wide_list`] lists.
+pub(crate) trait Wide {
+    fn put<S: SerializeSeq>(&self, seq: &mut S) -> Result<(), S::Error>;
+}
+
+impl Wide for f32 {
+    fn put<S: SerializeSeq>(&self, seq: &mut S) -> Result<(), S::Error> {
+        seq.serialize_element(&f64::from(*self))
+    }
+}
+
+impl<const N: usize> Wide for [f32; N] {
+    fn put<S: SerializeSeq>(&self, seq: &mut S) -> Result<(), S::Error> {
+        seq.serialize_element(&WideSlice(self))
+    }
+}
+
+/// `f32`s as `f64`s.
+pub(crate) struct WideSlice<'a>(pub(crate) &'a [f32]);
+
+impl Serialize for WideSlice<'_> {
+    fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_seq(self.0.iter().map(|&v| f64::from(v)))
+    }
+}
+
+pub(crate) fn wide_array<S: Serializer, const N: usize>(v: &[f32; N], s: S) -> Result<S::Ok, S::Error> {
+    WideSlice(v).serialize(s)
+}
