@@ -8,6 +8,7 @@
 //!   real pen goes through.
 //! - [`PenSource::Daemon`]: events from `pend`'s socket.
 //! - [`PenSource::Device`]: a base station over USB HID or serial, with a calibration file.
+//! - [`PenSource::None`]: no pen; the document is looked at and edited from the keyboard.
 //!
 //! The thread sends [`Feed`] messages over a bounded channel: when the modeler is slower than
 //! the source (rendering frames of a demo that runs faster than real time), the source waits.
@@ -60,6 +61,8 @@ pub enum PenSource {
     },
     /// `pend`'s socket.
     Daemon(PathBuf),
+    /// No pen: the session is looked at and edited from the keyboard.
+    None,
     /// A device, and its calibration file (`None`: the default file if it exists).
     Device {
         /// HID, serial, or a named simulated scenario.
@@ -70,21 +73,20 @@ pub enum PenSource {
 }
 
 impl PenSource {
-    /// `sim` (the demo), `daemon`, `daemon:SOCKET`, `hid`, `hid:PATH`, `serial:PATH` or
+    /// `sim` (the demo), `none`, `daemon`, `daemon:SOCKET`, `hid`, `hid:PATH`, `serial:PATH` or
     /// `sim:SCENARIO` (a named pen-sim scenario with an identity calibration).
     pub fn parse(s: &str, speed: f64) -> Result<PenSource, String> {
         match s.split_once(':') {
             None if s == "sim" => Ok(PenSource::Demo { speed, seed: 1 }),
+            None if s == "none" => Ok(PenSource::None),
             None if s == "daemon" => Ok(PenSource::Daemon(pen_host::daemon::default_socket())),
             Some(("daemon", path)) if !path.is_empty() => Ok(PenSource::Daemon(PathBuf::from(path))),
             _ => {
                 let mut source: Source = s.parse().map_err(|e| match e {
-                    SourceError::UnknownKind { given } => {
-                        format!(
-                            "unknown source {given:?}: sim, daemon, daemon:SOCKET, {}",
-                            Source::FORMS
-                        )
-                    }
+                    SourceError::UnknownKind { given } => format!(
+                        "unknown source {given:?}: sim (the built-in demo), sim:SCENARIO, none, daemon, \
+                         daemon:SOCKET, hid, hid:PATH or serial:PATH"
+                    ),
                     other => other.to_string(),
                 })?;
                 if let Source::Sim(o) = &mut source {
@@ -118,6 +120,8 @@ pub fn spawn(source: PenSource, capacity: usize) -> (Receiver<Feed>, JoinHandle<
             let result = match source {
                 PenSource::Demo { speed, seed } => run_demo(&tx, speed, seed),
                 PenSource::Daemon(path) => run_daemon(&tx, &path),
+                // Said once; the channel then closes and the session goes on without a pen.
+                PenSource::None => send(&tx, Feed::Status("no pen: keyboard only".into())),
                 PenSource::Device { source, calibration } => run_device(&tx, source, calibration),
             };
             // A closed channel means the modeler is gone: nothing to tell.

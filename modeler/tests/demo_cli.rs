@@ -99,7 +99,27 @@ fn the_demo_runs_headless_and_writes_its_results() {
     assert!(String::from_utf8_lossy(&again.stdout).contains("wrote"));
     assert_eq!(png_size(&out_dir.join("frames/frame_00000.png")), (160, 90));
 
-    // Continue the document: the demo's pen draws on it. Its region overlaps the one there and
+    // Open the document with no pen: it is the user's now, so the demo does not play into it.
+    // Headless there is nothing to do: refused, saying how to attach a pen; nothing touched.
+    let bytes_before = std::fs::read(out_dir.join("document.json")).expect("the document");
+    let refused = run(
+        dir.path(),
+        &["open", "out/document.json", "--out", "more", "--fps", "1"],
+    );
+    assert_eq!(refused.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert!(
+        stderr.contains("no pen") && stderr.contains("pend") && stderr.contains("--source sim"),
+        "{stderr}"
+    );
+    assert_eq!(
+        std::fs::read(out_dir.join("document.json")).expect("the document"),
+        bytes_before,
+        "untouched"
+    );
+    assert!(!dir.path().join("more/document.json").exists());
+
+    // Asked for explicitly, the demo's pen draws on it. Its region overlaps the one there and
     // is refused (counted, told); its figures land in the existing region; nothing is lost.
     let before = penmodel_terrain::Document::load(&out_dir.join("document.json")).expect("valid");
     let open = run(
@@ -107,6 +127,8 @@ fn the_demo_runs_headless_and_writes_its_results() {
         &[
             "open",
             "out/document.json",
+            "--source",
+            "sim",
             "--out",
             "more",
             "--size",
@@ -149,12 +171,26 @@ fn a_real_session_never_overwrites_a_document() {
         std::fs::read_to_string(dir.path().join("out/document.json")).expect("kept"),
         "{}"
     );
-    // A source that is not one is a usage error with the choices.
+    // Nor does the demo replace a document it did not write.
+    let demo = run(dir.path(), &["--fps", "1"]);
+    assert_eq!(demo.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&demo.stderr);
+    assert!(stderr.contains("exists") && stderr.contains("--out"), "{stderr}");
+    assert_eq!(
+        std::fs::read_to_string(dir.path().join("out/document.json")).expect("kept"),
+        "{}"
+    );
+    // A source that is not one is a usage error with the choices, each named once.
     let bad = run(dir.path(), &["--source", "carrier-pigeon"]);
     assert_eq!(bad.status.code(), Some(2));
+    let stderr = String::from_utf8_lossy(&bad.stderr);
     assert!(
-        String::from_utf8_lossy(&bad.stderr).contains("sim, daemon"),
-        "{}",
-        String::from_utf8_lossy(&bad.stderr)
+        stderr.contains("sim (the built-in demo), sim:SCENARIO, none, daemon"),
+        "{stderr}"
+    );
+    assert_eq!(
+        stderr.matches("sim,").count() + stderr.matches("sim ").count(),
+        1,
+        "{stderr}"
     );
 }

@@ -39,8 +39,9 @@ pub enum Show {
 /// Options of a modeling session.
 #[derive(clap::Args, Clone)]
 pub struct LiveArgs {
-    /// The pen: sim (the built-in demo), daemon, daemon:SOCKET, hid, hid:PATH, serial:PATH or
-    /// sim:SCENARIO [default: daemon if pend is running, else sim].
+    /// The pen: sim (the built-in demo), none (keyboard only), daemon, daemon:SOCKET, hid,
+    /// hid:PATH, serial:PATH or sim:SCENARIO [default: daemon if pend is running; else sim for a
+    /// new session, none for `open` in a window].
     #[arg(long, value_name = "SOURCE", value_parser = source)]
     source: Option<String>,
     /// Window, files, or a window when there is a display.
@@ -85,6 +86,11 @@ pub struct LiveArgs {
     json: bool,
 }
 
+/// The file beside the demo's document that says an earlier demo wrote it, so the next demo may
+/// replace it; a user's document has none.
+const DEMO_MARK: &str = ".penmodel-demo";
+const DEMO_MARK_TEXT: &str = "document.json here was written by penmodel's built-in demo; the next demo replaces it.\n";
+
 /// A pen source's name, checked.
 fn source(s: &str) -> Result<String, String> {
     PenSource::parse(s, 0.0).map(|_| s.to_string())
@@ -98,12 +104,31 @@ struct Written {
     shown: bool,
 }
 
-fn default_source() -> String {
+/// The pen when `--source` is not given: pend if it is running; otherwise the demo for a new
+/// session. An opened document is the user's: the demo never plays into it unless asked
+/// (`--source sim`), so without pend it is opened with no pen in a window, and refused headless
+/// (there would be nothing to do).
+fn default_source(open: Option<&Path>, window: bool) -> Result<String> {
     let socket = pen_host::daemon::default_socket();
     if std::os::unix::net::UnixStream::connect(&socket).is_ok() {
-        "daemon".into()
-    } else {
-        "sim".into()
+        return Ok("daemon".into());
+    }
+    match open {
+        None => Ok("sim".into()),
+        Some(_) if window => {
+            eprintln!(
+                "penmodel: no pen (pend is not running at {}): the document is open to look at and to edit \
+                 from the keyboard; start pend, or give --source hid|serial:PATH, to model with the pen",
+                socket.display()
+            );
+            Ok("none".into())
+        }
+        Some(doc) => bail!(
+            "no pen to model {} with: pend is not running at {}. Start pend (pend --hid, or pend --serial PATH), \
+             or give --source hid|serial:PATH; --source sim plays the built-in demo into this document",
+            doc.display(),
+            socket.display()
+        ),
     }
 }
 
@@ -117,7 +142,10 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
         Show::Window => true,
         Show::Auto => output::window::has_display(),
     };
-    let source_name = args.source.clone().unwrap_or_else(default_source);
+    let source_name = match &args.source {
+        Some(s) => s.clone(),
+        None => default_source(open, window_wanted)?,
+    };
     let speed = args.speed.unwrap_or(if window_wanted { 1.0 } else { 0.0 });
     let mut source = PenSource::parse(&source_name, speed).map_err(anyhow::Error::msg)?;
     let demo = matches!(source, PenSource::Demo { .. });
@@ -141,15 +169,31 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
         }
         None => {
             let path = args.doc.clone().unwrap_or_else(|| args.out.join("document.json"));
-            // The demo's document is the demo's; a real session never overwrites work.
-            if path.exists() && !(demo && args.doc.is_none()) {
+            // The demo replaces only a document an earlier demo wrote (its mark beside it); a
+            // real session never overwrites anything, and no session plays the demo into work.
+            let demo_mark = args.out.join(DEMO_MARK);
+            let replaceable = demo && args.doc.is_none() && demo_mark.exists();
+            if path.exists() && !replaceable {
+                let hint = if demo {
+                    "; give the demo another --out"
+                } else {
+                    ", or give another --doc"
+                };
                 bail!(
-                    "{} exists: `penmodel open {}` continues it, or give another --doc",
+                    "{} exists: `penmodel open {}` continues it{hint}",
                     path.display(),
                     path.display()
                 );
             }
-            (Editor::create(&path, blank_document())?, path)
+            let editor = Editor::create(&path, blank_document())?;
+            if demo && args.doc.is_none() {
+                std::fs::write(&demo_mark, DEMO_MARK_TEXT)
+                    .with_context(|| format!("cannot write {}", demo_mark.display()))?;
+            } else if path == args.out.join("document.json") && demo_mark.exists() {
+                // This document is the user's now: the next demo must not replace it.
+                std::fs::remove_file(&demo_mark).with_context(|| format!("cannot remove {}", demo_mark.display()))?;
+            }
+            (editor, path)
         }
     };
     let tuning = Tuning::default();
