@@ -12,7 +12,7 @@ use crate::address::{CurvePath, FigurePath};
 use crate::cells::{self, Mask};
 use crate::change::{FigureList, ListChange, Scope};
 use crate::document::{Document, Figure, FigureKind, Point, Region};
-use crate::validate::{self, Defect, ValidationError};
+use crate::validate::{self, ValidationError};
 
 /// One change to a document. Serialised (in the journal) as an object tagged by `"op"`.
 #[allow(missing_docs)] // fields named for what they hold; each variant says what it does with them.
@@ -136,9 +136,7 @@ fn apply(doc: &mut Document, edit: &Edit) -> Result<Applied, EditError> {
     match edit {
         Edit::SetHeight { at, height } => {
             let f = at.get_mut(doc).ok_or_else(|| EditError::NoFigure(at.clone()))?;
-            if !height.is_finite() {
-                return Err(ValidationError::new(format!("{at}.height"), Defect::NotFinite).into());
-            }
+            validate::height(*height, || format!("{at}.height"))?;
             let old = std::mem::replace(&mut f.height, *height);
             let inverse = Edit::SetHeight {
                 at: at.clone(),
@@ -151,9 +149,7 @@ fn apply(doc: &mut Document, edit: &Edit) -> Result<Applied, EditError> {
         }
         Edit::SetSlope { at, slope } => {
             let f = at.get_mut(doc).ok_or_else(|| EditError::NoFigure(at.clone()))?;
-            if !slope.is_finite() {
-                return Err(ValidationError::new(format!("{at}.slope"), Defect::NotFinite).into());
-            }
+            validate::slope(*slope, || format!("{at}.slope"))?;
             let old = std::mem::replace(&mut f.slope, *slope);
             let inverse = Edit::SetSlope {
                 at: at.clone(),
@@ -266,6 +262,10 @@ fn apply(doc: &mut Document, edit: &Edit) -> Result<Applied, EditError> {
                 .map(|(j, m)| (if j >= *index { j + 1 } else { j }, m));
             validate::region_overlap(*index, &mask, shifted)?;
             doc.regions.insert(*index, region.clone());
+            if let Err(e) = validate::memory(doc) {
+                doc.regions.remove(*index);
+                return Err(e.into());
+            }
             Ok(Applied {
                 inverse: Edit::DeleteRegion { index: *index },
                 scope: Scope::RegionAdded(*index),
@@ -304,12 +304,14 @@ fn no_point(curve: &CurvePath, index: usize) -> EditError {
     }
 }
 
-/// Changes top-level region `index` with `f`, keeping the change only if the region stays valid.
-/// Figure edits cannot change a region's boundary, so overlap with other regions is unaffected.
+/// Changes top-level region `index` with `f`, keeping the change only if the region stays valid
+/// and the terrain engine's memory within its limit. Figure edits cannot change a region's
+/// boundary, so overlap with other regions is unaffected.
 fn change_region(doc: &mut Document, index: usize, f: impl FnOnce(&mut Document)) -> Result<(), EditError> {
     let saved = doc.regions.get(index).ok_or(EditError::NoRegion(index))?.clone();
     f(doc);
-    if let Err(e) = validate::region(&doc.grid, &doc.regions[index], index) {
+    let checked = validate::region(&doc.grid, &doc.regions[index], index).and_then(|()| validate::memory(doc));
+    if let Err(e) = checked {
         doc.regions[index] = saved;
         return Err(e.into());
     }
@@ -336,6 +338,10 @@ fn replace_region(doc: &mut Document, index: usize, new: Region, scope: Scope) -
     let mask = cells::closed_mask(&doc.grid, &new.boundary);
     validate::region_overlap(index, &mask, region_masks(doc).iter().enumerate())?;
     let old = std::mem::replace(&mut doc.regions[index], new);
+    if let Err(e) = validate::memory(doc) {
+        doc.regions[index] = old;
+        return Err(e.into());
+    }
     Ok(Applied {
         inverse: Edit::ReplaceRegion { index, region: old },
         scope,

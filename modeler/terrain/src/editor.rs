@@ -73,6 +73,9 @@ pub struct OpenReport {
     pub dropped_torn_line: bool,
     /// Where a journal that belonged to another version of the document was moved.
     pub stale_journal: Option<PathBuf>,
+    /// A journal that belongs to another version of the document, left where it is and not
+    /// replayed ([`Editor::open_read_only`] moves nothing), so that the caller can say so.
+    pub ignored_stale_journal: Option<PathBuf>,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -138,10 +141,10 @@ pub struct Editor {
 }
 
 fn journal_io(path: &Path) -> impl FnOnce(io::Error) -> EditorError + '_ {
-    move |source| {
+    move |cause| {
         EditorError::Journal(JournalError::Io {
             path: path.to_owned(),
-            source,
+            cause,
         })
     }
 }
@@ -201,6 +204,8 @@ impl Editor {
                     let aside = PathBuf::from(aside);
                     fs::rename(&jpath, &aside).map_err(journal_io(&jpath))?;
                     report.stale_journal = Some(aside);
+                } else {
+                    report.ignored_stale_journal = Some(jpath.clone());
                 }
             }
             Replay::Entries {

@@ -271,34 +271,38 @@ impl RegionNode {
         })
     }
 
-    /// Eq. 3's weights of every figure on the owned cells.
+    /// Eq. 3's weights of every figure on the owned cells. Written in place: a second set of
+    /// share maps would add 4 bytes per figure per cell to the engine's peak memory.
     fn shares(&mut self) {
         let n = self.mask.box_len();
-        let mut shares = vec![vec![0.0f32; n]; self.figures.len()];
-        let w = self.mask.width as usize;
-        for run in &self.owned {
+        let RegionNode {
+            mask, owned, figures, ..
+        } = self;
+        for f in figures.iter_mut() {
+            f.share.clear();
+            f.share.resize(n, 0.0);
+        }
+        let w = mask.width as usize;
+        for run in owned.iter() {
             let b = run.row as usize * w;
             for i in b + run.start as usize..b + run.end as usize {
-                let on = self.figures.iter().filter(|f| f.dp[i] == 0).count();
+                let on = figures.iter().filter(|f| f.dp[i] == 0).count();
                 if on > 0 {
                     let each = 1.0 / on as f64;
-                    for (s, f) in shares.iter_mut().zip(&self.figures) {
+                    for f in figures.iter_mut() {
                         if f.dp[i] == 0 {
-                            s[i] = each as f32;
+                            f.share[i] = each as f32;
                         }
                     }
                 } else {
-                    let total: f64 = self.figures.iter().map(|f| profile::inverse_distance(f.dp[i])).sum();
+                    let total: f64 = figures.iter().map(|f| profile::inverse_distance(f.dp[i])).sum();
                     if total > 0.0 {
-                        for (s, f) in shares.iter_mut().zip(&self.figures) {
-                            s[i] = (profile::inverse_distance(f.dp[i]) / total) as f32;
+                        for f in figures.iter_mut() {
+                            f.share[i] = (profile::inverse_distance(f.dp[i]) / total) as f32;
                         }
                     }
                 }
             }
-        }
-        for (f, s) in self.figures.iter_mut().zip(shares) {
-            f.share = s;
         }
     }
 

@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::edit::Edit;
-use crate::persist::write_atomic;
+use crate::persist::{self, write_atomic};
 
 /// The journal format version.
 pub const JOURNAL_VERSION: u32 = 1;
@@ -102,9 +102,10 @@ pub enum Replay {
 #[allow(missing_docs)] // the fields say which file, where and why.
 #[derive(Debug, thiserror::Error)]
 pub enum JournalError {
-    /// Reading or writing failed.
-    #[error("journal {}: {source}", path.display())]
-    Io { path: PathBuf, source: io::Error },
+    /// Reading or writing failed. The reason is in the message only, not also a
+    /// [`source`](std::error::Error::source) that a chain printer would repeat.
+    #[error("journal {}: {cause}", path.display())]
+    Io { path: PathBuf, cause: io::Error },
     /// A complete line is not a journal entry.
     #[error("journal {} line {line}: {message}", path.display())]
     Corrupt {
@@ -120,10 +121,10 @@ pub fn read(path: &Path, base: &str) -> Result<Replay, JournalError> {
     let bytes = match fs::read(path) {
         Ok(b) => b,
         Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Replay::Missing),
-        Err(source) => {
+        Err(cause) => {
             return Err(JournalError::Io {
                 path: path.to_owned(),
-                source,
+                cause,
             });
         }
     };
@@ -134,13 +135,19 @@ pub fn read(path: &Path, base: &str) -> Result<Replay, JournalError> {
     };
     let valid_len = bytes.iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1);
     let torn = valid_len < bytes.len();
-    let text = std::str::from_utf8(&bytes[..valid_len]).map_err(|e| corrupt(0, e.to_string()))?;
+    let text = std::str::from_utf8(&bytes[..valid_len]).map_err(|e| {
+        // The line holding the first invalid byte, counted like the other errors' lines.
+        let at = e.valid_up_to();
+        let line = bytes[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+        let column = at - bytes[..at].iter().rposition(|&b| b == b'\n').map_or(0, |i| i + 1) + 1;
+        corrupt(line, format!("not UTF-8 text: an invalid byte at column {column}"))
+    })?;
     let mut lines = text.lines().enumerate();
     let Some((_, first)) = lines.next() else {
         // Not even the first line was completed: the journal was being created, nothing to replay.
         return Ok(Replay::Missing);
     };
-    match serde_json::from_str::<Entry>(first) {
+    match entry(first) {
         Ok(Entry::Open { journal, base: found }) => {
             if journal != JOURNAL_VERSION {
                 return Err(corrupt(1, format!("unsupported journal version {journal}")));
@@ -150,11 +157,11 @@ pub fn read(path: &Path, base: &str) -> Result<Replay, JournalError> {
             }
         }
         Ok(_) => return Err(corrupt(1, "the first line is not an \"open\" entry".into())),
-        Err(e) => return Err(corrupt(1, e.to_string())),
+        Err(e) => return Err(corrupt(1, e)),
     }
     let mut entries = Vec::new();
     for (i, line) in lines {
-        let entry: Entry = serde_json::from_str(line).map_err(|e| corrupt(i + 1, e.to_string()))?;
+        let entry = entry(line).map_err(|message| corrupt(i + 1, message))?;
         if matches!(entry, Entry::Open { .. }) || (matches!(entry, Entry::History { .. }) && i != 1) {
             return Err(corrupt(i + 1, "an \"open\" or \"history\" entry out of place".into()));
         }
@@ -164,6 +171,18 @@ pub fn read(path: &Path, base: &str) -> Result<Replay, JournalError> {
         entries,
         valid_len: valid_len as u64,
         torn,
+    })
+}
+
+/// One line as an entry, or why it is not one (the element, the reason and the column).
+fn entry(line: &str) -> Result<Entry, String> {
+    persist::parse_json(line, "journal entry").map_err(|e| {
+        let at = if e.path.is_empty() {
+            String::new()
+        } else {
+            format!("{}: ", e.path)
+        };
+        format!("{at}{} (column {})", e.message, e.column)
     })
 }
 

@@ -29,9 +29,11 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
 #[allow(missing_docs)] // the fields say which file and why.
 #[derive(Debug, Error)]
 pub enum LoadError {
-    /// The file could not be read.
-    #[error("cannot read {}: {source}", path.display())]
-    Io { path: PathBuf, source: io::Error },
+    /// The file could not be read. The reason is part of the message and not also a
+    /// [`source`](std::error::Error::source), which a chain printer (anyhow's `{:#}`) would print
+    /// a second time.
+    #[error("cannot read {}: {cause}", path.display())]
+    Io { path: PathBuf, cause: io::Error },
     /// The text is not JSON of the document's shape.
     #[error("{}: {message} (line {line}, column {column})", if path.is_empty() { "document" } else { path })]
     Parse {
@@ -55,9 +57,10 @@ pub enum SaveError {
     /// The document is not valid; nothing was written.
     #[error(transparent)]
     Invalid(#[from] ValidationError),
-    /// Writing failed; the previous file, if any, is intact.
-    #[error("cannot write {}: {source}", path.display())]
-    Io { path: PathBuf, source: io::Error },
+    /// Writing failed; the previous file, if any, is intact. The reason is in the message only,
+    /// as for [`LoadError::Io`].
+    #[error("cannot write {}: {cause}", path.display())]
+    Io { path: PathBuf, cause: io::Error },
 }
 
 #[derive(Deserialize)]
@@ -88,11 +91,7 @@ impl Document {
 
     /// Reads and validates the document at `path`.
     pub fn load(path: &Path) -> Result<Document, LoadError> {
-        let text = fs::read_to_string(path).map_err(|source| LoadError::Io {
-            path: path.to_owned(),
-            source,
-        })?;
-        Document::from_json(&text)
+        Ok(read_document(path)?.0)
     }
 
     /// Validates the document and writes it to `path` atomically: a temporary file in the same
@@ -101,9 +100,9 @@ impl Document {
     pub fn save(&self, path: &Path) -> Result<Vec<u8>, SaveError> {
         validate::document(self)?;
         let bytes = self.to_json().into_bytes();
-        write_atomic(path, &bytes).map_err(|source| SaveError::Io {
+        write_atomic(path, &bytes).map_err(|cause| SaveError::Io {
             path: path.to_owned(),
-            source,
+            cause,
         })?;
         Ok(bytes)
     }
@@ -112,31 +111,151 @@ impl Document {
 /// Reads and validates the document at `path`, returning its bytes too (the journal names the
 /// file it applies to by their fingerprint).
 pub fn read_document(path: &Path) -> Result<(Document, Vec<u8>), LoadError> {
-    let bytes = fs::read(path).map_err(|source| LoadError::Io {
+    let bytes = fs::read(path).map_err(|cause| LoadError::Io {
         path: path.to_owned(),
-        source,
+        cause,
     })?;
-    let text = std::str::from_utf8(&bytes).map_err(|e| LoadError::Io {
-        path: path.to_owned(),
-        source: io::Error::new(io::ErrorKind::InvalidData, e),
+    let text = std::str::from_utf8(&bytes).map_err(|e| {
+        let at = e.valid_up_to();
+        let line = bytes[..at].iter().filter(|&&b| b == b'\n').count() + 1;
+        LoadError::Io {
+            path: path.to_owned(),
+            cause: io::Error::new(
+                io::ErrorKind::InvalidData,
+                format!("not UTF-8 text: an invalid byte on line {line} (byte offset {at})"),
+            ),
+        }
     })?;
     let doc = Document::from_json(text)?;
     Ok((doc, bytes))
 }
 
 fn parse<'de, T: Deserialize<'de>>(text: &'de str) -> Result<T, LoadError> {
-    let de = &mut serde_json::Deserializer::from_str(text);
-    let value = serde_path_to_error::deserialize(de).map_err(|e| {
+    parse_json(text, "document").map_err(|e| LoadError::Parse {
+        path: e.path,
+        message: e.message,
+        line: e.line,
+        column: e.column,
+    })
+}
+
+/// JSON text that is not of the expected shape: where, and why in the document's words.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct JsonError {
+    /// The element, e.g. `regions[0].figures[1].height`; empty when the text itself is at fault
+    /// (a syntax error is located by its line and column, not by the element being read).
+    pub path: String,
+    pub message: String,
+    /// 1-based line.
+    pub line: usize,
+    /// 1-based column.
+    pub column: usize,
+}
+
+/// Parses one JSON value of type `T` (a `what`, for messages) from the whole of `text`: anything
+/// after it but whitespace is an error, so a file holding a document and then garbage, or two
+/// documents, is refused rather than half read.
+pub(crate) fn parse_json<'de, T: Deserialize<'de>>(text: &'de str, what: &str) -> Result<T, JsonError> {
+    let mut de = serde_json::Deserializer::from_str(text);
+    let value = serde_path_to_error::deserialize(&mut de).map_err(|e| {
         let path = e.path().to_string();
-        let inner = e.into_inner();
-        LoadError::Parse {
-            path: if path == "." { String::new() } else { path },
-            message: strip_position(&inner.to_string()),
-            line: inner.line(),
-            column: inner.column(),
-        }
+        describe(&path, &e.into_inner())
+    })?;
+    de.end().map_err(|e| JsonError {
+        path: String::new(),
+        message: format!("unexpected text after the end of the {what}"),
+        line: e.line(),
+        column: e.column(),
     })?;
     Ok(value)
+}
+
+/// serde_json's error in the document's words.
+fn describe(path: &str, e: &serde_json::Error) -> JsonError {
+    use serde_json::error::Category;
+    let raw = strip_position(&e.to_string());
+    // The path names the element being read; an element the reader could not name (a map key
+    // being read, an internally tagged edit) is `?`, so the path stops before it.
+    let mut path = match path.find('?') {
+        Some(i) => path[..i].trim_end_matches('.').to_owned(),
+        None if path == "." => String::new(),
+        None => path.to_owned(),
+    };
+    let message = if raw.starts_with("recursion limit exceeded") {
+        path.clear();
+        format!(
+            "nested too deeply (more than 128 arrays and objects; figures may be nested at most {} deep)",
+            crate::validate::MAX_DEPTH
+        )
+    } else if raw == "trailing characters" && !path.is_empty() {
+        // Inside a value this is a fixed-length array with more elements: points are the only ones.
+        "a point is [x, y]: two numbers, found more".to_owned()
+    } else if let Some(n) = raw
+        .strip_prefix("invalid length ")
+        .and_then(|r| r.strip_suffix(", expected an array of length 2"))
+    {
+        format!("a point is [x, y]: two numbers, found {n}")
+    } else {
+        if matches!(e.classify(), Category::Syntax | Category::Eof) {
+            // Where the reader was is not where the text is wrong (a comma missing inside a figure
+            // is reported while reading `regions`); the line and column say where.
+            path.clear();
+        }
+        words(&raw)
+    };
+    JsonError {
+        path,
+        message,
+        line: e.line(),
+        column: e.column(),
+    }
+}
+
+/// Replaces the Rust type names serde puts in its messages with what they are in the file.
+fn words(message: &str) -> String {
+    const NAMES: [(&str, &str); 12] = [
+        (
+            "struct VersionOnly with 1 element",
+            "a document (a JSON object with \"version\", \"grid\" and \"regions\")",
+        ),
+        (
+            "struct VersionOnly",
+            "a document (a JSON object with \"version\", \"grid\" and \"regions\")",
+        ),
+        (
+            "struct Document",
+            "a document (a JSON object with \"version\", \"grid\" and \"regions\")",
+        ),
+        (
+            "struct Grid",
+            "a grid (an object with \"cols\", \"rows\" and \"cell_size\")",
+        ),
+        (
+            "struct Region",
+            "a region (an object with \"boundary\" and \"figures\")",
+        ),
+        (
+            "struct Figure",
+            "a figure (an object with \"kind\", \"points\", \"height\" and \"slope\")",
+        ),
+        (
+            "struct UndoStep",
+            "an undo step (an object with \"edit\" and \"inverse\")",
+        ),
+        (
+            "internally tagged enum Entry",
+            "a journal entry (an object with \"op\")",
+        ),
+        ("internally tagged enum Edit", "an edit (an object with \"op\")"),
+        ("expected f64", "expected a number"),
+        ("expected u32", "expected a whole number from 0 to 4294967295"),
+        ("expected usize", "expected a whole number ≥ 0"),
+    ];
+    let mut out = message.to_owned();
+    for (from, to) in NAMES {
+        out = out.replace(from, to);
+    }
+    out
 }
 
 /// serde_json's message without its " at line L column C" suffix (reported separately).

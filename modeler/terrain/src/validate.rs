@@ -1,9 +1,14 @@
 //! Validation of a document, with errors that name the element and the reason.
 //!
 //! A document is valid when:
-//! - its version is [`VERSION`], the grid has at least one cell, a
-//!   positive finite cell size and at most [`MAX_CELLS`] cells;
-//! - every number is finite and every point lies on the grid (`0 ≤ x < cols·s`, `0 ≤ y < rows·s`);
+//! - its version is [`VERSION`], the grid has at least one cell, a cell size within
+//!   [[`MIN_CELL_SIZE`], [`MAX_CELL_SIZE`]] m and at most [`MAX_CELLS`] cells;
+//! - every number is finite, every point lies on the grid (`0 ≤ x < cols·s`, `0 ≤ y < rows·s`),
+//!   heights are within ±[`MAX_HEIGHT`] m and slopes within ±[`MAX_SLOPE`] — the ranges that make
+//!   every intermediate term of eq. 1–4 and every `f32` height finite;
+//! - figures are nested at most [`MAX_DEPTH`] deep (a figure path has at most that many figure
+//!   indices), so that every document and journal line the editor writes parses back;
+//! - the terrain engine's caches ([`engine_bytes`]) fit in [`MAX_ENGINE_BYTES`];
 //! - a point figure has one point, a polyline at least two, and no point repeats the one before;
 //! - region boundaries and closed figures are closed (last point equal to the first), have at
 //!   least three distinct vertices and do not cross or touch themselves (polylines may cross
@@ -15,7 +20,15 @@
 //!   region (each is the region of its nested figures). Overlap is tested on the rasterised cells,
 //!   so two curves closer than a cell that share a cell overlap.
 //!
-//! Errors stop at the first problem, in document order.
+//! Errors stop at the first problem, in document order (the memory check comes last).
+//!
+//! The curve checks are linear in the number of vertices for drawn curves: a curve's segments go
+//! into a grid of buckets about one segment long ([`SegmentIndex`]) and each segment is tested only
+//! against those in its neighbouring buckets; points are located against their region's edge
+//! through bands of rows ([`Bands`]).
+
+use std::collections::HashMap;
+use std::fmt;
 
 use glam::DVec2;
 use thiserror::Error;
@@ -27,6 +40,75 @@ use crate::geometry::{self, Side};
 /// The most cells a grid may have: 4096 × 4096. The engine keeps about 12 bytes per cell per
 /// figure of a region plus about 30 per cell, so a larger grid would not fit a workstation.
 pub const MAX_CELLS: u64 = 1 << 24;
+
+/// The smallest cell size, in metres. Below it mesh vertices `(c + ½)·s` would round together in
+/// `f32` and their normals become undefined.
+pub const MIN_CELL_SIZE: f64 = 1e-3;
+
+/// The largest cell size, in metres: 100 km, so the grid's extent (≤ 4096 cells) stays far within
+/// `f32` range with room for squared distances.
+pub const MAX_CELL_SIZE: f64 = 1e5;
+
+/// The largest absolute height, in metres (1000 km). A cell's height is the base plus a weighted
+/// mean of reliefs (height − base, at most twice this), so every term stays a finite `f32`.
+pub const MAX_HEIGHT: f64 = 1e6;
+
+/// The largest absolute slope coefficient. Eq. 4 adds two slopes and multiplies by a weight;
+/// eq. 2 raises a number in [0, 1] to `1 ± s`: within this range nothing overflows, and beyond a
+/// few units the profile is already a step.
+pub const MAX_SLOPE: f64 = 1e3;
+
+/// The deepest a figure may be nested: a top-level figure is at depth 1, a figure in it at 2. The
+/// JSON reader stops at 128 nested arrays and objects; a figure at depth d is 2d + 5 deep in the
+/// document and 2d + 7 in a journal's `history` line, so 32 leaves room, and the editor refuses
+/// the figure that would go deeper.
+pub const MAX_DEPTH: usize = 32;
+
+/// Bytes the terrain engine keeps per figure per cell of its region's bounding box: distances
+/// (`u32`), eq. 3 shares and coefficients (`f32`).
+pub const BYTES_PER_FIGURE_CELL: u64 = 12;
+
+/// Bytes the terrain engine keeps, or allocates for a moment, per cell of a region's bounding
+/// box whatever its figures: the mask, edge distances, the pull and plateau caches, a search
+/// queue and a distance map being rebuilt.
+pub const BYTES_PER_REGION_CELL: u64 = 32;
+
+/// The most memory the terrain engine may need for a document, in bytes (2 GiB): see
+/// [`engine_bytes`]. 100 figures over 1024² cells need about 1.3 GB; 300 over 2048² would need
+/// 15 GB, which aborted the process before this limit.
+pub const MAX_ENGINE_BYTES: u64 = 2 << 30;
+
+/// A number written compactly for a message: the shortest form that reads back, in exponent
+/// notation when it is very large or very small (`1e308`, not 309 digits).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Num(pub f64);
+
+impl fmt::Display for Num {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let v = self.0;
+        let a = v.abs();
+        if v == 0.0 || !v.is_finite() || (1e-4..1e15).contains(&a) {
+            write!(f, "{v}")
+        } else {
+            write!(f, "{v:e}")
+        }
+    }
+}
+
+/// A byte count for a message, in the largest unit that keeps it ≥ 1 (`1.3 GB`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Bytes(pub u64);
+
+impl fmt::Display for Bytes {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let b = self.0 as f64;
+        match self.0 {
+            0..1_000_000 => write!(f, "{:.1} kB", b / 1e3),
+            1_000_000..1_000_000_000 => write!(f, "{:.1} MB", b / 1e6),
+            _ => write!(f, "{:.1} GB", b / 1e9),
+        }
+    }
+}
 
 /// A document element that is not valid, and why.
 #[derive(Debug, Clone, PartialEq, Error)]
@@ -58,8 +140,8 @@ pub enum Defect {
     /// The grid has no cells.
     #[error("the grid needs at least one column and one row")]
     EmptyGrid,
-    /// The cell size is not a positive finite number.
-    #[error("the cell size must be a positive finite number of metres, got {0}")]
+    /// The cell size is not within [[`MIN_CELL_SIZE`], [`MAX_CELL_SIZE`]] metres (or not finite).
+    #[error("the cell size must be between {} and {} m, got {}", Num(MIN_CELL_SIZE), Num(MAX_CELL_SIZE), Num(*.0))]
     CellSize(f64),
     /// The grid has more cells than [`MAX_CELLS`].
     #[error("{cells} cells is more than the {max} this build can hold in memory")]
@@ -67,8 +149,34 @@ pub enum Defect {
     /// A number is NaN or infinite.
     #[error("not a finite number")]
     NotFinite,
+    /// A height beyond ±[`MAX_HEIGHT`] metres.
+    #[error("a height must be within ±{} m, got {}", Num(MAX_HEIGHT), Num(*.0))]
+    HeightRange(f64),
+    /// A slope beyond ±[`MAX_SLOPE`].
+    #[error("a slope must be within ±{}, got {}", Num(MAX_SLOPE), Num(*.0))]
+    SlopeRange(f64),
+    /// A figure nested deeper than [`MAX_DEPTH`].
+    #[error("figures may be nested at most {MAX_DEPTH} deep; this one is at depth {0}")]
+    TooDeep(usize),
+    /// The terrain engine would need more than [`MAX_ENGINE_BYTES`].
+    #[error(
+        "the terrain would need about {} of memory ({figures} figures over {cells} cells of region bounding boxes), \
+         more than the limit of {}: use fewer figures or a coarser grid",
+        Bytes(*bytes),
+        Bytes(*max)
+    )]
+    TooLarge {
+        /// The estimate, [`engine_bytes`].
+        bytes: u64,
+        /// Figures in the document, at every depth.
+        figures: u64,
+        /// Cells of every region's and nested region's bounding box, summed.
+        cells: u64,
+        /// [`MAX_ENGINE_BYTES`].
+        max: u64,
+    },
     /// A point lies off the grid.
-    #[error("({x}, {y}) lies outside the grid [0, {width}) × [0, {height}) m")]
+    #[error("({}, {}) lies outside the grid [0, {}) × [0, {}) m", Num(*x), Num(*y), Num(*width), Num(*height))]
     OutsideGrid {
         x: f64,
         y: f64,
@@ -90,7 +198,7 @@ pub enum Defect {
     #[error("repeats the previous point")]
     RepeatedPoint,
     /// A closed curve whose last point is not its first.
-    #[error("the curve is open: its last point ({}, {}) is not its first ({}, {})", last[0], last[1], first[0], first[1])]
+    #[error("the curve is open: its last point ({}, {}) is not its first ({}, {})", Num(last[0]), Num(last[1]), Num(first[0]), Num(first[1]))]
     OpenCurve { first: Point, last: Point },
     /// A closed curve that crosses or touches itself.
     #[error("the curve crosses itself: the segment from this point meets the segment from points[{0}]")]
@@ -137,6 +245,79 @@ pub fn document(doc: &Document) -> Result<(), ValidationError> {
     for (i, m) in masks.iter().enumerate() {
         region_overlap(i, m, masks.iter().enumerate().take(i))?;
     }
+    memory(doc)
+}
+
+/// The terrain engine's memory for `doc`, in bytes, an upper bound on what it keeps and
+/// allocates while building and updating: per region (top-level, and the nested region of each
+/// closed figure) its bounding box's cells × ([`BYTES_PER_FIGURE_CELL`] × its figures +
+/// [`BYTES_PER_REGION_CELL`]), plus 4 bytes per grid cell for the heightmap. Returns the
+/// estimate, the number of figures and the summed box cells. Linear in the document's points.
+pub fn engine_bytes(doc: &Document) -> (u64, u64, u64) {
+    fn box_cells(grid: &Grid, pts: &[Point]) -> u64 {
+        // A closed curve's cells span exactly the cells of its extreme points (each segment's
+        // walk stays between its end cells), so the box needs no rasterising.
+        let Some(&first) = pts.first() else { return 0 };
+        let (mut lo, mut hi) = (cells::point_cell(grid, first), cells::point_cell(grid, first));
+        for &p in pts {
+            let (c, r) = cells::point_cell(grid, p);
+            lo = (lo.0.min(c), lo.1.min(r));
+            hi = (hi.0.max(c), hi.1.max(r));
+        }
+        u64::from(hi.0 - lo.0 + 1) * u64::from(hi.1 - lo.1 + 1)
+    }
+    fn region(grid: &Grid, edge: &[Point], figs: &[Figure], acc: &mut (u64, u64, u64)) {
+        let cells = box_cells(grid, edge);
+        let n = figs.len() as u64;
+        acc.0 = acc
+            .0
+            .saturating_add(cells.saturating_mul(BYTES_PER_FIGURE_CELL * n + BYTES_PER_REGION_CELL));
+        acc.1 += n;
+        acc.2 = acc.2.saturating_add(cells);
+        for f in figs.iter().filter(|f| f.kind == FigureKind::Closed) {
+            region(grid, &f.points, &f.figures, acc);
+        }
+    }
+    let mut acc = (4 * doc.grid.cells() as u64, 0, 0);
+    for r in &doc.regions {
+        region(&doc.grid, &r.boundary, &r.figures, &mut acc);
+    }
+    acc
+}
+
+/// Checks that the terrain engine's memory for `doc` ([`engine_bytes`]) is within
+/// [`MAX_ENGINE_BYTES`], before anything allocates it.
+pub fn memory(doc: &Document) -> Result<(), ValidationError> {
+    let (bytes, figures, cells) = engine_bytes(doc);
+    if bytes > MAX_ENGINE_BYTES {
+        return Err(ValidationError::new(
+            "regions",
+            Defect::TooLarge {
+                bytes,
+                figures,
+                cells,
+                max: MAX_ENGINE_BYTES,
+            },
+        ));
+    }
+    Ok(())
+}
+
+/// Checks a figure's height: finite and within ±[`MAX_HEIGHT`] metres.
+pub fn height(v: f64, path: impl Fn() -> String) -> Result<(), ValidationError> {
+    finite(v, &path)?;
+    if v.abs() > MAX_HEIGHT {
+        return Err(ValidationError::new(path(), Defect::HeightRange(v)));
+    }
+    Ok(())
+}
+
+/// Checks a figure's slope: finite and within ±[`MAX_SLOPE`].
+pub fn slope(v: f64, path: impl Fn() -> String) -> Result<(), ValidationError> {
+    finite(v, &path)?;
+    if v.abs() > MAX_SLOPE {
+        return Err(ValidationError::new(path(), Defect::SlopeRange(v)));
+    }
     Ok(())
 }
 
@@ -145,7 +326,7 @@ pub fn grid(g: &Grid) -> Result<(), ValidationError> {
     if g.cols == 0 || g.rows == 0 {
         return Err(ValidationError::new("grid", Defect::EmptyGrid));
     }
-    if !(g.cell_size.is_finite() && g.cell_size > 0.0 && g.width().is_finite() && g.height().is_finite()) {
+    if !(MIN_CELL_SIZE..=MAX_CELL_SIZE).contains(&g.cell_size) {
         return Err(ValidationError::new("grid.cell_size", Defect::CellSize(g.cell_size)));
     }
     let cells = u64::from(g.cols) * u64::from(g.rows);
@@ -174,6 +355,7 @@ pub fn region(grid: &Grid, region: &Region, index: usize) -> Result<(), Validati
         &region.boundary,
         &format!("{path}.boundary"),
         &path,
+        1,
     )
 }
 
@@ -231,6 +413,189 @@ fn points(grid: &Grid, pts: &[Point], path: &impl Fn(usize) -> String) -> Result
     Ok(())
 }
 
+/// The segments `pts[i] pts[i + 1]` of a polyline in a grid of square buckets, for finding the
+/// segments near another in time linear in the number of segments (for drawn curves, whose
+/// segments are of similar length).
+///
+/// The bucket side `h` is the mean segment length. A segment is represented by sample points no
+/// more than `h/3` apart, its ends included, each in the bucket holding it. A point common to two
+/// segments lies within `h/6` of a sample of each, so those samples are at most `h/3` apart and
+/// their buckets are equal or neighbours (also after rounding, which is far smaller than `h`):
+/// looking up the 3 × 3 buckets around each sample of one segment finds every segment that can
+/// touch it. A segment has at most `3·len/h + 2` samples, so the samples of a curve number at most
+/// `5n`; a segment `k` times longer than the mean costs `k` times more, not `n`.
+pub(crate) struct SegmentIndex<'a> {
+    pts: &'a [Point],
+    origin: DVec2,
+    h: f64,
+    buckets: HashMap<(i64, i64), Vec<u32>>,
+    /// The query a segment was last found by, to report each candidate once.
+    seen: Vec<u32>,
+    query: u32,
+}
+
+impl<'a> SegmentIndex<'a> {
+    pub(crate) fn new(pts: &'a [Point]) -> SegmentIndex<'a> {
+        let n = pts.len().saturating_sub(1);
+        let mut origin = DVec2::splat(f64::INFINITY);
+        let mut total = 0.0;
+        for (i, &p) in pts.iter().enumerate() {
+            origin = origin.min(DVec2::from(p));
+            if i > 0 {
+                total += geometry::distance(pts[i - 1], p);
+            }
+        }
+        let mean = total / n.max(1) as f64;
+        // Points are on the grid, so finite; a curve of one repeated point has no length.
+        let h = if mean.is_finite() && mean > 0.0 { mean } else { 1.0 };
+        let mut index = SegmentIndex {
+            pts,
+            origin,
+            h,
+            buckets: HashMap::new(),
+            seen: vec![0; n],
+            query: 0,
+        };
+        let mut cells = Vec::new();
+        for i in 0..n {
+            cells.clear();
+            index.samples(pts[i], pts[i + 1], &mut cells);
+            for &cell in &cells {
+                let list = index.buckets.entry(cell).or_default();
+                if list.last() != Some(&(i as u32)) {
+                    list.push(i as u32);
+                }
+            }
+        }
+        index
+    }
+
+    /// The buckets of the samples of segment `a b` (consecutive repeats removed).
+    fn samples(&self, a: Point, b: Point, out: &mut Vec<(i64, i64)>) {
+        let (a, b) = (DVec2::from(a), DVec2::from(b));
+        let steps = (3.0 * a.distance(b) / self.h).ceil().clamp(1.0, 1e9) as u64;
+        for k in 0..=steps {
+            let p = a.lerp(b, k as f64 / steps as f64);
+            let q = (p - self.origin) / self.h;
+            // `as` saturates: a point far outside the curve's box lands in an edge bucket, which
+            // only adds candidates.
+            let cell = (q.x.floor() as i64, q.y.floor() as i64);
+            if out.last() != Some(&cell) {
+                out.push(cell);
+            }
+        }
+    }
+
+    /// Every indexed segment that may touch segment `a b`, in increasing order (a superset of
+    /// those that do).
+    pub(crate) fn near(&mut self, a: Point, b: Point, out: &mut Vec<usize>) {
+        out.clear();
+        self.query += 1;
+        let mut cells = Vec::new();
+        self.samples(a, b, &mut cells);
+        for (x, y) in cells {
+            for dy in -1..=1 {
+                for dx in -1..=1 {
+                    let key = (x.saturating_add(dx), y.saturating_add(dy));
+                    let Some(list) = self.buckets.get(&key) else { continue };
+                    for &i in list {
+                        if self.seen[i as usize] != self.query {
+                            self.seen[i as usize] = self.query;
+                            out.push(i as usize);
+                        }
+                    }
+                }
+            }
+        }
+        out.sort_unstable();
+    }
+
+    /// Whether segment `a b` touches any indexed segment.
+    fn touches(&mut self, a: Point, b: Point, scratch: &mut Vec<usize>) -> bool {
+        self.near(a, b, scratch);
+        let pts = self.pts;
+        scratch
+            .iter()
+            .any(|&i| geometry::segments_touch(a, b, pts[i], pts[i + 1]))
+    }
+}
+
+/// A closed curve's edges in horizontal bands, to locate points against it in time proportional
+/// to the edges in the point's band rather than all of them. Each edge is in every band its
+/// `y` range meets, so every edge that can hold the point or cross its horizontal ray is in the
+/// point's band; [`Bands::locate`] gives exactly [`geometry::locate`]'s answer.
+struct Bands<'a> {
+    ring: &'a [Point],
+    y0: f64,
+    height: f64,
+    bands: Vec<Vec<u32>>,
+}
+
+impl<'a> Bands<'a> {
+    fn new(ring: &'a [Point]) -> Bands<'a> {
+        let n = ring.len().saturating_sub(1);
+        let (mut y0, mut y1, mut rise) = (f64::INFINITY, f64::NEG_INFINITY, 0.0);
+        for (i, p) in ring.iter().enumerate() {
+            y0 = y0.min(p[1]);
+            y1 = y1.max(p[1]);
+            if i > 0 {
+                rise += (p[1] - ring[i - 1][1]).abs();
+            }
+        }
+        // Bands at least as tall as an edge's mean rise, so the edges' band entries number at
+        // most about 3n; and at most n + 1 bands.
+        let span = (y1 - y0).max(0.0);
+        let height = (rise / n.max(1) as f64).max(span / n.max(1) as f64);
+        let height = if height.is_finite() && height > 0.0 {
+            height
+        } else {
+            1.0
+        };
+        let count = ((span / height).floor() as usize).saturating_add(1).min(n + 1);
+        let mut bands = Bands {
+            ring,
+            y0,
+            height,
+            bands: vec![Vec::new(); count.max(1)],
+        };
+        for i in 0..n {
+            let (a, b) = (ring[i][1], ring[i + 1][1]);
+            for band in bands.band(a.min(b))..=bands.band(a.max(b)) {
+                bands.bands[band].push(i as u32);
+            }
+        }
+        bands
+    }
+
+    /// The band of height `y` (monotonic in `y`, clamped to the bands).
+    fn band(&self, y: f64) -> usize {
+        let k = ((y - self.y0) / self.height).floor();
+        // `as` saturates (NaN to 0), then the clamp keeps it in range.
+        (k.max(0.0) as usize).min(self.bands.len() - 1)
+    }
+
+    /// [`geometry::locate`] of `p`, through the edges of its band only.
+    fn locate(&self, p: Point) -> Side {
+        let edges = &self.bands[self.band(p[1])];
+        let mut inside = false;
+        for &i in edges {
+            let (a, b) = (self.ring[i as usize], self.ring[i as usize + 1]);
+            if geometry::on_segment(a, b, p) {
+                return Side::On;
+            }
+            // The same half-open test and crossing as geometry::locate, so the same bits.
+            let (a, b, q) = (DVec2::from(a), DVec2::from(b), DVec2::from(p));
+            if (a.y > q.y) != (b.y > q.y) {
+                let x = a.x + (q.y - a.y) * (b.x - a.x) / (b.y - a.y);
+                if q.x < x {
+                    inside = !inside;
+                }
+            }
+        }
+        if inside { Side::Inside } else { Side::Outside }
+    }
+}
+
 /// A closed curve: valid points, closed, three or more vertices, not touching itself.
 fn ring(grid: &Grid, pts: &[Point], path: impl Fn(usize) -> String, whole: &str) -> Result<(), ValidationError> {
     points(grid, pts, &path)?;
@@ -245,8 +610,13 @@ fn ring(grid: &Grid, pts: &[Point], path: impl Fn(usize) -> String, whole: &str)
         return Err(ValidationError::new(whole, Defect::CurveTooShort(n)));
     }
     let seg = |i: usize| (pts[i], pts[i + 1]);
+    let mut index = SegmentIndex::new(pts);
+    let mut near = Vec::new();
+    // The first segment j meeting an earlier one, and the first such i: the order of checking
+    // every pair, with only the pairs that can meet looked at.
     for j in 1..n {
-        for i in 0..j {
+        index.near(pts[j], pts[j + 1], &mut near);
+        for &i in near.iter().take_while(|&&i| i < j) {
             let adjacent = j == i + 1 || (i == 0 && j == n - 1);
             let meets = if adjacent {
                 // Adjacent segments share a vertex; they meet elsewhere only by doubling back.
@@ -269,10 +639,36 @@ fn ring(grid: &Grid, pts: &[Point], path: impl Fn(usize) -> String, whole: &str)
     Ok(())
 }
 
-/// The figures of one region, bounded by `edge` (named `edge_path`), with paths under `parent`.
-fn figures(grid: &Grid, figs: &[Figure], edge: &[Point], edge_path: &str, parent: &str) -> Result<(), ValidationError> {
+/// A region's edge, indexed for the figures inside it.
+struct Edge<'a> {
+    path: &'a str,
+    segments: SegmentIndex<'a>,
+    bands: Bands<'a>,
+}
+
+/// The figures of one region, bounded by `edge` (named `edge_path`), with paths under `parent`,
+/// at nesting `depth` (1 for a top-level region's figures).
+fn figures(
+    grid: &Grid,
+    figs: &[Figure],
+    edge: &[Point],
+    edge_path: &str,
+    parent: &str,
+    depth: usize,
+) -> Result<(), ValidationError> {
+    if !figs.is_empty() && depth > MAX_DEPTH {
+        return Err(ValidationError::new(
+            format!("{parent}.figures[0]"),
+            Defect::TooDeep(depth),
+        ));
+    }
+    let mut edge = Edge {
+        path: edge_path,
+        segments: SegmentIndex::new(edge),
+        bands: Bands::new(edge),
+    };
     for (k, f) in figs.iter().enumerate() {
-        figure(grid, f, edge, edge_path, &format!("{parent}.figures[{k}]"))?;
+        figure(grid, f, &mut edge, &format!("{parent}.figures[{k}]"), depth)?;
     }
     // Sibling closed figures bound nested regions, which must not share cells.
     let closed: Vec<(usize, Mask)> = figs
@@ -297,9 +693,9 @@ fn figures(grid: &Grid, figs: &[Figure], edge: &[Point], edge_path: &str, parent
     Ok(())
 }
 
-fn figure(grid: &Grid, f: &Figure, edge: &[Point], edge_path: &str, path: &str) -> Result<(), ValidationError> {
-    finite(f.height, || format!("{path}.height"))?;
-    finite(f.slope, || format!("{path}.slope"))?;
+fn figure(grid: &Grid, f: &Figure, edge: &mut Edge<'_>, path: &str, depth: usize) -> Result<(), ValidationError> {
+    height(f.height, || format!("{path}.height"))?;
+    slope(f.slope, || format!("{path}.slope"))?;
     let point_path = |i: usize| format!("{path}.points[{i}]");
     match f.kind {
         FigureKind::Point => {
@@ -320,30 +716,28 @@ fn figure(grid: &Grid, f: &Figure, edge: &[Point], edge_path: &str, path: &str) 
         }
         FigureKind::Closed => ring(grid, &f.points, point_path, &format!("{path}.points"))?,
     }
+    let mut scratch = Vec::new();
     for (i, &p) in f.points.iter().enumerate() {
-        match geometry::locate(edge, p) {
+        match edge.bands.locate(p) {
             Side::Inside => {}
             Side::On => {
                 return Err(ValidationError::new(
                     point_path(i),
-                    Defect::OnRegionEdge(edge_path.into()),
+                    Defect::OnRegionEdge(edge.path.into()),
                 ));
             }
             Side::Outside => {
                 return Err(ValidationError::new(
                     point_path(i),
-                    Defect::OutsideRegion(edge_path.into()),
+                    Defect::OutsideRegion(edge.path.into()),
                 ));
             }
         }
-        if i > 0 {
-            let (a, b) = (f.points[i - 1], p);
-            if edge.windows(2).any(|e| geometry::segments_touch(a, b, e[0], e[1])) {
-                return Err(ValidationError::new(
-                    point_path(i),
-                    Defect::CrossesRegionEdge(edge_path.into()),
-                ));
-            }
+        if i > 0 && edge.segments.touches(f.points[i - 1], p, &mut scratch) {
+            return Err(ValidationError::new(
+                point_path(i),
+                Defect::CrossesRegionEdge(edge.path.into()),
+            ));
         }
     }
     if !f.figures.is_empty() {
@@ -353,7 +747,7 @@ fn figure(grid: &Grid, f: &Figure, edge: &[Point], edge_path: &str, path: &str) 
                 Defect::NestedInOpenFigure(f.kind.name()),
             ));
         }
-        figures(grid, &f.figures, &f.points, &format!("{path}.points"), path)?;
+        figures(grid, &f.figures, &f.points, &format!("{path}.points"), path, depth + 1)?;
     }
     Ok(())
 }

@@ -358,7 +358,8 @@ fn torn_last_line_is_dropped_and_stale_journal_set_aside() {
         OpenReport {
             replayed: 1,
             dropped_torn_line: true,
-            stale_journal: None
+            stale_journal: None,
+            ignored_stale_journal: None,
         }
     );
     assert_eq!(editor.document(), &after_one);

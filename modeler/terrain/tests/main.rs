@@ -6,5 +6,6 @@ mod editing;
 mod equations;
 mod examples;
 mod exports;
+mod limits;
 mod properties;
 mod validation;

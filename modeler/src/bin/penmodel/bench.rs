@@ -12,6 +12,10 @@
 //! - Pull update: [`Editor::preview`] of the first figure's height, alternating between two
 //!   values after a first (untimed) step that starts the pull.
 //! - Medians over repeated runs after warm-up.
+//! - Memory, measured first: the peak resident set (`VmHWM` of /proc/self/status, Linux) after
+//!   building the terrain of a document with K point figures in one region over most of an
+//!   N × N grid (default 100 figures on 1024², cell size 1 m), beside the bound validation
+//!   computes for it ([`validate::engine_bytes`], at most [`validate::MAX_ENGINE_BYTES`]).
 
 use std::io::IsTerminal;
 use std::time::Instant;
@@ -19,7 +23,7 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use penmodel_render::{Camera, Frame, Renderer, Scene, SlopeBar};
-use penmodel_terrain::{Document, Edit, Editor, FigurePath};
+use penmodel_terrain::{Document, Edit, Editor, Figure, FigureKind, FigurePath, Grid, Region, TerrainEngine, validate};
 
 /// Grid sizes measured.
 const GRIDS: [u32; 3] = [256, 512, 1024];
@@ -41,6 +45,82 @@ pub struct Args {
     /// Grid sizes to measure (repeatable; default 256, 512 and 1024).
     #[arg(long = "grid", value_name = "N", value_parser = clap::value_parser!(u32).range(2..=4096))]
     grids: Vec<u32>,
+    /// The memory case's grid: N × N cells.
+    #[arg(long, value_name = "N", default_value_t = 1024, value_parser = clap::value_parser!(u32).range(16..=4096))]
+    memory_grid: u32,
+    /// The memory case's number of point figures.
+    #[arg(long, value_name = "K", default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=10000))]
+    memory_figures: u32,
+}
+
+/// The memory case: `k` point figures on a lattice in one square region over most of an n × n
+/// grid of 1 m cells.
+fn memory_document(n: u32, k: u32) -> Document {
+    let size = f64::from(n);
+    let (lo, hi) = (0.02 * size, 0.98 * size);
+    let side = (f64::from(k).sqrt().ceil() as u32).max(1);
+    let step = (hi - lo) / f64::from(side + 1);
+    let figures = (0..k)
+        .map(|i| Figure {
+            kind: FigureKind::Point,
+            points: vec![[lo + step * f64::from(i % side + 1), lo + step * f64::from(i / side + 1)]],
+            height: 10.0 + f64::from(i % 7) * 5.0,
+            slope: 0.0,
+            figures: Vec::new(),
+        })
+        .collect();
+    let mut doc = Document::new(Grid {
+        cols: n,
+        rows: n,
+        cell_size: 1.0,
+    });
+    doc.regions.push(Region {
+        boundary: vec![[lo, lo], [hi, lo], [hi, hi], [lo, hi], [lo, lo]],
+        figures,
+    });
+    doc
+}
+
+/// `VmHWM` (peak resident set) from /proc/self/status, in bytes; `None` where there is none.
+fn peak_rss() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kb: u64 = line
+        .trim_start_matches("VmHWM:")
+        .trim()
+        .trim_end_matches("kB")
+        .trim()
+        .parse()
+        .ok()?;
+    Some(kb * 1024)
+}
+
+struct Memory {
+    grid: u32,
+    figures: u32,
+    estimate: u64,
+    before: Option<u64>,
+    peak: Option<u64>,
+}
+
+fn measure_memory(n: u32, k: u32) -> Result<Memory> {
+    let doc = memory_document(n, k);
+    let (estimate, _, _) = validate::engine_bytes(&doc);
+    let before = peak_rss();
+    let engine = TerrainEngine::new(&doc)?;
+    let peak = peak_rss();
+    drop(engine);
+    Ok(Memory {
+        grid: n,
+        figures: k,
+        estimate,
+        before,
+        peak,
+    })
+}
+
+fn mb(bytes: u64) -> f64 {
+    (bytes as f64 / 1e6 * 10.0).round() / 10.0
 }
 
 fn document(n: u32) -> Result<Document> {
@@ -157,6 +237,8 @@ pub fn run(args: &Args) -> Result<()> {
     } else {
         ProgressBar::hidden()
     };
+    // First, while the process is small, so the peak is the engine's.
+    let memory = measure_memory(args.memory_grid, args.memory_figures)?;
     let mut results = Vec::new();
     for &n in &grids {
         bar.set_message(format!("{n}×{n}"));
@@ -173,7 +255,17 @@ pub fn run(args: &Args) -> Result<()> {
             .iter()
             .map(|r| serde_json::json!({"grid": r.grid, "ms": round3(r.pull_ms)}))
             .collect();
-        println!("{}", serde_json::json!({"render": render, "pull_update": pull}));
+        let memory = serde_json::json!({
+            "grid": memory.grid,
+            "figures": memory.figures,
+            "estimate_mb": mb(memory.estimate),
+            "peak_rss_mb": memory.peak.map(mb),
+            "rss_before_mb": memory.before.map(mb),
+        });
+        println!(
+            "{}",
+            serde_json::json!({"render": render, "pull_update": pull, "memory": memory})
+        );
     } else {
         println!("grid        frame {w}×{h}   frames/s   terrain on screen   pull update");
         for r in &results {
@@ -188,6 +280,17 @@ pub fn run(args: &Args) -> Result<()> {
             );
         }
         println!("medians of {FRAMES} frames and {PULLS} pull updates per grid; targets at 512×512: ≤ 16.7 ms, ≤ 2 ms");
+        let show = |v: Option<u64>| v.map_or("unknown".to_owned(), |b| format!("{} MB", mb(b)));
+        println!(
+            "memory: {} figures on {}×{}: peak resident {} (before building {}), bound {} MB (limit {} MB)",
+            memory.figures,
+            memory.grid,
+            memory.grid,
+            show(memory.peak),
+            show(memory.before),
+            mb(memory.estimate),
+            mb(validate::MAX_ENGINE_BYTES)
+        );
     }
     Ok(())
 }

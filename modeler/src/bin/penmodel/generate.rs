@@ -4,7 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use penmodel_terrain::editor::Editor;
-use penmodel_terrain::{Heightmap, export};
+use penmodel_terrain::{Heightmap, export, journal};
 
 /// Arguments of `penmodel generate`.
 #[derive(clap::Args)]
@@ -49,9 +49,25 @@ fn export(
 /// Runs the command.
 pub fn run(args: &Args) -> Result<()> {
     let (editor, report) = Editor::open_read_only(&args.doc)?;
+    // The terrain is the saved document's alone then; say so rather than silently leave out
+    // edits the user may expect.
+    if let Some(stale) = &report.ignored_stale_journal {
+        eprintln!(
+            "penmodel: {} was not replayed: it was written for another version of {} (it is left as it is; \
+             `penmodel open` sets it aside)",
+            stale.display(),
+            args.doc.display()
+        );
+    }
+    if report.dropped_torn_line {
+        eprintln!(
+            "penmodel: the last line of {} was cut off by a crash and was not replayed",
+            journal::path_for(&args.doc).display()
+        );
+    }
     let map = editor.heightmap();
     let mut raw = Vec::new();
-    export::write_raw(map, &mut raw)?;
+    export::write_raw(map, &mut raw).with_context(|| format!("cannot export {}", args.raw.display()))?;
     write(&args.raw, &raw)?;
     export(map, &args.png, |m, out| export::write_png(m, out).map(|_| ()))?;
     export(map, &args.obj, |m, out| export::write_obj(m, out))?;

@@ -21,6 +21,7 @@ impl Mesh {
         if cols < 2 || rows < 2 {
             return Err(ExportError::TooSmallForMesh { cols, rows });
         }
+        super::check_finite(map)?;
         let s = map.cell_size();
         let h = |c: u32, r: u32| f64::from(map.get(c, r));
         let mut positions = Vec::with_capacity(map.heights().len());

@@ -25,6 +25,21 @@ pub use obj::write_obj;
 pub use png::{HeightRange, KEY_CELL_SIZE, KEY_HEIGHT_MAX, KEY_HEIGHT_MIN, read_png_range, write_png};
 pub use raw::{read_raw, write_raw};
 
+/// Checks that every height of `map` is finite, so no file gets NaN or infinity in it.
+pub fn check_finite(map: &crate::Heightmap) -> Result<(), ExportError> {
+    match map.heights().iter().position(|h| !h.is_finite()) {
+        None => Ok(()),
+        Some(i) => {
+            let cols = map.cols().max(1) as usize;
+            Err(ExportError::NotFinite {
+                col: (i % cols) as u32,
+                row: (i / cols) as u32,
+                value: map.heights()[i],
+            })
+        }
+    }
+}
+
 /// Why an export failed.
 #[allow(missing_docs)] // fields named for what they hold.
 #[derive(Debug, Error)]
@@ -38,6 +53,10 @@ pub enum ExportError {
     /// A mesh needs at least 2 × 2 cells.
     #[error("a mesh needs at least 2 × 2 cells, the grid is {cols} × {rows}")]
     TooSmallForMesh { cols: u32, rows: u32 },
+    /// A height is NaN or infinite. A valid document never gives one (its heights, slopes and
+    /// cell size are bounded for that); this guards the files against a heightmap built otherwise.
+    #[error("the height of cell ({col}, {row}) is {value}, not a finite number; nothing was exported")]
+    NotFinite { col: u32, row: u32, value: f32 },
     /// The mesh does not fit the format's 32-bit sizes.
     #[error("the mesh is too large for binary glTF ({0} bytes)")]
     TooLarge(u64),

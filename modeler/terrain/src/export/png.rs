@@ -48,6 +48,7 @@ fn encode_error(e: impl std::fmt::Display) -> ExportError {
 
 /// Writes the heightmap as a 16-bit grayscale PNG and returns the range it recorded.
 pub fn write_png(map: &Heightmap, out: impl Write) -> Result<HeightRange, ExportError> {
+    super::check_finite(map)?;
     let (min, max) = map.range();
     let mut enc = png::Encoder::new(out, map.cols(), map.rows());
     enc.set_color(png::ColorType::Grayscale);

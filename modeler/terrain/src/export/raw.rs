@@ -6,13 +6,14 @@ use std::io::{self, Read, Write};
 use crate::heightmap::Heightmap;
 
 /// Writes the heights as raw little-endian float32.
-pub fn write_raw(map: &Heightmap, mut out: impl Write) -> io::Result<()> {
+pub fn write_raw(map: &Heightmap, mut out: impl Write) -> Result<(), super::ExportError> {
+    super::check_finite(map)?;
     let mut bytes = Vec::with_capacity(map.heights().len() * 4);
     for h in map.heights() {
         bytes.extend_from_slice(&h.to_le_bytes());
     }
     out.write_all(&bytes)?;
-    out.flush()
+    Ok(out.flush()?)
 }
 
 /// Reads `cols × rows` raw little-endian float32 heights.
