@@ -87,7 +87,7 @@ fn usage_errors_exit_2() {
     assert_eq!(penmodel(&["frobnicate"]).status.code(), Some(2));
     // Without a subcommand penmodel models with the pen (tests/demo_cli.rs); its options are
     // checked like any others.
-    assert_eq!(penmodel(&["--fps", "0"]).status.code(), Some(2));
+    assert_eq!(penmodel(&["--fps", "61"]).status.code(), Some(2));
     assert_eq!(penmodel(&["--show", "sideways"]).status.code(), Some(2));
     let help = penmodel(&["generate", "--help"]);
     assert!(help.status.success());
@@ -207,11 +207,22 @@ fn render_of_a_bad_document_exits_1_with_the_reason() {
 
 #[test]
 fn bench_json_has_the_documented_shape() {
-    let out = penmodel(&["bench", "--json", "--grid", "16", "--grid", "24"]);
+    let out = penmodel(&[
+        "bench",
+        "--json",
+        "--grid",
+        "16",
+        "--grid",
+        "24",
+        "--memory-grid",
+        "64",
+        "--memory-figures",
+        "10",
+    ]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let obj = v.as_object().unwrap();
-    assert_eq!(obj.keys().collect::<Vec<_>>(), ["render", "pull_update"]);
+    assert_eq!(obj.keys().collect::<Vec<_>>(), ["render", "pull_update", "memory"]);
     let render = v["render"].as_array().unwrap();
     let pull = v["pull_update"].as_array().unwrap();
     for (i, n) in [16, 24].into_iter().enumerate() {
@@ -225,4 +236,118 @@ fn bench_json_has_the_documented_shape() {
         assert_eq!(pull[i]["grid"].as_u64(), Some(n));
         assert!(pull[i]["ms"].as_f64().unwrap() >= 0.0);
     }
+    let memory = &v["memory"];
+    assert_eq!(
+        (memory["grid"].as_u64(), memory["figures"].as_u64()),
+        (Some(64), Some(10))
+    );
+    assert!(memory["estimate_mb"].as_f64().unwrap() > 0.0);
+    // Linux reports the peak resident set; elsewhere it is null.
+    assert!(memory["peak_rss_mb"].is_null() || memory["peak_rss_mb"].as_f64().unwrap() > 0.0);
+}
+
+/// Runs `generate` on `text` as a document (and `journal` beside it), returning exit code and stderr.
+fn generate_text(text: &[u8], journal: Option<&[u8]>) -> (Option<i32>, String) {
+    let dir = tempfile::tempdir().unwrap();
+    let doc = dir.path().join("d.json");
+    std::fs::write(&doc, text).unwrap();
+    if let Some(j) = journal {
+        std::fs::write(dir.path().join("d.json.journal"), j).unwrap();
+    }
+    let out = penmodel(&["generate", s(&doc), "--raw", s(&dir.path().join("o.f32"))]);
+    (out.status.code(), String::from_utf8_lossy(&out.stderr).into_owned())
+}
+
+fn volcano_with(from: &str, to: &str) -> String {
+    let text = std::fs::read_to_string(example("04-volcano.json")).unwrap();
+    assert!(text.contains(from), "{from}");
+    text.replacen(from, to, 1)
+}
+
+#[test]
+fn generate_refuses_what_would_not_make_finite_terrain() {
+    let volcano = std::fs::read_to_string(example("04-volcano.json")).unwrap();
+    let (code, err) = generate_text(volcano_with("\"height\": 70.0", "\"height\": 1.7e308").as_bytes(), None);
+    assert_eq!(code, Some(1));
+    assert!(err.contains("a height must be within ±1000000 m, got 1.7e308"), "{err}");
+    let (code, err) = generate_text(
+        volcano_with("\"cell_size\": 2.0", "\"cell_size\": 1e308").as_bytes(),
+        None,
+    );
+    assert_eq!(code, Some(1));
+    assert_eq!(
+        err,
+        "penmodel: grid.cell_size: the cell size must be between 0.001 and 100000 m, got 1e308\n"
+    );
+    // A journal that sets such a height does not replay.
+    let dir = tempfile::tempdir().unwrap();
+    let doc = dir.path().join("v.json");
+    std::fs::write(&doc, &volcano).unwrap();
+    let base = penmodel_terrain::journal::fingerprint(volcano.as_bytes());
+    let journal = format!(
+        "{{\"op\":\"open\",\"journal\":1,\"base\":\"{base}\"}}\n{{\"op\":\"do\",\"edit\":{{\"op\":\"set_height\",\"at\":\"regions[0].figures[0]\",\"height\":1e308}}}}\n"
+    );
+    let (code, err) = generate_text(volcano.as_bytes(), Some(journal.as_bytes()));
+    assert_eq!(code, Some(1));
+    assert!(
+        err.contains("line 2: cannot replay") && err.contains("got 1e308"),
+        "{err}"
+    );
+}
+
+#[test]
+fn generate_refuses_text_after_the_document() {
+    let volcano = std::fs::read_to_string(example("04-volcano.json")).unwrap();
+    for tail in ["xyz garbage {", volcano.as_str()] {
+        let (code, err) = generate_text(format!("{volcano}{tail}").as_bytes(), None);
+        assert_eq!(code, Some(1));
+        assert!(
+            err.starts_with("penmodel: document: unexpected text after the end of the document"),
+            "{err}"
+        );
+    }
+}
+
+#[test]
+fn generate_messages_name_the_problem_once() {
+    let (code, err) = generate_text(b"{", None);
+    assert_eq!(code, Some(1));
+    assert!(err.starts_with("penmodel: document: ") && !err.contains('?'), "{err}");
+    let (_, err) = generate_text(b"[]", None);
+    assert!(
+        err.contains("expected a document") && !err.contains("VersionOnly"),
+        "{err}"
+    );
+    let (_, err) = generate_text(
+        br#"{"version": 1, "grid": {"cols": 4, "rows": 4, "cell_size": 1}, "regions": [{"boundary": [[0, 0, 1]]}]}"#,
+        None,
+    );
+    assert!(
+        err.starts_with("penmodel: regions[0].boundary[0]: a point is [x, y]: two numbers, found more"),
+        "{err}"
+    );
+    // A directory as the document: the OS's reason once.
+    let dir = tempfile::tempdir().unwrap();
+    let out = penmodel(&["generate", s(dir.path()), "--raw", s(&dir.path().join("o.f32"))]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(err.matches("os error").count(), 1, "{err}");
+    // A journal line that is not UTF-8 is named by its line.
+    let volcano = std::fs::read_to_string(example("04-volcano.json")).unwrap();
+    let base = penmodel_terrain::journal::fingerprint(volcano.as_bytes());
+    let mut journal =
+        format!("{{\"op\":\"open\",\"journal\":1,\"base\":\"{base}\"}}\n{{\"op\":\"undo\"}}\n").into_bytes();
+    journal.extend_from_slice(b"{\"op\":\"re\xffdo\"}\n");
+    let (code, err) = generate_text(volcano.as_bytes(), Some(&journal));
+    assert_eq!(code, Some(1));
+    assert!(err.contains("line 3: not UTF-8 text"), "{err}");
+}
+
+#[test]
+fn generate_says_when_it_skips_a_stale_journal() {
+    let volcano = std::fs::read_to_string(example("04-volcano.json")).unwrap();
+    let journal = b"{\"op\":\"open\",\"journal\":1,\"base\":\"fnv1a64:0000000000000000\"}\n";
+    let (code, err) = generate_text(volcano.as_bytes(), Some(journal));
+    assert_eq!(code, Some(0));
+    assert!(err.contains("d.json.journal was not replayed"), "{err}");
 }
