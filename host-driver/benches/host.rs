@@ -24,6 +24,7 @@ fn bench(c: &mut Criterion) {
         kind: FitKind::Similarity,
         display: DisplaySize::REFERENCE,
         residuals: Vec::new(),
+        device: None,
     };
     let report = |seq: u16| PenReport {
         sw1: seq % 64 < 32,

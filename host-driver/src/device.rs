@@ -1,9 +1,11 @@
 //! A device session that survives unplugging: it reads samples, says when the device goes away,
-//! keeps trying to reattach, and says when it is back.
+//! keeps trying to reattach, and says when it is back. At each attach it reads the device's
+//! information, so that whoever uses the session knows which base station it is (its unique ID)
+//! before the first sample — a calibration is checked against it.
 
 use std::time::{Duration, Instant};
 
-use pen_protocol::{Message, TofReport};
+use pen_protocol::{DeviceInfo, Message, ReportId, TofReport};
 
 use crate::sample::{Sample, Sampler, now_us};
 use crate::source::Source;
@@ -33,6 +35,7 @@ pub struct Device {
     sampler: Sampler,
     next_try: Instant,
     last_error: Option<String>,
+    info: Result<DeviceInfo, String>,
 }
 
 impl Device {
@@ -44,6 +47,7 @@ impl Device {
             sampler: Sampler::new(),
             next_try: Instant::now(),
             last_error: None,
+            info: Err("not attached".into()),
         }
     }
 
@@ -67,6 +71,19 @@ impl Device {
         self.last_error.as_deref()
     }
 
+    /// The attached device's information (read at each attach), or why it could not be read.
+    pub fn info(&self) -> Result<&DeviceInfo, &str> {
+        self.info.as_ref().map_err(String::as_str)
+    }
+
+    /// Lets the device go without its having gone away (it is refused, say), and tries to
+    /// reattach only after `retry_in`: a different device may have taken its place by then.
+    pub fn detach(&mut self, retry_in: Duration) {
+        self.transport = None;
+        self.info = Err("not attached".into());
+        self.next_try = Instant::now() + retry_in;
+    }
+
     /// Waits at most `timeout` for the next thing to happen.
     pub fn next(&mut self, timeout: Duration) -> Option<DeviceEvent> {
         let Some(transport) = self.transport.as_mut() else {
@@ -77,8 +94,13 @@ impl Device {
             }
             self.next_try = now + RETRY_EVERY;
             return match self.source.open() {
-                Ok(t) => {
+                Ok(mut t) => {
                     let name = t.describe();
+                    self.info = match t.get_feature(ReportId::DeviceInfo) {
+                        Ok(Message::DeviceInfo(info)) => Ok(info),
+                        Ok(other) => Err(format!("it answered with a {} report", other.id())),
+                        Err(e) => Err(e.to_string()),
+                    };
                     self.transport = Some(t);
                     self.sampler = Sampler::new();
                     self.last_error = None;
@@ -99,6 +121,7 @@ impl Device {
             Ok(_) => None,
             Err(TransportError::Disconnected(why)) => {
                 self.transport = None;
+                self.info = Err("not attached".into());
                 self.next_try = Instant::now();
                 Some(DeviceEvent::Lost(why))
             }

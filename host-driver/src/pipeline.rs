@@ -1,4 +1,9 @@
 //! From a device to pen events: samples through the calibration into the event detector.
+//!
+//! A calibration that records its base station is checked against each device as it attaches
+//! (or reattaches: another base station may have been plugged in meanwhile); a device it does
+//! not belong to is refused — let go and tried again later — with a `device_lost` event saying
+//! why and what to do, and none of its samples become events.
 
 use std::time::Duration;
 
@@ -8,12 +13,17 @@ use crate::events::{DisplayPoint, EventDetector, PenEvent};
 use crate::sample::{Sample, now_us};
 use crate::source::Source;
 
+/// How long a refused device is left alone before it is tried again: long enough not to fill
+/// a log, short enough to take the right base station soon after it is plugged in.
+pub const REFUSED_RETRY: Duration = Duration::from_secs(2);
+
 /// A device, its calibration, and the pen's state.
 pub struct Pipeline {
     device: Device,
     calibration: Calibration,
     detector: EventDetector,
     lost: u64,
+    refused: Option<String>,
 }
 
 impl Pipeline {
@@ -29,7 +39,13 @@ impl Pipeline {
             calibration,
             detector: EventDetector::new(),
             lost: 0,
+            refused: None,
         }
+    }
+
+    /// Why the last device attached was refused (its calibration is another's), while it is.
+    pub fn refused(&self) -> Option<&str> {
+        self.refused.as_deref()
     }
 
     /// The device session, for requests.
@@ -68,6 +84,17 @@ impl Pipeline {
                 Some(s)
             }
             DeviceEvent::Found(name) => {
+                if let Err(e) = self.calibration.check_device(self.device.info()) {
+                    self.device.detach(REFUSED_RETRY);
+                    let why = format!("{name} refused: {e}");
+                    // Said once per refusal, not at every retry.
+                    if self.refused.as_deref() != Some(why.as_str()) {
+                        self.detector.on_device_lost(now_us(), &why, out);
+                        self.refused = Some(why);
+                    }
+                    return None;
+                }
+                self.refused = None;
                 self.detector.on_device_found(now_us(), &name, out);
                 None
             }

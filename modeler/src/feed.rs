@@ -243,9 +243,17 @@ fn run_daemon(tx: &SyncSender<Feed>, path: &std::path::Path) -> Result<(), Stop>
 }
 
 fn run_device(tx: &SyncSender<Feed>, source: Source, calibration: Option<PathBuf>) -> Result<(), Stop> {
-    let path = calibration.or_else(|| pen_host::calibration::default_path().filter(|p| p.exists()));
+    // The simulated pen's calibration is its own; each is applied only to the base station it
+    // records (the pipeline refuses another), and one recording none is used with a warning.
+    let path = calibration.or_else(|| pen_host::calibration::default_path_for_source(&source).filter(|p| p.exists()));
     let calibration = match &path {
-        Some(p) => Calibration::load(p).map_err(|e| Stop::Failed(e.to_string()))?,
+        Some(p) => {
+            let c = Calibration::load(p).map_err(|e| Stop::Failed(e.to_string()))?;
+            if let Some(warning) = c.unbound_warning(p) {
+                send(tx, Feed::Status(format!("warning: {warning}")))?;
+            }
+            c
+        }
         None => {
             send(
                 tx,

@@ -47,6 +47,9 @@ pub struct Scenario {
     pub timeline: Timeline,
     /// The configuration the device runs.
     pub config: Config,
+    /// The unique ID the device reports ([`SIM_UNIQUE_ID`] unless set otherwise): another
+    /// one stands for another base station, whose calibration is not this one's.
+    pub unique_id: [u8; 12],
 }
 
 impl Scenario {
@@ -59,7 +62,13 @@ impl Scenario {
             acoustics,
             timeline,
             config,
+            unique_id: SIM_UNIQUE_ID,
         }
+    }
+
+    /// The same session on a base station reporting `unique_id`.
+    pub fn with_unique_id(self, unique_id: [u8; 12]) -> Scenario {
+        Scenario { unique_id, ..self }
     }
 }
 
@@ -239,7 +248,7 @@ impl Simulation {
         let engine: SimEngine = Rc::new(Mutex::new(RefCell::new(Engine::new(
             Some(scenario.config),
             SIM_FIRMWARE,
-            SIM_UNIQUE_ID,
+            scenario.unique_id,
         ))));
         let station = Station::new(
             engine.clone(),

@@ -11,7 +11,7 @@ use std::time::Duration;
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use pen_host::calibration::procedure::{self as calibrate, Prompt};
-use pen_host::calibration::{self, DisplaySize, FitKind, plot};
+use pen_host::calibration::{self, Calibration, CalibrationError, DeviceId, DisplaySize, FitKind, plot};
 use pen_host::device::{Device, DeviceEvent};
 use pen_host::hex;
 use pen_host::source::{self, SimSwitch, Source};
@@ -152,7 +152,8 @@ struct CalibrateArgs {
     /// The transform to fit.
     #[arg(long, value_enum, default_value_t = Fit::Similarity)]
     fit: Fit,
-    /// Where to save the calibration [default: $XDG_CONFIG_HOME/penscape/calibration.toml].
+    /// Where to save the calibration [default: $XDG_CONFIG_HOME/penscape/calibration.toml;
+    /// calibration-sim.toml for the simulated pen, so that it never replaces the real one's].
     #[arg(long, value_name = "FILE")]
     out: Option<PathBuf>,
     /// Also draw the residuals into this PNG.
@@ -212,6 +213,61 @@ struct InfoJson<'a> {
     /// The device information report, tagged like `penctl decode` prints it.
     info: &'a Message,
     config: &'a Config,
+    /// The calibration pend would apply to this device by default.
+    calibration: CalibrationJson,
+}
+
+/// The default calibration file for a device and whether it is this device's.
+#[derive(Serialize)]
+struct CalibrationJson {
+    /// The file, if there is one.
+    path: Option<String>,
+    /// The base station it records (hex), if it records one.
+    device: Option<String>,
+    /// Whether pend applies it to this device.
+    applies: bool,
+    /// What it means, in words.
+    status: String,
+}
+
+/// Which calibration pend would apply to the device `info` describes by default, and whether
+/// it may: the user sees whether calibrating is needed before starting pend.
+fn calibration_status(simulated: bool, info: &pen_protocol::DeviceInfo) -> CalibrationJson {
+    let id = DeviceId::of(info);
+    let path = calibration::default_path_for(simulated || id.is_simulated());
+    let Some(path) = path.filter(|p| p.exists()) else {
+        return CalibrationJson {
+            path: None,
+            device: None,
+            applies: false,
+            status: "none: run `penctl calibrate`".into(),
+        };
+    };
+    let (device, applies, status) = match Calibration::load(&path) {
+        Err(e) => (None, false, format!("unreadable ({e}): run `penctl calibrate`")),
+        Ok(c) => match c.check_device(Ok(info)) {
+            Ok(()) if c.device.is_some() => (c.device, true, "this base station's".into()),
+            Ok(()) => (
+                None,
+                true,
+                "records no base station (version 1): run `penctl calibrate`".into(),
+            ),
+            Err(_) => (
+                c.device,
+                false,
+                format!(
+                    "base station {}'s, not this one's: run `penctl calibrate`",
+                    c.device.map(|d| d.to_string()).unwrap_or_default()
+                ),
+            ),
+        },
+    };
+    CalibrationJson {
+        path: Some(path.display().to_string()),
+        device: device.map(|d| d.to_hex()),
+        applies,
+        status,
+    }
 }
 
 /// Reads configuration changes in JSON (the form `config get --json` prints); errors name the
@@ -238,11 +294,13 @@ fn info(args: &DeviceArgs, as_json: bool) -> Result<()> {
     };
     pen_protocol::check_version(info.protocol)?;
     let config = get_config(t)?;
+    let calibration = calibration_status(args.is_sim(), &info);
     if as_json {
         print_json(&InfoJson {
             device: t.describe(),
             info: &Message::DeviceInfo(info),
             config: &config,
+            calibration,
         })?;
     } else {
         outln!("device       {}", t.describe());
@@ -252,6 +310,10 @@ fn info(args: &DeviceArgs, as_json: bool) -> Result<()> {
         outln!("fix rate     {} Hz", info.fix_rate_hz);
         outln!("unique ID    {}", hex::to_hex(&info.unique_id));
         outln!("display pose {}", if config.display.is_some() { "set" } else { "none" });
+        match &calibration.path {
+            Some(p) => outln!("calibration  {p}: {}", calibration.status),
+            None => outln!("calibration  {}", calibration.status),
+        }
     }
     Ok(())
 }
@@ -371,15 +433,20 @@ fn calibration_source(device: &DeviceArgs, _targets: &[glam::DVec2]) -> Result<S
 fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
     let (width_mm, height_mm) = size::<f64>(&a.display_mm, "--display-mm")?;
     let (width_px, height_px) = size::<u32>(&a.display_px, "--display-px")?;
-    if !(width_mm > 0.0 && height_mm > 0.0 && width_px > 0 && height_px > 0) {
-        bail!("the display's size must be positive");
-    }
     let display = DisplaySize {
         width_mm,
         height_mm,
         width_px,
         height_px,
     };
+    // Checked before the touches, not after the user has made them all.
+    if let Err(e) = display.check() {
+        let flag = match &e {
+            CalibrationError::Display { key, .. } if key.ends_with("_px") => "--display-px",
+            _ => "--display-mm",
+        };
+        bail!("{flag}: {e}");
+    }
     let targets = display.targets(a.targets as usize);
     let kind = match a.fit {
         Fit::Rigid => FitKind::Rigid,
@@ -388,6 +455,17 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
     let source = calibration_source(&a.device, &targets)?;
     let mut device = Device::new(source);
     calibrate::attach(&mut device, Duration::from_secs(2))?;
+    // The calibration records its base station, and is refused for any other.
+    let id = match device.info() {
+        Ok(info) => DeviceId::of(info),
+        Err(why) => bail!("cannot read the base station's unique ID, which the calibration records: {why}"),
+    };
+    // Chosen before the touches, so that a missing home is said at once.
+    let out = match a.out {
+        Some(p) => p,
+        None => calibration::default_path_for(a.device.is_sim() || id.is_simulated())
+            .context("neither XDG_CONFIG_HOME nor HOME is set; give --out")?,
+    };
     let original = calibrate::prepare(&mut device)?;
     let patience = Duration::from_secs_f64(a.patience.max(1.0));
     let tty = std::io::stderr().is_terminal();
@@ -420,7 +498,8 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
             return Err(e.into());
         }
     };
-    let cal = calibration::fit(&targets, &touched, kind, display)?;
+    let mut cal = calibration::fit(&targets, &touched, kind, display)?;
+    cal.device = Some(id);
     outln!("target (u, v) mm     residual mm");
     for r in &cal.residuals {
         outln!(
@@ -442,15 +521,20 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
             cal.transform.scale
         );
     }
-    let out = match a.out {
-        Some(p) => p,
-        None => pen_host::calibration::default_path().context("neither XDG_CONFIG_HOME nor HOME is set; give --out")?,
-    };
+    // Replacing another base station's calibration is what the user asked for, but say so.
+    if let Ok(old) = Calibration::load(&out)
+        && let Some(other) = old.device.filter(|d| *d != id)
+    {
+        eprintln!(
+            "penctl: {} was base station {other}'s; it is now this one's ({id})",
+            out.display()
+        );
+    }
     if let Some(dir) = out.parent().filter(|d| !d.as_os_str().is_empty()) {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     }
     cal.save(&out).with_context(|| format!("saving {}", out.display()))?;
-    outln!("saved {}", out.display());
+    outln!("saved {} (base station {id})", out.display());
     if let Some(png) = &a.plot {
         plot::write_residual_plot(&cal, png, 900).with_context(|| format!("writing {}", png.display()))?;
         outln!("plot {}", png.display());

@@ -28,8 +28,9 @@ struct Cli {
     socket: Option<PathBuf>,
     #[command(flatten)]
     device: DeviceArgs<SimScenario>,
-    /// The calibration file [default: $XDG_CONFIG_HOME/penscape/calibration.toml if it exists;
-    /// otherwise tracker coordinates are display coordinates].
+    /// The calibration file [default: $XDG_CONFIG_HOME/penscape/calibration.toml if it exists,
+    /// calibration-sim.toml for --sim; otherwise tracker coordinates are display coordinates].
+    /// It is applied only to the base station it records.
     #[arg(long, value_name = "FILE")]
     calibration: Option<PathBuf>,
     /// Events a client may have waiting before it misses some.
@@ -41,11 +42,15 @@ fn run(cli: Cli) -> Result<()> {
     let source = cli.device.source()?;
     let calibration = match cli
         .calibration
-        .or_else(|| pen_host::calibration::default_path().filter(|p| p.exists()))
+        .or_else(|| pen_host::calibration::default_path_for_source(&source).filter(|p| p.exists()))
     {
         Some(path) => {
             let c = Calibration::load(&path)?;
-            eprintln!("pend: calibration {} (RMS {:.2} mm)", path.display(), c.rms_mm());
+            let whose = c.device.map(|d| format!(", base station {d}")).unwrap_or_default();
+            eprintln!("pend: calibration {} (RMS {:.2} mm{whose})", path.display(), c.rms_mm());
+            if let Some(warning) = c.unbound_warning(&path) {
+                eprintln!("pend: warning: {warning}");
+            }
             c
         }
         None => {

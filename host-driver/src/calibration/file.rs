@@ -6,10 +6,15 @@ use std::path::Path;
 use glam::{DQuat, DVec2, DVec3};
 use serde::{Deserialize, Serialize};
 
-use super::{Calibration, CalibrationError, DisplaySize, FitKind, TargetResidual, Transform};
+use super::fit::compact;
+use super::{Calibration, CalibrationError, DeviceId, DisplaySize, FitKind, TargetResidual, Transform};
 
-/// The calibration file's format version.
-pub const FILE_VERSION: u32 = 1;
+/// The calibration file's format version: 2 records the base station (`[device]`).
+pub const FILE_VERSION: u32 = 2;
+/// The format before the base station was recorded: still read, and applied to any base station
+/// with a warning ([`Calibration::unbound_warning`]), so that an existing calibration keeps
+/// working until the user calibrates again.
+pub const FILE_VERSION_UNBOUND: u32 = 1;
 
 // The file format (docs/calibration.md), with every field optional so that a missing key is
 // reported by name rather than by the parser's position.
@@ -20,6 +25,12 @@ struct FileDisplay {
     height_mm: Option<f64>,
     width_px: Option<u32>,
     height_px: Option<u32>,
+}
+
+#[derive(Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct FileDevice {
+    unique_id: Option<String>,
 }
 
 #[derive(Serialize, Deserialize, Default)]
@@ -52,18 +63,27 @@ struct FileFit {
 #[serde(deny_unknown_fields)]
 struct File {
     version: Option<u32>,
+    device: Option<FileDevice>,
     display: Option<FileDisplay>,
     transform: Option<FileTransform>,
     fit: Option<FileFit>,
 }
 
 impl Calibration {
-    /// The calibration as the text of a TOML file.
+    /// The calibration as the text of a TOML file: version 2 with the base station it belongs
+    /// to, or version 1 when it records none.
     pub fn to_toml(&self) -> String {
         let q = self.transform.rotation;
         let t = self.transform.translation_mm;
         let file = File {
-            version: Some(FILE_VERSION),
+            version: Some(if self.device.is_some() {
+                FILE_VERSION
+            } else {
+                FILE_VERSION_UNBOUND
+            }),
+            device: self.device.map(|d| FileDevice {
+                unique_id: Some(d.to_hex()),
+            }),
             display: Some(FileDisplay {
                 width_mm: Some(self.display.width_mm),
                 height_mm: Some(self.display.height_mm),
@@ -91,7 +111,11 @@ impl Calibration {
             }),
         };
         let body = toml::to_string_pretty(&file).unwrap_or_default();
-        format!("# penscape calibration: tracker frame → display frame (docs/calibration.md)\n{body}")
+        let whose = match self.device {
+            Some(d) if d.is_simulated() => " of the simulated pen",
+            _ => "",
+        };
+        format!("# penscape calibration{whose}: tracker frame → display frame (docs/calibration.md)\n{body}")
     }
 
     /// Parses a calibration file's text; `path` names it in errors.
@@ -106,33 +130,41 @@ impl Calibration {
             problem: problem.into(),
         };
         let missing = |key: &str| bad(key, "is missing");
-        match file.version {
-            Some(FILE_VERSION) => {}
-            Some(v) => {
+        let device = match (file.version, file.device) {
+            (Some(FILE_VERSION), Some(d)) => {
+                let id = d.unique_id.ok_or_else(|| missing("device.unique_id"))?;
+                let id = DeviceId::from_hex(&id).ok_or_else(|| {
+                    bad(
+                        "device.unique_id",
+                        "must be the base station's 24 hex digits, as `penctl info` shows them",
+                    )
+                })?;
+                Some(id)
+            }
+            (Some(FILE_VERSION), None) => return Err(missing("device")),
+            (Some(FILE_VERSION_UNBOUND), None) => None,
+            (Some(FILE_VERSION_UNBOUND), Some(_)) => {
+                return Err(bad("device", "is new in version 2: set `version = 2`"));
+            }
+            (Some(v), _) => {
                 return Err(bad(
                     "version",
-                    &format!("is {v}; this program reads version {FILE_VERSION}"),
+                    &format!("is {v}; this program reads versions {FILE_VERSION_UNBOUND} and {FILE_VERSION}"),
                 ));
             }
-            None => return Err(missing("version")),
-        }
+            (None, _) => return Err(missing("version")),
+        };
         let d = file.display.ok_or_else(|| missing("display"))?;
-        let positive = |key: &str, v: Option<f64>| match v {
-            Some(v) if v.is_finite() && v > 0.0 => Ok(v),
-            Some(v) => Err(bad(key, &format!("must be a positive number, is {v}"))),
-            None => Err(missing(key)),
-        };
-        let pixels = |key: &str, v: Option<u32>| match v {
-            Some(v) if v > 0 => Ok(v),
-            Some(_) => Err(bad(key, "must be at least 1")),
-            None => Err(missing(key)),
-        };
         let display = DisplaySize {
-            width_mm: positive("display.width_mm", d.width_mm)?,
-            height_mm: positive("display.height_mm", d.height_mm)?,
-            width_px: pixels("display.width_px", d.width_px)?,
-            height_px: pixels("display.height_px", d.height_px)?,
+            width_mm: d.width_mm.ok_or_else(|| missing("display.width_mm"))?,
+            height_mm: d.height_mm.ok_or_else(|| missing("display.height_mm"))?,
+            width_px: d.width_px.ok_or_else(|| missing("display.width_px"))?,
+            height_px: d.height_px.ok_or_else(|| missing("display.height_px"))?,
         };
+        display.check().map_err(|e| match e {
+            CalibrationError::Display { key, problem } => bad(&format!("display.{key}"), &problem),
+            other => other,
+        })?;
         let t = file.transform.ok_or_else(|| missing("transform"))?;
         let kind = t.kind.ok_or_else(|| missing("transform.kind"))?;
         let q = t.rotation_wxyz.ok_or_else(|| missing("transform.rotation_wxyz"))?;
@@ -149,7 +181,12 @@ impl Calibration {
         }
         let scale = match t.scale {
             Some(s) if s.is_finite() && (0.5..=2.0).contains(&s) => s,
-            Some(s) => return Err(bad("transform.scale", &format!("must be between 0.5 and 2, is {s}"))),
+            Some(s) => {
+                return Err(bad(
+                    "transform.scale",
+                    &format!("must be between 0.5 and 2, is {}", compact(s)),
+                ));
+            }
             None => return Err(missing("transform.scale")),
         };
         if kind == FitKind::Rigid && scale != 1.0 {
@@ -190,6 +227,7 @@ impl Calibration {
             kind,
             display,
             residuals,
+            device,
         })
     }
 
@@ -211,14 +249,4 @@ impl Calibration {
         file.write_all(self.to_toml().as_bytes())?;
         file.commit()
     }
-}
-
-/// Where the calibration is kept by default: `$XDG_CONFIG_HOME/penscape/calibration.toml`
-/// (`~/.config/penscape/calibration.toml`); `None` when neither variable is set.
-pub fn default_path() -> Option<std::path::PathBuf> {
-    let base = std::env::var_os("XDG_CONFIG_HOME")
-        .filter(|d| !d.is_empty())
-        .map(std::path::PathBuf::from)
-        .or_else(|| std::env::var_os("HOME").map(|h| std::path::PathBuf::from(h).join(".config")))?;
-    Some(base.join("penscape/calibration.toml"))
 }

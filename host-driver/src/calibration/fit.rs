@@ -17,6 +17,7 @@ use pen_protocol::DisplayPose;
 use serde::{Deserialize, Serialize};
 use thiserror::Error;
 
+use super::device::DeviceId;
 use crate::events::DisplayPoint;
 
 /// The fewest targets a calibration takes.
@@ -48,6 +49,25 @@ pub enum CalibrationError {
     /// A calibration file could not be read or parsed.
     #[error("{path}: {message}")]
     File { path: String, message: String },
+    /// The display's size is out of range.
+    #[error("`display.{key}` {problem}")]
+    Display {
+        /// `width_mm`, `height_mm`, `width_px` or `height_px`.
+        key: &'static str,
+        problem: String,
+    },
+    /// The calibration belongs to another base station.
+    #[error(
+        "the calibration is for base station {calibrated}, not for the one attached, {attached}: \
+         calibrate this one with `penctl calibrate` (or give its own file with --calibration FILE)"
+    )]
+    WrongDevice { calibrated: DeviceId, attached: DeviceId },
+    /// The attached base station did not say which it is.
+    #[error(
+        "the calibration is for base station {calibrated}, and the one attached does not say which it is \
+         ({why}); check it with `penctl info`"
+    )]
+    DeviceUnknown { calibrated: DeviceId, why: String },
     /// A calibration file has a bad value.
     #[error("{path}: `{key}` {problem}")]
     BadValue {
@@ -90,6 +110,50 @@ impl DisplaySize {
         width_px: 2560,
         height_px: 1440,
     };
+
+    /// Display sizes a calibration accepts, mm: from a small tablet to a wall.
+    pub const MM_RANGE: std::ops::RangeInclusive<f64> = 20.0..=10_000.0;
+    /// Pixel counts a calibration accepts along either side.
+    pub const PX_RANGE: std::ops::RangeInclusive<u32> = 16..=65_536;
+
+    /// Checks the sizes against [`MM_RANGE`](Self::MM_RANGE) and [`PX_RANGE`](Self::PX_RANGE):
+    /// a size outside them is a mistake (metres for millimetres, a stray exponent), and one near
+    /// zero would make every pixel coordinate infinite. The error names the key.
+    pub fn check(&self) -> Result<(), CalibrationError> {
+        let mm = |key, v: f64| {
+            if Self::MM_RANGE.contains(&v) {
+                Ok(())
+            } else {
+                Err(CalibrationError::Display {
+                    key,
+                    problem: format!(
+                        "must be between {} and {} mm, is {}",
+                        Self::MM_RANGE.start(),
+                        Self::MM_RANGE.end(),
+                        compact(v)
+                    ),
+                })
+            }
+        };
+        let px = |key, v: u32| {
+            if Self::PX_RANGE.contains(&v) {
+                Ok(())
+            } else {
+                Err(CalibrationError::Display {
+                    key,
+                    problem: format!(
+                        "must be between {} and {} pixels, is {v}",
+                        Self::PX_RANGE.start(),
+                        Self::PX_RANGE.end()
+                    ),
+                })
+            }
+        };
+        mm("width_mm", self.width_mm)?;
+        mm("height_mm", self.height_mm)?;
+        px("width_px", self.width_px)?;
+        px("height_px", self.height_px)
+    }
 
     /// `n` target positions: 4 corners inset by 10 % (with the centre for 5), or a 3 × 3 grid at
     /// 10, 50 and 90 % for 9.
@@ -164,6 +228,9 @@ pub struct Calibration {
     pub display: DisplaySize,
     /// Per target.
     pub residuals: Vec<TargetResidual>,
+    /// The base station it was measured with, and the only one it is applied to; `None` for
+    /// any (the identity, a fit not yet saved, a file of format version 1).
+    pub device: Option<DeviceId>,
 }
 
 impl Calibration {
@@ -174,6 +241,7 @@ impl Calibration {
             kind: FitKind::Rigid,
             display,
             residuals: Vec::new(),
+            device: None,
         }
     }
 
@@ -282,6 +350,7 @@ pub fn fit(
     kind: FitKind,
     display: DisplaySize,
 ) -> Result<Calibration, CalibrationError> {
+    display.check()?;
     if targets.len() != touched.len() || targets.len() < MIN_TARGETS {
         return Err(CalibrationError::TooFewPoints(targets.len().min(touched.len())));
     }
@@ -366,5 +435,16 @@ pub fn fit(
         kind,
         display,
         residuals,
+        device: None,
     })
+}
+
+/// A number for a message: as written for everyday sizes, in exponent form otherwise (`1e-300`
+/// rather than 300 zeros).
+pub(crate) fn compact(v: f64) -> String {
+    if v == 0.0 || !v.is_finite() || (1e-3..1e9).contains(&v.abs()) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
 }

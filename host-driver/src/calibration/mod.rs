@@ -3,13 +3,17 @@
 //! * [`fit`]: the transform from touched targets (Horn's closed form), display sizes and
 //!   display coordinates.
 //! * [`file`]: the calibration file, `~/.config/penscape/calibration.toml`.
+//! * [`device`]: which base station a calibration belongs to (it is refused for any other), and
+//!   where each one's file is kept (the simulated pen's apart from the real one's).
 //! * [`procedure`]: leading the user (or the simulated pen) through the targets.
 //! * [`plot`]: the residuals as a PNG.
 
+pub mod device;
 pub mod file;
 pub mod fit;
 pub mod plot;
 pub mod procedure;
 
-pub use file::{FILE_VERSION, default_path};
+pub use device::{DeviceId, SIMULATED_ID, default_path, default_path_for, default_path_for_source, default_sim_path};
+pub use file::{FILE_VERSION, FILE_VERSION_UNBOUND};
 pub use fit::{Calibration, CalibrationError, DisplaySize, FitKind, MIN_TARGETS, TargetResidual, Transform, fit};
