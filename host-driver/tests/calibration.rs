@@ -4,7 +4,7 @@ use std::time::Duration;
 
 use glam::{DQuat, DVec2, DVec3};
 use pen_host::calibration::procedure::{Prompt, attach, collect_touches, prepare};
-use pen_host::calibration::{Calibration, CalibrationError, DisplaySize, FitKind, fit};
+use pen_host::calibration::{Calibration, CalibrationError, DeviceId, DisplaySize, FitKind, SIMULATED_ID, fit};
 use pen_host::device::Device;
 use pen_host::source::Source;
 use pen_host::transport::sim::SimOptions;
@@ -115,7 +115,10 @@ fn the_file_round_trips_and_bad_values_are_named() {
             .to_string()
     };
     assert!(bad("scale = 1.0", "scale = 7.0").contains("`transform.scale` must be between 0.5 and 2, is 7"));
-    assert!(bad("width_mm = 600.0", "width_mm = -600.0").contains("`display.width_mm` must be a positive number"));
+    assert!(
+        bad("width_mm = 600.0", "width_mm = -600.0")
+            .contains("`display.width_mm` must be between 20 and 10000 mm, is -600")
+    );
     assert!(bad("version = 1", "version = 9").contains("`version` is 9"));
     assert!(bad("rotation_wxyz = [", "rotation_wxyz = [2.0, ").contains("rotation_wxyz"));
     assert!(bad("width_px = 2560", "").contains("`display.width_px` is missing"));
@@ -177,4 +180,199 @@ fn a_calibration_written_to_the_device_makes_it_report_display_coordinates() {
         }
     }
     assert_eq!(checked, 20, "touches seen after the calibration was written");
+}
+
+/// A calibration of base station A, applied to B: the pen's samples never become events.
+#[test]
+fn a_calibration_is_refused_for_another_base_station() {
+    use pen_host::events::EventKind;
+    use pen_host::pipeline::Pipeline;
+
+    let scenario = pen_sim::scenarios::by_name("hold").expect("scenario");
+    let source = |id: [u8; 12]| {
+        Source::Sim(SimOptions {
+            scenario: scenario.clone().with_unique_id(id),
+            seed: 1,
+            speed: 0.0,
+            plug: Default::default(),
+        })
+    };
+    let station_a = DeviceId(*b"station-A-id");
+    let calibration = Calibration {
+        device: Some(station_a),
+        ..Calibration::identity(DisplaySize::REFERENCE)
+    };
+    let poll = |pipeline: &mut Pipeline, seconds: f64| {
+        let mut events = Vec::new();
+        let end = std::time::Instant::now() + Duration::from_secs_f64(seconds);
+        while std::time::Instant::now() < end {
+            pipeline.poll(Duration::from_millis(50), &mut events);
+        }
+        events
+    };
+
+    // Its own base station: attached, and the pen's events flow.
+    let mut own = Pipeline::new(source(station_a.0), calibration.clone());
+    let events = poll(&mut own, 0.5);
+    assert!(matches!(
+        events.first().map(|e| &e.kind),
+        Some(EventKind::DeviceFound { .. })
+    ));
+    assert!(events.iter().any(|e| e.point.is_some()), "samples become events");
+    assert_eq!(own.refused(), None);
+
+    // Another: refused once with what to do, retried (another may be plugged in meanwhile)
+    // without repeating it, and no sample becomes an event.
+    let mut other = Pipeline::new(source(*b"station-B-id"), calibration);
+    let events = poll(&mut other, pen_host::pipeline::REFUSED_RETRY.as_secs_f64() + 0.5);
+    let reasons: Vec<&str> = events
+        .iter()
+        .filter_map(|e| match &e.kind {
+            EventKind::DeviceLost { reason } => Some(reason.as_str()),
+            _ => None,
+        })
+        .collect();
+    assert_eq!(reasons.len(), 1, "{events:?}");
+    let b = DeviceId(*b"station-B-id");
+    assert!(
+        reasons[0].contains(&format!(
+            "refused: the calibration is for base station {}, not for the one attached, {}",
+            station_a.to_hex(),
+            b.to_hex()
+        )) && reasons[0].contains("penctl calibrate"),
+        "{}",
+        reasons[0]
+    );
+    assert_eq!(events.len(), 1, "nothing but the refusal: {events:?}");
+    assert!(other.refused().is_some());
+
+    // The check itself, and a device that does not say which it is.
+    let info = |id: [u8; 12]| pen_protocol::DeviceInfo {
+        protocol: pen_protocol::PROTOCOL_VERSION,
+        firmware: pen_sim::sim::SIM_FIRMWARE,
+        receiver_count: 4,
+        max_receivers: 8,
+        fix_rate_hz: 150,
+        unique_id: id,
+    };
+    let cal = Calibration {
+        device: Some(station_a),
+        ..Calibration::identity(DisplaySize::REFERENCE)
+    };
+    assert_eq!(cal.check_device(Ok(&info(station_a.0))), Ok(()));
+    assert_eq!(
+        cal.check_device(Ok(&info(b.0))),
+        Err(CalibrationError::WrongDevice {
+            calibrated: station_a,
+            attached: b
+        })
+    );
+    assert!(matches!(
+        cal.check_device(Err("no answer")),
+        Err(CalibrationError::DeviceUnknown { .. })
+    ));
+    // One recording no device goes with any.
+    assert_eq!(
+        Calibration::identity(DisplaySize::REFERENCE).check_device(Ok(&info(b.0))),
+        Ok(())
+    );
+    // The simulated pen's ID is the one pen-sim reports.
+    assert_eq!(SIMULATED_ID.0, pen_sim::sim::SIM_UNIQUE_ID);
+}
+
+#[test]
+fn the_file_records_the_device_and_version_1_is_read_with_a_warning() {
+    let targets = DisplaySize::REFERENCE.targets(5);
+    let (r, t) = misaligned();
+    let touched: Vec<DVec3> = targets.iter().map(|p| r.inverse() * (p.extend(0.0) - t)).collect();
+    let mut cal = fit(&targets, &touched, FitKind::Rigid, DisplaySize::REFERENCE).expect("fit");
+    cal.device = Some(DeviceId(*b"station-A-id"));
+    let text = cal.to_toml();
+    assert!(text.contains("version = 2\n"), "{text}");
+    assert!(
+        text.contains("[device]\nunique_id = \"73746174696f6e2d412d6964\""),
+        "{text}"
+    );
+    let back = Calibration::from_toml(&text, "cal.toml").expect("loads");
+    assert_eq!(back, cal);
+    assert_eq!(back.unbound_warning(std::path::Path::new("cal.toml")), None);
+
+    let bad = |from: &str, to: &str| {
+        Calibration::from_toml(&text.replacen(from, to, 1), "cal.toml")
+            .unwrap_err()
+            .to_string()
+    };
+    assert!(bad("[device]\nunique_id = \"73746174696f6e2d412d6964\"", "").contains("`device` is missing"));
+    assert!(
+        bad("unique_id = \"7374", "unique_id = \"zz")
+            .contains("`device.unique_id` must be the base station's 24 hex digits")
+    );
+    assert!(bad("version = 2", "version = 1").contains("`device` is new in version 2"));
+    assert!(bad("version = 2", "version = 3").contains("`version` is 3; this program reads versions 1 and 2"));
+
+    // A file of version 1, written before calibrations recorded their device: read, for any
+    // base station, with a warning that says how to bind it.
+    let old = text.replacen("version = 2", "version = 1", 1).replacen(
+        "[device]\nunique_id = \"73746174696f6e2d412d6964\"\n",
+        "",
+        1,
+    );
+    let v1 = Calibration::from_toml(&old, "old.toml").expect("version 1 still loads");
+    assert_eq!(v1.device, None);
+    assert_eq!(v1.transform, cal.transform);
+    let warning = v1.unbound_warning(std::path::Path::new("old.toml")).expect("a warning");
+    assert!(
+        warning.contains("old.toml records no base station") && warning.contains("run `penctl calibrate`"),
+        "{warning}"
+    );
+}
+
+#[test]
+fn display_sizes_are_checked_on_fit_and_load() {
+    let targets = DisplaySize::REFERENCE.targets(4);
+    let touched: Vec<DVec3> = targets.iter().map(|t| t.extend(5.0)).collect();
+    let tiny = DisplaySize {
+        width_mm: 1e-300,
+        ..DisplaySize::REFERENCE
+    };
+    let e = fit(&targets, &touched, FitKind::Rigid, tiny).unwrap_err();
+    assert_eq!(
+        e.to_string(),
+        "`display.width_mm` must be between 20 and 10000 mm, is 1e-300"
+    );
+    let huge_px = DisplaySize {
+        height_px: 1_000_000,
+        ..DisplaySize::REFERENCE
+    };
+    assert!(
+        fit(&targets, &touched, FitKind::Rigid, huge_px)
+            .unwrap_err()
+            .to_string()
+            .contains("`display.height_px` must be between 16 and 65536 pixels, is 1000000")
+    );
+    let text = fit(&targets, &touched, FitKind::Rigid, DisplaySize::REFERENCE)
+        .expect("fit")
+        .to_toml();
+    let load = |from: &str, to: &str| {
+        Calibration::from_toml(&text.replacen(from, to, 1), "cal.toml")
+            .unwrap_err()
+            .to_string()
+    };
+    assert_eq!(
+        load("width_mm = 600.0", "width_mm = 1e-300"),
+        "cal.toml: `display.width_mm` must be between 20 and 10000 mm, is 1e-300"
+    );
+    assert!(
+        load("height_mm = 340.0", "height_mm = nan")
+            .contains("`display.height_mm` must be between 20 and 10000 mm, is NaN")
+    );
+    assert!(
+        load("height_mm = 340.0", "height_mm = 2e7")
+            .contains("`display.height_mm` must be between 20 and 10000 mm, is 20000000")
+    );
+    assert!(
+        load("width_px = 2560", "width_px = 1")
+            .contains("`display.width_px` must be between 16 and 65536 pixels, is 1")
+    );
+    assert!(load("scale = 1.0", "scale = 1e300").contains("`transform.scale` must be between 0.5 and 2, is 1e300"));
 }

@@ -1,14 +1,29 @@
 //! `penctl` as a user runs it: the real binary, its stdout, stderr and exit status.
 
+use std::path::Path;
 use std::process::{Command, Output};
 
 use pen_protocol::{PenReport, Position, Quality, REPORT_DESCRIPTOR};
 
-fn penctl(args: &[&str]) -> Output {
+/// A home of its own for every run, so that no test reads or writes the real one's files
+/// (`~/.config/penscape/calibration.toml` above all).
+fn home() -> tempfile::TempDir {
+    tempfile::tempdir().expect("a temporary home")
+}
+
+/// penctl with `HOME` at `home` and no `XDG_CONFIG_HOME`: the configuration under
+/// `home/.config`.
+fn penctl_in(home: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_penctl"))
         .args(args)
+        .env("HOME", home)
+        .env_remove("XDG_CONFIG_HOME")
         .output()
         .expect("penctl runs")
+}
+
+fn penctl(args: &[&str]) -> Output {
+    penctl_in(home().path(), args)
 }
 
 fn hex(bytes: &[u8]) -> String {
@@ -167,7 +182,8 @@ fn config_is_validated_before_it_is_sent() {
 
 #[test]
 fn calibrate_with_the_simulated_pen_writes_the_file_and_plot() {
-    let dir = std::env::temp_dir().join(format!("penctl-cal-{}", std::process::id()));
+    let tmp = home();
+    let dir = tmp.path().join("out");
     let file = dir.join("calibration.toml");
     let png = dir.join("residuals.png");
     let out = penctl(&[
@@ -191,7 +207,6 @@ fn calibrate_with_the_simulated_pen_writes_the_file_and_plot() {
     assert!(std::fs::metadata(&png).expect("plot written").len() > 1000);
     let too_few = penctl(&["calibrate", "--sim", "--targets", "3"]);
     assert_eq!(too_few.status.code(), Some(2), "fewer than 4 targets is a usage error");
-    let _ = std::fs::remove_dir_all(&dir);
 }
 
 #[test]
@@ -201,6 +216,172 @@ fn no_device_is_a_clear_error() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("cannot attach") && err.contains("/dev/does-not-exist"),
+        "{err}"
+    );
+}
+
+/// The real device's calibration as a user has it: the simulated pen must never replace it.
+const REAL_CALIBRATION: &str = r#"# a real base station's calibration
+version = 2
+
+[device]
+unique_id = "0123456789abcdef01234567"
+
+[display]
+width_mm = 600.0
+height_mm = 340.0
+width_px = 2560
+height_px = 1440
+
+[transform]
+kind = "rigid"
+rotation_wxyz = [1.0, 0.0, 0.0, 0.0]
+translation_mm = [1.0, 2.0, 3.0]
+scale = 1.0
+"#;
+
+#[test]
+fn calibrating_the_simulated_pen_never_writes_the_real_devices_file() {
+    let home = home();
+    let config = home.path().join(".config/penscape");
+    std::fs::create_dir_all(&config).expect("config folder");
+    let real = config.join("calibration.toml");
+    std::fs::write(&real, REAL_CALIBRATION).expect("the real calibration");
+    let out = penctl_in(
+        home.path(),
+        &["calibrate", "--sim", "--sim-speed", "0", "--targets", "4"],
+    );
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert_eq!(
+        std::fs::read_to_string(&real).expect("still there"),
+        REAL_CALIBRATION,
+        "the real device's calibration is untouched"
+    );
+    let sim = config.join("calibration-sim.toml");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert!(stdout.contains(&format!("saved {}", sim.display())), "{stdout}");
+    let cal = pen_host::calibration::Calibration::load(&sim).expect("the simulated pen's own file");
+    assert_eq!(
+        cal.device,
+        Some(pen_host::calibration::SIMULATED_ID),
+        "it records the device"
+    );
+    let text = std::fs::read_to_string(&sim).expect("read");
+    assert!(
+        text.contains("version = 2") && text.contains("unique_id = \"70656e73636170652d73696d\""),
+        "{text}"
+    );
+
+    // XDG_CONFIG_HOME is honoured the same way; with no real calibration, none appears.
+    let xdg = self::home();
+    let out = Command::new(env!("CARGO_BIN_EXE_penctl"))
+        .args(["calibrate", "--sim", "--sim-speed", "0", "--targets", "4"])
+        .env("HOME", home.path())
+        .env("XDG_CONFIG_HOME", xdg.path())
+        .output()
+        .expect("penctl runs");
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(xdg.path().join("penscape/calibration-sim.toml").exists());
+    assert!(!xdg.path().join("penscape/calibration.toml").exists());
+
+    // penctl info says whether the device has a calibration of its own.
+    let info = penctl_in(home.path(), &["info", "--sim"]);
+    let text = String::from_utf8_lossy(&info.stdout);
+    assert!(
+        text.contains(&format!("calibration  {}: this base station's", sim.display())),
+        "{text}"
+    );
+}
+
+#[test]
+fn another_devices_calibration_is_refused_by_pend_saying_what_to_do() {
+    let home = home();
+    let config = home.path().join(".config/penscape");
+    std::fs::create_dir_all(&config).expect("config folder");
+    // The simulated pen's default calibration belongs to another base station.
+    let sim = config.join("calibration-sim.toml");
+    std::fs::write(&sim, REAL_CALIBRATION).expect("write");
+    let info = penctl_in(home.path(), &["info", "--sim", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&info.stdout).expect("JSON");
+    assert_eq!(v["calibration"]["applies"], false, "{v}");
+    assert_eq!(v["calibration"]["device"], "0123456789abcdef01234567");
+
+    let socket = home.path().join("pend.sock");
+    let mut pend = Command::new(env!("CARGO_BIN_EXE_pend"))
+        .args(["--sim", "--sim-speed", "0", "--socket"])
+        .arg(&socket)
+        .env("HOME", home.path())
+        .env_remove("XDG_CONFIG_HOME")
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("pend starts");
+    let stderr = pend.stderr.take().expect("piped");
+    // Read pend's log on a thread so that a pend that never says it cannot hang the test.
+    let (tx, rx) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        use std::io::BufRead;
+        for line in std::io::BufReader::new(stderr).lines().map_while(Result::ok) {
+            if tx.send(line).is_err() {
+                break;
+            }
+        }
+    });
+    let mut log = Vec::new();
+    let end = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    while std::time::Instant::now() < end && !log.iter().any(|l: &String| l.contains("refused")) {
+        if let Ok(line) = rx.recv_timeout(std::time::Duration::from_millis(200)) {
+            log.push(line);
+        }
+    }
+    let _ = pend.kill();
+    let _ = pend.wait();
+    let log = log.join("\n");
+    assert!(log.contains(&format!("pend: calibration {}", sim.display())), "{log}");
+    assert!(
+        log.contains("refused: the calibration is for base station 0123456789abcdef01234567, not for the one attached, 70656e73636170652d73696d (the simulated pen)")
+            && log.contains("penctl calibrate"),
+        "{log}"
+    );
+    assert!(
+        !log.contains("attached sim"),
+        "the device is not served with another's calibration: {log}"
+    );
+}
+
+#[test]
+fn a_display_size_out_of_range_is_refused_naming_it() {
+    let out = penctl(&["calibrate", "--sim", "--display-mm", "1e-300x340"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--display-mm: `display.width_mm` must be between 20 and 10000 mm, is 1e-300"),
+        "{err}"
+    );
+    assert!(!err.contains("target 1"), "refused before any touch: {err}");
+    let out = penctl(&["calibrate", "--sim", "--display-px", "2560x0"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("--display-px: `display.height_px` must be between 16 and 65536 pixels, is 0"),
+        "{err}"
+    );
+
+    // A file with such a width is refused on load, by pend too, before it serves anything.
+    let home = home();
+    let file = home.path().join("tiny.toml");
+    std::fs::write(&file, REAL_CALIBRATION.replace("width_mm = 600.0", "width_mm = 1e-300")).expect("write");
+    let out = Command::new(env!("CARGO_BIN_EXE_pend"))
+        .args(["--sim", "--socket"])
+        .arg(home.path().join("pend.sock"))
+        .arg("--calibration")
+        .arg(&file)
+        .env("HOME", home.path())
+        .output()
+        .expect("pend runs");
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("`display.width_mm` must be between 20 and 10000 mm, is 1e-300"),
         "{err}"
     );
 }
