@@ -33,7 +33,12 @@ impl Pipeline {
     }
 
     /// A pipeline on a device session already under way (after a calibration, say).
-    pub fn with_device(device: Device, calibration: Calibration) -> Pipeline {
+    pub fn with_device(mut device: Device, calibration: Calibration) -> Pipeline {
+        // A device attached already gave its `Found` to someone else: let it go so that it
+        // attaches again through the check below, which says why it is refused.
+        if device.transport().is_some() && calibration.check_device(device.info()).is_err() {
+            device.detach(Duration::ZERO);
+        }
         Pipeline {
             device,
             calibration,

@@ -223,7 +223,7 @@ fn a_calibration_is_refused_for_another_base_station() {
 
     // Another: refused once with what to do, retried (another may be plugged in meanwhile)
     // without repeating it, and no sample becomes an event.
-    let mut other = Pipeline::new(source(*b"station-B-id"), calibration);
+    let mut other = Pipeline::new(source(*b"station-B-id"), calibration.clone());
     let events = poll(&mut other, pen_host::pipeline::REFUSED_RETRY.as_secs_f64() + 0.5);
     let reasons: Vec<&str> = events
         .iter()
@@ -245,6 +245,16 @@ fn a_calibration_is_refused_for_another_base_station() {
     );
     assert_eq!(events.len(), 1, "nothing but the refusal: {events:?}");
     assert!(other.refused().is_some());
+
+    // A device attached before the pipeline took it is checked all the same.
+    let mut device = Device::new(source(*b"station-B-id"));
+    attach(&mut device, Duration::from_secs(2)).expect("attach");
+    let mut taken = Pipeline::with_device(device, calibration);
+    let events = poll(&mut taken, 0.5);
+    assert!(
+        matches!(events.as_slice(), [e] if matches!(&e.kind, EventKind::DeviceLost { reason } if reason.contains("refused"))),
+        "{events:?}"
+    );
 
     // The check itself, and a device that does not say which it is.
     let info = |id: [u8; 12]| pen_protocol::DeviceInfo {
