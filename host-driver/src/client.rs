@@ -32,7 +32,8 @@ pub enum Line {
 }
 
 /// Parses one JSON line (docs/events.md): a line that is not JSON, lacks a key its `type`
-/// needs, or has one of the wrong type or range is an error saying which.
+/// needs, or has one of the wrong type or range is an error saying which. pend's refusal is a
+/// `ConnectionRefused` I/O error with its reason.
 pub fn parse_line(line: &str) -> Result<Line, ClientError> {
     let bad = |why: String| ClientError::Bad {
         line: line.to_string(),
@@ -41,6 +42,14 @@ pub fn parse_line(line: &str) -> Result<Line, ClientError> {
     let wire: SocketLine = serde_json::from_str(line).map_err(|e| bad(e.to_string()))?;
     let device = match &wire {
         SocketLine::Hello(h) => Some(h.device.clone()),
+        // Not a bad line but a closed door: an I/O error of the connection's kind, so a caller
+        // that stops on socket errors stops here too, with pend's reason.
+        SocketLine::Refused(r) => {
+            return Err(ClientError::Io(std::io::Error::new(
+                std::io::ErrorKind::ConnectionRefused,
+                format!("pend refused this client: {}", r.reason),
+            )));
+        }
         _ => None,
     };
     match wire.into_event().map_err(|e| bad(e.to_string()))? {
@@ -104,6 +113,19 @@ mod tests {
             (2_000_001, Some((7, 9)), Some([true, false, false]))
         );
         assert_eq!(e.point.map(|p| p.v_px), Some(5.0));
+    }
+
+    #[test]
+    fn a_refusal_is_a_refused_connection_with_the_reason() {
+        let line = r#"{"type":"refused","t":1.5,"reason":"pend serves at most 64 clients at once"}"#;
+        match parse_line(line) {
+            Err(ClientError::Io(e)) => {
+                assert_eq!(e.kind(), std::io::ErrorKind::ConnectionRefused);
+                assert!(e.to_string().contains("at most 64 clients"), "{e}");
+            }
+            other => panic!("{other:?}"),
+        }
+        assert!(why(r#"{"type":"refused","t":1}"#).contains("missing field `reason`"));
     }
 
     #[test]

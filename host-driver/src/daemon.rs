@@ -1,75 +1,195 @@
-//! `pend`: one process owns the device and serves its events to any number of clients on a Unix
-//! domain socket, as JSON lines (docs/events.md).
+//! `pend`: one process owns the device and serves its events to a bounded number of clients on
+//! a Unix domain socket, as JSON lines (docs/events.md).
 //!
 //! The device is read on its own thread and every event is encoded once and offered to each
-//! client's bounded queue. A client that does not keep up loses events from its own queue only —
-//! counted, and announced to it with a `missed` event as soon as it reads again — and never slows
-//! the device reader or the other clients, each of which has its own writer thread.
+//! client's bounded queue. A client that does not keep up loses events from its own queue only,
+//! and never slows the device reader or the other clients, each of which has its own writer
+//! thread. The loss is marked where it happened: the events before it stay queued, and once
+//! there is room again the `missed` notice goes into the queue at the gap, followed by the
+//! events that bring the client from the state it last saw to the pen's state now, so its
+//! downs and ups stay paired. A client that joins gets the greeting and then the same kind of
+//! events for the state it joins in (a pen already down gives it `tip_down`).
+//!
+//! Clients are bounded (`--max-clients`, 64 by default): one more is sent a `refused` line
+//! saying why, and closed, instead of costing a thread.
 
-use std::io::{BufWriter, Write};
+use std::collections::VecDeque;
+use std::io::{BufWriter, Read, Write};
+use std::net::Shutdown;
 use std::os::unix::net::{UnixListener, UnixStream};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
-use std::sync::mpsc::{Receiver, SyncSender, TrySendError, sync_channel};
-use std::sync::{Arc, Mutex};
+use std::sync::{Arc, Condvar, Mutex};
 use std::time::Duration;
 
-use crate::events::{EventKind, PenEvent};
+use crate::events::{EventKind, PenEvent, PenState};
 use crate::pipeline::Pipeline;
 use crate::sample::now_us;
 use crate::socket::{self, SocketError};
 
-use crate::wire::{self, Hello, SocketLine};
+use crate::wire::{self, Hello, Refused, SocketLine};
 
 /// Events a client may have queued before it starts missing them: about a second at 1 kHz.
 pub const DEFAULT_QUEUE: usize = 1024;
+
+/// Clients served at once. Each costs a writer thread and, while it lags, up to its queue of
+/// lines (about 300 KB at 1024); 64 is far more than the programs one pen feeds, and small
+/// enough that a runaway script opening connections cannot exhaust threads or memory.
+pub const DEFAULT_MAX_CLIENTS: usize = 64;
+
+/// A writer only moves lines from its queue to its socket: a small stack suffices, and many
+/// clients then reserve little address space.
+const WRITER_STACK: usize = 64 * 1024;
+
+/// Lines a writer takes from its queue per write: enough to send a burst in one system call,
+/// few enough that the lines in flight stay small beside the queue.
+const BATCH: usize = 64;
+
+/// How long a writer waits for events before checking that its client is still there, so a
+/// client that leaves while the pen is quiet frees its place.
+const IDLE_CHECK: Duration = Duration::from_secs(1);
 
 /// The default socket: `$XDG_RUNTIME_DIR/penscape/pend.sock`, or `/tmp/penscape-UID/pend.sock`.
 pub fn default_socket() -> PathBuf {
     socket::default_path()
 }
 
-struct Client {
-    queue: SyncSender<Arc<str>>,
-    missed: Arc<AtomicU64>,
+/// One client's lines, shared by the publisher (which appends) and its writer (which takes).
+struct Queue {
+    state: Mutex<QueueState>,
+    wake: Condvar,
 }
 
-/// The clients and the device's state, shared by the device thread and the acceptor.
-#[derive(Default)]
+struct QueueState {
+    lines: VecDeque<Arc<str>>,
+    /// The writer has stopped: the client left or its socket failed.
+    gone: bool,
+    /// The writer is waiting for lines: only then is it worth a wake-up.
+    waiting: bool,
+}
+
+/// Events a lagging client has lost since the last one queued for it.
+struct Gap {
+    /// The state its queued events leave it in.
+    seen: PenState,
+    count: u64,
+}
+
+struct Client {
+    queue: Arc<Queue>,
+    capacity: usize,
+    gap: Option<Gap>,
+}
+
+struct Inner {
+    clients: Vec<Client>,
+    /// The pen's state after the events published so far.
+    state: PenState,
+    /// The last event's time: when `state` was last known to hold.
+    last_t_us: u64,
+}
+
+/// The clients and the pen's state, shared by the device thread and the acceptor.
 pub struct Hub {
-    clients: Mutex<Vec<Client>>,
-    device: Mutex<Option<String>>,
+    inner: Mutex<Inner>,
+    max_clients: usize,
     delivered: AtomicU64,
     missed: AtomicU64,
+    refused: AtomicU64,
+}
+
+impl Default for Hub {
+    fn default() -> Hub {
+        Hub::new(DEFAULT_MAX_CLIENTS)
+    }
 }
 
 impl Hub {
+    /// A hub serving at most `max_clients` at once (at least one).
+    pub fn new(max_clients: usize) -> Hub {
+        Hub {
+            inner: Mutex::new(Inner {
+                clients: Vec::new(),
+                state: PenState::default(),
+                last_t_us: 0,
+            }),
+            max_clients: max_clients.max(1),
+            delivered: AtomicU64::new(0),
+            missed: AtomicU64::new(0),
+            refused: AtomicU64::new(0),
+        }
+    }
+
     /// Offers one event to every client.
     pub fn publish(&self, event: &PenEvent) {
-        match &event.kind {
-            EventKind::DeviceFound { device } => *lock(&self.device) = Some(device.clone()),
-            EventKind::DeviceLost { .. } => *lock(&self.device) = None,
-            _ => {}
-        }
         let line: Arc<str> = Arc::from(wire::line(event));
-        let mut clients = lock(&self.clients);
-        clients.retain(|c| match c.queue.try_send(line.clone()) {
-            Ok(()) => {
+        let mut inner = lock(&self.inner);
+        let Inner {
+            clients,
+            state,
+            last_t_us,
+        } = &mut *inner;
+        let mut resync = Vec::new();
+        clients.retain_mut(|c| {
+            let mut q = lock(&c.queue.state);
+            if q.gone {
+                return false;
+            }
+            let queued = match c.gap.take() {
+                None if q.lines.len() < c.capacity => {
+                    q.lines.push_back(line.clone());
+                    true
+                }
+                // The queue is full: the gap starts here, after what the client will read.
+                None => {
+                    c.gap = Some(Gap {
+                        seen: state.clone(),
+                        count: 1,
+                    });
+                    false
+                }
+                Some(mut gap) => {
+                    // The notice and the catch-up go in at the gap, before this event, and at
+                    // its time, so the client's times never go backwards.
+                    resync.clear();
+                    resync.push(PenEvent::missed(gap.count, event.t_us));
+                    gap.seen.resync(state, event.t_us, &mut resync);
+                    // An empty queue takes them whatever its size, or a tiny one never would.
+                    if q.lines.is_empty() || q.lines.len() + resync.len() < c.capacity {
+                        q.lines.extend(resync.iter().map(|e| Arc::from(wire::line(e))));
+                        q.lines.push_back(line.clone());
+                        true
+                    } else {
+                        gap.count += 1;
+                        c.gap = Some(gap);
+                        false
+                    }
+                }
+            };
+            if queued {
                 self.delivered.fetch_add(1, Ordering::Relaxed);
-                true
-            }
-            Err(TrySendError::Full(_)) => {
-                c.missed.fetch_add(1, Ordering::Relaxed);
+                if q.waiting {
+                    c.queue.wake.notify_one();
+                }
+            } else {
                 self.missed.fetch_add(1, Ordering::Relaxed);
-                true
             }
-            Err(TrySendError::Disconnected(_)) => false,
+            true
         });
+        state.apply(event);
+        *last_t_us = event.t_us;
     }
 
     /// Clients connected.
     pub fn clients(&self) -> usize {
-        lock(&self.clients).len()
+        let mut inner = lock(&self.inner);
+        inner.clients.retain(|c| !lock(&c.queue.state).gone);
+        inner.clients.len()
+    }
+
+    /// The most clients served at once.
+    pub fn max_clients(&self) -> usize {
+        self.max_clients
     }
 
     /// Events queued for clients, and events clients missed, since the start.
@@ -80,16 +200,71 @@ impl Hub {
         )
     }
 
-    /// Serves a connected client: greets it, then writes events to it from its own thread, its
-    /// queue holding at most `queue_len`.
-    pub fn connect(&self, stream: UnixStream, queue_len: usize) {
-        let (tx, rx) = sync_channel(queue_len.max(1));
-        let missed = Arc::new(AtomicU64::new(0));
-        let device = lock(&self.device).clone();
-        let hello = SocketLine::Hello(Hello::new(now_us(), device)).to_text();
-        let client_missed = missed.clone();
-        std::thread::spawn(move || write_client(stream, rx, client_missed, &hello));
-        lock(&self.clients).push(Client { queue: tx, missed });
+    /// Clients turned away because `max_clients` were connected, since the start.
+    pub fn refused(&self) -> u64 {
+        self.refused.load(Ordering::Relaxed)
+    }
+
+    /// Serves a connected client from its own writer thread, its queue holding at most
+    /// `queue_len` events: the greeting, the events of the pen's current state, then every
+    /// event. When `max_clients` are connected it is sent a `refused` line and closed instead;
+    /// the result says whether it was taken.
+    pub fn connect(&self, stream: UnixStream, queue_len: usize) -> bool {
+        let mut inner = lock(&self.inner);
+        inner.clients.retain(|c| !lock(&c.queue.state).gone);
+        if inner.clients.len() >= self.max_clients {
+            drop(inner);
+            self.refuse(stream);
+            return false;
+        }
+        // Greeting and state are taken under the lock that publishing holds, so no event falls
+        // between them and the first one queued.
+        let mut lines = VecDeque::new();
+        lines.push_back(Arc::from(
+            SocketLine::Hello(Hello::new(now_us(), inner.state.device.clone())).to_text(),
+        ));
+        let mut join = Vec::new();
+        inner.state.greeted().resync(&inner.state, inner.last_t_us, &mut join);
+        lines.extend(join.iter().map(|e| Arc::from(wire::line(e))));
+        let queue = Arc::new(Queue {
+            state: Mutex::new(QueueState {
+                lines,
+                gone: false,
+                waiting: false,
+            }),
+            wake: Condvar::new(),
+        });
+        let writer = queue.clone();
+        let spawned = std::thread::Builder::new()
+            .name("pend-client".into())
+            .stack_size(WRITER_STACK)
+            .spawn(move || write_client(stream, &writer));
+        // Without a thread the stream was dropped with the closure: the client sees the
+        // connection close, and pend goes on serving the others.
+        if spawned.is_err() {
+            return false;
+        }
+        inner.clients.push(Client {
+            queue,
+            capacity: queue_len.max(1),
+            gap: None,
+        });
+        true
+    }
+
+    /// Tells a client there is no room for it, and closes it.
+    fn refuse(&self, stream: UnixStream) {
+        self.refused.fetch_add(1, Ordering::Relaxed);
+        let reason = format!(
+            "pend serves at most {} clients at once (pend --max-clients); try again when one has left",
+            self.max_clients
+        );
+        let line = SocketLine::Refused(Refused::new(now_us(), reason)).to_text();
+        // A new socket's buffer takes one line; the timeout only keeps a strange one from
+        // holding up the acceptor.
+        let _ = stream.set_write_timeout(Some(Duration::from_millis(100)));
+        let _ = (&stream).write_all(line.as_bytes());
+        let _ = stream.shutdown(Shutdown::Both);
     }
 }
 
@@ -98,28 +273,72 @@ fn lock<T>(m: &Mutex<T>) -> std::sync::MutexGuard<'_, T> {
     m.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// A client's writer: its queue to its socket, announcing what it missed.
-fn write_client(stream: UnixStream, rx: Receiver<Arc<str>>, missed: Arc<AtomicU64>, hello: &str) {
-    let mut out = BufWriter::new(stream);
-    if out.write_all(hello.as_bytes()).and_then(|()| out.flush()).is_err() {
+/// Marks the queue's writer gone however it ends (an error, the client leaving, a panic), so
+/// the hub drops the client and frees its place.
+struct Leaving<'a>(&'a Queue);
+
+impl Drop for Leaving<'_> {
+    fn drop(&mut self) {
+        let mut q = lock(&self.0.state);
+        q.gone = true;
+        q.lines = VecDeque::new();
+    }
+}
+
+/// A client's writer: its queue to its socket, a batch per write.
+fn write_client(stream: UnixStream, queue: &Queue) {
+    let _leaving = Leaving(queue);
+    // Reads only check that the client is still there; the receive timeout leaves writes
+    // blocking, so a client that stops reading blocks only this thread.
+    if stream.set_read_timeout(Some(Duration::from_millis(1))).is_err() {
         return;
     }
-    while let Ok(line) = rx.recv() {
-        let lost = missed.swap(0, Ordering::Relaxed);
-        if lost > 0 {
-            let notice = wire::line(&PenEvent::missed(lost, now_us()));
-            if out.write_all(notice.as_bytes()).is_err() {
+    let mut out = BufWriter::with_capacity(16 * 1024, &stream);
+    let mut batch: Vec<Arc<str>> = Vec::with_capacity(BATCH);
+    loop {
+        {
+            let mut q = lock(&queue.state);
+            while q.lines.is_empty() {
+                q.waiting = true;
+                let (guard, wait) = queue
+                    .wake
+                    .wait_timeout(q, IDLE_CHECK)
+                    .unwrap_or_else(|e| e.into_inner());
+                q = guard;
+                q.waiting = false;
+                if wait.timed_out() && q.lines.is_empty() {
+                    drop(q);
+                    if client_left(&stream) {
+                        return;
+                    }
+                    q = lock(&queue.state);
+                }
+            }
+            let n = q.lines.len().min(BATCH);
+            batch.extend(q.lines.drain(..n));
+        }
+        for line in batch.drain(..) {
+            if out.write_all(line.as_bytes()).is_err() {
                 return;
             }
         }
-        // Flush only when nothing else is waiting: a burst goes out in one write.
-        let result = out.write_all(line.as_bytes()).and_then(|()| match rx.try_recv() {
-            Ok(next) => out.write_all(next.as_bytes()).and_then(|()| out.flush()),
-            Err(_) => out.flush(),
-        });
-        if result.is_err() {
+        if out.flush().is_err() {
             return;
         }
+    }
+}
+
+/// Whether the client closed its end: a read sees the end of its stream. Anything it wrote is
+/// read and ignored (docs/events.md: clients only read).
+fn client_left(stream: &UnixStream) -> bool {
+    let mut buf = [0u8; 512];
+    match (&*stream).read(&mut buf) {
+        Ok(0) => true,
+        Ok(_) => false,
+        Err(e) => !matches!(
+            e.kind(),
+            std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
+        ),
     }
 }
 

@@ -7,6 +7,9 @@
 //! a `proximity_out` if the pen was in range, so a client never waits for a release that cannot
 //! come; when it returns, `device_found` starts from nothing pressed and out of range. The JSON
 //! form is in docs/events.md.
+//!
+//! `PenState` is what a client knows from the events it has read; pend uses it to bring a client
+//! that joins late, or lost events, up to date with the same kinds of events.
 
 use crate::sample::Sample;
 
@@ -225,6 +228,134 @@ impl EventDetector {
     }
 }
 
+/// The pen's state as a client knows it from the events it has read: whether a device is
+/// attached (and which attachment), whether the pen is in range, its switches and where it was
+/// last seen. pend keeps the current one, and the one a lagging client last saw, so it can
+/// bring a client that joins late or lost events up to date with events (`resync`).
+#[derive(Debug, Default, Clone, PartialEq)]
+pub struct PenState {
+    /// The attached device, as its last `device_found` named it.
+    pub device: Option<String>,
+    /// Attachments seen (`device_found` events): a device lost and found again while a client
+    /// was not reading differs from one that stayed, even under the same name.
+    pub attachments: u64,
+    /// In range (after `proximity_in`, until `proximity_out`).
+    pub in_range: bool,
+    /// [SW1, SW2, SW3].
+    pub sw: [bool; 3],
+    /// Where the pen was last seen.
+    pub point: Option<DisplayPoint>,
+}
+
+/// `device_lost`'s reason when a client lost the real one in a gap.
+pub const LOST_IN_GAP: &str = "lost while this client was not reading";
+
+impl PenState {
+    /// The state after `e`. Switch events set only their switch, so a stream that pairs its
+    /// downs and ups (as `EventDetector`'s does) keeps the state exact.
+    pub fn apply(&mut self, e: &PenEvent) {
+        if let Some(p) = e.point {
+            self.point = Some(p);
+        }
+        match &e.kind {
+            EventKind::ProximityIn => self.in_range = true,
+            EventKind::ProximityOut => self.in_range = false,
+            EventKind::TipDown => self.sw[0] = true,
+            EventKind::TipUp => self.sw[0] = false,
+            EventKind::ButtonDown { button } => self.set_button(*button, true),
+            EventKind::ButtonUp { button } => self.set_button(*button, false),
+            EventKind::Motion | EventKind::Missed { .. } => {}
+            EventKind::DeviceLost { .. } => self.device = None,
+            EventKind::DeviceFound { device } => {
+                // The detector starts a new device from nothing pressed and out of range.
+                *self = PenState {
+                    device: Some(device.clone()),
+                    attachments: self.attachments + 1,
+                    ..PenState::default()
+                };
+            }
+        }
+    }
+
+    fn set_button(&mut self, button: u8, down: bool) {
+        if let Some(sw) = self.sw.get_mut(usize::from(button).wrapping_sub(1)) {
+            *sw = down;
+        }
+    }
+
+    /// What a client that joins now already knows from the greeting: the device, nothing
+    /// about the pen.
+    pub fn greeted(&self) -> PenState {
+        PenState {
+            device: self.device.clone(),
+            attachments: self.attachments,
+            ..PenState::default()
+        }
+    }
+
+    /// The events that take a client from this state to `to`, at `t_us`, in the order one
+    /// report's events come (docs/events.md): if the device changed, `device_lost` with the
+    /// releases and `proximity_out` it implies, then `device_found`; then `proximity_in`,
+    /// switch transitions, `proximity_out`. They carry no `seq` (no report made them); their
+    /// position is the pen's last known one. Applying them to this state gives `to`, except
+    /// for the last-seen position.
+    pub fn resync(&self, to: &PenState, t_us: u64, out: &mut Vec<PenEvent>) {
+        let mut at = self.clone();
+        let device_changed = at.attachments != to.attachments || at.device.is_some() != to.device.is_some();
+        if device_changed {
+            if at.device.is_some() {
+                let mut lost = Vec::new();
+                let mut detector = EventDetector {
+                    in_range: at.in_range,
+                    sw: at.sw,
+                    last_point: at.point,
+                };
+                detector.on_device_lost(t_us, LOST_IN_GAP, &mut lost);
+                out.append(&mut lost);
+            }
+            at = PenState {
+                device: None,
+                attachments: to.attachments,
+                point: at.point,
+                ..PenState::default()
+            };
+            if let Some(device) = &to.device {
+                out.push(PenEvent::bare(EventKind::DeviceFound { device: device.clone() }, t_us));
+                at.device = Some(device.clone());
+            }
+        }
+        let point = to.point.or(at.point);
+        let mut push = |kind, sw: [bool; 3]| {
+            out.push(PenEvent {
+                kind,
+                t_us,
+                point,
+                sw: Some(sw),
+                seq: None,
+            })
+        };
+        if to.in_range && !at.in_range {
+            push(EventKind::ProximityIn, at.sw);
+        }
+        for i in 0..3 {
+            if at.sw[i] == to.sw[i] {
+                continue;
+            }
+            at.sw[i] = to.sw[i];
+            let kind = match (i, to.sw[i]) {
+                (0, true) => EventKind::TipDown,
+                (0, false) => EventKind::TipUp,
+                (b, true) => EventKind::ButtonDown { button: b as u8 + 1 },
+                (b, false) => EventKind::ButtonUp { button: b as u8 + 1 },
+            };
+            push(kind, at.sw);
+        }
+        if at.in_range && !to.in_range {
+            push(EventKind::ProximityOut, at.sw);
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -294,6 +425,91 @@ mod tests {
         d.on_device_found(6000, "sim", &mut out);
         d.on_sample(&sample(2, true, [true, false, false]), point(2.0), &mut out);
         assert_eq!(names(&out), ["device_found", "proximity_in", "tip_down", "motion"]);
+    }
+
+    /// The state after `events`, from `from`.
+    fn after(from: &PenState, events: &[PenEvent]) -> PenState {
+        let mut s = from.clone();
+        for e in events {
+            s.apply(e);
+        }
+        s
+    }
+
+    #[test]
+    fn resync_takes_a_client_to_the_pen_s_state_in_one_report_s_order() {
+        let mut d = EventDetector::new();
+        let mut pen = PenState::default();
+        let mut out = Vec::new();
+        d.on_device_found(10, "sim", &mut out);
+        d.on_sample(&sample(1, true, [true, false, true]), point(1.0), &mut out);
+        for e in &out {
+            pen.apply(e);
+        }
+        assert_eq!((pen.in_range, pen.sw, pen.attachments), (true, [true, false, true], 1));
+
+        // Joining: the greeting names the device; the events give the pen.
+        let joined = pen.greeted();
+        let mut sync = Vec::new();
+        joined.resync(&pen, 99, &mut sync);
+        assert_eq!(names(&sync), ["proximity_in", "tip_down", "button_down"]);
+        assert!(
+            sync.iter()
+                .all(|e| e.seq.is_none() && e.t_us == 99 && e.point == Some(point(1.0)))
+        );
+        assert_eq!(sync[2].sw, Some([true, false, true]));
+        assert_eq!(after(&joined, &sync).sw, pen.sw);
+
+        // Lost in a gap: the tip lifted and the pen left; SW2 pressed.
+        let seen = pen.clone();
+        out.clear();
+        d.on_sample(&sample(2, false, [false, true, true]), point(2.0), &mut out);
+        for e in &out {
+            pen.apply(e);
+        }
+        sync.clear();
+        seen.resync(&pen, 100, &mut sync);
+        assert_eq!(names(&sync), ["tip_up", "button_down", "proximity_out"]);
+        assert_eq!(after(&seen, &sync).sw, [false, true, true]);
+
+        // Lost in a gap: the device lost and found again, the pen back with the tip down.
+        let seen = pen.clone();
+        out.clear();
+        d.on_device_lost(200, "unplugged", &mut out);
+        d.on_device_found(300, "sim", &mut out);
+        d.on_sample(&sample(3, true, [true, false, false]), point(3.0), &mut out);
+        for e in &out {
+            pen.apply(e);
+        }
+        sync.clear();
+        seen.resync(&pen, 400, &mut sync);
+        assert_eq!(
+            names(&sync),
+            [
+                "device_lost",
+                "button_up",
+                "button_up",
+                "device_found",
+                "proximity_in",
+                "tip_down"
+            ]
+        );
+        assert_eq!(
+            sync[0].kind,
+            EventKind::DeviceLost {
+                reason: LOST_IN_GAP.into()
+            }
+        );
+        let caught = after(&seen, &sync);
+        assert_eq!(
+            (caught.device, caught.attachments, caught.in_range, caught.sw),
+            (Some("sim".into()), 2, true, [true, false, false])
+        );
+
+        // In step: nothing to say.
+        sync.clear();
+        pen.resync(&pen, 500, &mut sync);
+        assert!(sync.is_empty());
     }
 
     #[test]

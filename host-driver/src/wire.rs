@@ -11,8 +11,10 @@ use serde::{Deserialize, Serialize};
 
 use crate::events::{DisplayPoint, EventKind, PenEvent};
 
-/// The events schema's version, the greeting's `events`.
-pub const EVENTS_VERSION: u32 = 1;
+/// The events schema's version, the greeting's `events`. Version 2 added the `refused` line and
+/// the events that bring a client up to date when it joins and after a `missed` notice
+/// (docs/events.md).
+pub const EVENTS_VERSION: u32 = 2;
 
 /// One line on the socket, by its `type`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -21,6 +23,8 @@ pub const EVENTS_VERSION: u32 = 1;
 pub enum SocketLine {
     /// The first line a client reads.
     Hello(Hello),
+    /// The only line a client reads when pend has no room for it, instead of the greeting.
+    Refused(Refused),
     ProximityIn(Pen),
     ProximityOut(Pen),
     TipDown(Pen),
@@ -44,6 +48,15 @@ pub struct Hello {
     pub connected: bool,
     /// The device, `null` while none is attached.
     pub device: Option<String>,
+}
+
+/// pend turned the client away (it serves a bounded number at once); the connection closes.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Refused {
+    /// Host time, seconds since the Unix epoch.
+    pub t: f64,
+    /// Why, for a person: the limit and what to do.
+    pub reason: String,
 }
 
 /// Where the pen is (or was last seen): all five keys, or none. Rounded to µm when written.
@@ -170,6 +183,16 @@ impl Hello {
     }
 }
 
+impl Refused {
+    /// The refusal at `t_us`, saying `reason`.
+    pub fn new(t_us: u64, reason: String) -> Refused {
+        Refused {
+            t: seconds(t_us),
+            reason,
+        }
+    }
+}
+
 impl Point {
     fn of(p: Option<DisplayPoint>) -> Point {
         let Some(p) = p else { return Point::default() };
@@ -258,7 +281,7 @@ impl From<&PenEvent> for SocketLine {
 }
 
 impl SocketLine {
-    /// The event this line carries; `Ok(None)` for the greeting.
+    /// The event this line carries; `Ok(None)` for the greeting and a refusal.
     pub fn into_event(self) -> Result<Option<PenEvent>, WireError> {
         let bare = |kind, t| -> Result<PenEvent, WireError> {
             Ok(PenEvent {
@@ -296,8 +319,8 @@ impl SocketLine {
             })
         };
         Ok(Some(match self {
-            SocketLine::Hello(h) => {
-                micros(h.t)?;
+            SocketLine::Hello(Hello { t, .. }) | SocketLine::Refused(Refused { t, .. }) => {
+                micros(t)?;
                 return Ok(None);
             }
             SocketLine::ProximityIn(p) => pen(EventKind::ProximityIn, p)?,

@@ -1,4 +1,6 @@
-//! The daemon: many clients at 1 kHz while one stops reading, and a clean stop on SIGTERM.
+//! The daemon: many clients at 1 kHz while one stops reading; a lagging client's loss marked
+//! where it happened with its state brought up to date; a client joining mid-stroke told the pen
+//! is down; clients beyond the limit refused; a clean stop on SIGTERM.
 
 use std::io::{BufRead, BufReader};
 use std::os::unix::fs::PermissionsExt;
@@ -9,13 +11,16 @@ use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
+use glam::DVec3;
 use pen_host::calibration::{Calibration, DisplaySize};
 use pen_host::client::{Line, parse_line};
 use pen_host::daemon::{self, Hub};
-use pen_host::events::EventKind;
+use pen_host::events::{DisplayPoint, EventDetector, EventKind, PenEvent, PenState};
 use pen_host::pipeline::Pipeline;
+use pen_host::sample::Sample;
 use pen_host::source::Source;
 use pen_host::transport::sim::SimOptions;
+use pen_protocol::Quality;
 
 fn socket_path(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("pend-test-{}-{name}/pend.sock", std::process::id()))
@@ -28,6 +33,33 @@ struct Seen {
     missed: u64,
     gaps: u64,
     latencies_us: Vec<u64>,
+    /// What broke the stream's promises: a down without its up, time going backwards, a gap in
+    /// the reports with no `missed` notice at it, a notice where no report is missing.
+    broken: Vec<String>,
+}
+
+/// Checks one event against the client's view of the pen, and updates it: every down has its
+/// up, proximity alternates, times never go backwards.
+fn follow(view: &mut PenState, last_t: &mut u64, e: &PenEvent) -> Result<(), String> {
+    let ok = match &e.kind {
+        EventKind::ProximityIn => !view.in_range,
+        EventKind::ProximityOut => view.in_range,
+        EventKind::TipDown => !view.sw[0],
+        EventKind::TipUp => view.sw[0],
+        EventKind::ButtonDown { button } => !view.sw[usize::from(*button) - 1],
+        EventKind::ButtonUp { button } => view.sw[usize::from(*button) - 1],
+        _ => true,
+    };
+    let before = *last_t;
+    *last_t = e.t_us;
+    view.apply(e);
+    if !ok {
+        return Err(format!("{} out of turn at t {}", e.kind.name(), e.t_us));
+    }
+    if e.t_us < before {
+        return Err(format!("{} at t {} after t {before}", e.kind.name(), e.t_us));
+    }
+    Ok(())
 }
 
 /// A hang guard only: a loaded machine is slow, never this slow.
@@ -40,6 +72,7 @@ fn read_client(stream: UnixStream, enough: u64, until_missed: bool, until: Insta
     let mut reader = BufReader::new(stream);
     let mut seen = Seen::default();
     let mut last_seq: Option<u16> = None;
+    let (mut view, mut last_t, mut notice) = (PenState::default(), 0u64, false);
     let mut line = String::new();
     while seen.motions < enough && !(until_missed && seen.missed > 0) && Instant::now() < until {
         line.clear();
@@ -50,19 +83,37 @@ fn read_client(stream: UnixStream, enough: u64, until_missed: bool, until: Insta
         }
         let received = pen_host::sample::now_us();
         match parse_line(line.trim_end()) {
-            Ok(Line::Event(e)) => match e.kind {
-                EventKind::Motion => {
-                    seen.motions += 1;
-                    seen.latencies_us.push(received.saturating_sub(e.t_us));
-                    let seq = e.seq.map(|s| s.0).unwrap_or(0);
-                    if last_seq.is_some_and(|l| seq != l.wrapping_add(1)) {
-                        seen.gaps += 1;
-                    }
-                    last_seq = Some(seq);
+            Ok(Line::Event(e)) => {
+                if let Err(why) = follow(&mut view, &mut last_t, &e) {
+                    seen.broken.push(why);
                 }
-                EventKind::Missed { count } => seen.missed += count,
-                _ => {}
-            },
+                match e.kind {
+                    EventKind::Motion => {
+                        seen.motions += 1;
+                        seen.latencies_us.push(received.saturating_sub(e.t_us));
+                        let seq = e.seq.map(|s| s.0).unwrap_or(0);
+                        let jumped = last_seq.is_some_and(|l| seq != l.wrapping_add(1));
+                        if jumped {
+                            seen.gaps += 1;
+                        }
+                        // The held pen makes one motion per report and nothing else, so a
+                        // notice comes exactly where the reports jump.
+                        if jumped != notice {
+                            seen.broken.push(format!(
+                                "seq {last_seq:?} then {seq} with{} a missed notice between",
+                                if notice { "" } else { "out" }
+                            ));
+                        }
+                        notice = false;
+                        last_seq = Some(seq);
+                    }
+                    EventKind::Missed { count } => {
+                        seen.missed += count;
+                        notice = true;
+                    }
+                    _ => {}
+                }
+            }
             Ok(Line::Hello { .. }) => {}
             Err(e) => panic!("bad line from pend: {e}"),
         }
@@ -119,6 +170,7 @@ fn sixteen_clients_at_1_khz_while_one_stops_reading() {
         // Every motion event, none missed, none skipped.
         assert_eq!(s.motions, MOTIONS, "client {i} within {GUARD:?}");
         assert_eq!((s.missed, s.gaps), (0, 0), "client {i}");
+        assert!(s.broken.is_empty(), "client {i}: {:?}", s.broken);
     }
     let mut lat: Vec<u64> = seen.iter().flat_map(|s| s.latencies_us.iter().copied()).collect();
     lat.sort_unstable();
@@ -132,11 +184,14 @@ fn sixteen_clients_at_1_khz_while_one_stops_reading() {
     // The slow client missed events, and is told so when it reads again.
     let (_, missed) = hub.counts();
     assert!(missed > 0, "the slow client's queue overflowed");
-    let resumed = read_client(slow, u64::MAX, true, Instant::now() + GUARD);
+    // It reads on past the notice: the queued events before the gap, the notice at the gap,
+    // then the events after it, in order.
+    let resumed = read_client(slow, 2 * daemon::DEFAULT_QUEUE as u64, false, Instant::now() + GUARD);
     assert!(
-        resumed.missed > 0,
+        resumed.missed > 0 && resumed.gaps > 0,
         "the slow client was told it missed {missed} events: {resumed:?}"
     );
+    assert!(resumed.broken.is_empty(), "the slow client: {:?}", resumed.broken);
     stop.store(true, Ordering::Relaxed);
 }
 
@@ -167,4 +222,350 @@ fn sigterm_stops_pend_cleanly() {
     let code = pend.wait().expect("pend exits");
     assert_eq!(code.code(), Some(0), "exit status 0 on SIGTERM");
     assert!(!path.exists(), "socket removed");
+}
+
+/// A pen driven sample by sample through the real event detector, each event published with
+/// its own time (1 µs apart) so a client's stream says exactly which events it got.
+struct Pen {
+    detector: EventDetector,
+    seq: u16,
+    next_t: u64,
+    /// The pen's state after each event published, by the event's time.
+    states: Vec<(u64, PenState)>,
+    state: PenState,
+}
+
+impl Pen {
+    fn new() -> Pen {
+        Pen {
+            detector: EventDetector::new(),
+            seq: 0,
+            next_t: 1_000_000,
+            states: Vec::new(),
+            state: PenState::default(),
+        }
+    }
+
+    fn publish(&mut self, hub: &Hub, mut events: Vec<PenEvent>) {
+        for e in &mut events {
+            e.t_us = self.next_t;
+            self.next_t += 1;
+            self.state.apply(e);
+            self.states.push((e.t_us, self.state.clone()));
+            hub.publish(e);
+        }
+    }
+
+    fn sample(&mut self, hub: &Hub, in_range: bool, sw: [bool; 3]) {
+        self.seq = self.seq.wrapping_add(1);
+        let s = Sample {
+            seq: self.seq,
+            device_us: u64::from(self.seq) * 1000,
+            host_us: 0,
+            sw,
+            in_range,
+            display_frame: true,
+            position_mm: DVec3::new(100.0, 50.0, 0.0),
+            quality: Quality::NONE,
+        };
+        let point = DisplayPoint {
+            u_mm: 100.0 + f64::from(self.seq % 100),
+            v_mm: 50.0,
+            h_mm: 0.0,
+            u_px: 400.0,
+            v_px: 200.0,
+        };
+        let mut events = Vec::new();
+        self.detector.on_sample(&s, point, &mut events);
+        self.publish(hub, events);
+    }
+
+    fn found(&mut self, hub: &Hub, device: &str) {
+        let mut events = Vec::new();
+        self.detector.on_device_found(0, device, &mut events);
+        self.publish(hub, events);
+    }
+
+    fn lost(&mut self, hub: &Hub) {
+        let mut events = Vec::new();
+        self.detector.on_device_lost(0, "unplugged", &mut events);
+        self.publish(hub, events);
+    }
+
+    /// The state after the event at `t_us`.
+    fn state_at(&self, t_us: u64) -> &PenState {
+        let i = self.states.partition_point(|(t, _)| *t < t_us);
+        &self.states[i].1
+    }
+}
+
+/// Reads lines until `done` says so, or the guard passes; returns the greeting's device and the
+/// events.
+fn read_events(stream: UnixStream, mut done: impl FnMut(&PenEvent) -> bool) -> (Option<Option<String>>, Vec<PenEvent>) {
+    let _ = stream.set_read_timeout(Some(Duration::from_millis(200)));
+    let until = Instant::now() + GUARD;
+    let mut reader = BufReader::new(stream);
+    let (mut hello, mut events) = (None, Vec::new());
+    let mut line = String::new();
+    while Instant::now() < until {
+        line.clear();
+        match reader.read_line(&mut line) {
+            Ok(0) => break,
+            Ok(_) => {}
+            Err(_) => continue,
+        }
+        match parse_line(line.trim_end()) {
+            Ok(Line::Hello { device }) => hello = Some(device),
+            Ok(Line::Event(e)) => {
+                let stop = done(&e);
+                events.push(e);
+                if stop {
+                    break;
+                }
+            }
+            Err(e) => panic!("bad line from pend: {e}"),
+        }
+    }
+    (hello, events)
+}
+
+fn names(events: &[PenEvent]) -> Vec<&'static str> {
+    events.iter().map(|e| e.kind.name()).collect()
+}
+
+/// Issue 22 item 6: a client that stalls mid-stroke while the tip is lifted and put down again
+/// and the device is lost and found. Its `missed` notice must come exactly at the gap (the
+/// events before it are all it got before the loss, none older follow it), its times never go
+/// backwards, and the events after the notice bring it to the pen's state, so it never sees two
+/// `tip_down` without a `tip_up`.
+#[test]
+fn a_lagging_client_sees_its_loss_where_it_happened_and_the_state_after_it() {
+    const QUEUE: usize = 32;
+    let hub = Arc::new(Hub::default());
+    let (ours, theirs) = UnixStream::pair().expect("socket pair");
+    assert!(hub.connect(ours, QUEUE));
+    let mut pen = Pen::new();
+    pen.found(&hub, "sim");
+    // Mid-stroke, the client not reading: its socket buffer and queue fill, then it misses.
+    let down = [true, false, false];
+    let mut filled = 0;
+    while hub.counts().1 == 0 {
+        pen.sample(&hub, true, down);
+        filled += 1;
+        assert!(filled < 1_000_000, "the client's queue never filled");
+    }
+    // All lost to it while it does not read: the tip lifted and put down again, SW3 pressed, the
+    // device lost and found, the pen back with the tip down and SW2 pressed.
+    let gap_from = pen.next_t;
+    pen.sample(&hub, true, [false, false, false]);
+    pen.sample(&hub, true, [true, false, false]);
+    pen.sample(&hub, true, [true, false, true]);
+    pen.lost(&hub);
+    pen.found(&hub, "sim");
+    pen.sample(&hub, true, [true, true, false]);
+    let gap_to = pen.next_t;
+
+    // The client reads again, while the pen goes on (paced, not timed: each publication
+    // offers the notice again until its queue has room).
+    let caught_up = Arc::new(AtomicBool::new(false));
+    let flag = caught_up.clone();
+    let reader = std::thread::spawn(move || {
+        let mut notice = false;
+        read_events(theirs, |e| {
+            notice |= matches!(e.kind, EventKind::Missed { .. });
+            let done = notice && e.seq.is_some();
+            if done {
+                flag.store(true, Ordering::Relaxed);
+            }
+            done
+        })
+    });
+    let until = Instant::now() + GUARD;
+    while !caught_up.load(Ordering::Relaxed) && Instant::now() < until {
+        pen.sample(&hub, true, [true, true, false]);
+        std::thread::sleep(Duration::from_millis(1));
+    }
+    let (hello, events) = reader.join().expect("reader");
+    assert_eq!(hello, Some(None), "greeted before any device");
+
+    // The stream: every down paired, times in order.
+    let (mut view, mut last_t) = (PenState::default(), 0);
+    for e in &events {
+        follow(&mut view, &mut last_t, e).unwrap_or_else(|why| panic!("{why}: {:?}", names(&events)));
+    }
+    // Each notice sits exactly at its gap: the real event before it and the first after it are
+    // `count` + 1 apart, and between them come only events pend made up (no `seq`).
+    let notices: Vec<usize> = (0..events.len())
+        .filter(|&i| matches!(events[i].kind, EventKind::Missed { .. }))
+        .collect();
+    assert!(!notices.is_empty(), "{:?}", names(&events));
+    let mut counted = 0;
+    let mut covered = false;
+    for &i in &notices {
+        let EventKind::Missed { count } = events[i].kind else {
+            unreachable!()
+        };
+        counted += count;
+        let before = events[..i]
+            .iter()
+            .rev()
+            .find(|e| e.seq.is_some())
+            .expect("an event before the gap");
+        let after_at = i + events[i..]
+            .iter()
+            .position(|e| e.seq.is_some())
+            .expect("an event after the gap");
+        let after = &events[after_at];
+        assert_eq!(after.t_us - before.t_us - 1, count, "notice {i} marks its gap");
+        assert_eq!(events[i].t_us, after.t_us, "the notice at the gap's end");
+        // What came between is the difference between the state the client saw and the pen's.
+        let mut caught = pen.state_at(before.t_us).clone();
+        for e in &events[i + 1..after_at] {
+            assert_eq!((e.seq, e.t_us), (None, after.t_us), "made up at the gap: {e:?}");
+            caught.apply(e);
+        }
+        let now = pen.state_at(after.t_us - 1);
+        assert_eq!(
+            (caught.in_range, caught.sw, &caught.device, caught.attachments),
+            (now.in_range, now.sw, &now.device, now.attachments),
+            "resynchronised at notice {i}"
+        );
+        if before.t_us < gap_from && after.t_us >= gap_to {
+            covered = true;
+            // The tip never came up for this client before the device was lost: pend says the
+            // device went, releases and takes the pen out of range, then the new device, the
+            // pen, its tip and SW2.
+            assert_eq!(
+                names(&events[i + 1..after_at]),
+                [
+                    "device_lost",
+                    "tip_up",
+                    "proximity_out",
+                    "device_found",
+                    "proximity_in",
+                    "tip_down",
+                    "button_down"
+                ]
+            );
+        }
+    }
+    assert!(covered, "one gap spans the lifted tip and the lost device");
+    assert_eq!(counted, hub.counts().1, "every event missed is counted in a notice");
+}
+
+/// Issue 19 item 7: a client that joins mid-stroke is told the pen is in range with the tip
+/// and SW3 down before the next motion, so it sees the stroke's `tip_up` paired.
+#[test]
+fn a_client_joining_mid_stroke_is_told_the_pen_is_down() {
+    let hub = Arc::new(Hub::default());
+    let mut pen = Pen::new();
+    pen.found(&hub, "sim");
+    pen.sample(&hub, true, [false; 3]);
+    pen.sample(&hub, true, [true, false, true]);
+    pen.sample(&hub, true, [true, false, true]);
+    let joined_at = pen.next_t - 1;
+    let (ours, theirs) = UnixStream::pair().expect("socket pair");
+    assert!(hub.connect(ours, daemon::DEFAULT_QUEUE));
+    pen.sample(&hub, true, [true, false, true]);
+    pen.sample(&hub, true, [false, false, false]);
+    let (hello, events) = read_events(theirs, |e| e.kind == EventKind::ButtonUp { button: 3 });
+    assert_eq!(hello, Some(Some("sim".to_string())));
+    assert_eq!(
+        names(&events),
+        [
+            "proximity_in",
+            "tip_down",
+            "button_down",
+            "motion",
+            "tip_up",
+            "button_up"
+        ]
+    );
+    // Made up from the state, at the time of the last event that made it, with its position.
+    for e in &events[..3] {
+        assert_eq!((e.seq, e.t_us), (None, joined_at), "{e:?}");
+        assert!(e.point.is_some());
+    }
+    assert_eq!(events[1].sw, Some([true, false, false]));
+    assert_eq!(events[2].sw, Some([true, false, true]));
+    let (mut view, mut last_t) = (PenState::default(), 0);
+    for e in &events {
+        follow(&mut view, &mut last_t, e).expect("paired");
+    }
+}
+
+/// The first line on a new connection to pend.
+fn first_line(path: &std::path::Path) -> (UnixStream, String) {
+    let stream = UnixStream::connect(path).expect("connect");
+    stream.set_read_timeout(Some(GUARD)).expect("timeout");
+    let mut reader = BufReader::new(stream.try_clone().expect("clone"));
+    let mut line = String::new();
+    reader.read_line(&mut line).expect("a line");
+    (stream, line)
+}
+
+fn threads(pid: u32) -> usize {
+    let status = std::fs::read_to_string(format!("/proc/{pid}/status")).expect("status");
+    status
+        .lines()
+        .find_map(|l| l.strip_prefix("Threads:"))
+        .and_then(|n| n.trim().parse().ok())
+        .expect("Threads:")
+}
+
+/// Issue 22 item 9: pend serves at most `--max-clients` at once; one more reads a `refused`
+/// line saying why and is closed, costing no thread; a place is freed when a client leaves.
+#[test]
+fn clients_beyond_the_limit_are_refused_and_cost_no_thread() {
+    let path = socket_path("limit");
+    let mut pend = Command::new(env!("CARGO_BIN_EXE_pend"))
+        .args(["--sim", "hold", "--max-clients", "4", "--socket"])
+        .arg(&path)
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("pend starts");
+    let end = Instant::now() + GUARD;
+    while UnixStream::connect(&path).is_err() {
+        assert!(Instant::now() < end, "pend did not listen");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    // Threads settle to pend's own (main, acceptor, device) once the probe above is gone.
+    let wait_threads = |want: usize| {
+        let end = Instant::now() + GUARD;
+        while threads(pend.id()) != want {
+            assert!(Instant::now() < end, "threads {} not {want}", threads(pend.id()));
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    };
+    wait_threads(3);
+    let mut served: Vec<UnixStream> = (0..4)
+        .map(|_| {
+            let (s, line) = first_line(&path);
+            assert!(line.contains(r#""type":"hello""#), "{line}");
+            s
+        })
+        .collect();
+    assert_eq!(threads(pend.id()), 3 + 4, "a writer per client");
+    for _ in 0..50 {
+        let (stream, line) = first_line(&path);
+        match parse_line(line.trim_end()) {
+            Err(pen_host::client::ClientError::Io(e)) => {
+                assert_eq!(e.kind(), std::io::ErrorKind::ConnectionRefused);
+                assert!(e.to_string().contains("at most 4 clients"), "{e}");
+            }
+            other => panic!("{line}: {other:?}"),
+        }
+        let mut rest = String::new();
+        let n = BufReader::new(stream).read_line(&mut rest).expect("closed");
+        assert_eq!(n, 0, "closed after the refusal: {rest}");
+    }
+    assert_eq!(threads(pend.id()), 3 + 4, "refused clients cost no thread");
+    // One leaves: its writer ends and its place is taken by the next.
+    drop(served.pop());
+    wait_threads(3 + 3);
+    let (_, line) = first_line(&path);
+    assert!(line.contains(r#""type":"hello""#), "{line}");
+    let _ = pend.kill();
+    let _ = pend.wait();
+    let _ = std::fs::remove_file(&path);
 }

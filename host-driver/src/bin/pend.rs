@@ -1,6 +1,6 @@
 //! `pend`: the pen daemon. Attaches to the base station (USB HID by default, `--serial PATH`, or
 //! `--sim` for the simulated pen), applies the calibration, and serves pen events to any number
-//! of clients on a Unix domain socket as JSON lines (docs/events.md). SIGTERM and SIGINT stop it:
+//! of clients (a bounded number at once) on a Unix domain socket as JSON lines (docs/events.md). SIGTERM and SIGINT stop it:
 //! the socket is removed and the exit status is 0.
 
 use std::path::PathBuf;
@@ -12,7 +12,7 @@ use std::time::Duration;
 use anyhow::{Context, Result};
 use clap::Parser;
 use pen_host::calibration::{Calibration, DisplaySize};
-use pen_host::daemon::{self, DEFAULT_QUEUE, Hub};
+use pen_host::daemon::{self, DEFAULT_MAX_CLIENTS, DEFAULT_QUEUE, Hub};
 use pen_host::pipeline::Pipeline;
 use pen_host::source::{DeviceArgs, SimScenario};
 
@@ -36,6 +36,10 @@ struct Cli {
     /// Events a client may have waiting before it misses some.
     #[arg(long, default_value_t = DEFAULT_QUEUE)]
     queue: usize,
+    /// Clients served at once; one more is sent a `refused` line and closed.
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_CLIENTS as u16,
+          value_parser = clap::value_parser!(u16).range(1..))]
+    max_clients: u16,
 }
 
 fn run(cli: Cli) -> Result<()> {
@@ -66,7 +70,7 @@ fn run(cli: Cli) -> Result<()> {
     for signal in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
         signal_hook::flag::register(signal, stop.clone()).context("installing signal handlers")?;
     }
-    let hub = Arc::new(Hub::default());
+    let hub = Arc::new(Hub::new(usize::from(cli.max_clients)));
     let (h, s) = (hub.clone(), stop.clone());
     let queue = cli.queue;
     std::thread::spawn(move || daemon::accept(listener, h, queue, s));
@@ -81,7 +85,11 @@ fn run(cli: Cli) -> Result<()> {
     }
     let _ = std::fs::remove_file(&socket);
     let (delivered, missed) = hub.counts();
-    eprintln!("pend: stopped; {delivered} events delivered, {missed} missed by slow clients");
+    let refused = hub.refused();
+    eprintln!(
+        "pend: stopped; {delivered} events delivered, {missed} missed by slow clients, {refused} clients refused (more than {} at once)",
+        hub.max_clients()
+    );
     Ok(())
 }
 
