@@ -148,6 +148,13 @@ impl Hub {
                     });
                     false
                 }
+                // Not even the notice and this event fit: still in the gap, and cheaply so,
+                // since a lagging client meets this for every event until it reads.
+                Some(mut gap) if !q.lines.is_empty() && q.lines.len() + 2 > c.capacity => {
+                    gap.count += 1;
+                    c.gap = Some(gap);
+                    false
+                }
                 Some(mut gap) => {
                     // The notice and the catch-up go in at the gap, before this event, and at
                     // its time, so the client's times never go backwards.
