@@ -68,7 +68,8 @@ fn the_demo_runs_headless_and_writes_its_results() {
         frames >= 20,
         "{frames} frames at 1 per second of a session over 20 s long"
     );
-    assert_eq!(png_size(&out_dir.join("frames/frame_00000.png")), (480, 180));
+    // By default the animation only; single frames and meshes on request (a compact default).
+    assert!(!out_dir.join("frames/frame_00000.png").exists());
     assert_eq!(png_size(&out_dir.join("frames/animation.png")), (480, 180));
     // The terrain: 16-bit heightmap, float32, meshes, renders; the document.
     assert_eq!(png_size(&out_dir.join("terrain.png")), (480, 272));
@@ -76,8 +77,11 @@ fn the_demo_runs_headless_and_writes_its_results() {
         .expect("terrain.f32")
         .len();
     assert_eq!(raw, 480 * 272 * 4);
-    for name in ["terrain.obj", "terrain.glb", "render.png", "display.png"] {
+    for name in ["render.png", "display.png"] {
         assert!(out_dir.join(name).exists(), "{name}");
+    }
+    for name in ["terrain.obj", "terrain.glb"] {
+        assert!(!out_dir.join(name).exists(), "{name} only with --meshes");
     }
     let doc = penmodel_terrain::Document::load(&out_dir.join("document.json")).expect("a valid document");
     assert_eq!(doc.regions.len(), 1);
@@ -93,11 +97,29 @@ fn the_demo_runs_headless_and_writes_its_results() {
         "the plateau's peak, pulled 110 mm at 1:10 000: {hi} m"
     );
 
-    // Run again: the demo's own outputs are replaced, nothing refuses.
-    let again = run(dir.path(), &["--size", "160x90", "--fps", "1", "--no-overview"]);
+    // Run again: the demo's own outputs are replaced, nothing refuses; frames and meshes asked.
+    let again = run(
+        dir.path(),
+        &[
+            "--size",
+            "160x90",
+            "--fps",
+            "1",
+            "--no-overview",
+            "--frames",
+            "--meshes",
+        ],
+    );
     assert!(again.status.success(), "{}", String::from_utf8_lossy(&again.stderr));
-    assert!(String::from_utf8_lossy(&again.stdout).contains("wrote"));
+    let stdout = String::from_utf8_lossy(&again.stdout);
+    assert!(
+        stdout.contains("1 region,") && stdout.contains("its meshes"),
+        "{stdout}"
+    );
     assert_eq!(png_size(&out_dir.join("frames/frame_00000.png")), (160, 90));
+    for name in ["terrain.obj", "terrain.glb"] {
+        assert!(out_dir.join(name).exists(), "{name}");
+    }
 
     // Open the document with no pen: it is the user's now, so the demo does not play into it.
     // Headless there is nothing to do: refused, saying how to attach a pen; nothing touched.
@@ -134,7 +156,7 @@ fn the_demo_runs_headless_and_writes_its_results() {
             "--size",
             "160x90",
             "--fps",
-            "1",
+            "0",
             "--json",
         ],
     );
@@ -142,6 +164,10 @@ fn the_demo_runs_headless_and_writes_its_results() {
     assert!(open.status.success(), "{stderr}");
     assert!(stderr.contains("refused"), "{stderr}");
     let summary: Value = serde_json::from_slice(&open.stdout).expect("JSON");
+    // --fps 0: no animation, the results alone.
+    assert_eq!(summary["frames"], 0, "{summary}");
+    assert!(!dir.path().join("more/frames").exists());
+    assert!(dir.path().join("more/terrain.png").exists());
     assert!(
         summary["stats"]["refused"].as_u64().is_some_and(|n| n >= 1),
         "{summary}"

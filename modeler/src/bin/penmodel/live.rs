@@ -58,9 +58,16 @@ pub struct LiveArgs {
     /// in a corner).
     #[arg(long)]
     no_overview: bool,
-    /// Frames per second of the session written to --out/frames when headless.
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u16).range(1..=60))]
+    /// Frames per second of the session's animation (OUT/frames/animation.png) when headless;
+    /// 0 draws none.
+    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u16).range(0..=60))]
     fps: u16,
+    /// Keep every frame of the animation as its own PNG in OUT/frames (large).
+    #[arg(long)]
+    frames: bool,
+    /// Also write the terrain as meshes: OUT/terrain.obj and OUT/terrain.glb (large).
+    #[arg(long)]
+    meshes: bool,
     /// The demo's speed: device seconds per second [default: 1 in a window, as fast as frames
     /// are drawn when headless].
     #[arg(long)]
@@ -84,6 +91,15 @@ pub struct LiveArgs {
     /// Print a JSON summary on stdout at the end.
     #[arg(long)]
     json: bool,
+}
+
+/// `n` and the noun, plural unless one: "1 region", "2 regions".
+fn count(n: u64, noun: &str) -> String {
+    if n == 1 {
+        format!("1 {noun}")
+    } else {
+        format!("{n} {noun}s")
+    }
 }
 
 /// The file beside the demo's document that says an earlier demo wrote it, so the next demo may
@@ -250,7 +266,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
         .editor
         .save()
         .with_context(|| format!("cannot save {}", doc_path.display()))?;
-    let results = write_results(&args.out, &session, &look, &mut painter)?;
+    let results = write_results(&args.out, args.meshes, &session, &look, &mut painter)?;
     let stats = session.interaction.stats().clone();
     let state = match session.state() {
         State::Running => "stopped".to_string(),
@@ -280,25 +296,33 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
         println!("{summary}");
     } else {
         println!(
-            "{state}: {} pen events; {} regions, {} figures, {} pulls, {} slopes, {} undos; terrain {lo:.0} to {hi:.0} m",
-            session.events(),
-            stats.regions,
-            stats.figures,
-            stats.pulls,
-            stats.slopes,
-            stats.undos
+            "{state}: {}; {}, {}, {}, {}, {}; terrain {lo:.0} to {hi:.0} m",
+            count(session.events(), "pen event"),
+            count(stats.regions as u64, "region"),
+            count(stats.figures as u64, "figure"),
+            count(stats.pulls as u64, "pull"),
+            count(stats.slopes as u64, "slope"),
+            count(stats.undos as u64, "undo"),
         );
-        let anim = written
-            .animation
-            .map(|p| format!(" and {}", p.display()))
-            .unwrap_or_default();
-        let frames = if written.shown {
-            format!("showed {} frames; wrote", written.frames)
-        } else {
-            format!("wrote {} frames{anim},", written.frames)
+        let what = match (written.shown, &written.animation) {
+            (true, _) => format!("showed {}; wrote", count(written.frames as u64, "frame")),
+            (false, Some(anim)) if args.frames => {
+                format!(
+                    "wrote {} and their animation {},",
+                    count(written.frames as u64, "frame"),
+                    anim.display()
+                )
+            }
+            (false, Some(anim)) => format!(
+                "wrote the animation of {} ({}),",
+                count(written.frames as u64, "frame"),
+                anim.display()
+            ),
+            (false, None) => "wrote".to_string(),
         };
+        let meshes = if args.meshes { ", its meshes" } else { "" };
         println!(
-            "{frames} the terrain, its render and the document to {}/ (document: {})",
+            "{what} the terrain{meshes}, its render and the document to {}/ (document: {})",
             args.out.display(),
             doc_path.display()
         );
@@ -427,8 +451,12 @@ fn run_headless(
     stop: &AtomicBool,
     demo_us: Option<u64>,
 ) -> Result<Written> {
-    let mut frames = Sequence::create(&args.out.join("frames"), args.fps)?;
-    let step_us = 1_000_000 / u64::from(args.fps);
+    // No frames at all with --fps 0: the results alone.
+    let mut frames = match args.fps {
+        0 => None,
+        fps => Some(Sequence::create(&args.out.join("frames"), fps)?),
+    };
+    let step_us = 1_000_000 / u64::from(args.fps.max(1));
     let mut next_us: Option<u64> = None;
     let progress = match demo_us {
         Some(total) => {
@@ -457,7 +485,7 @@ fn run_headless(
                 next_us = None;
             }
             let due = *next_us.get_or_insert(t);
-            if t >= due {
+            if let Some(frames) = frames.as_mut().filter(|_| t >= due) {
                 frames.push(painter.session(session, look)?)?;
                 next_us = Some(due + step_us);
                 progress.set_message(format!("{} frames", frames.frames().len()));
@@ -468,8 +496,20 @@ fn run_headless(
         }
     }
     progress.finish_and_clear();
-    let count = frames.frames().len();
-    let animation = frames.finish()?;
+    let (count, animation) = match frames {
+        None => (0, None),
+        Some(frames) => {
+            let paths = frames.frames().to_vec();
+            let animation = frames.finish()?;
+            if !args.frames {
+                // The animation holds them all; the single frames only on request.
+                for f in &paths {
+                    std::fs::remove_file(f).with_context(|| format!("cannot remove {}", f.display()))?;
+                }
+            }
+            (paths.len(), animation)
+        }
+    };
     Ok(Written {
         frames: count,
         animation,
@@ -584,7 +624,13 @@ fn run_window(
 }
 
 /// Writes the final terrain, its render and the exports; returns what was written, by kind.
-fn write_results(out: &Path, session: &Session, look: &Look, painter: &mut Painter) -> Result<serde_json::Value> {
+fn write_results(
+    out: &Path,
+    meshes: bool,
+    session: &Session,
+    look: &Look,
+    painter: &mut Painter,
+) -> Result<serde_json::Value> {
     let map: &Heightmap = session.editor.heightmap();
     let write = |name: &str, bytes: &[u8]| -> Result<PathBuf> {
         let path = out.join(name);
@@ -598,12 +644,16 @@ fn write_results(out: &Path, session: &Session, look: &Look, painter: &mut Paint
     bytes.clear();
     export::write_raw(map, &mut bytes)?;
     let raw = write("terrain.f32", &bytes)?;
-    bytes.clear();
-    export::write_obj(map, &mut bytes)?;
-    let obj = write("terrain.obj", &bytes)?;
-    bytes.clear();
-    export::write_glb(map, &mut bytes)?;
-    let glb = write("terrain.glb", &bytes)?;
+    // Meshes are large (a 512² grid is 18 MB of OBJ) and derived from the heightmap: on request.
+    let (mut obj, mut glb) = (None, None);
+    if meshes {
+        bytes.clear();
+        export::write_obj(map, &mut bytes)?;
+        obj = Some(write("terrain.obj", &bytes)?);
+        bytes.clear();
+        export::write_glb(map, &mut bytes)?;
+        glb = Some(write("terrain.glb", &bytes)?);
+    }
     // The final state, without the pen or a highlight, the ground level: as the display shows
     // it, and from the orbit camera of the overview.
     let view = View {
