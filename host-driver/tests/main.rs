@@ -1,6 +1,7 @@
 //! The integration tests of pen-host, in one binary: a module per area.
 mod calibration;
 mod daemon;
+mod delays;
 mod events;
 mod penctl;
 mod socket;

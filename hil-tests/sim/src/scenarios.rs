@@ -5,7 +5,7 @@ use glam::{DVec2, DVec3};
 
 use crate::acoustics::{Acoustics, Air};
 use crate::rig::Rig;
-use crate::script::{HOVER_MM, SW2, SW3, Script};
+use crate::script::{HOVER_MM, SW1, SW2, SW3, Script};
 use crate::sim::Scenario;
 
 /// Every scenario name with a line about it.
@@ -109,6 +109,27 @@ pub fn calibration(targets_mm: &[DVec2], rig: Rig) -> Scenario {
     }
     s.move_to(home());
     Scenario::new("calibration", rig, Acoustics::clean(), s.build())
+}
+
+/// The transducer-delay procedure (`penctl delays --sim`): the hand holds the pen still with its
+/// emitter at each of `points_mm` (tracker frame; the reference rig, whose display frame is the
+/// tracker frame), pressing SW1 for 0.8 s at each. The device starts uncalibrated, with the
+/// firmware's default delays of 0 µs, so the rig's true delays are what the procedure must find.
+pub fn transducer_delays(points_mm: &[DVec3]) -> Scenario {
+    let rig = Rig::reference();
+    // The tip sits below the emitter along the pen's nominal lean (the hand's slow wobble moves
+    // the emitter by up to 0.5 mm about it).
+    let lean = crate::hand::TILT_DEG.to_radians();
+    let axis = DVec3::new(0.0, -lean.sin(), lean.cos());
+    let mut s = Script::new(home());
+    for p in points_mm {
+        let tip = *p - axis * rig.emitter_offset_mm;
+        s.move_to(tip).hold(0.3).press(SW1).hold(0.8).release(SW1).hold(0.2);
+    }
+    s.move_to(home());
+    let mut scenario = Scenario::new("transducer-delays", rig, Acoustics::clean(), s.build());
+    scenario.config.transducer_delay_us = [0.0; pen_protocol::MAX_RECEIVERS];
+    scenario
 }
 
 /// Where every scenario starts and ends: hovering over the middle of the display.

@@ -78,6 +78,8 @@ enum Command {
     },
     /// Calibrate: touch targets on the display, fit the tracker → display transform.
     Calibrate(CalibrateArgs),
+    /// Measure each receiver's transducer delay from the pen held at surveyed points, and write it to the device.
+    Delays(pen_host::calibration::delays::cli::DelaysArgs),
     /// Print the USB HID report descriptor as one line of hex.
     Descriptor,
     /// Decode a report given in hex and print it as one JSON object.
@@ -616,6 +618,7 @@ fn run(cli: Cli) -> Result<()> {
             Ok(())
         }
         Command::Calibrate(a) => calibrate_cmd(a),
+        Command::Delays(a) => pen_host::calibration::delays::cli::run(a),
         Command::Descriptor => {
             outln!("{}", hex::to_hex(&REPORT_DESCRIPTOR));
             Ok(())

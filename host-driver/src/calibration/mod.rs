@@ -7,7 +7,10 @@
 //!   where each one's file is kept (the simulated pen's apart from the real one's).
 //! * [`procedure`]: leading the user (or the simulated pen) through the targets.
 //! * [`plot`]: the residuals as a PNG.
+//! * [`delays`]: each receiver's transducer delay from a pen held at surveyed points
+//!   (`penctl delays`).
 
+pub mod delays;
 pub mod device;
 pub mod file;
 pub mod fit;
