@@ -2,20 +2,43 @@
 # Builds the board's release image and writes it as a raw binary for the ROM DFU bootloader:
 # firmware/target/pen-firmware.bin, to be flashed at 0x08000000 with
 #   dfu-util -a 0 -s 0x08000000:leave -D firmware/target/pen-firmware.bin
+#
+# Needs only rustup's toolchain and the thumbv7em-none-eabihf target (installed here if missing):
+# no emulator, no Debian package. The ELF → binary step is LLVM's objcopy as the toolchain
+# ships it (`rust-objcopy` in rustc's sysroot, which rustc itself uses to strip binaries); a
+# toolchain without it gets the `llvm-tools` rustup component, which has `llvm-objcopy`.
+# Checks the image before it is flashed: its vector table must start with the stack at the top
+# of the STM32F411CE's RAM and a reset vector in its flash.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-source scripts/setup.sh
+SETUP=firmware source scripts/setup.sh
 (cd firmware && cargo build --release --locked -q)
-# rustc ships rust-objcopy (LLVM's objcopy) in its sysroot; older toolchains have it in the
-# llvm-tools component instead.
 sysroot=$(rustc --print sysroot)
-objcopy=$(ls "$sysroot"/lib/rustlib/*/bin/rust-objcopy "$sysroot"/lib/rustlib/*/bin/llvm-objcopy 2>/dev/null | head -n 1 || true)
+find_objcopy() {
+    ls "$sysroot"/lib/rustlib/*/bin/rust-objcopy "$sysroot"/lib/rustlib/*/bin/llvm-objcopy 2>/dev/null | head -n 1 || true
+}
+objcopy=$(find_objcopy)
 if [ -z "$objcopy" ]; then
+    echo "setup: adding Rust component llvm-tools" >&2
     rustup component add llvm-tools >/dev/null 2>&1
-    objcopy=$(ls "$sysroot"/lib/rustlib/*/bin/llvm-objcopy | head -n 1)
+    objcopy=$(find_objcopy)
 fi
+[ -n "$objcopy" ] || { echo "firmware-bin: no LLVM objcopy in $sysroot (rustup component add llvm-tools)" >&2; exit 1; }
 elf=firmware/target/thumbv7em-none-eabihf/release/pen-firmware
 bin=firmware/target/pen-firmware.bin
 # The tool links against the toolchain's own LLVM library, which lives in the sysroot.
 LD_LIBRARY_PATH="$sysroot/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" "$objcopy" -O binary "$elf" "$bin"
-echo "$bin: $(stat -c %s "$bin") bytes"
+
+# Word 0: the initial stack pointer, the top of RAM (0x2000_0000 + 128 KiB); word 1: the reset
+# handler, a Thumb address (odd) inside the program's flash sectors 0–6 (below 0x0806_0000).
+read -r sp reset < <(od -A n -t x4 -N 8 --endian=little "$bin")
+size=$(stat -c %s "$bin")
+if [ "$sp" != 20020000 ] || (( (16#$reset & 1) == 0 || 16#$reset < 0x08000000 || 16#$reset >= 0x08060000 )); then
+    echo "firmware-bin: $bin does not start with the board's vector table (stack $sp, reset $reset)" >&2
+    exit 1
+fi
+if (( size > 0x60000 )); then
+    echo "firmware-bin: $bin is $size bytes, more than sectors 0–6 (384 KiB) hold" >&2
+    exit 1
+fi
+echo "$bin: $size bytes (stack 0x$sp, reset 0x$reset)"

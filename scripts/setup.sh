@@ -7,6 +7,12 @@ DEB_PACKAGES=(binutils qemu-system-arm)
 # The board's target; clippy and rustfmt for the checks.
 RUST_TARGETS=(thumbv7em-none-eabihf)
 RUST_COMPONENTS=(clippy rustfmt)
+# SETUP=firmware (scripts/firmware-bin.sh): only what building the board's image needs, the
+# target — no Debian packages, no emulator.
+if [ "${SETUP:-}" = firmware ]; then
+    DEB_PACKAGES=()
+    RUST_COMPONENTS=()
+fi
 
 setup() {
     local missing=()

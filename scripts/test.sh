@@ -20,5 +20,6 @@ cargo test --workspace --locked
 step "firmware: lint and release image for thumbv7em-none-eabihf"
 (cd firmware && cargo clippy --release --locked --workspace -- -D warnings && cargo build --release --locked)
 scripts/firmware-size.sh
+scripts/firmware-bin.sh
 
 step "all checks passed"
