@@ -37,6 +37,21 @@ fn run(targets: &[DVec2], seed: u64) -> Calibration {
         steps.iter().filter(|s| matches!(s, Prompt::Taken { .. })).count(),
         targets.len()
     );
+    // The pen is shown as it goes: each taken touch is the mean of pressed positions just before
+    // it, so the last pressed position told lies near it.
+    let mut last_pressed = None;
+    for s in &steps {
+        match s {
+            Prompt::Pen {
+                position_mm, pressed, ..
+            } if *pressed => last_pressed = Some(*position_mm),
+            Prompt::Taken { touched_mm, .. } => {
+                let p = last_pressed.take().expect("pressed positions before a taken touch");
+                assert!(p.distance(*touched_mm) < 3.0, "{p} vs {touched_mm}");
+            }
+            _ => {}
+        }
+    }
     fit(targets, &touched, FitKind::Similarity, DisplaySize::REFERENCE).expect("fit")
 }
 

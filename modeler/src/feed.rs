@@ -22,7 +22,7 @@ use std::time::Duration;
 use glam::DVec2;
 use pen_host::calibration::procedure::{CalibrateError, Prompt, attach, collect_touches, prepare};
 use pen_host::calibration::{Calibration, DisplaySize, FitKind, fit};
-use pen_host::client::{Client, Line};
+use pen_host::client::{Client, ClientError, Line};
 use pen_host::device::Device;
 use pen_host::events::PenEvent;
 use pen_host::pipeline::Pipeline;
@@ -39,12 +39,92 @@ pub enum Feed {
     Display([f64; 2]),
     /// Something to tell the user: attaching, calibrating.
     Status(String),
+    /// The calibration procedure as it goes: the targets and the pen, for a picture of it.
+    Calibrating(Calibrating),
     /// A pen event in the display frame.
     Event(PenEvent),
     /// The source has ended normally (the demo's session is over, pend closed the socket).
     End(String),
     /// The source failed and cannot go on.
     Failed(String),
+}
+
+/// The calibration procedure as it goes, in display mm (`v` up from the lower edge).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Calibrating {
+    /// The targets, in the order they are touched.
+    pub targets: Vec<[f64; 2]>,
+    /// How many are taken: the next to touch is `targets[taken]`.
+    pub taken: usize,
+    /// The pen's tip, where the display probably is: before the fit, the tracker frame shifted
+    /// by the mean offset between the targets taken and where they were touched. `None` out of
+    /// range.
+    pub pen_mm: Option<[f64; 2]>,
+    /// The tip is pressed.
+    pub pressed: bool,
+}
+
+/// Device µs between two pictures of the pen during calibration: 30 a second is smooth enough.
+const CALIBRATION_PEN_US: u64 = 33_000;
+
+/// Turns the procedure's prompts into [`Calibrating`] pictures; `send` gets each new one.
+struct CalibrationPicture {
+    state: Calibrating,
+    /// Sum of (target − touched) over the taken targets, for the pen's guessed offset.
+    offset_sum: DVec2,
+    last_pen_us: Option<u64>,
+}
+
+impl CalibrationPicture {
+    fn new(targets: &[DVec2]) -> CalibrationPicture {
+        CalibrationPicture {
+            state: Calibrating {
+                targets: targets.iter().map(|t| [t.x, t.y]).collect(),
+                taken: 0,
+                pen_mm: None,
+                pressed: false,
+            },
+            offset_sum: DVec2::ZERO,
+            last_pen_us: None,
+        }
+    }
+
+    /// The picture after `prompt`, if it changed enough to be worth sending.
+    fn after(&mut self, prompt: &Prompt) -> Option<Calibrating> {
+        match prompt {
+            Prompt::Touch { index, .. } => self.state.taken = *index,
+            Prompt::Taken { touched_mm, .. } => {
+                if let Some(t) = self.state.targets.get(self.state.taken) {
+                    self.offset_sum += DVec2::from(*t) - touched_mm.truncate();
+                }
+                self.state.taken += 1;
+            }
+            Prompt::Pen {
+                position_mm,
+                pressed,
+                device_us,
+            } => {
+                let press_changed = *pressed != self.state.pressed;
+                if !press_changed
+                    && self
+                        .last_pen_us
+                        .is_some_and(|t| device_us.saturating_sub(t) < CALIBRATION_PEN_US)
+                {
+                    return None;
+                }
+                self.last_pen_us = Some(*device_us);
+                let offset = match self.state.taken {
+                    0 => DVec2::ZERO,
+                    n => self.offset_sum / n.min(self.state.targets.len()) as f64,
+                };
+                let at = position_mm.truncate() + offset;
+                self.state.pen_mm = Some([at.x, at.y]);
+                self.state.pressed = *pressed;
+            }
+            Prompt::Lift | Prompt::Again { .. } => return None,
+        }
+        Some(self.state.clone())
+    }
 }
 
 /// A pen to model with.
@@ -170,7 +250,11 @@ fn run_demo(tx: &SyncSender<Feed>, speed: f64, seed: u64) -> Result<(), Stop> {
     let mut closed = false;
     let mut taken = 0;
     let count = targets.len();
+    let mut picture = CalibrationPicture::new(&targets);
     let touched = collect_touches(&mut device, &targets, Duration::from_secs(60), |step| {
+        if let Some(p) = picture.after(step) {
+            closed |= tx.send(Feed::Calibrating(p)).is_err();
+        }
         if let Prompt::Taken { fixes, .. } = step {
             taken += 1;
             let line = format!("calibrating: target {taken} of {count} taken ({fixes} fixes)");
@@ -215,8 +299,7 @@ fn display_mm(c: &Calibration) -> [f64; 2] {
 }
 
 fn run_daemon(tx: &SyncSender<Feed>, path: &std::path::Path) -> Result<(), Stop> {
-    let mut client = Client::connect(path)
-        .map_err(|e| Stop::Failed(format!("cannot connect to pend at {}: {e}", path.display())))?;
+    let mut client = Client::connect(path).map_err(|e| Stop::Failed(not_connected(path, &e)))?;
     send(tx, Feed::Status(format!("connected to pend at {}", path.display())))?;
     let mut bad = 0u64;
     loop {
@@ -227,9 +310,12 @@ fn run_daemon(tx: &SyncSender<Feed>, path: &std::path::Path) -> Result<(), Stop>
                 send(tx, Feed::Status(format!("pend: {what}")))?;
             }
             Some(Ok(Line::Event(e))) => send(tx, Feed::Event(e))?,
-            Some(Err(pen_host::client::ClientError::Io(e))) => {
-                return Err(Stop::Failed(format!("pend socket: {e}")));
+            // pend has as many clients as it serves (`pend --max-clients`): the session ends
+            // with pend's reason rather than wait for a place that may never come.
+            Some(Err(ClientError::Io(e))) if e.kind() == std::io::ErrorKind::ConnectionRefused => {
+                return Err(Stop::Failed(e.to_string()));
             }
+            Some(Err(e @ ClientError::Io(_))) => return Err(Stop::Failed(e.to_string())),
             Some(Err(e)) => {
                 // A line that is not an event is dropped, counted and told.
                 bad += 1;
@@ -239,6 +325,26 @@ fn run_daemon(tx: &SyncSender<Feed>, path: &std::path::Path) -> Result<(), Stop>
                 )?;
             }
         }
+    }
+}
+
+/// Why pend's socket at `path` did not take a connection, and what to do.
+fn not_connected(path: &std::path::Path, e: &ClientError) -> String {
+    let not_running = match e {
+        ClientError::Io(io) => matches!(
+            io.kind(),
+            std::io::ErrorKind::NotFound | std::io::ErrorKind::ConnectionRefused
+        ),
+        ClientError::Bad { .. } => false,
+    };
+    if not_running {
+        format!(
+            "pend is not running (nothing listens at {}): start it (`pend`, or `systemctl --user start pend`; \
+             pend --help), or give another --source (hid, serial:PATH, sim)",
+            path.display()
+        )
+    } else {
+        format!("cannot connect to pend at {}: {e}", path.display())
     }
 }
 
@@ -270,8 +376,52 @@ fn run_device(tx: &SyncSender<Feed>, source: Source, calibration: Option<PathBuf
     let mut events = Vec::new();
     loop {
         pipeline.poll(Duration::from_millis(100), &mut events);
+        if let Some(notice) = pipeline.take_notice() {
+            send(tx, Feed::Status(notice))?;
+        }
         for e in events.drain(..) {
             send(tx, Feed::Event(e))?;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    #[test]
+    fn the_calibration_picture_follows_the_targets_and_guesses_the_pen() {
+        let targets = [DVec2::new(100.0, 50.0), DVec2::new(500.0, 290.0)];
+        let mut p = CalibrationPicture::new(&targets);
+        let touch = |index| Prompt::Touch {
+            index,
+            count: 2,
+            target_mm: targets[index],
+        };
+        let pen = |x, y, pressed, device_us| Prompt::Pen {
+            position_mm: DVec3::new(x, y, 0.0),
+            pressed,
+            device_us,
+        };
+        assert_eq!(p.after(&touch(0)).map(|c| c.taken), Some(0));
+        // Before any touch the tracker frame is shown as it is.
+        let c = p.after(&pen(90.0, 45.0, false, 0)).expect("first pen");
+        assert_eq!(c.pen_mm, Some([90.0, 45.0]));
+        // Within 33 ms and no press change: not worth a picture.
+        assert!(p.after(&pen(91.0, 45.0, false, 10_000)).is_none());
+        // A press is shown at once.
+        assert!(p.after(&pen(91.0, 45.0, true, 20_000)).is_some_and(|c| c.pressed));
+        let c = p
+            .after(&Prompt::Taken {
+                touched_mm: DVec3::new(90.0, 45.0, 0.0),
+                fixes: 30,
+            })
+            .expect("taken");
+        assert_eq!(c.taken, 1);
+        // Now the pen is shifted by the offset the first touch showed: (10, 5).
+        let c = p.after(&pen(490.0, 285.0, false, 100_000)).expect("pen");
+        assert_eq!(c.pen_mm, Some([500.0, 290.0]));
+        assert!(p.after(&Prompt::Lift).is_none());
     }
 }

@@ -6,11 +6,13 @@
 //!   (`docs/modeler.md`).
 //! - [`feed`] and [`session`]: pen events from the built-in demo, `pend` or a device, on a thread
 //!   of their own, into an editor.
+//! - [`keys`]: the live window's keys and the help it shows for them.
 //! - [`picture`]: what a frame of the session shows — the document and the interaction turned
 //!   into the renderer's plain-data scene.
 #![cfg_attr(not(test), warn(clippy::unwrap_used))]
 
 pub mod feed;
 pub mod interaction;
+pub mod keys;
 pub mod picture;
 pub mod session;

@@ -8,6 +8,7 @@ use penmodel_terrain::Heightmap;
 use penmodel_terrain::address::{CurvePath, FigurePath};
 use penmodel_terrain::document::{Document, Figure, FigureKind, Point};
 
+use crate::feed::Calibrating;
 use crate::interaction::{Interaction, View};
 use crate::session::Session;
 
@@ -19,6 +20,14 @@ pub const MOVING_COLOUR: Rgba = [255, 160, 32, 255];
 pub const DELETING_COLOUR: Rgba = [120, 120, 120, 255];
 /// Colour of the pen's tip and its foot on the ground.
 pub const PEN_COLOUR: Rgba = [255, 255, 255, 255];
+/// Colour of the calibration target to touch next.
+pub const TARGET_NEXT_COLOUR: Rgba = [255, 220, 0, 255];
+/// Colour of a calibration target already taken.
+pub const TARGET_TAKEN_COLOUR: Rgba = [80, 220, 120, 255];
+/// Colour of a calibration target still to come.
+pub const TARGET_LATER_COLOUR: Rgba = [150, 150, 150, 255];
+/// Radius of a calibration target's ring on the display, mm.
+pub const TARGET_RADIUS_MM: f64 = 8.0;
 
 /// How the session is looked at.
 #[derive(Debug, Clone, PartialEq)]
@@ -87,6 +96,9 @@ impl Picture {
     pub fn of(session: &Session, look: &Look) -> Picture {
         let ui = &session.interaction;
         let doc = session.editor.document();
+        if let (Some(c), crate::session::State::Running) = (session.calibrating(), session.state()) {
+            return Picture::calibrating(c, ui.view(), look);
+        }
         let mode = match session.state() {
             crate::session::State::Ended(why) => format!("{why} | Esc closes"),
             crate::session::State::Failed(why) => format!("the pen failed: {why} | Esc closes"),
@@ -96,6 +108,59 @@ impl Picture {
             crate::session::State::Running => ui.status(doc),
         };
         Picture::from_parts(ui, doc, mode, look)
+    }
+
+    /// The calibration procedure: its targets on the display as rings (taken green, the next
+    /// yellow with a dot at its centre, the rest grey), the pen's tip, and what to do.
+    pub fn calibrating(c: &Calibrating, view: &View, look: &Look) -> Picture {
+        let ring = |centre: [f64; 2], radius_mm: f64| -> Vec<Point> {
+            (0..24)
+                .map(|i| {
+                    let a = std::f64::consts::TAU * f64::from(i) / 24.0;
+                    view.to_ground(centre[0] + radius_mm * a.cos(), centre[1] + radius_mm * a.sin())
+                })
+                .collect()
+        };
+        let mut overlays = Vec::new();
+        for (i, t) in c.targets.iter().enumerate() {
+            let (colour, width) = match i.cmp(&c.taken) {
+                std::cmp::Ordering::Less => (TARGET_TAKEN_COLOUR, 3.0),
+                std::cmp::Ordering::Equal => (TARGET_NEXT_COLOUR, 5.0),
+                std::cmp::Ordering::Greater => (TARGET_LATER_COLOUR, 2.0),
+            };
+            overlays.push(Overlay {
+                points: ring(*t, TARGET_RADIUS_MM),
+                closed: true,
+                colour,
+                width,
+                height: None,
+            });
+            if i == c.taken {
+                overlays.push(dot(view.to_ground(t[0], t[1]), None, colour, 5.0));
+            }
+        }
+        if let Some(p) = c.pen_mm {
+            let colour = if c.pressed { DRAWING_COLOUR } else { PEN_COLOUR };
+            overlays.push(dot(view.to_ground(p[0], p[1]), None, colour, 7.0));
+        }
+        let count = c.targets.len();
+        let mode = if c.taken < count {
+            format!(
+                "calibrating: touch the yellow target ({} of {count}) with the tip, hold it still a moment, lift",
+                c.taken + 1
+            )
+        } else {
+            format!("calibrating: all {count} targets taken, fitting")
+        };
+        Picture {
+            overlays,
+            selection: None,
+            slope_bar: None,
+            mode,
+            camera: camera(view, look.head_m),
+            vertical_scale: view.exaggeration as f32,
+            look: look.clone(),
+        }
     }
 
     /// The document alone through `view`: no pen, no highlight, `mode` as the text line.
@@ -190,6 +255,11 @@ impl Picture {
         &self.overlays
     }
 
+    /// The text line shown at the top.
+    pub fn mode(&self) -> &str {
+        &self.mode
+    }
+
     /// The highlighted overlay's index.
     pub fn selection(&self) -> Option<usize> {
         self.selection
@@ -256,4 +326,63 @@ pub fn document_overlays_at(doc: &Document) -> Vec<(CurvePath, Overlay)> {
         figures(&region.figures, &|i| FigurePath::new(r, i), &mut out);
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::session::blank_document;
+    use penmodel_render::{Frame, Renderer};
+
+    fn calibrating(taken: usize) -> Calibrating {
+        Calibrating {
+            targets: vec![[60.0, 34.0], [300.0, 170.0], [540.0, 306.0]],
+            taken,
+            pen_mm: Some([310.0, 160.0]),
+            pressed: false,
+        }
+    }
+
+    #[test]
+    fn calibration_shows_each_target_where_it_is_and_the_pen() {
+        let doc = blank_document();
+        let view = View::fit([600.0, 340.0], &doc.grid);
+        let c = calibrating(1);
+        let picture = Picture::calibrating(&c, &view, &Look::default());
+        let rings: Vec<&Overlay> = picture.overlays().iter().filter(|o| o.closed).collect();
+        assert_eq!(rings.len(), 3);
+        for (ring, target) in rings.iter().zip(&c.targets) {
+            // Every point of the ring is TARGET_RADIUS_MM from its target on the display.
+            for p in &ring.points {
+                let d = view.to_display(*p);
+                let r = ((d[0] - target[0]).powi(2) + (d[1] - target[1]).powi(2)).sqrt();
+                assert!((r - TARGET_RADIUS_MM).abs() < 1e-6, "{r}");
+            }
+        }
+        let colours: Vec<Rgba> = rings.iter().map(|o| o.colour).collect();
+        assert_eq!(colours, [TARGET_TAKEN_COLOUR, TARGET_NEXT_COLOUR, TARGET_LATER_COLOUR]);
+        let pen = picture.overlays().last().expect("the pen");
+        assert_eq!(pen.colour, PEN_COLOUR);
+        let at = view.to_display(pen.points[0]);
+        assert!((at[0] - 310.0).abs() < 1e-9 && (at[1] - 160.0).abs() < 1e-9);
+        assert!(picture.mode().contains("2 of 3"), "{}", picture.mode());
+    }
+
+    #[test]
+    fn the_targets_are_drawn() {
+        let doc = blank_document();
+        let map = penmodel_terrain::generate(&doc).expect("valid");
+        let view = View::fit([600.0, 340.0], &doc.grid);
+        let mut frame = Frame::new(480, 272).expect("frame");
+        let mut renderer = Renderer::new();
+        let count = |frame: &Frame, colour: Rgba| frame.pixels().iter().filter(|p| **p == colour).count();
+        let picture = Picture::calibrating(&calibrating(1), &view, &Look::default());
+        renderer.render(&picture.scene(&map), &mut frame).expect("render");
+        assert!(count(&frame, TARGET_NEXT_COLOUR) > 20);
+        assert!(count(&frame, TARGET_TAKEN_COLOUR) > 20);
+        // Once all are taken, none is yellow.
+        let picture = Picture::calibrating(&calibrating(3), &view, &Look::default());
+        renderer.render(&picture.scene(&map), &mut frame).expect("render");
+        assert_eq!(count(&frame, TARGET_NEXT_COLOUR), 0);
+    }
 }

@@ -2,7 +2,7 @@
 
 use pen_host::events::PenEvent;
 
-use crate::feed::Feed;
+use crate::feed::{Calibrating, Feed};
 use crate::interaction::{Interaction, Tuning, View};
 use penmodel_terrain::document::{Document, Grid};
 use penmodel_terrain::editor::Editor;
@@ -35,6 +35,7 @@ pub struct Session {
     /// The pen's state machine and the view.
     pub interaction: Interaction,
     status: String,
+    calibrating: Option<Calibrating>,
     state: State,
     events: u64,
     last_event_us: Option<u64>,
@@ -48,6 +49,7 @@ impl Session {
             editor,
             interaction: Interaction::new(view, tuning),
             status: String::new(),
+            calibrating: None,
             state: State::Running,
             events: 0,
             last_event_us: None,
@@ -57,7 +59,13 @@ impl Session {
     /// Takes one message from the feed; returns what the interaction said about it.
     pub fn feed(&mut self, feed: Feed) -> Vec<String> {
         match feed {
+            Feed::Calibrating(c) => {
+                self.calibrating = Some(c);
+                Vec::new()
+            }
             Feed::Display(mm) => {
+                // Sent once the calibration is fitted: the procedure is over.
+                self.calibrating = None;
                 if mm != self.interaction.view().display_mm {
                     let tuning = *self.interaction.tuning();
                     let view = View::fit(mm, &self.editor.document().grid);
@@ -70,6 +78,7 @@ impl Session {
                 vec![s]
             }
             Feed::Event(e) => {
+                self.calibrating = None;
                 self.event(&e);
                 self.interaction.take_messages()
             }
@@ -101,6 +110,11 @@ impl Session {
     /// The feed's last status line (calibrating, connected).
     pub fn status(&self) -> &str {
         &self.status
+    }
+
+    /// The calibration procedure, while it runs.
+    pub fn calibrating(&self) -> Option<&Calibrating> {
+        self.calibrating.as_ref()
     }
 
     /// Pen events handled.

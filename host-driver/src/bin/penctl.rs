@@ -482,6 +482,7 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
             target_mm.x,
             target_mm.y
         ),
+        Prompt::Pen { .. } => {}
         Prompt::Lift => eprintln!("  lift the pen first"),
         Prompt::Again { fixes } => eprintln!("  too short ({fixes} fixes): touch again and hold a moment"),
         Prompt::Taken { fixes, .. } => {

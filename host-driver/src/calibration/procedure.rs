@@ -43,6 +43,15 @@ pub enum Prompt {
         /// Fixes taken.
         fixes: usize,
     },
+    /// Where the pen is now, for a picture of the procedure (every sample in range).
+    Pen {
+        /// The tip, tracker frame, mm.
+        position_mm: DVec3,
+        /// SW1 (the tip) is pressed.
+        pressed: bool,
+        /// Device clock, µs.
+        device_us: u64,
+    },
     /// Target taken.
     Taken {
         /// Where the pen was, tracker frame.
@@ -134,6 +143,13 @@ pub fn collect_touches(
                 DeviceEvent::Lost(why) => return Err(CalibrateError::Device(format!("device lost: {why}"))),
                 _ => continue,
             };
+            if s.in_range {
+                tell(&Prompt::Pen {
+                    position_mm: s.position_mm,
+                    pressed: s.sw[0],
+                    device_us: s.device_us,
+                });
+            }
             if !s.sw[0] {
                 if pressed_at.take().is_some() {
                     if fixes.len() >= MIN_FIXES {

@@ -1,7 +1,9 @@
 //! A built-in bitmap font: 5 × 7 pixel glyphs for printable ASCII, no font files.
 //!
 //! Each glyph is five column bytes, bit 0 the top row (the classic public-domain 5 × 7 LCD
-//! character set). A glyph cell is 6 × 8 font pixels (one column and one row of spacing), drawn
+//! character set), and bit 7 the descender row below the baseline, which `g j p q y` use — in
+//! the 5 × 7 set they sit on the baseline, and `g` reads as `9`. A glyph cell is 6 × 8 font
+//! pixels (one column of spacing; the eighth row is the descenders' or the line's spacing), drawn
 //! at an integer scale. Characters outside ASCII 32–126 are drawn as `?`.
 
 use super::frame::{Frame, Rgba};
@@ -85,17 +87,17 @@ const GLYPHS: [[u8; 5]; 95] = [
     [0x38, 0x44, 0x44, 0x48, 0x7F], // d
     [0x38, 0x54, 0x54, 0x54, 0x18], // e
     [0x08, 0x7E, 0x09, 0x01, 0x02], // f
-    [0x0C, 0x52, 0x52, 0x52, 0x3E], // g
+    [0x18, 0xA4, 0xA4, 0xA4, 0x7C], // g
     [0x7F, 0x08, 0x04, 0x04, 0x78], // h
     [0x00, 0x44, 0x7D, 0x40, 0x00], // i
-    [0x20, 0x40, 0x44, 0x3D, 0x00], // j
+    [0x40, 0x80, 0x84, 0x7D, 0x00], // j
     [0x7F, 0x10, 0x28, 0x44, 0x00], // k
     [0x00, 0x41, 0x7F, 0x40, 0x00], // l
     [0x7C, 0x04, 0x18, 0x04, 0x78], // m
     [0x7C, 0x08, 0x04, 0x04, 0x78], // n
     [0x38, 0x44, 0x44, 0x44, 0x38], // o
-    [0x7C, 0x14, 0x14, 0x14, 0x08], // p
-    [0x08, 0x14, 0x14, 0x18, 0x7C], // q
+    [0xFC, 0x24, 0x24, 0x24, 0x18], // p
+    [0x18, 0x24, 0x24, 0x24, 0xFC], // q
     [0x7C, 0x08, 0x04, 0x04, 0x08], // r
     [0x48, 0x54, 0x54, 0x54, 0x20], // s
     [0x04, 0x3F, 0x44, 0x40, 0x20], // t
@@ -103,7 +105,7 @@ const GLYPHS: [[u8; 5]; 95] = [
     [0x1C, 0x20, 0x40, 0x20, 0x1C], // v
     [0x3C, 0x40, 0x30, 0x40, 0x3C], // w
     [0x44, 0x28, 0x10, 0x28, 0x44], // x
-    [0x0C, 0x50, 0x50, 0x50, 0x3C], // y
+    [0x1C, 0xA0, 0xA0, 0xA0, 0x7C], // y
     [0x44, 0x64, 0x54, 0x4C, 0x44], // z
     [0x00, 0x08, 0x36, 0x41, 0x00], // {
     [0x00, 0x00, 0x7F, 0x00, 0x00], // |
@@ -111,7 +113,7 @@ const GLYPHS: [[u8; 5]; 95] = [
     [0x08, 0x04, 0x08, 0x10, 0x08], // ~
 ];
 
-/// The five column bytes of `ch` (bit 0 = top row).
+/// The five column bytes of `ch` (bit 0 = top row, bit 7 = the descender row).
 pub fn glyph(ch: char) -> [u8; 5] {
     let code = ch as u32;
     let index = if (32..127).contains(&code) {
@@ -143,7 +145,7 @@ pub fn draw(frame: &mut Frame, clip: &Bounds, (x, y): (i64, i64), text: &str, co
     for (i, ch) in text.chars().enumerate() {
         let gx = x + i as i64 * i64::from(CELL_WIDTH) * scale;
         for (col, bits) in glyph(ch).iter().enumerate() {
-            for row in 0..7 {
+            for row in 0..8 {
                 if bits >> row & 1 == 0 {
                     continue;
                 }
@@ -157,6 +159,52 @@ pub fn draw(frame: &mut Frame, clip: &Bounds, (x, y): (i64, i64), text: &str, co
                     }
                 }
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The rows a glyph lights, as a bit set (bit 0 the top row).
+    fn rows(ch: char) -> u8 {
+        glyph(ch).iter().fold(0, |acc, col| acc | col)
+    }
+
+    #[test]
+    fn lowercase_letters_without_ascenders_stay_below_the_x_height() {
+        // Rows 0 and 1 belong to capitals, digits and ascenders; a lowercase letter that uses them
+        // reads as something else (the old `g` read as `9`).
+        for ch in "acegmnopqrsuvwxyz".chars() {
+            assert_eq!(rows(ch) & 0b11, 0, "{ch} reaches above the x-height");
+            assert_ne!(rows(ch) >> 2, 0, "{ch} is empty");
+        }
+        for ch in "bdfhklt0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZ".chars() {
+            assert_ne!(rows(ch) & 0b11, 0, "{ch} should reach above the x-height");
+        }
+    }
+
+    #[test]
+    fn only_descenders_go_below_the_baseline() {
+        for code in 32u8..127 {
+            let ch = char::from(code);
+            let below = rows(ch) & 0x80 != 0;
+            assert_eq!(below, "gjpqy".contains(ch), "{ch}");
+        }
+    }
+
+    #[test]
+    fn letters_that_look_alike_differ_in_several_pixels() {
+        let differ = |a: char, b: char| {
+            glyph(a)
+                .iter()
+                .zip(glyph(b))
+                .map(|(x, y)| (x ^ y).count_ones())
+                .sum::<u32>()
+        };
+        for (a, b) in [('g', '9'), ('g', 'q'), ('g', 'y'), ('a', 'g'), ('o', '0')] {
+            assert!(differ(a, b) >= 4, "{a} and {b} differ in {} pixels", differ(a, b));
         }
     }
 }

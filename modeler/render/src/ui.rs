@@ -1,4 +1,5 @@
-//! The 2D layer drawn over the terrain: the slope bar and the mode line.
+//! The 2D layer drawn over the terrain: the slope bar, the mode line, and text panels (the
+//! window's help, a notice under the mode line).
 //!
 //! Both are laid out in the eye's viewport (for side-by-side stereo, each half gets its own,
 //! squeezed like the rest of the half), at zero parallax. They sit on translucent dark panels so
@@ -153,4 +154,111 @@ pub fn mode_line(frame: &mut Frame, viewport: &Bounds, mode: &str, style: &Style
         PANEL_SHOW,
     );
     text::draw(frame, viewport, (x, y), mode, style.text_colour, s);
+}
+
+/// Where [`panel`] puts its text.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Place {
+    /// In the middle of the viewport (the help).
+    Centre,
+    /// At the top left, under the mode line (a notice).
+    UnderModeLine,
+}
+
+/// Draws `lines` on a translucent panel in `viewport`; a line longer than the viewport is cut
+/// by the viewport, not wrapped. Nothing is drawn for no lines.
+pub fn panel(frame: &mut Frame, viewport: &Bounds, lines: &[String], place: Place, style: &Style) {
+    if lines.is_empty() {
+        return;
+    }
+    let s = style.text_scale.max(1);
+    let line_h = i64::from(text::height(s)) + i64::from(s);
+    let w = lines.iter().map(|l| i64::from(text::width(l, s))).max().unwrap_or(0);
+    let h = line_h * lines.len() as i64;
+    let (vx0, vy0) = (i64::from(viewport.x0), i64::from(viewport.y0));
+    let (vw, vh) = (i64::from(viewport.x1) - vx0, i64::from(viewport.y1) - vy0);
+    let (x, y) = match place {
+        Place::Centre => (vx0 + ((vw - w) / 2).max(MARGIN), vy0 + ((vh - h) / 2).max(MARGIN)),
+        Place::UnderModeLine => (vx0 + MARGIN, vy0 + MARGIN * 2 + line_h),
+    };
+    fill(
+        frame,
+        viewport,
+        (x - MARGIN, y - MARGIN, x + w + MARGIN, y + h + MARGIN),
+        [0, 0, 0, 255],
+        PANEL_SHOW / 2.0,
+    );
+    for (i, line) in lines.iter().enumerate() {
+        text::draw(frame, viewport, (x, y + i as i64 * line_h), line, style.text_colour, s);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn lit(frame: &Frame, colour: Rgba) -> Vec<(u32, u32)> {
+        let w = frame.width();
+        frame
+            .pixels()
+            .iter()
+            .enumerate()
+            .filter(|(_, p)| **p == colour)
+            .map(|(i, _)| (i as u32 % w, i as u32 / w))
+            .collect()
+    }
+
+    #[test]
+    fn a_panel_darkens_its_box_and_writes_each_line_inside_it() {
+        let style = Style::default();
+        let mut frame = Frame::new(320, 200).expect("frame");
+        frame.pixels_mut().fill([100, 100, 100, 255]);
+        let all = Bounds {
+            x0: 0,
+            x1: 320,
+            y0: 0,
+            y1: 200,
+        };
+        let lines = vec!["keys".to_string(), "  u  undo".to_string()];
+        panel(&mut frame, &all, &lines, Place::Centre, &style);
+        let text = lit(&frame, style.text_colour);
+        assert!(!text.is_empty());
+        // Centred: the text's box has its middle near the frame's.
+        let (x0, x1) = (
+            text.iter().map(|p| p.0).min().unwrap(),
+            text.iter().map(|p| p.0).max().unwrap(),
+        );
+        let (y0, y1) = (
+            text.iter().map(|p| p.1).min().unwrap(),
+            text.iter().map(|p| p.1).max().unwrap(),
+        );
+        assert!(((x0 + x1) as i64 - 320).abs() < 24, "{x0}..{x1}");
+        assert!(((y0 + y1) as i64 - 200).abs() < 24, "{y0}..{y1}");
+        // Two lines: text in two bands of rows.
+        assert!(y1 - y0 > text::height(style.text_scale));
+        // The panel is darker than the frame; the corners are untouched.
+        let p = frame.pixels()[(y0 as usize - 2) * 320 + x0 as usize];
+        assert!(p[0] < 100, "{p:?}");
+        assert_eq!(frame.pixels()[0], [100, 100, 100, 255]);
+    }
+
+    #[test]
+    fn a_notice_sits_under_the_mode_line_and_nothing_is_drawn_for_no_lines() {
+        let style = Style::default();
+        let all = Bounds {
+            x0: 0,
+            x1: 320,
+            y0: 0,
+            y1: 200,
+        };
+        let mut frame = Frame::new(320, 200).expect("frame");
+        panel(&mut frame, &all, &[], Place::UnderModeLine, &style);
+        assert!(frame.pixels().iter().all(|p| *p == [0, 0, 0, 0]));
+        mode_line(&mut frame, &all, "mode", &style);
+        let mode_bottom = lit(&frame, style.text_colour).iter().map(|p| p.1).max().unwrap();
+        let mut notice = Frame::new(320, 200).expect("frame");
+        panel(&mut notice, &all, &["saved".to_string()], Place::UnderModeLine, &style);
+        let top = lit(&notice, style.text_colour).iter().map(|p| p.1).min().unwrap();
+        assert!(top > mode_bottom, "notice at {top}, mode line down to {mode_bottom}");
+    }
 }

@@ -14,10 +14,12 @@ use std::time::{Duration, Instant};
 use anyhow::{Context, Result, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use penmodel::feed::{self, Feed, PenSource};
-use penmodel::interaction::{KeyCommand, Tuning, View};
+use penmodel::interaction::{Tuning, View};
+use penmodel::keys::{self, KeyAction};
 use penmodel::picture::{Look, Picture};
 use penmodel::session::{Session, State, blank_document};
 use penmodel_render::output::{self, Sequence, Viewer, ViewerEvent, WindowError};
+use penmodel_render::ui::{self, Place};
 use penmodel_render::{Frame, Renderer, Stereo};
 use penmodel_terrain::editor::Editor;
 use penmodel_terrain::{Heightmap, export};
@@ -112,6 +114,43 @@ fn source(s: &str) -> Result<String, String> {
     PenSource::parse(s, 0.0).map(|_| s.to_string())
 }
 
+/// What a session created, to remove when nothing is modeled.
+#[derive(Default)]
+struct Created {
+    /// The --out folder, when it did not exist.
+    out: Option<PathBuf>,
+    /// Its frames folder, when it did not exist.
+    frames: Option<PathBuf>,
+    /// A new session's document (and its journal).
+    document: Option<PathBuf>,
+    /// The demo's mark beside it.
+    demo_mark: Option<PathBuf>,
+}
+
+impl Created {
+    /// Removes what was created; folders only if empty.
+    fn remove(&self) -> Result<()> {
+        let remove = |path: &Path| match std::fs::remove_file(path) {
+            Err(e) if e.kind() != std::io::ErrorKind::NotFound => {
+                Err(e).with_context(|| format!("cannot remove {}", path.display()))
+            }
+            _ => Ok(()),
+        };
+        if let Some(doc) = &self.document {
+            remove(doc)?;
+            remove(&penmodel_terrain::journal::path_for(doc))?;
+        }
+        if let Some(mark) = &self.demo_mark {
+            remove(mark)?;
+        }
+        // A folder goes only if empty (remove_dir refuses any other): its frames folder first.
+        for dir in self.frames.iter().chain(&self.out) {
+            let _ = std::fs::remove_dir(dir);
+        }
+        Ok(())
+    }
+}
+
 /// Where the results went.
 struct Written {
     frames: usize,
@@ -168,6 +207,12 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
     if let PenSource::Demo { seed, .. } = &mut source {
         *seed = args.seed;
     }
+    // What this session creates it removes again if nothing is modeled: no empty results.
+    let mut created = Created {
+        out: (!args.out.exists()).then(|| args.out.clone()),
+        frames: (!args.out.join("frames").exists()).then(|| args.out.join("frames")),
+        ..Created::default()
+    };
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let (editor, doc_path) = match open {
         Some(path) => {
@@ -202,9 +247,11 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
                 );
             }
             let editor = Editor::create(&path, blank_document())?;
+            created.document = Some(path.clone());
             if demo && args.doc.is_none() {
                 std::fs::write(&demo_mark, DEMO_MARK_TEXT)
                     .with_context(|| format!("cannot write {}", demo_mark.display()))?;
+                created.demo_mark = Some(demo_mark.clone());
             } else if path == args.out.join("document.json") && demo_mark.exists() {
                 // This document is the user's now: the next demo must not replace it.
                 std::fs::remove_file(&demo_mark).with_context(|| format!("cannot remove {}", demo_mark.display()))?;
@@ -262,6 +309,21 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
     };
     drop(rx);
 
+    // Nothing modeled (the pen never came, pend is not running, the session was stopped at
+    // once): nothing is written, and only a window closed by its user is a success.
+    if !(session.editor.can_undo() || session.editor.can_redo()) {
+        created.remove()?;
+        let stopped = stop.load(Ordering::Relaxed);
+        return match session.state() {
+            State::Failed(why) => bail!("the pen failed: {why}; nothing modeled, nothing written"),
+            State::Ended(why) => bail!("{why}; nothing modeled, nothing written"),
+            State::Running if stopped => bail!("stopped before anything was modeled: nothing written"),
+            State::Running => {
+                eprintln!("penmodel: nothing modeled: nothing written");
+                Ok(())
+            }
+        };
+    }
     session
         .editor
         .save()
@@ -476,8 +538,12 @@ fn run_headless(
             Err(RecvTimeoutError::Disconnected) => break,
         };
         let done = matches!(feed, Feed::End(_) | Feed::Failed(_));
+        // A failure ends the session, which says it then.
+        let failed = matches!(feed, Feed::Failed(_));
         let messages = session.feed(feed);
-        say(messages, Some(&progress));
+        if !failed {
+            say(messages, Some(&progress));
+        }
         if let Some(t) = session.last_event_us() {
             progress.set_position(t / 1000);
             // A reattached device restarts its clock: so do the frames.
@@ -517,6 +583,35 @@ fn run_headless(
     })
 }
 
+/// A message shown under the mode line for a while: what a key did (saved, undone, nothing to
+/// delete), what the pen's edits said — the window's user may not see the terminal.
+struct Notice {
+    text: String,
+    since: Instant,
+}
+
+impl Notice {
+    const SHOWN: Duration = Duration::from_secs(4);
+
+    fn lines(notice: &Option<Notice>) -> Vec<String> {
+        match notice {
+            Some(n) if n.since.elapsed() < Notice::SHOWN => vec![n.text.clone()],
+            _ => Vec::new(),
+        }
+    }
+}
+
+/// Says `messages` on stderr and keeps the last for the window.
+fn tell(messages: Vec<String>, notice: &mut Option<Notice>) {
+    if let Some(last) = messages.last() {
+        *notice = Some(Notice {
+            text: last.clone(),
+            since: Instant::now(),
+        });
+    }
+    say(messages, None);
+}
+
 fn run_window(
     mut viewer: Viewer,
     rx: &std::sync::mpsc::Receiver<Feed>,
@@ -529,57 +624,43 @@ fn run_window(
     let mut dirty = true;
     let mut last = Instant::now() - FRAME;
     let mut frames = 0;
+    let mut help = false;
+    let mut notice: Option<Notice> = None;
     'session: while viewer.is_open() && !stop.load(Ordering::Relaxed) {
         while let Some(e) = viewer.poll() {
-            let command = match &e {
-                ViewerEvent::Closed => break 'session,
-                ViewerEvent::Key(k) => match k.as_str() {
-                    "Escape" | "q" => break 'session,
-                    "u" | "z" => Some(KeyCommand::Undo),
-                    "r" | "y" => Some(KeyCommand::Redo),
-                    "Delete" | "Backspace" => Some(KeyCommand::Delete),
-                    "ArrowLeft" => Some(KeyCommand::Pan {
-                        du_mm: -20.0,
-                        dv_mm: 0.0,
-                    }),
-                    "ArrowRight" => Some(KeyCommand::Pan {
-                        du_mm: 20.0,
-                        dv_mm: 0.0,
-                    }),
-                    "ArrowUp" => Some(KeyCommand::Pan {
-                        du_mm: 0.0,
-                        dv_mm: 20.0,
-                    }),
-                    "ArrowDown" => Some(KeyCommand::Pan {
-                        du_mm: 0.0,
-                        dv_mm: -20.0,
-                    }),
-                    "+" | "=" => Some(KeyCommand::Zoom { factor: 1.25 }),
-                    "-" => Some(KeyCommand::Zoom { factor: 0.8 }),
-                    "f" => Some(KeyCommand::Fit),
-                    "o" => {
-                        let next = if painter.overview == Overview::Off {
-                            Overview::Corner
-                        } else {
-                            Overview::Off
-                        };
-                        painter.set_overview(next)?;
-                        None
-                    }
-                    "s" => {
-                        match session.editor.save() {
-                            Ok(()) => eprintln!("penmodel: saved"),
-                            Err(e) => eprintln!("penmodel: cannot save: {e}"),
-                        }
-                        None
-                    }
-                    _ => None,
-                },
-                ViewerEvent::Resized { .. } => None,
+            let ViewerEvent::Key(k) = &e else {
+                if e == ViewerEvent::Closed {
+                    break 'session;
+                }
+                dirty = true;
+                continue;
             };
-            if let Some(c) = command {
-                session.interaction.command(&mut session.editor, c);
-                say(session.interaction.take_messages(), None);
+            match keys::action(k, session.interaction.view().display_mm) {
+                Some(KeyAction::Quit) => break 'session,
+                Some(KeyAction::Help) => help = !help,
+                Some(KeyAction::Overview) => {
+                    let next = if painter.overview == Overview::Off {
+                        Overview::Corner
+                    } else {
+                        Overview::Off
+                    };
+                    painter.set_overview(next)?;
+                }
+                Some(KeyAction::Save) => {
+                    let said = match session.editor.save() {
+                        Ok(()) => match session.editor.path() {
+                            Some(p) => format!("saved {}", p.display()),
+                            None => "saved".to_string(),
+                        },
+                        Err(e) => format!("cannot save: {e}"),
+                    };
+                    tell(vec![said], &mut notice);
+                }
+                Some(KeyAction::Command(c)) => {
+                    session.interaction.command(&mut session.editor, c);
+                    tell(session.interaction.take_messages(), &mut notice);
+                }
+                None => tell(vec![format!("key {k} does nothing: h shows the keys")], &mut notice),
             }
             dirty = true;
         }
@@ -587,11 +668,10 @@ fn run_window(
         let wait = FRAME.saturating_sub(last.elapsed());
         match rx.recv_timeout(wait.max(Duration::from_millis(1))) {
             Ok(feed) => {
-                let messages = session.feed(feed);
-                say(messages, None);
+                tell(session.feed(feed), &mut notice);
                 dirty = true;
                 while let Ok(more) = rx.try_recv() {
-                    say(session.feed(more), None);
+                    tell(session.feed(more), &mut notice);
                     if last.elapsed() >= FRAME {
                         break;
                     }
@@ -603,11 +683,33 @@ fn run_window(
                 std::thread::sleep(FRAME);
             }
         }
-        if dirty && last.elapsed() >= FRAME {
+        // A notice going away is a change too.
+        let noticed = notice
+            .as_ref()
+            .is_some_and(|n| n.since.elapsed() < Notice::SHOWN + FRAME * 2);
+        if (dirty || noticed) && last.elapsed() >= FRAME {
             if let Some(t) = session.last_event_us() {
                 session.interaction.advance(t);
             }
-            let frame = painter.session(session, look)?.clone();
+            let mut frame = painter.session(session, look)?.clone();
+            let (w, h) = (painter.view.width() as i32, painter.view.height() as i32);
+            let viewport = penmodel_render::rasterise::Bounds {
+                x0: 0,
+                x1: w,
+                y0: 0,
+                y1: h,
+            };
+            let style = &look.style;
+            ui::panel(
+                &mut frame,
+                &viewport,
+                &Notice::lines(&notice),
+                Place::UnderModeLine,
+                style,
+            );
+            if help {
+                ui::panel(&mut frame, &viewport, &keys::help_lines(), Place::Centre, style);
+            }
             if viewer.show(frame).is_err() {
                 break;
             }
