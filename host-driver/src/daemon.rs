@@ -380,6 +380,9 @@ pub fn run_device(mut pipeline: Pipeline, hub: Arc<Hub>, stop: Arc<AtomicBool>, 
     while !stop.load(Ordering::Relaxed) {
         events.clear();
         pipeline.poll(Duration::from_millis(50), &mut events);
+        if let Some(notice) = pipeline.take_notice() {
+            log(&notice);
+        }
         for e in &events {
             match &e.kind {
                 EventKind::DeviceFound { device } => log(&format!("attached {device}")),

@@ -24,6 +24,7 @@ pub struct Pipeline {
     detector: EventDetector,
     lost: u64,
     refused: Option<String>,
+    notice: Option<String>,
 }
 
 impl Pipeline {
@@ -45,12 +46,19 @@ impl Pipeline {
             detector: EventDetector::new(),
             lost: 0,
             refused: None,
+            notice: None,
         }
     }
 
     /// Why the last device attached was refused (its calibration is another's), while it is.
     pub fn refused(&self) -> Option<&str> {
         self.refused.as_deref()
+    }
+
+    /// What the device session last said while it waits for a device
+    /// ([`DeviceEvent::Waiting`]), once: every tool shows it as it is.
+    pub fn take_notice(&mut self) -> Option<String> {
+        self.notice.take()
     }
 
     /// The device session, for requests.
@@ -105,6 +113,10 @@ impl Pipeline {
             }
             DeviceEvent::Lost(why) => {
                 self.detector.on_device_lost(now_us(), &why, out);
+                None
+            }
+            DeviceEvent::Waiting(notice) => {
+                self.notice = Some(notice);
                 None
             }
             DeviceEvent::Tof(_) => None,

@@ -5,3 +5,4 @@ mod delays;
 mod events;
 mod penctl;
 mod socket;
+mod waiting;

@@ -133,6 +133,30 @@ fn help_and_usage_errors() {
 }
 
 #[test]
+fn monitor_prints_a_column_header_then_one_row_per_sample() {
+    let out = penctl(&["monitor", "--sim", "--sim-speed", "0", "--count", "3"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    let lines: Vec<&str> = text.lines().collect();
+    assert_eq!(lines.len(), 4, "a header and 3 rows:\n{text}");
+    let header: Vec<&str> = lines[0].split("  ").map(str::trim).filter(|c| !c.is_empty()).collect();
+    assert_eq!(
+        header,
+        [
+            "seq", "t s", "range", "x mm", "y mm", "z mm", "switches", "rx", "resid mm", "DOP", "lost"
+        ]
+    );
+    // Each row's fields end where their header does (right-aligned numbers).
+    let end = |line: &str, col: &str| line.find(col).map(|i| i + col.len());
+    let row = lines[3];
+    let fields: Vec<&str> = row.split_whitespace().collect();
+    assert_eq!(fields.len(), 13, "{row}");
+    assert_eq!(fields[0], "2");
+    assert_eq!(row.find(" 2 ").map(|i| i + 2), end(lines[0], "seq"), "{row}");
+    assert_eq!(fields[2], "in");
+}
+
+#[test]
 fn monitor_prints_one_json_object_per_sample() {
     let out = penctl(&["monitor", "--sim", "--sim-speed", "0", "--json", "--count", "5"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));

@@ -2,3 +2,4 @@
 mod cli;
 mod demo_cli;
 mod interaction;
+mod waiting_cli;

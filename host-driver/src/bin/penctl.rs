@@ -320,10 +320,23 @@ fn info(args: &DeviceArgs, as_json: bool) -> Result<()> {
     Ok(())
 }
 
+/// `penctl monitor`'s column header (not in --json mode), aligned with its rows: sequence
+/// number, device time, in range, position, switches, receivers used, fix residual, DOP, reports
+/// lost just before.
+fn monitor_header() -> String {
+    format!(
+        "{:>5}  {:>11}  {:5}  {:>8}  {:>8}  {:>8}  {:11}  {:>3}  {:>8}  {:>4}  {:>4}",
+        "seq", "t s", "range", "x mm", "y mm", "z mm", "switches", "rx", "resid mm", "DOP", "lost"
+    )
+}
+
 fn monitor(args: &DeviceArgs, as_json: bool, count: Option<u64>) -> Result<()> {
     let mut device = Device::new(args.source()?);
     let mut printed = 0u64;
     let mut out = std::io::stdout().lock();
+    if !as_json {
+        writeln!(out, "{}", monitor_header())?;
+    }
     while count.is_none_or(|n| printed < n) {
         match device.next(Duration::from_millis(200)) {
             Some(DeviceEvent::Sample(s, lost)) => {
@@ -333,10 +346,10 @@ fn monitor(args: &DeviceArgs, as_json: bool, count: Option<u64>) -> Result<()> {
                     let sw = |on: bool, name: &'static str| if on { name } else { "---" };
                     writeln!(
                         out,
-                        "seq {:5}  t {:11.6} s  {}  x {:8.1}  y {:8.1}  z {:8.1} mm  {} {} {}  {}/{:.1} mm/{:.1}{}",
+                        "{:5}  {:11.6}  {:5}  {:8.1}  {:8.1}  {:8.1}  {} {} {}  {:3}  {:8.1}  {:4.1}  {:4}",
                         s.seq,
                         s.device_us as f64 * 1e-6,
-                        if s.in_range { "in " } else { "out" },
+                        if s.in_range { "in" } else { "out" },
                         s.position_mm.x,
                         s.position_mm.y,
                         s.position_mm.z,
@@ -346,17 +359,14 @@ fn monitor(args: &DeviceArgs, as_json: bool, count: Option<u64>) -> Result<()> {
                         s.quality.receivers_used,
                         s.quality.residual_mm(),
                         s.quality.dop(),
-                        if lost > 0 {
-                            format!("  ({lost} lost)")
-                        } else {
-                            String::new()
-                        }
+                        lost,
                     )?;
                 }
                 printed += 1;
             }
             Some(DeviceEvent::Found(name)) => eprintln!("penctl: attached {name}"),
             Some(DeviceEvent::Lost(why)) => eprintln!("penctl: device lost ({why}); waiting for it"),
+            Some(DeviceEvent::Waiting(notice)) => eprintln!("penctl: {notice}"),
             _ => {}
         }
     }

@@ -40,6 +40,16 @@ pub fn list() -> Result<Vec<HidPen>, TransportError> {
     Ok(out)
 }
 
+/// Why `path` did not open, in the OS's words once (hidapi's message repeats them): not there,
+/// not this user's to open (with what to do), or hidapi's own reason.
+fn open_error(path: &str, e: hidapi::HidError) -> TransportError {
+    match std::fs::OpenOptions::new().read(true).write(true).open(path) {
+        Err(io) if io.kind() == std::io::ErrorKind::NotFound => TransportError::NotFound(format!("{path}: {io}")),
+        Err(io) if io.kind() == std::io::ErrorKind::PermissionDenied => super::denied(path),
+        _ => TransportError::Os(format!("cannot open {path}: {e}")),
+    }
+}
+
 /// The HID interface of one base station.
 pub struct HidTransport {
     device: HidDevice,
@@ -60,9 +70,7 @@ impl HidTransport {
         };
         let api = HidApi::new().map_err(|e| TransportError::Os(format!("HID: {e}")))?;
         let c = CString::new(path.clone()).map_err(|_| TransportError::NotFound(format!("bad path {path:?}")))?;
-        let device = api
-            .open_path(&c)
-            .map_err(|e| TransportError::Os(format!("cannot open {path}: {e} (udev rules: docs/flashing.md)")))?;
+        let device = api.open_path(&c).map_err(|e| open_error(&path, e))?;
         Ok(HidTransport {
             device,
             path,

@@ -41,9 +41,53 @@ pub enum TransportError {
     /// The device answered with something other than what was asked.
     #[error("unexpected answer from the device: {0}")]
     Unexpected(String),
-    /// The operating system refused (permissions, a busy port).
+    /// The operating system refused (a busy port, an I/O error).
     #[error("{0}")]
     Os(String),
+    /// This user may not open the device's file; `fix` says how to allow it ([`denied`]).
+    #[error("cannot open {path}: {why}; {fix}")]
+    Denied {
+        /// The device's file.
+        path: String,
+        /// The OS's words.
+        why: String,
+        /// What to do.
+        fix: String,
+    },
+}
+
+/// The udev rules that give the base station's devices to the `plugdev` group.
+pub const UDEV_RULES: &str = "host-driver/udev/70-penscape.rules";
+
+/// Permission to open `path` was denied: the error, with what to do. A file of group `root` has
+/// no rule giving it to a group yet (the udev rules do, for the base station); any other group
+/// (`plugdev`, `dialout`) is one to join.
+pub fn denied(path: &str) -> TransportError {
+    use std::os::unix::fs::MetadataExt;
+    let group = std::fs::metadata(path)
+        .ok()
+        .and_then(|m| {
+            nix::unistd::Group::from_gid(nix::unistd::Gid::from_raw(m.gid()))
+                .ok()
+                .flatten()
+        })
+        .map(|g| g.name);
+    let rules = format!(
+        "install the udev rules ({UDEV_RULES}: sudo cp {UDEV_RULES} /etc/udev/rules.d/ && sudo udevadm control \
+         --reload && sudo udevadm trigger), which give the base station to group plugdev"
+    );
+    let fix = match group.as_deref() {
+        Some(g) if g != "root" => format!(
+            "{path} belongs to group {g}: join it (sudo usermod -aG {g} $USER, then log in again); for the base \
+             station, {rules}"
+        ),
+        _ => format!("{rules}; join that group (sudo usermod -aG plugdev $USER, then log in again) and replug it"),
+    };
+    TransportError::Denied {
+        path: path.to_string(),
+        why: nix::errno::Errno::EACCES.desc().to_string(),
+        fix,
+    }
 }
 
 /// A connection to one base station.

@@ -33,6 +33,7 @@ impl SerialTransport {
             .map_err(|e| match e.kind() {
                 serialport::ErrorKind::NoDevice => TransportError::NotFound(format!("{path}: {e}")),
                 serialport::ErrorKind::Io(ErrorKind::NotFound) => TransportError::NotFound(format!("{path}: {e}")),
+                serialport::ErrorKind::Io(ErrorKind::PermissionDenied) => super::denied(path),
                 _ => TransportError::Os(format!("cannot open {path}: {e}")),
             })?;
         Ok(SerialTransport {

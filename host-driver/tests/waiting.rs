@@ -1,0 +1,229 @@
+//! Waiting for a base station that is not there, or not this user's to open: pend and penctl
+//! say what they wait for and why, with what to do — at once and then every few seconds, not at
+//! every retry (issue 19.3). The real binaries, their stderr and exit status.
+
+use std::os::unix::fs::PermissionsExt;
+use std::path::Path;
+use std::process::{Child, Command, Output, Stdio};
+use std::time::Duration;
+
+/// Runs `cmd` for `for_`, then stops it with SIGTERM (or kills it, for penctl, which has no
+/// handler), and returns what it said.
+fn run_for(mut cmd: Command, for_: Duration) -> Output {
+    let child: Child = cmd
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("the program starts");
+    std::thread::sleep(for_);
+    let status = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(status.success(), "still running after {for_:?}");
+    child.wait_with_output().expect("it exits")
+}
+
+fn stderr(out: &Output) -> String {
+    String::from_utf8_lossy(&out.stderr).into_owned()
+}
+
+fn lines_with(text: &str, pat: &str) -> usize {
+    text.lines().filter(|l| l.contains(pat)).count()
+}
+
+fn penctl(home: &Path, args: &[&str]) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_penctl"));
+    c.args(args).env("HOME", home).env_remove("XDG_CONFIG_HOME");
+    c
+}
+
+#[test]
+fn penctl_monitor_says_what_it_waits_for_every_few_seconds_not_every_retry() {
+    let home = tempfile::tempdir().expect("home");
+    let args = ["monitor", "--serial", "/dev/ttyDOESNOTEXIST"];
+    // The default interval (5 s): in 1.5 s, one notice for 7 retries.
+    let mut default = penctl(home.path(), &args);
+    default.env_remove("PENSCAPE_NOTICE_SECS");
+    // A short interval: the notice repeats, with the time waited.
+    let mut short = penctl(home.path(), &args);
+    short.env("PENSCAPE_NOTICE_SECS", "0.3");
+    let t = std::thread::spawn(move || run_for(short, Duration::from_millis(1500)));
+    let once = stderr(&run_for(default, Duration::from_millis(1500)));
+    let repeated = stderr(&t.join().expect("joined"));
+
+    assert_eq!(lines_with(&once, "waiting for"), 1, "{once}");
+    let first = once.lines().find(|l| l.contains("waiting for")).unwrap_or_default();
+    assert!(
+        first.starts_with("penctl: waiting for the base station on /dev/ttyDOESNOTEXIST: ")
+            && first.contains("No such file or directory")
+            && first.contains("is it plugged in?")
+            && first.contains("`penctl list`"),
+        "{first}"
+    );
+    // The OS's words once, not twice.
+    assert_eq!(first.matches("No such file or directory").count(), 1, "{first}");
+
+    let still = lines_with(
+        &repeated,
+        "still waiting for the base station on /dev/ttyDOESNOTEXIST (",
+    );
+    assert!((2..=5).contains(&still), "a notice every 0.3 s for 1.5 s:\n{repeated}");
+    assert_eq!(lines_with(&repeated, "penctl: waiting for"), 1, "{repeated}");
+}
+
+#[test]
+fn pend_says_what_it_waits_for() {
+    let dir = tempfile::tempdir().expect("dir");
+    let mut pend = Command::new(env!("CARGO_BIN_EXE_pend"));
+    pend.args(["--serial", "/dev/ttyDOESNOTEXIST", "--socket"])
+        .arg(dir.path().join("pend.sock"))
+        .env("HOME", dir.path())
+        .env_remove("XDG_CONFIG_HOME")
+        .env("PENSCAPE_NOTICE_SECS", "0.3");
+    let out = run_for(pend, Duration::from_millis(1200));
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(0), "SIGTERM ends pend cleanly: {err}");
+    assert_eq!(
+        lines_with(
+            &err,
+            "pend: waiting for the base station on /dev/ttyDOESNOTEXIST: no device found: /dev/ttyDOESNOTEXIST: \
+             No such file or directory; is it plugged in?"
+        ),
+        1,
+        "{err}"
+    );
+    assert!(lines_with(&err, "pend: still waiting for") >= 2, "{err}");
+}
+
+#[test]
+fn a_missing_hidraw_device_is_named_once() {
+    let home = tempfile::tempdir().expect("home");
+    let out = penctl(home.path(), &["info", "--hid", "/dev/hidraw-does-not-exist"])
+        .output()
+        .expect("penctl runs");
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.starts_with(
+            "penctl: cannot attach: no device found: /dev/hidraw-does-not-exist: No such file or directory"
+        ),
+        "{err}"
+    );
+    assert_eq!(err.matches("No such file or directory").count(), 1, "{err}");
+    assert!(err.contains("`penctl list`"), "{err}");
+}
+
+/// A device file this user may not open: a file nobody but root may read, opened as a user.
+/// As root (who may open anything) the programs run as `nobody` (setpriv), as anyone else
+/// the file's mode is 000.
+struct Forbidden {
+    dir: tempfile::TempDir,
+    root: bool,
+}
+
+impl Forbidden {
+    fn new() -> Forbidden {
+        let dir = tempfile::tempdir().expect("dir");
+        // The folder is open to all, so only the file's own mode refuses.
+        std::fs::set_permissions(dir.path(), std::fs::Permissions::from_mode(0o777)).expect("chmod");
+        let file = dir.path().join("ttyFORBIDDEN");
+        std::fs::write(&file, b"").expect("file");
+        let root = nix::unistd::Uid::effective().is_root();
+        let mode = if root { 0o600 } else { 0o000 };
+        std::fs::set_permissions(&file, std::fs::Permissions::from_mode(mode)).expect("chmod");
+        // pend's socket in a folder of the user's own, closed to others, as pend demands.
+        let run = dir.path().join("run");
+        std::fs::create_dir(&run).expect("run folder");
+        std::fs::set_permissions(&run, std::fs::Permissions::from_mode(0o700)).expect("chmod");
+        if root {
+            let nobody = Some(nix::unistd::Uid::from_raw(65534));
+            nix::unistd::chown(&run, nobody, Some(nix::unistd::Gid::from_raw(65534))).expect("chown");
+        }
+        Forbidden { dir, root }
+    }
+
+    fn path(&self) -> String {
+        self.dir.path().join("ttyFORBIDDEN").display().to_string()
+    }
+
+    /// `program` with `args`, as a user the file refuses.
+    fn command(&self, program: &str, args: &[&str]) -> Command {
+        let mut c = if self.root {
+            let mut c = Command::new("setpriv");
+            c.args(["--reuid=65534", "--regid=65534", "--clear-groups", program]);
+            c
+        } else {
+            Command::new(program)
+        };
+        c.args(args)
+            .env("HOME", self.dir.path())
+            .env_remove("XDG_CONFIG_HOME")
+            .env("XDG_RUNTIME_DIR", self.dir.path());
+        c
+    }
+}
+
+impl Drop for Forbidden {
+    fn drop(&mut self) {
+        // Let the temporary folder go, whatever the mode left.
+        let _ = std::fs::set_permissions(
+            self.dir.path().join("ttyFORBIDDEN"),
+            std::fs::Permissions::from_mode(0o600),
+        );
+    }
+}
+
+/// The fix named with a permission error: the udev rules and a group to join.
+fn says_how_to_get_access(err: &str) {
+    assert!(err.contains("Permission denied"), "{err}");
+    assert!(err.contains("host-driver/udev/70-penscape.rules"), "{err}");
+    assert!(err.contains("sudo usermod -aG"), "{err}");
+    assert!(err.contains("log in again"), "{err}");
+}
+
+#[test]
+fn permission_denied_is_shown_with_the_fix() {
+    let f = Forbidden::new();
+    let path = f.path();
+
+    // At once, where the tool gives up after a moment.
+    let out = f
+        .command(env!("CARGO_BIN_EXE_penctl"), &["info", "--serial", &path])
+        .output()
+        .expect("penctl runs");
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(
+        err.starts_with(&format!(
+            "penctl: cannot attach: cannot open {path}: Permission denied; "
+        )),
+        "{err}"
+    );
+    says_how_to_get_access(&err);
+
+    // While waiting, HID as serial.
+    let mut monitor = f.command(env!("CARGO_BIN_EXE_penctl"), &["monitor", "--hid", &path]);
+    monitor.env("PENSCAPE_NOTICE_SECS", "5");
+    let err = stderr(&run_for(monitor, Duration::from_millis(800)));
+    assert_eq!(lines_with(&err, "waiting for"), 1, "{err}");
+    assert!(
+        err.starts_with(&format!(
+            "penctl: waiting for the base station at {path}: cannot open {path}: Permission denied; "
+        )),
+        "{err}"
+    );
+    says_how_to_get_access(&err);
+
+    let socket = f.dir.path().join("run/pend.sock").display().to_string();
+    let pend = f.command(env!("CARGO_BIN_EXE_pend"), &["--serial", &path, "--socket", &socket]);
+    let out = run_for(pend, Duration::from_millis(800));
+    let err = stderr(&out);
+    assert!(
+        err.contains(&format!(
+            "pend: waiting for the base station on {path}: cannot open {path}: Permission denied; "
+        )),
+        "{err}"
+    );
+    says_how_to_get_access(&err);
+}
