@@ -31,6 +31,7 @@ pub mod journal;
 mod json;
 pub mod persist;
 pub mod profile;
+pub mod rocks;
 pub mod validate;
 
 pub use address::{CurvePath, FigurePath};

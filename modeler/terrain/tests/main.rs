@@ -8,4 +8,5 @@ mod examples;
 mod exports;
 mod limits;
 mod properties;
+mod rocks;
 mod validation;

@@ -1,0 +1,102 @@
+//! Rock field figures (issue 11, seed 001): the seed's fig. 1 recipe (r = 9, 3, 1 taking 20 %,
+//! 24 % and 56 % of the area) on a 512 × 512 field, whole and stage by stage; single diagrams
+//! r = 9, 3, 1 at A_s 0.5 as in the seed's table 1; and the Poisson-disk stage alone, the
+//! maximal sampler beside the seed's darts (eq. 1, c_d 0.7).
+//!
+//! The seed took 5.57 s for fig. 1 and 0.21 / 1.88 / 4.53 s for the single diagrams on a Core 2
+//! Duo 2.66 GHz. The peer (scipy's `qmc.PoissonDisk`) is timed by `scripts/rocks_peer.py`,
+//! which runs this machine's `penmodel rocks` on the same radius and area in the same run.
+//!
+//! Run: `cargo bench -p penmodel-terrain --bench rocks` (filter with e.g. `-- fig1`).
+
+use std::hint::black_box;
+use std::time::Duration;
+
+use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use penmodel_terrain::rocks::{self, Amount, Layer, Recipe, Sampler, Shape, poisson, scatter};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+
+const SIDE: u32 = 512;
+
+fn single(radius: f64) -> Recipe {
+    Recipe {
+        width: SIDE,
+        height: SIDE,
+        layers: vec![Layer {
+            radius,
+            amount: Amount::Fraction(0.5),
+            shape: Shape::DEFAULT,
+        }],
+        seed: 1,
+        sampler: Sampler::Saturate,
+    }
+}
+
+fn bench(c: &mut Criterion) {
+    let mut g = c.benchmark_group("rocks");
+    g.sample_size(20)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(4));
+    let fig1 = Recipe::figure_1(SIDE, SIDE, 1);
+    let once = scatter(&fig1, None).expect("fig. 1 is a valid recipe");
+    eprintln!(
+        "fig1/512: {} rocks; stages (ms): seeds+diagrams {:.2} (seeds {:.2}, labels {:.2} CPU), selection {:.2}, polygons {:.2}, meshes {:.2}, total {:.2}",
+        once.rocks.len(),
+        once.timing.seeds_and_diagrams,
+        once.timing.seeds,
+        once.timing.diagrams,
+        once.timing.selection,
+        once.timing.polygons,
+        once.timing.meshes,
+        once.timing.total
+    );
+    g.bench_function("fig1/512", |b| b.iter(|| scatter(black_box(&fig1), None)));
+    for r in [9.0, 3.0, 1.0] {
+        g.bench_with_input(BenchmarkId::new("single/512", r), &single(r), |b, recipe| {
+            b.iter(|| scatter(black_box(recipe), None))
+        });
+        g.bench_with_input(BenchmarkId::new("seeds-saturate/512", r), &r, |b, &r| {
+            let mut rng = ChaCha8Rng::seed_from_u64(1);
+            b.iter(|| poisson::saturate(SIDE, SIDE, r, &mut rng))
+        });
+        g.bench_with_input(BenchmarkId::new("seeds-darts/512", r), &r, |b, &r| {
+            let mut rng = ChaCha8Rng::seed_from_u64(1);
+            let throws = poisson::seed_throws(SIDE, SIDE, r, 0.7);
+            b.iter(|| poisson::darts(SIDE, SIDE, r, throws, &mut rng))
+        });
+    }
+    // The rocks' triangulations alone: ours against delaunator on the same point sets.
+    let sets: Vec<(Vec<[f64; 2]>, usize)> = once
+        .rocks
+        .iter()
+        .map(|r| {
+            (
+                r.polygon.iter().chain(&r.mesh.added).copied().collect(),
+                r.polygon.len(),
+            )
+        })
+        .collect();
+    g.bench_function("delaunay/fig1-rocks/ours", |b| {
+        b.iter(|| {
+            sets.iter()
+                .map(|(p, k)| rocks::delaunay::triangulate(black_box(p), *k).len())
+                .sum::<usize>()
+        })
+    });
+    g.bench_function("delaunay/fig1-rocks/delaunator", |b| {
+        b.iter(|| {
+            sets.iter()
+                .map(|(p, _)| {
+                    let pts: Vec<delaunator::Point> =
+                        p.iter().map(|q| delaunator::Point { x: q[0], y: q[1] }).collect();
+                    delaunator::triangulate(black_box(&pts)).triangles.len()
+                })
+                .sum::<usize>()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,407 @@
+//! Rocks of mixed sizes scattered on the ground (seed 001, Sakurai & Miyata 2010).
+//!
+//! A rock field is an image of `width × height` cells (pixels). For each radius r of its
+//! layers: Poisson-disk seeds no two within r ([`poisson`]), their Voronoi diagram
+//! ([`voronoi`]); then the diagrams, largest mean cell first, give up cells at random, each kept
+//! only if none of its pixels is taken yet, until the layer's area fraction or count
+//! ([`select`]); and each kept cell becomes a rock mesh ([`shape`]). Gaps between cells of
+//! different sizes stay, as in the seed (it rejected snapping them shut as unnatural).
+//!
+//! [`scatter`] is the whole method on a plain image (the `penmodel rocks` command); a document's
+//! rock field passes the mask of its outline, so only cells wholly inside become rocks. The same
+//! configuration and seed give the same rocks on any machine and any number of threads: every
+//! random draw comes from a ChaCha8 stream named by the seed, the layer and the cell.
+//!
+//! Stages run on all cores where they are independent: the diagrams' seeds and pixel labels one
+//! diagram per thread, the selected cells' polygons and meshes one rock per task. The selection
+//! is sequential by nature (each diagram sees what the larger ones took).
+
+pub mod delaunay;
+pub mod poisson;
+pub mod select;
+pub mod shape;
+pub mod voronoi;
+
+use std::time::Instant;
+
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rayon::prelude::*;
+use thiserror::Error;
+
+pub use select::Goal;
+pub use shape::{RockMesh, Shape};
+
+/// The largest field image, in pixels (as many as the largest terrain grid).
+pub const MAX_PIXELS: u64 = 1 << 24;
+
+/// How a layer's seeds are thrown.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Sampler {
+    /// Every pixel tried once in random order: maximal (see [`poisson`]). The default.
+    Saturate,
+    /// The seed's darts: `A·fill / (π(0.5r)²)` throws (eq. 1; the seed's `fill` is 0.7).
+    Darts {
+        /// The disk filling rate `c_d`.
+        fill: f64,
+    },
+}
+
+/// When a layer's diagram stops giving up cells.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Amount {
+    /// A fraction of the field's area `A_s` (0 to 1).
+    Fraction(f64),
+    /// A number of rocks.
+    Count(u32),
+}
+
+/// One diagram: a radius, how much of it to keep, and its rocks' shape.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Layer {
+    /// The Poisson-disk radius r in cells (no two seeds within r).
+    pub radius: f64,
+    /// How much the diagram may take.
+    pub amount: Amount,
+    /// Eq. 2 and 3.
+    pub shape: Shape,
+}
+
+/// A rock field's recipe.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recipe {
+    /// Field image width in cells.
+    pub width: u32,
+    /// Field image height in cells.
+    pub height: u32,
+    /// The diagrams.
+    pub layers: Vec<Layer>,
+    /// The random seed.
+    pub seed: u64,
+    /// How seeds are thrown.
+    pub sampler: Sampler,
+}
+
+impl Recipe {
+    /// The seed's fig. 1 (table 1) on a `width × height` field: r = 9, 3, 1 taking 20 %, 24 %
+    /// and 56 % of the area, with its per-diagram shape coefficients.
+    pub fn figure_1(width: u32, height: u32, seed: u64) -> Recipe {
+        let layer = |radius, fraction, widths, heights| Layer {
+            radius,
+            amount: Amount::Fraction(fraction),
+            shape: Shape { widths, heights },
+        };
+        Recipe {
+            width,
+            height,
+            layers: vec![
+                layer(9.0, 0.2, [0.0, 0.3, 0.3], [0.3, 0.3, 0.1]),
+                layer(3.0, 0.24, [0.0, 0.3, 0.1], [0.3, 0.3, 0.1]),
+                layer(1.0, 0.56, [0.1, 0.1, 0.1], [0.3, 0.0, 0.1]),
+            ],
+            seed,
+            sampler: Sampler::Saturate,
+        }
+    }
+}
+
+/// Why a recipe cannot be scattered. Each names the layer (`layers[i]`) or the field.
+#[allow(missing_docs)] // fields named for what they hold.
+#[derive(Debug, Clone, PartialEq, Error)]
+pub enum RecipeError {
+    #[error("the field is {width} × {height} cells; it needs at least 1 × 1 and at most {max} cells", max = MAX_PIXELS)]
+    FieldSize { width: u32, height: u32 },
+    #[error("there are no layers; give at least one radius")]
+    NoLayers,
+    #[error("layers[{layer}].radius: {radius} must be a number above 0")]
+    RadiusNotPositive { layer: usize, radius: f64 },
+    #[error("layers[{layer}].radius: {radius} is larger than the {width} × {height} field")]
+    RadiusTooLarge {
+        layer: usize,
+        radius: f64,
+        width: u32,
+        height: u32,
+    },
+    #[error("layers[{layer}].fraction: {fraction} must be from 0 to 1")]
+    FractionRange { layer: usize, fraction: f64 },
+    #[error("the fractions add up to {sum}, more than 1")]
+    FractionsOverOne { sum: f64 },
+    #[error("layers[{layer}].shape.{what}: {value} must be from {min} to {max}")]
+    ShapeRange {
+        layer: usize,
+        what: &'static str,
+        value: f64,
+        min: f64,
+        max: f64,
+    },
+    #[error("darts fill rate {0} must be above 0 and at most 10")]
+    Fill(f64),
+}
+
+/// The range of the eq. 2 coefficients (× r); eq. 3's are 0 to this (rocks stand up).
+pub const MAX_COEFFICIENT: f64 = 10.0;
+
+impl Recipe {
+    /// Checks the recipe; errors name the layer and field.
+    pub fn check(&self) -> Result<(), RecipeError> {
+        let (width, height) = (self.width, self.height);
+        if width == 0 || height == 0 || u64::from(width) * u64::from(height) > MAX_PIXELS {
+            return Err(RecipeError::FieldSize { width, height });
+        }
+        if self.layers.is_empty() {
+            return Err(RecipeError::NoLayers);
+        }
+        let mut sum = 0.0;
+        for (layer, l) in self.layers.iter().enumerate() {
+            let radius = l.radius;
+            if !(radius > 0.0 && radius.is_finite()) {
+                return Err(RecipeError::RadiusNotPositive { layer, radius });
+            }
+            if radius > f64::from(width.min(height)) {
+                return Err(RecipeError::RadiusTooLarge {
+                    layer,
+                    radius,
+                    width,
+                    height,
+                });
+            }
+            if let Amount::Fraction(fraction) = l.amount {
+                if !(0.0..=1.0).contains(&fraction) {
+                    return Err(RecipeError::FractionRange { layer, fraction });
+                }
+                sum += fraction;
+            }
+            let names = ["c_w1", "c_w2", "c_w3", "c_h1", "c_h2", "c_h3"];
+            let values = l.shape.widths.iter().chain(&l.shape.heights);
+            for (i, (&value, what)) in values.zip(names).enumerate() {
+                let min = if i < 3 { -MAX_COEFFICIENT } else { 0.0 };
+                if !(min..=MAX_COEFFICIENT).contains(&value) {
+                    return Err(RecipeError::ShapeRange {
+                        layer,
+                        what,
+                        value,
+                        min,
+                        max: MAX_COEFFICIENT,
+                    });
+                }
+            }
+        }
+        // A little slack for decimal fractions such as 0.2 + 0.24 + 0.56.
+        if sum > 1.0 + 1e-9 {
+            return Err(RecipeError::FractionsOverOne { sum });
+        }
+        if let Sampler::Darts { fill } = self.sampler
+            && !(fill > 0.0 && fill <= 10.0)
+        {
+            return Err(RecipeError::Fill(fill));
+        }
+        Ok(())
+    }
+}
+
+/// One diagram's result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Diagram {
+    /// Its radius.
+    pub radius: f64,
+    /// The seeds, pixel centres in field coordinates (`x + ½, y + ½`).
+    pub seeds: Vec<[f64; 2]>,
+    /// Its place in the selection order (0 first: the largest mean cell).
+    pub order: usize,
+    /// The kept cells, as seed indices, in the order drawn.
+    pub cells: Vec<u32>,
+    /// Pixels its kept cells cover.
+    pub pixels: usize,
+    /// Cells drawn before it stopped.
+    pub tried: usize,
+    /// Whether it reached its amount (false when the cells ran out first).
+    pub reached: bool,
+}
+
+/// A rock: a kept cell and its mesh.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Rock {
+    /// The diagram (layer index) it came from.
+    pub diagram: usize,
+    /// The cell (seed index in its diagram).
+    pub cell: u32,
+    /// The cell's polygon, counter-clockwise in (x, y) (positive area), no repeated vertex.
+    pub polygon: Vec<[f64; 2]>,
+    /// The mesh.
+    pub mesh: RockMesh,
+}
+
+/// Milliseconds per stage (summed over diagrams where they run one after another).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Timing {
+    /// Poisson-disk seeds and pixel labels of all diagrams (in parallel).
+    pub seeds_and_diagrams: f64,
+    /// Of which the seeds alone, per diagram summed (CPU time across threads).
+    pub seeds: f64,
+    /// Of which the Voronoi labels alone, per diagram summed (CPU time across threads).
+    pub diagrams: f64,
+    /// Exclusive selection.
+    pub selection: f64,
+    /// Polygons of the kept cells (in parallel).
+    pub polygons: f64,
+    /// The rocks' meshes (in parallel).
+    pub meshes: f64,
+    /// Everything.
+    pub total: f64,
+}
+
+/// A scattered field.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Scatter {
+    /// Field width in cells.
+    pub width: u32,
+    /// Field height in cells.
+    pub height: u32,
+    /// Pixels of the field (inside the mask), the area fractions' whole.
+    pub field_pixels: usize,
+    /// One per layer, in the recipe's order.
+    pub diagrams: Vec<Diagram>,
+    /// The rocks, diagram by diagram in selection order, each in the order drawn.
+    pub rocks: Vec<Rock>,
+    /// Stage times.
+    pub timing: Timing,
+}
+
+impl Scatter {
+    /// The area fraction diagram `d` took.
+    pub fn fraction(&self, d: usize) -> f64 {
+        self.diagrams[d].pixels as f64 / self.field_pixels.max(1) as f64
+    }
+}
+
+fn ms(since: Instant) -> f64 {
+    since.elapsed().as_secs_f64() * 1e3
+}
+
+/// A random stream for `purpose` of `layer` (and `cell`) of a field with `seed`.
+fn stream(seed: u64, purpose: u64, layer: usize, cell: u64) -> ChaCha8Rng {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    rng.set_stream(purpose << 56 | (layer as u64) << 40 | cell);
+    rng
+}
+
+const SEEDS: u64 = 1;
+const SELECT: u64 = 2;
+const SHAPE: u64 = 3;
+
+/// Runs the method on `recipe`. `inside`, if given, has one flag per pixel (row-major): cells
+/// with a pixel outside are never kept, and fractions are of the inside pixels.
+pub fn scatter(recipe: &Recipe, inside: Option<&[bool]>) -> Result<Scatter, RecipeError> {
+    recipe.check()?;
+    let start = Instant::now();
+    let (width, height) = (recipe.width, recipe.height);
+    let pixels = width as usize * height as usize;
+    let made: Vec<(Vec<u32>, Vec<u32>, f64, f64)> = recipe
+        .layers
+        .par_iter()
+        .enumerate()
+        .map(|(i, layer)| {
+            let t = Instant::now();
+            let mut rng = stream(recipe.seed, SEEDS, i, 0);
+            let seeds = match recipe.sampler {
+                Sampler::Saturate => poisson::saturate(width, height, layer.radius, &mut rng),
+                Sampler::Darts { fill } => {
+                    let throws = poisson::seed_throws(width, height, layer.radius, fill);
+                    poisson::darts(width, height, layer.radius, throws, &mut rng)
+                }
+            };
+            let seeds_ms = ms(t);
+            let t = Instant::now();
+            let labels = voronoi::label(width, height, &seeds, layer.radius);
+            (seeds, labels, seeds_ms, ms(t))
+        })
+        .collect();
+    let mut timing = Timing {
+        seeds_and_diagrams: ms(start),
+        seeds: made.iter().map(|m| m.2).sum(),
+        diagrams: made.iter().map(|m| m.3).sum(),
+        ..Timing::default()
+    };
+
+    let t = Instant::now();
+    let mut taken: Vec<bool> = match inside {
+        Some(mask) if mask.len() == pixels => mask.iter().map(|&i| !i).collect(),
+        _ => vec![false; pixels],
+    };
+    let field_pixels = taken.iter().filter(|&&t| !t).count();
+    // Largest mean cell first: the fewest seeds; ties keep the recipe's order.
+    let mut order: Vec<usize> = (0..recipe.layers.len()).collect();
+    order.sort_by_key(|&i| made[i].0.len());
+    let mut diagrams: Vec<Option<Diagram>> = vec![None; recipe.layers.len()];
+    for (rank, &i) in order.iter().enumerate() {
+        let (seeds, labels, _, _) = &made[i];
+        let cells = voronoi::CellPixels::of(labels, seeds.len());
+        let goal = match recipe.layers[i].amount {
+            Amount::Fraction(f) => Goal::Pixels((f * field_pixels as f64).ceil() as usize),
+            Amount::Count(c) => Goal::Cells(c as usize),
+        };
+        let mut rng = stream(recipe.seed, SELECT, i, 0);
+        let got = select::select(&cells, &mut taken, goal, &mut rng);
+        let reached = match goal {
+            Goal::Pixels(p) => got.pixels >= p,
+            Goal::Cells(c) => got.cells.len() >= c,
+        };
+        diagrams[i] = Some(Diagram {
+            radius: recipe.layers[i].radius,
+            seeds: seeds.iter().map(|&p| voronoi::centre(p, width)).collect(),
+            order: rank,
+            cells: got.cells,
+            pixels: got.pixels,
+            tried: got.tried,
+            reached,
+        });
+    }
+    let diagrams: Vec<Diagram> = diagrams.into_iter().flatten().collect();
+    timing.selection = ms(t);
+
+    let t = Instant::now();
+    let mut polygons: Vec<(usize, u32, Vec<[f64; 2]>)> = Vec::new();
+    for &i in &order {
+        let d = &diagrams[i];
+        // Seeds are more than r apart: a bucket of side r holds a few.
+        let buckets = voronoi::Buckets::new(&d.seeds, width, height, recipe.layers[i].radius.max(1.0));
+        let made: Vec<_> = d
+            .cells
+            .par_iter()
+            .map(|&cell| {
+                (
+                    i,
+                    cell,
+                    voronoi::cell_polygon(&d.seeds, &buckets, width, height, cell as usize),
+                )
+            })
+            .collect();
+        polygons.extend(made);
+    }
+    timing.polygons = ms(t);
+    let t = Instant::now();
+    let rocks: Vec<Rock> = polygons
+        .into_par_iter()
+        .map(|(i, cell, polygon)| {
+            let layer = &recipe.layers[i];
+            let mut rng = stream(recipe.seed, SHAPE, i, u64::from(cell));
+            let mesh = shape::rock(&polygon, layer.radius, &layer.shape, &mut rng);
+            Rock {
+                diagram: i,
+                cell,
+                polygon,
+                mesh,
+            }
+        })
+        .collect();
+    timing.meshes = ms(t);
+    timing.total = ms(start);
+    Ok(Scatter {
+        width,
+        height,
+        field_pixels,
+        diagrams,
+        rocks,
+        timing,
+    })
+}

@@ -1,0 +1,291 @@
+//! A Voronoi diagram of one radius's seeds: which cell each pixel is in, and a cell's polygon.
+//!
+//! Pixels: a pixel belongs to the seed nearest its centre; on a tie (seeds sit on pixel centres,
+//! so squared distances are whole numbers and ties are common) to the seed with the lowest index.
+//! Every pixel lies within the disk radius of some seed when the seeds are saturated
+//! ([`super::poisson::saturate`]), so each seed paints the pixels of its disk, keeping the nearer
+//! seed: about `3·A` steps for the whole image whatever the radius. Pixels no disk reached (the
+//! seed's unsaturated darts leave holes) are found by a search over the seed buckets.
+//!
+//! Polygons: a cell is the field's rectangle cut by the bisector of its seed and each neighbour,
+//! nearest first, ring by ring of seed buckets, until every seed within twice the cell's reach
+//! has cut it (no farther seed can). Only the selected cells need polygons.
+
+/// Seeds sorted into square buckets of side `size`, for neighbour searches.
+pub(crate) struct Buckets {
+    size: f64,
+    cols: i32,
+    rows: i32,
+    start: Vec<u32>,
+    /// Seed indices and positions, bucket by bucket (stored together: a search reads them in
+    /// bucket order instead of jumping about the seed list, which halved the polygon stage).
+    seeds: Vec<(u32, [f64; 2])>,
+}
+
+impl Buckets {
+    pub(crate) fn new(points: &[[f64; 2]], width: u32, height: u32, size: f64) -> Buckets {
+        let cols = ((f64::from(width) / size).ceil() as i32).max(1);
+        let rows = ((f64::from(height) / size).ceil() as i32).max(1);
+        let cell = |p: &[f64; 2]| -> usize {
+            let c = ((p[0] / size) as i32).clamp(0, cols - 1);
+            let r = ((p[1] / size) as i32).clamp(0, rows - 1);
+            (r * cols + c) as usize
+        };
+        let mut start = vec![0u32; (cols * rows) as usize + 1];
+        for p in points {
+            start[cell(p) + 1] += 1;
+        }
+        for i in 1..start.len() {
+            start[i] += start[i - 1];
+        }
+        let mut fill = start.clone();
+        let mut seeds = vec![(0u32, [0.0; 2]); points.len()];
+        for (i, p) in points.iter().enumerate() {
+            let b = cell(p);
+            seeds[fill[b] as usize] = (i as u32, *p);
+            fill[b] += 1;
+        }
+        Buckets {
+            size,
+            cols,
+            rows,
+            start,
+            seeds,
+        }
+    }
+
+    fn bucket_of(&self, p: [f64; 2]) -> (i32, i32) {
+        (
+            ((p[0] / self.size) as i32).clamp(0, self.cols - 1),
+            ((p[1] / self.size) as i32).clamp(0, self.rows - 1),
+        )
+    }
+
+    /// Calls `f` with each seed (index and position) in the buckets at Chebyshev distance
+    /// exactly `ring` from `(c, r)`.
+    fn ring(&self, (c, r): (i32, i32), ring: i32, mut f: impl FnMut(u32, [f64; 2])) {
+        let mut visit = |bc: i32, br: i32| {
+            if bc >= 0 && br >= 0 && bc < self.cols && br < self.rows {
+                let b = (br * self.cols + bc) as usize;
+                for &(s, p) in &self.seeds[self.start[b] as usize..self.start[b + 1] as usize] {
+                    f(s, p);
+                }
+            }
+        };
+        if ring == 0 {
+            visit(c, r);
+            return;
+        }
+        for bc in c - ring..=c + ring {
+            visit(bc, r - ring);
+            visit(bc, r + ring);
+        }
+        for br in r - ring + 1..r + ring {
+            visit(c - ring, br);
+            visit(c + ring, br);
+        }
+    }
+
+    /// The largest ring index that still meets the grid from `(c, r)`.
+    fn last_ring(&self, (c, r): (i32, i32)) -> i32 {
+        c.max(self.cols - 1 - c).max(r).max(self.rows - 1 - r)
+    }
+}
+
+/// Pixel → cell (seed index) for the whole `width × height` image; seeds at pixel indices.
+pub fn label(width: u32, height: u32, seeds: &[u32], radius: f64) -> Vec<u32> {
+    let n = width as usize * height as usize;
+    let mut best = vec![u32::MAX; n];
+    let mut owner = vec![u32::MAX; n];
+    let offsets = super::poisson::disk(radius);
+    let (w, h) = (width as i32, height as i32);
+    for (i, &p) in seeds.iter().enumerate() {
+        let (x, y) = ((p % width) as i32, (p / width) as i32);
+        for &(dx, dy) in &offsets {
+            let (px, py) = (x + dx, y + dy);
+            if px >= 0 && py >= 0 && px < w && py < h {
+                let at = (py * w + px) as usize;
+                let d = (dx * dx + dy * dy) as u32;
+                // Seeds are painted in index order, so a tie keeps the lower index.
+                if d < best[at] {
+                    best[at] = d;
+                    owner[at] = i as u32;
+                }
+            }
+        }
+    }
+    if owner.contains(&u32::MAX) && !seeds.is_empty() {
+        fill_holes(width, height, seeds, radius, &mut owner);
+    }
+    owner
+}
+
+/// Labels the pixels no disk reached by searching the seed buckets outwards.
+fn fill_holes(width: u32, height: u32, seeds: &[u32], radius: f64, owner: &mut [u32]) {
+    let points: Vec<[f64; 2]> = seeds.iter().map(|&p| centre(p, width)).collect();
+    let buckets = Buckets::new(&points, width, height, radius.max(1.0) * 2.0);
+    for (at, o) in owner.iter_mut().enumerate() {
+        if *o != u32::MAX {
+            continue;
+        }
+        let q = centre(at as u32, width);
+        let home = buckets.bucket_of(q);
+        let mut found: Option<(f64, u32)> = None;
+        for ring in 0..=buckets.last_ring(home) {
+            buckets.ring(home, ring, |s, p| {
+                let d = (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2);
+                if found.is_none_or(|(bd, bs)| d < bd || (d == bd && s < bs)) {
+                    found = Some((d, s));
+                }
+            });
+            // Seeds beyond this ring are at least `ring·size` away.
+            if let Some((d, _)) = found
+                && d.sqrt() <= f64::from(ring) * buckets.size
+            {
+                break;
+            }
+        }
+        if let Some((_, s)) = found {
+            *o = s;
+        }
+    }
+}
+
+/// The centre of pixel index `p`.
+pub(crate) fn centre(p: u32, width: u32) -> [f64; 2] {
+    [f64::from(p % width) + 0.5, f64::from(p / width) + 0.5]
+}
+
+/// Pixels grouped by cell: `pixels[start[c]..start[c + 1]]` are cell `c`'s, ascending.
+pub struct CellPixels {
+    /// Offsets into `pixels`, one more than there are cells.
+    pub start: Vec<u32>,
+    /// Pixel indices.
+    pub pixels: Vec<u32>,
+}
+
+impl CellPixels {
+    /// Groups `labels` (pixel → cell, `u32::MAX` for none) for `cells` cells.
+    pub fn of(labels: &[u32], cells: usize) -> CellPixels {
+        let mut start = vec![0u32; cells + 1];
+        for &l in labels {
+            if (l as usize) < cells {
+                start[l as usize + 1] += 1;
+            }
+        }
+        for i in 1..start.len() {
+            start[i] += start[i - 1];
+        }
+        let mut fill = start.clone();
+        let mut pixels = vec![0u32; start[cells] as usize];
+        for (p, &l) in labels.iter().enumerate() {
+            if (l as usize) < cells {
+                pixels[fill[l as usize] as usize] = p as u32;
+                fill[l as usize] += 1;
+            }
+        }
+        CellPixels { start, pixels }
+    }
+
+    /// Cell `c`'s pixels.
+    pub fn cell(&self, c: usize) -> &[u32] {
+        &self.pixels[self.start[c] as usize..self.start[c + 1] as usize]
+    }
+}
+
+/// Keeps the part of convex polygon `poly` on the seed's side of the bisector of `s` and `q`.
+fn clip(poly: &mut Vec<[f64; 2]>, scratch: &mut Vec<[f64; 2]>, s: [f64; 2], q: [f64; 2]) {
+    let n = [q[0] - s[0], q[1] - s[1]];
+    let m = [(s[0] + q[0]) * 0.5, (s[1] + q[1]) * 0.5];
+    let side = |p: [f64; 2]| (p[0] - m[0]) * n[0] + (p[1] - m[1]) * n[1];
+    if poly.iter().all(|&p| side(p) <= 0.0) {
+        return;
+    }
+    scratch.clear();
+    for i in 0..poly.len() {
+        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
+        let (sa, sb) = (side(a), side(b));
+        if sa <= 0.0 {
+            scratch.push(a);
+        }
+        if (sa <= 0.0) != (sb <= 0.0) {
+            let t = sa / (sa - sb);
+            scratch.push([a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t]);
+        }
+    }
+    std::mem::swap(poly, scratch);
+}
+
+/// The polygon of the cell of `points[cell]` within the `width × height` rectangle, its
+/// vertices counter-clockwise in (x, y) with y down (clockwise on screen), without repeats.
+pub(crate) fn cell_polygon(
+    points: &[[f64; 2]],
+    buckets: &Buckets,
+    width: u32,
+    height: u32,
+    cell: usize,
+) -> Vec<[f64; 2]> {
+    let s = points[cell];
+    let (w, h) = (f64::from(width), f64::from(height));
+    let mut poly = vec![[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]];
+    let mut scratch = Vec::with_capacity(16);
+    let home = buckets.bucket_of(s);
+    let last = buckets.last_ring(home);
+    let reach = |poly: &[[f64; 2]]| {
+        poly.iter()
+            .map(|p| (p[0] - s[0]).powi(2) + (p[1] - s[1]).powi(2))
+            .fold(0.0, f64::max)
+    };
+    // Neighbours nearest first: (squared distance, seed). A seed at distance d cuts the polygon
+    // only if the polygon reaches beyond d/2 from `s`, so the cutting stops at the first seed
+    // farther than twice the reach; seeds beyond ring k of buckets are farther than k·size.
+    let mut near: Vec<(f64, [f64; 2])> = Vec::with_capacity(32);
+    let mut next = 0;
+    let mut reach2 = reach(&poly);
+    'rings: for ring in 0..=last {
+        buckets.ring(home, ring, |q, p| {
+            if q as usize != cell {
+                near.push(((p[0] - s[0]).powi(2) + (p[1] - s[1]).powi(2), p));
+            }
+        });
+        near[next..].sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        let covered = f64::from(ring) * buckets.size;
+        let covered2 = covered * covered;
+        while next < near.len() && near[next].0 <= covered2 {
+            if near[next].0 > 4.0 * reach2 {
+                break 'rings;
+            }
+            clip(&mut poly, &mut scratch, s, near[next].1);
+            reach2 = reach(&poly);
+            next += 1;
+        }
+        if 4.0 * reach2 <= covered2 {
+            break;
+        }
+    }
+    // Clipping through a vertex shared by several bisectors repeats it; drop the repeats.
+    let mut out: Vec<[f64; 2]> = Vec::with_capacity(poly.len());
+    for p in poly {
+        let near = |a: &[f64; 2]| (a[0] - p[0]).abs() < 1e-9 && (a[1] - p[1]).abs() < 1e-9;
+        if !out.last().is_some_and(near) {
+            out.push(p);
+        }
+    }
+    let same = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs() < 1e-9 && (a[1] - b[1]).abs() < 1e-9;
+    while out.len() > 1 && same(out[0], out[out.len() - 1]) {
+        out.pop();
+    }
+    // A vertex on the straight line between its neighbours is not a corner.
+    let mut i = 0;
+    while out.len() > 3 && i < out.len() {
+        let n = out.len();
+        let (a, b, c) = (out[(i + n - 1) % n], out[i], out[(i + 1) % n]);
+        let cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+        if cross.abs() < 1e-9 {
+            out.remove(i);
+        } else {
+            i += 1;
+        }
+    }
+    out
+}
