@@ -3,6 +3,7 @@ mod calibration;
 mod daemon;
 mod delays;
 mod events;
+mod install;
 mod penctl;
 mod socket;
 mod waiting;

@@ -205,6 +205,30 @@ fn config_is_validated_before_it_is_sent() {
 }
 
 #[test]
+fn json_prints_the_devices_f32_numbers_as_their_shortest_decimals() {
+    // The simulated base station's delays include 36.2 and 40.1 µs and its filter's beta 0.1,
+    // none of which an f32 holds exactly.
+    for args in [
+        &["config", "get", "--sim", "--json"][..],
+        &["info", "--sim", "--json"][..],
+    ] {
+        let out = penctl(args);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(
+            text.contains(r#""transducer_delay_us":[38.0,41.5,36.2,40.1]"#) && text.contains(r#""beta":0.1,"#),
+            "{args:?}: {text}"
+        );
+        assert!(!text.contains("0000000"), "{args:?}: f32 noise in {text}");
+        // Read back, each is the device's f32 exactly.
+        let v: serde_json::Value = serde_json::from_str(&text).expect("JSON");
+        let config = if args[0] == "info" { &v["config"] } else { &v };
+        let delay = config["transducer_delay_us"][2].as_f64().expect("a number");
+        assert_eq!(delay as f32, 36.2f32);
+    }
+}
+
+#[test]
 fn calibrate_with_the_simulated_pen_writes_the_file_and_plot() {
     let tmp = home();
     let dir = tmp.path().join("out");
@@ -231,6 +255,20 @@ fn calibrate_with_the_simulated_pen_writes_the_file_and_plot() {
     assert!(std::fs::metadata(&png).expect("plot written").len() > 1000);
     let too_few = penctl(&["calibrate", "--sim", "--targets", "3"]);
     assert_eq!(too_few.status.code(), Some(2), "fewer than 4 targets is a usage error");
+}
+
+#[test]
+fn target_counts_other_than_4_5_and_9_are_refused_naming_them() {
+    for n in ["3", "6", "7", "8", "10", "seven"] {
+        let out = penctl(&["calibrate", "--sim", "--sim-speed", "0", "--targets", n]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "--targets {n}: {err}");
+        assert!(
+            err.contains("4 targets (the corners), 5 (and the centre) or 9 (a 3 × 3 grid)"),
+            "{err}"
+        );
+        assert!(!err.contains("target 1"), "refused before any touch: {err}");
+    }
 }
 
 #[test]
@@ -374,8 +412,19 @@ fn another_devices_calibration_is_refused_by_pend_saying_what_to_do() {
 
 #[test]
 fn a_display_size_out_of_range_is_refused_naming_it() {
+    // Not a size at all: a usage error, as clap says it.
+    for bad in ["600", "600x", "wide", "600x340x2"] {
+        let out = penctl(&["calibrate", "--sim", "--display-mm", bad]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "--display-mm {bad}: {err}");
+        assert!(err.contains("expected WIDTHxHEIGHT, such as 600x340"), "{err}");
+    }
+    let out = penctl(&["calibrate", "--sim", "--display-px", "2560"]);
+    assert_eq!(out.status.code(), Some(2));
+
+    // A size out of range: a usage error too, naming the flag and the range.
     let out = penctl(&["calibrate", "--sim", "--display-mm", "1e-300x340"]);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("--display-mm: `display.width_mm` must be between 20 and 10000 mm, is 1e-300"),
@@ -383,7 +432,7 @@ fn a_display_size_out_of_range_is_refused_naming_it() {
     );
     assert!(!err.contains("target 1"), "refused before any touch: {err}");
     let out = penctl(&["calibrate", "--sim", "--display-px", "2560x0"]);
-    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(
         err.contains("--display-px: `display.height_px` must be between 16 and 65536 pixels, is 0"),

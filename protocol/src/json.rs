@@ -6,8 +6,9 @@
 //! [`Config`] on its own is the settings object `penctl config set --file` reads back; it reads
 //! as a [`ConfigChanges`], which keeps the values of keys it lacks.
 //!
-//! Numbers the device holds as `f32` are written as the `f64` they widen to (`0.1f32` prints as
-//! `0.10000000149011612`): the exact value the device holds, the form penctl has always printed.
+//! Numbers the device holds as `f32` are written as the shortest decimal that reads back as the
+//! same `f32` (`0.1f32` prints as `0.1`, not as the `0.10000000149011612` it widens to): reading
+//! the JSON back gives the device's value exactly.
 //! No allocation: the firmware may enable the feature too.
 
 use core::fmt;

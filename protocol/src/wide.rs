@@ -1,6 +1,6 @@
 //! Number forms of the JSON output (feature `serde`): numbers the device holds as `f32` written
-//! as the `f64` they widen to (`0.1f32` prints as `0.10000000149011612`, the exact value the
-//! device holds), and tenths as decimals. A leaf: the report types name these helpers in their
+//! as the shortest decimal that reads back as the same `f32` (`36.2f32` prints as `36.2`, not as
+//! the `36.20000076293945` it widens to), and tenths as decimals. A leaf: the report types name these helpers in their
 //! serde attributes, and the JSON module uses them too.
 
 use serde::Serialize;
@@ -11,19 +11,20 @@ pub(crate) fn tenths<S: Serializer, T: Copy + Into<f64>>(v: &T, s: S) -> Result<
     s.serialize_f64((*v).into() / 10.0)
 }
 
-/// An `f32` as the `f64` it widens to.
+/// An `f32` as its shortest decimal (serde_json and every other format with an `f32` of its own
+/// write it so; this names the choice at each field).
 pub(crate) fn wide<S: Serializer>(v: &f32, s: S) -> Result<S::Ok, S::Error> {
-    s.serialize_f64(f64::from(*v))
+    s.serialize_f32(*v)
 }
 
 pub(crate) fn wide_opt<S: Serializer>(v: &Option<f32>, s: S) -> Result<S::Ok, S::Error> {
     match v {
-        Some(v) => s.serialize_f64(f64::from(*v)),
+        Some(v) => s.serialize_f32(*v),
         None => s.serialize_none(),
     }
 }
 
-/// A list of `f32` (or of `[f32; N]`) as `f64`s.
+/// A list of `f32` (or of `[f32; N]`), each as its shortest decimal.
 pub(crate) fn wide_list<S: Serializer, T: Wide>(v: &&[T], s: S) -> Result<S::Ok, S::Error> {
     let mut seq = s.serialize_seq(Some(v.len()))?;
     for x in v.iter() {
@@ -39,7 +40,7 @@ pub(crate) trait Wide {
 
 impl Wide for f32 {
     fn put<S: SerializeSeq>(&self, seq: &mut S) -> Result<(), S::Error> {
-        seq.serialize_element(&f64::from(*self))
+        seq.serialize_element(self)
     }
 }
 
@@ -49,12 +50,12 @@ impl<const N: usize> Wide for [f32; N] {
     }
 }
 
-/// `f32`s as `f64`s.
+/// `f32`s, each as its shortest decimal.
 pub(crate) struct WideSlice<'a>(pub(crate) &'a [f32]);
 
 impl Serialize for WideSlice<'_> {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.collect_seq(self.0.iter().map(|&v| f64::from(v)))
+        s.collect_seq(self.0.iter())
     }
 }
 

@@ -143,14 +143,14 @@ struct CalibrateArgs {
     #[command(flatten)]
     device: DeviceArgs,
     /// Targets: 4 (corners), 5 (and the centre) or 9 (a 3 × 3 grid).
-    #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u8).range(4..=9))]
+    #[arg(long, default_value_t = 5, value_parser = target_count)]
     targets: u8,
     /// The display's active area, mm.
-    #[arg(long, value_name = "WxH", default_value = "600x340")]
-    display_mm: String,
+    #[arg(long, value_name = "WxH", default_value = "600x340", value_parser = size::<f64>)]
+    display_mm: (f64, f64),
     /// The display's resolution.
-    #[arg(long, value_name = "WxH", default_value = "2560x1440")]
-    display_px: String,
+    #[arg(long, value_name = "WxH", default_value = "2560x1440", value_parser = size::<u32>)]
+    display_px: (u32, u32),
     /// The transform to fit.
     #[arg(long, value_enum, default_value_t = Fit::Similarity)]
     fit: Fit,
@@ -169,12 +169,27 @@ struct CalibrateArgs {
     patience: f64,
 }
 
-fn size<T: std::str::FromStr>(s: &str, what: &str) -> Result<(T, T)> {
+/// `WIDTHxHEIGHT`, for clap (a usage error otherwise).
+fn size<T: std::str::FromStr>(s: &str) -> Result<(T, T), String> {
     let parsed = s
-        .split_once('x')
+        .split_once(['x', 'X', '×'])
         .and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
-    parsed.with_context(|| format!("{what} must be WIDTHxHEIGHT, got {s:?}"))
+    parsed.ok_or_else(|| format!("expected WIDTHxHEIGHT, such as 600x340, got {s:?}"))
 }
+
+/// The calibration's target counts, for clap: any other is refused, not rounded to one of these.
+fn target_count(s: &str) -> Result<u8, String> {
+    match s.trim().parse::<u8>() {
+        Ok(n @ (4 | 5 | 9)) => Ok(n),
+        _ => Err("a calibration has 4 targets (the corners), 5 (and the centre) or 9 (a 3 × 3 grid)".into()),
+    }
+}
+
+/// A usage error found after parsing (values that parse but do not go together or are out of
+/// range): exit status 2, like clap's own.
+#[derive(Debug, thiserror::Error)]
+#[error("{0} (penctl --help)")]
+struct UsageError(String);
 
 /// Opens the device, waiting a moment for it to attach.
 fn attach(args: &DeviceArgs) -> Result<Device> {
@@ -443,8 +458,7 @@ fn calibration_source(device: &DeviceArgs, _targets: &[glam::DVec2]) -> Result<S
 }
 
 fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
-    let (width_mm, height_mm) = size::<f64>(&a.display_mm, "--display-mm")?;
-    let (width_px, height_px) = size::<u32>(&a.display_px, "--display-px")?;
+    let ((width_mm, height_mm), (width_px, height_px)) = (a.display_mm, a.display_px);
     let display = DisplaySize {
         width_mm,
         height_mm,
@@ -457,7 +471,7 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
             CalibrationError::Display { key, .. } if key.ends_with("_px") => "--display-px",
             _ => "--display-mm",
         };
-        bail!("{flag}: {e}");
+        return Err(UsageError(format!("{flag}: {e}")).into());
     }
     let targets = display.targets(a.targets as usize);
     let kind = match a.fit {
@@ -647,6 +661,10 @@ fn main() -> ExitCode {
                 .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe) =>
         {
             ExitCode::SUCCESS
+        }
+        Err(e) if e.downcast_ref::<UsageError>().is_some() => {
+            eprintln!("penctl: {e:#}");
+            ExitCode::from(2)
         }
         Err(e) => {
             eprintln!("penctl: {e:#}");

@@ -6,10 +6,14 @@ use anyhow::{Context, Result};
 use penmodel_terrain::editor::Editor;
 use penmodel_terrain::{Heightmap, export, journal};
 
-/// Arguments of `penmodel generate`.
+/// Arguments of `penmodel generate`: at least one output.
 #[derive(clap::Args)]
 #[command(
-    after_help = "Example:\n  penmodel generate modeler/examples/volcano.json --raw volcano.f32 --png volcano.png"
+    group(clap::ArgGroup::new("outputs").args(["raw", "png", "obj", "glb"]).required(true).multiple(true)),
+    after_help = "Give at least one output: --raw, --png, --obj or --glb.\n\
+    Examples (from the repository's folder):\n  \
+    penmodel generate modeler/examples/04-volcano.json --png volcano.png\n  \
+    penmodel generate modeler/examples/04-volcano.json --raw volcano.f32 --glb volcano.glb"
 )]
 pub struct Args {
     /// The document (JSON). A pending journal beside it (DOC.json.journal) is replayed, read-only.
@@ -17,7 +21,7 @@ pub struct Args {
     doc: PathBuf,
     /// Heights as raw float32: rows × cols little-endian, row-major (index r·cols + c), metres.
     #[arg(long, value_name = "OUT.f32")]
-    raw: PathBuf,
+    raw: Option<PathBuf>,
     /// Heights as a 16-bit grayscale PNG; the height range is in its tEXt chunks.
     #[arg(long, value_name = "OUT.png")]
     png: Option<PathBuf>,
@@ -66,9 +70,7 @@ pub fn run(args: &Args) -> Result<()> {
         );
     }
     let map = editor.heightmap();
-    let mut raw = Vec::new();
-    export::write_raw(map, &mut raw).with_context(|| format!("cannot export {}", args.raw.display()))?;
-    write(&args.raw, &raw)?;
+    export(map, &args.raw, |m, out| export::write_raw(m, out))?;
     export(map, &args.png, |m, out| export::write_png(m, out).map(|_| ()))?;
     export(map, &args.obj, |m, out| export::write_obj(m, out))?;
     export(map, &args.glb, |m, out| export::write_glb(m, out))?;
