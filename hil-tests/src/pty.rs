@@ -27,7 +27,7 @@ const MAX_BACKLOG: u32 = 4096;
 pub enum PtyError {
     /// Creating the pseudo-terminal pair failed.
     #[error("cannot create a pseudo-terminal: {0}")]
-    Open(#[from] serialport::Error),
+    Open(serialport::Error),
     /// The pseudo-terminal has no device path.
     #[error("the pseudo-terminal has no device path")]
     NoPath,
@@ -39,6 +39,14 @@ pub enum PtyError {
         /// Why.
         source: std::io::Error,
     },
+}
+
+// Not `#[from]`: that would make the error its source too, and a chain (`{:#}`) would say it
+// twice.
+impl From<serialport::Error> for PtyError {
+    fn from(e: serialport::Error) -> PtyError {
+        PtyError::Open(e)
+    }
 }
 
 /// How to serve.

@@ -42,7 +42,15 @@ pub enum QemuError {
     Emulated(String),
     /// Files could not be written or read.
     #[error("i/o: {0}")]
-    Io(#[from] std::io::Error),
+    Io(std::io::Error),
+}
+
+// Not `#[from]`: that would make the error its source too, and a chain (`{:#}`) would say it
+// twice.
+impl From<std::io::Error> for QemuError {
+    fn from(e: std::io::Error) -> QemuError {
+        QemuError::Io(e)
+    }
 }
 
 /// The replay file for `records`, run with `config`.

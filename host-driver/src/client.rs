@@ -13,10 +13,18 @@ use crate::wire::SocketLine;
 pub enum ClientError {
     /// The socket failed.
     #[error("pend socket: {0}")]
-    Io(#[from] std::io::Error),
+    Io(std::io::Error),
     /// A line is not an event.
     #[error("bad event line {line:?}: {why}")]
     Bad { line: String, why: String },
+}
+
+// Not `#[from]`: that would make the error its source too, and a chain (`{:#}`) would say it
+// twice.
+impl From<std::io::Error> for ClientError {
+    fn from(e: std::io::Error) -> ClientError {
+        ClientError::Io(e)
+    }
 }
 
 /// A line from pend: the greeting, or an event.

@@ -97,3 +97,22 @@ fn generate_writes_only_the_outputs_asked_for_and_needs_one() {
         "{err}"
     );
 }
+
+#[test]
+fn an_os_error_is_said_once() {
+    let dir = tempfile::tempdir().expect("dir");
+    let doc = repository().join("modeler/examples/02-twin-hills.json");
+    let doc = doc.to_str().expect("UTF-8 path");
+    for args in [
+        ["render", doc, "--png", "missing/x.png"],
+        ["generate", doc, "--png", "missing/x.png"],
+    ] {
+        let out = penmodel(dir.path(), &args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{args:?}: {err}");
+        assert_eq!(
+            err, "penmodel: cannot write missing/x.png: No such file or directory (os error 2)\n",
+            "{args:?}"
+        );
+    }
+}

@@ -23,9 +23,10 @@ pub use window::{Viewer, ViewerEvent, WindowError};
 #[allow(missing_docs)] // the fields say which file or frame and why.
 #[derive(Debug, Error)]
 pub enum OutputError {
-    /// A file could not be created or written.
-    #[error("cannot write {}: {source}", path.display())]
-    Io { path: PathBuf, source: io::Error },
+    /// A file could not be created or written. The OS's error is in the message and not a
+    /// `source`, so that a chain of errors (`{:#}`) says it once.
+    #[error("cannot write {}: {error}", path.display())]
+    Io { path: PathBuf, error: io::Error },
     /// The PNG encoder failed.
     #[error("PNG encoding failed: {0}")]
     Png(String),

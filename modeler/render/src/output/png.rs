@@ -26,8 +26,8 @@ pub fn encode_png(frame: &Frame, out: impl Write) -> Result<(), OutputError> {
 pub fn write_png(frame: &Frame, path: &Path) -> Result<(), OutputError> {
     let mut bytes = Vec::new();
     encode_png(frame, &mut bytes)?;
-    std::fs::write(path, bytes).map_err(|source| OutputError::Io {
+    std::fs::write(path, bytes).map_err(|error| OutputError::Io {
         path: path.to_owned(),
-        source,
+        error,
     })
 }

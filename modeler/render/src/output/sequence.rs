@@ -27,9 +27,9 @@ pub struct Sequence {
 }
 
 fn io_error(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
-    move |source| OutputError::Io {
+    move |error| OutputError::Io {
         path: path.to_owned(),
-        source,
+        error,
     }
 }
 
