@@ -3,4 +3,5 @@ mod cli;
 mod demo_cli;
 mod help_examples;
 mod interaction;
+mod rocks_cli;
 mod waiting_cli;

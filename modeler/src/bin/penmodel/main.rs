@@ -10,6 +10,7 @@ mod bench;
 mod generate;
 mod live;
 mod render;
+mod rocks;
 
 use std::process::ExitCode;
 
@@ -51,6 +52,8 @@ enum Command {
     Render(render::Args),
     /// Measure the renderer's frame time and the terrain update while pulling.
     Bench(bench::Args),
+    /// Scatter rocks of mixed sizes on a field (seed 001) and write them out.
+    Rocks(rocks::Args),
 }
 
 fn main() -> ExitCode {
@@ -61,6 +64,7 @@ fn main() -> ExitCode {
         Some(Command::Generate(args)) => generate::run(&args),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
+        Some(Command::Rocks(args)) => rocks::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

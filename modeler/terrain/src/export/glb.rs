@@ -26,46 +26,70 @@ fn pad(bytes: &mut Vec<u8>, with: u8) {
 }
 
 /// Writes the heightmap's mesh as binary glTF.
-pub fn write_glb(map: &Heightmap, mut out: impl Write) -> Result<(), ExportError> {
-    let mesh = Mesh::of(map)?;
-    let mut bin = Vec::with_capacity(mesh.positions.len() * 24 + mesh.indices.len() * 4);
-    for p in &mesh.positions {
-        p.iter().for_each(|v| bin.extend_from_slice(&v.to_le_bytes()));
-    }
-    let normals_at = bin.len();
-    for n in &mesh.normals {
-        n.iter().for_each(|v| bin.extend_from_slice(&v.to_le_bytes()));
-    }
-    let indices_at = bin.len();
-    for i in &mesh.indices {
-        bin.extend_from_slice(&i.to_le_bytes());
+pub fn write_glb(map: &Heightmap, out: impl Write) -> Result<(), ExportError> {
+    write_glb_with(map, &[], out)
+}
+
+/// Writes the heightmap's mesh and `placed` meshes (name, mesh; in the same frame) as binary
+/// glTF: one node and mesh each, the terrain first.
+pub fn write_glb_with(map: &Heightmap, placed: &[(String, Mesh)], out: impl Write) -> Result<(), ExportError> {
+    let terrain = Mesh::of(map)?;
+    let all: Vec<(&str, &Mesh)> = std::iter::once(("terrain", &terrain))
+        .chain(placed.iter().map(|(n, m)| (n.as_str(), m)))
+        .collect();
+    write_glb_meshes(&all, out)
+}
+
+/// Writes `meshes` (name, mesh) as binary glTF, one node each; meshes without triangles are left
+/// out (glTF has no empty accessors).
+pub fn write_glb_meshes(meshes: &[(&str, &Mesh)], mut out: impl Write) -> Result<(), ExportError> {
+    let all: Vec<&(&str, &Mesh)> = meshes.iter().filter(|(_, m)| !m.indices.is_empty()).collect();
+    let mut bin = Vec::new();
+    let (mut nodes, mut meshes, mut accessors, mut views) = (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+    for (k, (name, mesh)) in all.iter().enumerate() {
+        let at = bin.len();
+        for p in &mesh.positions {
+            p.iter().for_each(|v| bin.extend_from_slice(&v.to_le_bytes()));
+        }
+        let normals_at = bin.len();
+        for n in &mesh.normals {
+            n.iter().for_each(|v| bin.extend_from_slice(&v.to_le_bytes()));
+        }
+        let indices_at = bin.len();
+        for i in &mesh.indices {
+            bin.extend_from_slice(&i.to_le_bytes());
+        }
+        let end = bin.len();
+        let (mut min, mut max) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for p in &mesh.positions {
+            for k in 0..3 {
+                min[k] = min[k].min(p[k]);
+                max[k] = max[k].max(p[k]);
+            }
+        }
+        let n = mesh.positions.len();
+        let first = 3 * k;
+        nodes.push(json!({"mesh": k, "name": name}));
+        meshes.push(json!({"name": name, "primitives": [{
+            "attributes": {"POSITION": first, "NORMAL": first + 1}, "indices": first + 2, "mode": TRIANGLES}]}));
+        accessors.push(
+            json!({"bufferView": first, "componentType": FLOAT, "count": n, "type": "VEC3", "min": min, "max": max}),
+        );
+        accessors.push(json!({"bufferView": first + 1, "componentType": FLOAT, "count": n, "type": "VEC3"}));
+        accessors.push(json!({"bufferView": first + 2, "componentType": UNSIGNED_INT, "count": mesh.indices.len(), "type": "SCALAR"}));
+        views.push(json!({"buffer": 0, "byteOffset": at, "byteLength": normals_at - at, "target": ARRAY_BUFFER}));
+        views.push(json!({"buffer": 0, "byteOffset": normals_at, "byteLength": indices_at - normals_at, "target": ARRAY_BUFFER}));
+        views.push(json!({"buffer": 0, "byteOffset": indices_at, "byteLength": end - indices_at, "target": ELEMENT_ARRAY_BUFFER}));
     }
     let bin_len = bin.len();
-    let (mut min, mut max) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    for p in &mesh.positions {
-        for k in 0..3 {
-            min[k] = min[k].min(p[k]);
-            max[k] = max[k].max(p[k]);
-        }
-    }
-    let n = mesh.positions.len();
     let doc = json!({
         "asset": {"version": "2.0", "generator": "penmodel"},
         "scene": 0,
-        "scenes": [{"nodes": [0]}],
-        "nodes": [{"mesh": 0, "name": "terrain"}],
-        "meshes": [{"name": "terrain", "primitives": [{
-            "attributes": {"POSITION": 0, "NORMAL": 1}, "indices": 2, "mode": TRIANGLES}]}],
-        "accessors": [
-            {"bufferView": 0, "componentType": FLOAT, "count": n, "type": "VEC3", "min": min, "max": max},
-            {"bufferView": 1, "componentType": FLOAT, "count": n, "type": "VEC3"},
-            {"bufferView": 2, "componentType": UNSIGNED_INT, "count": mesh.indices.len(), "type": "SCALAR"}
-        ],
-        "bufferViews": [
-            {"buffer": 0, "byteOffset": 0, "byteLength": normals_at, "target": ARRAY_BUFFER},
-            {"buffer": 0, "byteOffset": normals_at, "byteLength": indices_at - normals_at, "target": ARRAY_BUFFER},
-            {"buffer": 0, "byteOffset": indices_at, "byteLength": bin_len - indices_at, "target": ELEMENT_ARRAY_BUFFER}
-        ],
+        "scenes": [{"nodes": (0..all.len()).collect::<Vec<_>>()}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "accessors": accessors,
+        "bufferViews": views,
         "buffers": [{"byteLength": bin_len}]
     });
     let mut json = doc.to_string().into_bytes();

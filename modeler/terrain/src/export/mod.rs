@@ -19,9 +19,9 @@ use std::io;
 
 use thiserror::Error;
 
-pub use glb::write_glb;
+pub use glb::{write_glb, write_glb_meshes, write_glb_with};
 pub use mesh::Mesh;
-pub use obj::write_obj;
+pub use obj::{write_meshes, write_obj, write_obj_with};
 pub use png::{HeightRange, KEY_CELL_SIZE, KEY_HEIGHT_MAX, KEY_HEIGHT_MIN, read_png_range, write_png};
 pub use raw::{read_raw, write_raw};
 

@@ -1,4 +1,5 @@
-//! Wavefront OBJ: `v` positions, `vn` normals, `f v//vn` triangles (1-based).
+//! Wavefront OBJ: `v` positions, `vn` normals, `f v//vn` triangles (1-based), one `o` object per
+//! mesh (the terrain, then each rock field's rocks).
 
 use std::io::Write;
 
@@ -7,6 +8,11 @@ use crate::heightmap::Heightmap;
 
 /// Writes the heightmap's mesh as OBJ text.
 pub fn write_obj(map: &Heightmap, out: impl Write) -> Result<(), ExportError> {
+    write_obj_with(map, &[], out)
+}
+
+/// Writes the heightmap's mesh and `placed` meshes (name, mesh; in the same frame) as OBJ text.
+pub fn write_obj_with(map: &Heightmap, placed: &[(String, Mesh)], out: impl Write) -> Result<(), ExportError> {
     let mesh = Mesh::of(map)?;
     let mut out = std::io::BufWriter::new(out);
     writeln!(
@@ -16,17 +22,31 @@ pub fn write_obj(map: &Heightmap, out: impl Write) -> Result<(), ExportError> {
         map.rows(),
         map.cell_size()
     )?;
-    writeln!(out, "o terrain")?;
-    for [x, y, z] in &mesh.positions {
-        writeln!(out, "v {x} {y} {z}")?;
-    }
-    for [x, y, z] in &mesh.normals {
-        writeln!(out, "vn {x} {y} {z}")?;
-    }
-    for t in mesh.indices.chunks_exact(3) {
-        let (a, b, c) = (t[0] + 1, t[1] + 1, t[2] + 1);
-        writeln!(out, "f {a}//{a} {b}//{b} {c}//{c}")?;
-    }
+    let all = std::iter::once(("terrain", &mesh)).chain(placed.iter().map(|(n, m)| (n.as_str(), m)));
+    write_meshes(all, &mut out)?;
     out.flush()?;
+    Ok(())
+}
+
+/// Writes `meshes` as OBJ objects, numbering vertices on from one object to the next.
+pub fn write_meshes<'a>(
+    meshes: impl Iterator<Item = (&'a str, &'a Mesh)>,
+    out: &mut impl Write,
+) -> Result<(), ExportError> {
+    let mut base = 1u64;
+    for (name, mesh) in meshes {
+        writeln!(out, "o {name}")?;
+        for [x, y, z] in &mesh.positions {
+            writeln!(out, "v {x} {y} {z}")?;
+        }
+        for [x, y, z] in &mesh.normals {
+            writeln!(out, "vn {x} {y} {z}")?;
+        }
+        for t in mesh.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| u64::from(i) + base);
+            writeln!(out, "f {a}//{a} {b}//{b} {c}//{c}")?;
+        }
+        base += mesh.positions.len() as u64;
+    }
     Ok(())
 }

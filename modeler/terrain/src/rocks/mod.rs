@@ -17,9 +17,11 @@
 //! is sequential by nature (each diagram sees what the larger ones took).
 
 pub mod delaunay;
+pub mod place;
 pub mod poisson;
 pub mod select;
 pub mod shape;
+pub mod top_view;
 pub mod voronoi;
 
 use std::time::Instant;

@@ -1,0 +1,151 @@
+//! `penmodel rocks` end to end: its outputs, the JSON of docs/rocks.md, the same rocks for the
+//! same seed, flags named in errors, and the examples of its --help.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn penmodel(dir: &Path, args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_penmodel"))
+        .current_dir(dir)
+        .args(args)
+        .output()
+        .expect("penmodel runs")
+}
+
+fn text(b: &[u8]) -> String {
+    String::from_utf8_lossy(b).into_owned()
+}
+
+#[test]
+fn rocks_writes_json_meshes_and_a_top_view() {
+    let dir = tempfile::tempdir().expect("dir");
+    let args = [
+        "rocks",
+        "--size",
+        "96x64",
+        "--radii",
+        "6,2",
+        "--fractions",
+        "0.3,0.4",
+        "--seed",
+        "5",
+        "--json",
+        "f.json",
+        "--obj",
+        "f.obj",
+        "--glb",
+        "f.glb",
+        "--png",
+        "f.png",
+    ];
+    let out = penmodel(dir.path(), &args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let stdout = text(&out.stdout);
+    assert!(stdout.starts_with("96 × 64 cells: "), "{stdout}");
+    let json: Value = serde_json::from_slice(&std::fs::read(dir.path().join("f.json")).expect("json")).expect("JSON");
+    assert_eq!(json["size"], serde_json::json!([96, 64]));
+    let diagrams = json["diagrams"].as_array().expect("diagrams");
+    assert_eq!(diagrams.len(), 2);
+    assert_eq!(diagrams[0]["radius"], 6.0);
+    let rocks = json["rocks"].as_array().expect("rocks");
+    let kept: u64 = diagrams.iter().map(|d| d["cells_kept"].as_u64().expect("count")).sum();
+    assert_eq!(rocks.len() as u64, kept);
+    let mut vertex_total = 0;
+    for r in rocks {
+        let k = r["polygon"].as_array().expect("polygon").len();
+        assert_eq!(r["added"].as_array().expect("added").len(), k);
+        assert_eq!(r["moved"].as_array().expect("moved").len(), k);
+        let n = r["vertices"].as_array().expect("vertices").len();
+        assert_eq!(n, 2 * k);
+        vertex_total += n;
+        for t in r["triangles"].as_array().expect("triangles") {
+            assert!(
+                t.as_array()
+                    .expect("triangle")
+                    .iter()
+                    .all(|i| (i.as_u64().expect("index") as usize) < n)
+            );
+        }
+    }
+    for stage in ["seeds_and_diagrams", "selection", "polygons", "meshes", "total"] {
+        assert!(json["timing_ms"][stage].as_f64().is_some(), "timing_ms.{stage}");
+    }
+    // The OBJ has every rock vertex; the glTF and PNG have their signatures.
+    let obj = std::fs::read_to_string(dir.path().join("f.obj")).expect("obj");
+    assert_eq!(obj.lines().filter(|l| l.starts_with("v ")).count(), vertex_total);
+    assert_eq!(&std::fs::read(dir.path().join("f.glb")).expect("glb")[..4], b"glTF");
+    assert_eq!(&std::fs::read(dir.path().join("f.png")).expect("png")[1..4], b"PNG");
+}
+
+#[test]
+fn the_same_seed_gives_the_same_rocks() {
+    let dir = tempfile::tempdir().expect("dir");
+    let run = |seed: &str| {
+        let out = penmodel(dir.path(), &["rocks", "--size", "80x80", "--seed", seed, "--json", "-"]);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let mut v: Value = serde_json::from_slice(&out.stdout).expect("one JSON document on stdout");
+        v["timing_ms"] = Value::Null;
+        v
+    };
+    assert_eq!(run("3"), run("3"));
+    assert_ne!(run("3")["rocks"], run("4")["rocks"]);
+}
+
+#[test]
+fn bad_flags_are_named() {
+    let dir = tempfile::tempdir().expect("dir");
+    for (args, status, words) in [
+        (
+            &["--radii", "0,3", "--fractions", "0.2,0.2"][..],
+            1,
+            "--radii: the 1st radius, 0, must be above 0",
+        ),
+        (
+            &["--radii", "9,3", "--fractions", "0.6,0.5"],
+            1,
+            "--fractions: they add up to 1.1",
+        ),
+        (&["--radii", "9,3"], 1, "--fractions or --counts"),
+        (
+            &["--size", "64x64", "--radii", "65", "--counts", "3"],
+            1,
+            "--radii: the 1st radius, 65, is larger",
+        ),
+        (
+            &["--radii", "9", "--counts", "3,4"],
+            1,
+            "--counts: give one count per radius",
+        ),
+        (&["--heights", "-1,0,0"], 1, "--heights: c_h1 = -1 must be from 0 to 10"),
+        (&["--size", "12"], 2, "WIDTHxHEIGHT"),
+        (&["--radii", "x"], 2, "--radii"),
+    ] {
+        let mut all = vec!["rocks"];
+        all.extend_from_slice(args);
+        let out = penmodel(dir.path(), &all);
+        assert_eq!(out.status.code(), Some(status), "{all:?}: {}", text(&out.stderr));
+        assert!(text(&out.stderr).contains(words), "{all:?}: {}", text(&out.stderr));
+        assert!(
+            std::fs::read_dir(dir.path()).expect("dir").next().is_none(),
+            "{all:?} wrote a file"
+        );
+    }
+}
+
+#[test]
+fn the_help_examples_run() {
+    let dir = tempfile::tempdir().expect("dir");
+    let help = text(&penmodel(dir.path(), &["rocks", "--help"]).stdout);
+    let examples: Vec<Vec<&str>> = help
+        .lines()
+        .filter_map(|l| l.trim().strip_prefix("penmodel "))
+        .map(|l| l.split('#').next().unwrap_or_default().split_whitespace().collect())
+        .collect();
+    assert!(examples.len() >= 3, "{help}");
+    for e in examples {
+        let out = penmodel(dir.path(), &e);
+        assert!(out.status.success(), "{e:?}: {}", text(&out.stderr));
+    }
+}
