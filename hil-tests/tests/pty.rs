@@ -104,7 +104,11 @@ fn reports_stream_in_real_time_over_the_pty() {
         assert_eq!(pair[1].timestamp_us.wrapping_sub(pair[0].timestamp_us), 6500);
     }
     assert!(pens.iter().filter(|p| p.in_range).count() > pens.len() * 9 / 10);
-    assert!(pens.iter().all(|p| !p.in_range || p.quality.receivers_used == 4));
+    // A fresh fix uses all four receivers; a held one (in range, no fix this cycle) none.
+    assert!(
+        pens.iter()
+            .all(|p| !p.in_range || matches!(p.quality.receivers_used, 0 | 4))
+    );
 }
 
 #[test]

@@ -18,7 +18,8 @@ pub struct Sample {
     pub host_us: u64,
     /// SW1, SW2, SW3.
     pub sw: [bool; 3],
-    /// The pen was located this cycle; `position_mm` is meaningless otherwise.
+    /// The pen is in range (fixed within 100 ms, or its tip pressed); `position_mm` is
+    /// meaningless otherwise. A fresh fix this cycle has `quality.receivers_used` > 0.
     pub in_range: bool,
     /// The position is in the display frame (the device applies a calibration).
     pub display_frame: bool,

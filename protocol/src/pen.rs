@@ -112,8 +112,10 @@ impl Quality {
 
 /// The pen input report, sent once per measurement cycle.
 ///
-/// When `in_range` is false no fix was made this cycle and `position` repeats the last fix (or
-/// zero before the first); hosts must not use it.
+/// `in_range` is HID In Range: the pen was fixed within the last 100 ms, or its tip is pressed
+/// (after a first fix). A cycle without a fix repeats the last position with
+/// `quality.receivers_used` 0; when `in_range` is false the position is stale (zero before the
+/// first fix) and hosts must not use it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct PenReport {
@@ -123,7 +125,7 @@ pub struct PenReport {
     pub sw2: bool,
     /// SW3, the second barrel button (HID Secondary Barrel Switch).
     pub sw3: bool,
-    /// The pen was located this cycle (HID In Range).
+    /// HID In Range: a fix within the last 100 ms, or the tip pressed (see above).
     pub in_range: bool,
     /// The position is in the display frame (the device applies a calibration), not the tracker frame.
     pub display_frame: bool,

@@ -30,6 +30,12 @@ pub const TICK_US: u64 = 500;
 /// expected error exceeds 7 mm. The reference build stays below 3.7 with all receivers; only a
 /// fix from a poorly placed subset (three receivers left, say) comes near it.
 pub const MAX_REPORTED_DOP: f32 = 10.0;
+/// How long the pen stays in range after its last reported fix, µs. A cycle without a fix (an
+/// echo-spoiled or gated one) is common and short; ending proximity for it would make an OS end
+/// the stroke (Windows lifts the contact, libinput drops a tip outside proximity). 100 ms is 15
+/// cycles: long enough to ride out a run of bad cycles, short enough that a pen taken away is
+/// out of range before a user notices.
+pub const IN_RANGE_HOLD_US: u64 = 100_000;
 
 /// One measurement cycle as the receivers heard it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -122,9 +128,13 @@ pub struct Engine {
     // The latest cycle.
     /// The latest reportable fix, smoothed, tracker frame.
     smoothed: Option<Vec3>,
-    /// The position of the last report (repeated while out of range).
+    /// The position of the last report (held while no fix comes).
     position: Position,
-    in_range: bool,
+    /// Device time of the last reported fix: the pen is in range for [`IN_RANGE_HOLD_US`] after
+    /// it, or while the tip is pressed.
+    last_fix_us: Option<u64>,
+    /// The latest cycle fixed: its position is fresh.
+    fixed: bool,
     quality: Quality,
     timestamp_us: u32,
     tof: TofReport,
@@ -169,7 +179,8 @@ impl Engine {
             status: Status::ok(0),
             smoothed: None,
             position: Position::default(),
-            in_range: false,
+            last_fix_us: None,
+            fixed: false,
             quality: Quality::NONE,
             timestamp_us: 0,
             tof: TofReport {
@@ -282,9 +293,12 @@ impl Engine {
                 None
             }
         };
-        self.in_range = reported.is_some();
+        self.fixed = reported.is_some();
+        if self.fixed {
+            self.last_fix_us = Some(cycle.t0_us);
+        }
         self.quality = match raw {
-            Ok(fix) if self.in_range => Quality::new(fix.used, fix.residual_rms_mm, fix.dop),
+            Ok(fix) if self.fixed => Quality::new(fix.used, fix.residual_rms_mm, fix.dop),
             _ => Quality::NONE,
         };
         // The device clock wraps in the report, as the protocol defines.
@@ -348,7 +362,7 @@ impl Engine {
         }
         self.fresh = false;
         self.last_report_us = Some(now_us);
-        if self.in_range
+        if self.fixed
             && let Some(p) = self
                 .smoothed
                 .and_then(|p| Position::from_mm(self.presented(p).to_array()))
@@ -360,7 +374,7 @@ impl Engine {
             sw1,
             sw2,
             sw3,
-            in_range: self.in_range,
+            in_range: self.in_range(now_us, sw1),
             display_frame: self.settings.config.report_display_frame,
             position: self.position,
             seq: self.seq,
@@ -370,6 +384,14 @@ impl Engine {
         self.seq = self.seq.wrapping_add(1);
         self.counters.reports += 1;
         Some(report)
+    }
+
+    /// In range at `now_us` with the tip at `tip`: a fix within [`IN_RANGE_HOLD_US`], or the tip
+    /// pressed (the pen is on the display, where it was last seen). Never before the first fix:
+    /// there is no position to hold.
+    fn in_range(&self, now_us: u64, tip: bool) -> bool {
+        self.last_fix_us
+            .is_some_and(|t| tip || now_us.saturating_sub(t) <= IN_RANGE_HOLD_US)
     }
 
     /// The time-of-flight report of the latest cycle, when the configuration streams them.
@@ -414,6 +436,10 @@ impl Engine {
         let request = ReportId::Config as u8;
         match Settings::new(config) {
             Ok(settings) => {
+                // A held position belongs to the old geometry or frame: out of range until the
+                // next fix.
+                self.last_fix_us = None;
+                self.fixed = false;
                 let filter_changed = settings.config.filter != self.settings.config.filter;
                 self.settings = settings;
                 if filter_changed {

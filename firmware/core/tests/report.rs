@@ -88,19 +88,72 @@ fn cycles_become_reports() {
     assert_eq!(e.counters().reports, 21);
 }
 
+/// Reports for cycles from `from` with the arrivals `spoil` leaves; the tip at `tip`.
+fn run_spoiled(e: &mut Engine, from: u64, n: u64, p: Vec3, tip: bool, spoil: impl Fn(&mut Cycle)) -> Vec<PenReport> {
+    let mut out = Vec::new();
+    for k in 0..n {
+        let t0 = from + k * PERIOD_US;
+        e.on_switches(t0, [tip, false, false]);
+        let mut c = cycle_at(e, t0, p);
+        spoil(&mut c);
+        e.on_cycle(&c);
+        out.extend(e.poll_report(t0 + 5_000));
+    }
+    out
+}
+
 #[test]
-fn a_lost_pen_is_out_of_range() {
+fn a_cycle_without_a_fix_keeps_the_pen_in_range_for_100_ms() {
     let mut e = engine();
     let p = Vec3::new(300.0, 170.0, 80.0);
     run(&mut e, 0, 3, p);
-    let mut c = cycle_at(&e, 3 * PERIOD_US, p);
-    c.arrival_ns[0] = None;
-    c.arrival_ns[2] = None;
-    assert_eq!(e.on_cycle(&c).fix, Err(NoFix::TooFewRanges));
-    let r = e.poll_report(3 * PERIOD_US + 5_000).expect("report");
-    assert!(!r.in_range);
-    assert_eq!(r.quality.receivers_used, 0);
-    assert_eq!(e.counters().too_few, 1);
+    // Cycles that cannot fix (two receivers silent): the pen stays in range at its last
+    // position, with no quality (nothing fresh), for 100 ms after the last fix at 13 ms …
+    let lost = run_spoiled(&mut e, 3 * PERIOD_US, 30, p, false, |c| {
+        c.arrival_ns[0] = None;
+        c.arrival_ns[2] = None;
+    });
+    assert_eq!(e.counters().too_few, 30);
+    let last_fix_us = 2 * PERIOD_US;
+    for (k, r) in lost.iter().enumerate() {
+        let now = (3 + k as u64) * PERIOD_US + 5_000;
+        assert_eq!(r.in_range, now - last_fix_us <= 100_000, "at {now} µs");
+        assert_eq!(r.quality.receivers_used, 0);
+        assert!(
+            (Vec3::from_array(r.position.to_mm()) - p).length() < 0.1,
+            "held position"
+        );
+    }
+    // … and out of range after it: a pen taken away.
+    assert!(lost.iter().filter(|r| r.in_range).count() >= 13);
+    assert!(!lost.last().expect("reports").in_range);
+}
+
+#[test]
+fn a_pressed_tip_is_always_in_range_once_the_pen_was_seen() {
+    let mut e = engine();
+    let p = Vec3::new(200.0, 100.0, 6.0);
+    // Before any fix there is no position to hold: the tip alone does not bring it in range.
+    let before = run_spoiled(&mut e, 0, 3, p, true, |c| c.arrival_ns = [None; MAX_RECEIVERS]);
+    assert!(before.iter().all(|r| r.sw1 && !r.in_range));
+    run_spoiled(&mut e, 3 * PERIOD_US, 5, p, true, |_| {});
+    // A stroke with every other cycle spoiled by two late echoes among the four receivers
+    // (gated or inconsistent), and then a second of no fix at all: Tip never comes without
+    // In Range, so the OS never sees the stroke break.
+    let stroke = run_spoiled(&mut e, 8 * PERIOD_US, 200, p, true, |c| {
+        if (c.t0_us / PERIOD_US).is_multiple_of(2) || c.t0_us > 60 * PERIOD_US {
+            for a in c.arrival_ns.iter_mut().take(2).flatten() {
+                *a += 300_000;
+            }
+        }
+    });
+    assert!(e.counters().inconsistent + e.counters().gated > 150);
+    assert!(stroke.iter().all(|r| r.sw1 && r.in_range));
+    // The tip lifted: the hold runs out 100 ms after the last fix.
+    let lifted = run_spoiled(&mut e, 208 * PERIOD_US, 2, p, false, |c| {
+        c.arrival_ns = [None; MAX_RECEIVERS]
+    });
+    assert!(lifted.iter().all(|r| !r.sw1 && !r.in_range));
 }
 
 #[test]

@@ -170,7 +170,9 @@ pub fn collect_touches(
             }
             let start = *pressed_at.get_or_insert(s.device_us);
             let held = s.device_us.saturating_sub(start);
-            if held >= SETTLE_US && s.in_range {
+            // Only fresh fixes: a held position (in range, no receivers used) would weigh the
+            // last fix again.
+            if held >= SETTLE_US && s.in_range && s.quality.receivers_used > 0 {
                 fixes.push(s.position_mm);
             }
             if held >= SETTLE_US + AVERAGE_US && fixes.len() >= MIN_FIXES {
