@@ -128,6 +128,9 @@ def check_comparator():
 def check_power_and_switches():
     vout = v.boost_vout()
     check("boost: 12 V ± 3 %", abs(vout - 12) <= 0.36, f"{vout:.2f} V")
+    swing = v.tx_swing()
+    check("transmitter: ≥ 95 % of the 24 V swing reaches the transducer past its DC block", swing >= 0.95 * 24,
+          f"{swing:.1f} V peak to peak")
     droop = v.burst_droop()
     check("12 V rail: a burst droops it < 1 %", droop < 0.12, f"{droop * 1e3:.1f} mV")
     press = v.R_SW_SERIES * v.C_SW

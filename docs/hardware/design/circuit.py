@@ -67,6 +67,9 @@ CAP_C0G = two_pin("C", "C", C0603, "capacitor C0G/NP0 0603, 50 V, 5 % (sets a fr
 CAP_BULK = two_pin("C", "C", C1206, "capacitor X5R 1206, 25 V", "Murata GRM31CR61E series",
                    "Samsung CL31A series", 0.12)
 
+CAP_TX = two_pin("C", "C", "Capacitor_SMD:C_1206_3216Metric", "capacitor X7R 1206, 50 V (the transducer's DC block)",
+                 "Murata GRM31MR71H104", "Samsung CL31B104KBCNNNC", 0.08)
+
 BLACK_PILL_LEFT = ["PB12", "PB13", "PB14", "PB15", "PA8", "PA9", "PA10", "PA11", "PA12", "PA15",
                    "PB3", "PB4", "PB5", "PB6", "PB7", "PB8", "PB9", "5V", "GND", "3V3"]
 BLACK_PILL_RIGHT = ["VBAT", "PC13", "PC14", "PC15", "NRST", "PA0", "PA1", "PA2", "PA3", "PA4",
@@ -286,7 +289,11 @@ def build():
     cc("C4", 100e-9)[1, 2] += v33, gnd
     drv = add(TC4427, "U3")
     tx_a, tx_b = Net("TX_A"), Net("TX_B")
-    drv["INA", "INB", "OUTA", "OUTB", "VDD", "GND"] += burst, burst_n, tx_a, tx_b, v12, gnd
+    out_b = Net("TX_B_DRV")
+    drv["INA", "INB", "OUTA", "OUTB", "VDD", "GND"] += burst, burst_n, tx_a, out_b, v12, gnd
+    # No DC across the transducer between bursts: B through 100 nF, 1 M across the pair.
+    add(CAP_TX, "C10", v.fmt_c(v.C_TX_DC))[1, 2] += out_b, tx_b
+    rc("R10", v.R_TX_BLEED)[1, 2] += tx_a, tx_b
     cc("C5", 1e-6, CAP_BULK)[1, 2] += v12, gnd
     cc("C6", 100e-9)[1, 2] += v12, gnd
 

@@ -179,10 +179,14 @@ def transmitter():
         elm.Wire("|-").at(pa8.center).to((pa8.center[0] + 1.5, drv.INB[1]))
         logic.Not().right().at((pa8.center[0] + 1.5, drv.INB[1])).label("U2 74LVC1G04", loc="bottom")
         elm.Line().right().tox(drv.INB)
-        top, bottom = (drv.OUTA, drv.OUTB) if drv.OUTA[1] > drv.OUTB[1] else (drv.OUTB, drv.OUTA)
-        elm.Line().right(1.5).at(top)
-        elm.Crystal().down().toy(bottom).label("LS501 MA40S4S in the pen\n±12 V across it, 24 V p-p", loc="bottom")
-        elm.Line().left().tox(bottom)
+        # OUTB (on top) through the DC block; the transducer and its bleed resistor in the pen's cable.
+        elm.Capacitor().right(3.0).at(drv.OUTB).label(f"C10 {C(v.C_TX_DC)}")
+        b = elm.Dot()
+        elm.Line().right(1.5)
+        elm.Crystal().down().toy(drv.OUTA).label(f"LS501 MA40S4S\nin the pen\n{v.tx_swing():.1f} V p-p", loc="bottom")
+        a = elm.Dot()
+        elm.Line().left().tox(drv.OUTA)
+        elm.Resistor().down().at(b.center).toy(a.center).label(f"R10\n{R(v.R_TX_BLEED)}", loc="bottom")
     return _svg(d)
 
 

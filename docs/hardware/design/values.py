@@ -161,6 +161,19 @@ def burst_droop():
     return BURST_PERIODS * 2 * TRANSDUCER_C * 2 * V12 / C_RESERVOIR
 
 
+# At rest PA8 is low, so driver A is low and driver B (through the inverter) high: 12 V would
+# sit across the transducer between bursts. A 100 nF capacitor in series with B's output takes
+# that DC, and 1 M across the transducer's leads keeps it at 0 V at rest (τ 0.1 s); during a
+# burst the transducer sees 0 → 24 V steps (2.5 nF against 100 nF: 97.5 % of the swing).
+C_TX_DC = 100e-9
+R_TX_BLEED = 1e6
+
+
+def tx_swing():
+    """The transducer's share of the drivers' 24 V swing through the DC-blocking capacitor."""
+    return 2 * V12 * C_TX_DC / (C_TX_DC + TRANSDUCER_C)
+
+
 # PA8 is an input with no pull during reset: 100 k holds the driver's input low, so the
 # transducer is not driven before the firmware runs.
 R_BURST_PULLDOWN = 100e3
