@@ -17,7 +17,16 @@ if [ ! -x "$venv/bin/python" ] || [ "$(cat "$stamp" 2>/dev/null)" != "$want" ]; 
     python=$(command -v python3.11 || command -v python3)
     echo "hardware: installing the pinned Python packages into $venv" >&2
     rm -rf "$venv"
-    "$python" -m venv "$venv"
+    if ! "$python" -m venv "$venv" >/dev/null 2>&1; then
+        # Debian's own Python keeps venv (ensurepip) in a package of its own.
+        rm -rf "$venv"
+        sudo=""
+        [ "$(id -u)" -eq 0 ] || sudo="sudo"
+        $sudo apt-get update -qq
+        DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -qq --no-install-recommends python3-venv >/dev/null
+        python=/usr/bin/python3
+        "$python" -m venv "$venv"
+    fi
     "$venv/bin/pip" install -q --disable-pip-version-check -r "$req"
     echo "$want" >"$stamp"
 fi
