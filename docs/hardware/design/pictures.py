@@ -11,6 +11,7 @@
 import io
 import math
 import pathlib
+import re
 
 import matplotlib
 
@@ -32,12 +33,20 @@ C = v.fmt_c
 
 
 def _svg(drawing):
-    return drawing.get_imagedata("svg").decode()
+    """The drawing's SVG with a white rectangle behind it: schemdraw sets the background only in
+    CSS, which some viewers ignore (black lines on a dark page)."""
+    text = drawing.get_imagedata("svg").decode()
+    m = re.search(r'viewBox="([-\d.]+) ([-\d.]+) ([\d.]+) ([\d.]+)"', text)
+    if m:
+        x, y, w, h = m.groups()
+        end = text.index(">") + 1
+        text = text[:end] + f'<rect x="{x}" y="{y}" width="{w}" height="{h}" fill="white" />' + text[end:]
+    return text
 
 
 def receiver():
     with schemdraw.Drawing(show=False) as d:
-        d.config(fontsize=10, unit=2.2)
+        d.config(fontsize=10, unit=2.2, bgcolor="white")
         # Stage 1: non-inverting, + input on top.
         op1 = elm.Opamp(leads=True).flip().label("U1A\n" + v.OPAMP, loc="center", ofst=(-0.3, 0), fontsize=8)
         elm.Line().left(1.2).at(op1.in2)
@@ -113,14 +122,15 @@ def receiver():
         elm.Line().down().toy(cmp_.out)
         elm.Line().right(0.6).at(cmp_.out)
         elm.Resistor().right().label(f"{R(v.R_OUT)}")
-        elm.Tag().right().label("to capture pin")
-        elm.Line().right(2.5).color("white")  # room for the tag's text
+        elm.Line().right(0.6)
+        elm.Dot(open=True).label("to the capture pin, over the cable", loc="right")
+        elm.Line().right(5.0).color("white")  # room for the label
     return _svg(d)
 
 
 def transmitter():
     with schemdraw.Drawing(show=False) as d:
-        d.config(fontsize=10, unit=2.2)
+        d.config(fontsize=10, unit=2.2, bgcolor="white")
         # Boost: +5 V → L1 → SW → D1 → +12 V; R1/R2 set it (0.6 V · (1 + R1/R2)).
         elm.Vdd().label("+5 V (USB)")
         elm.Line().down(0.5)
@@ -134,7 +144,8 @@ def transmitter():
         elm.Line().right(2.0)
         res = elm.Dot()
         elm.Line().right(1.5)
-        elm.Tag().right().label(f"+12 V ({v.boost_vout():.2f} V)")
+        elm.Dot(open=True).label(f"+12 V ({v.boost_vout():.2f} V)", loc="right")
+        elm.Line().right(3.0).color("white")  # room for the label
         elm.Capacitor().down().at(vin.center).label("C1 22 µF", loc="bottom")
         elm.Ground()
         elm.Capacitor().down().at(out.center).label("C2 22 µF", loc="bottom")
@@ -161,7 +172,8 @@ def transmitter():
         elm.Tag().left().label("+5 V")
         # Driver: PA8's burst to A, inverted to B; the transducer between the outputs.
         base = (sw.center[0] - 6.0, sw.center[1] - 10.0)
-        elm.Tag().left().at(base).label("PA8 (TIM1 CH1)").reverse()
+        elm.Line().left(3.0).at(base).color("white")  # room for the label
+        elm.Dot(open=True).at(base).label("PA8 (TIM1 CH1)", loc="left")
         elm.Line().right(1.0).at(base)
         pa8 = elm.Dot()
         d.push()
@@ -192,7 +204,7 @@ def transmitter():
 
 def switches():
     with schemdraw.Drawing(show=False) as d:
-        d.config(fontsize=10, unit=2.2)
+        d.config(fontsize=10, unit=2.2, bgcolor="white")
         elm.Ground()
         elm.Button().up().label("SW1 (tip)\nin the pen", loc="bottom")
         elm.Line().up(0.5)
@@ -355,7 +367,7 @@ def beam():
     ax.axhline(BEAM_HALF_DEG, color="r", lw=1)
     ax.text(1, BEAM_HALF_DEG + 1.5, f"−6 dB half-angle ({BEAM_HALF_DEG:.0f}°)", color="r", fontsize=8)
     ax.axvspan(25, 45, color="#eee")
-    ax.text(35, 5, "usual hand\n(pen-sim: 35°)", ha="center", fontsize=8)
+    ax.text(35, 25, "usual hand\n(pen-sim: 35°)", ha="center", fontsize=8)
     ax.set_xlabel("pen tilt from the display's normal, °")
     ax.set_ylabel("angle off the fan of sound, °")
     ax.set_ylim(0, 90)
