@@ -149,3 +149,32 @@ fn the_help_examples_run() {
         assert!(out.status.success(), "{e:?}: {}", text(&out.stderr));
     }
 }
+
+#[test]
+fn generate_puts_a_documents_rocks_into_the_meshes() {
+    let dir = tempfile::tempdir().expect("dir");
+    let volcano = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/04-volcano.json"))
+        .expect("example");
+    let field = r#""rocks": [{"at": [120.0, 110.0], "outline": [[0.0, 0.0], [80.0, 0.0], [80.0, 60.0], [0.0, 60.0], [0.0, 0.0]],
+        "cell_size": 0.5, "layers": [{"radius": 8.0, "fraction": 0.3}, {"radius": 3.0, "fraction": 0.3}], "seed": 2}]"#;
+    let end = volcano.rfind('}').expect("an object");
+    let doc = format!("{},\n{field}\n}}\n", volcano[..end].trim_end()).replace("\"version\": 1", "\"version\": 2");
+    std::fs::write(dir.path().join("d.json"), doc).expect("write");
+    let out = penmodel(dir.path(), &["generate", "d.json", "--obj", "d.obj", "--glb", "d.glb"]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let obj = std::fs::read_to_string(dir.path().join("d.obj")).expect("obj");
+    let objects: Vec<&str> = obj.lines().filter(|l| l.starts_with("o ")).collect();
+    assert_eq!(objects, ["o terrain", "o rocks 0"]);
+    let vertices = obj.lines().filter(|l| l.starts_with("v ")).count();
+    assert!(vertices > 160 * 160 + 1000, "{vertices} vertices");
+    // The rocks stand on the cone: their heights are above 0.
+    let rock_heights: Vec<f64> = obj
+        .lines()
+        .skip_while(|l| *l != "o rocks 0")
+        .filter_map(|l| l.strip_prefix("v "))
+        .map(|l| l.split(' ').nth(1).expect("y").parse().expect("number"))
+        .collect();
+    assert!(rock_heights.iter().all(|&h| h > 0.0), "a rock below the ground");
+    let glb = std::fs::read(dir.path().join("d.glb")).expect("glb");
+    assert!(String::from_utf8_lossy(&glb).contains("\"name\":\"rocks 0\""));
+}

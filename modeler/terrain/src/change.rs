@@ -56,4 +56,7 @@ pub enum Scope {
     RegionReplaced(usize),
     /// Only top-level region N's boundary changed.
     RegionOutline(usize),
+    /// Rock field N was added, removed, moved or replaced: the terrain is unchanged (rocks stand
+    /// on it; [`crate::rocks::cache::Rocks`] follows the document).
+    Rocks(usize),
 }

@@ -7,8 +7,11 @@
 
 use serde::{Deserialize, Serialize};
 
-/// The format version this build reads and writes.
-pub const VERSION: u32 = 1;
+/// The format version this build writes (and reads).
+pub const VERSION: u32 = 2;
+
+/// The oldest version this build reads: a version 1 document (no rock fields) loads as version 2.
+pub const OLDEST_VERSION: u32 = 1;
 
 /// A point in the ground plane, `[x, y]` in metres: x along columns, y along rows.
 pub type Point = [f64; 2];
@@ -26,6 +29,62 @@ pub struct Document {
     pub grid: Grid,
     /// The top-level generation regions, which never overlap.
     pub regions: Vec<Region>,
+    /// Rock fields (seed 001) on the terrain; version 2 on.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rocks: Vec<RockField>,
+}
+
+/// A rock field: rocks of mixed sizes scattered inside an outline (seed 001), standing on the
+/// terrain. Its rocks are a pure function of everything here but `at`, so moving a field moves
+/// the same rocks.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RockField {
+    /// Where the field is: the document point its outline is drawn from, metres.
+    pub at: Point,
+    /// The closed outline relative to `at` (last point repeats the first), metres.
+    pub outline: Vec<Point>,
+    /// Metres per cell of the field's image; radii and rock heights count these cells.
+    pub cell_size: f64,
+    /// The diagrams, one per radius.
+    pub layers: Vec<RockLayer>,
+    /// The random seed: the same seed, the same rocks.
+    #[serde(default)]
+    pub seed: u64,
+}
+
+/// One diagram of a rock field.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RockLayer {
+    /// The Poisson-disk radius in field cells (no two seeds within it).
+    pub radius: f64,
+    /// The area fraction `A_s` its rocks take (0 to 1); or give `count`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fraction: Option<f64>,
+    /// The number of rocks, instead of `fraction`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub count: Option<u32>,
+    /// Eq. 2's `c_w1, c_w2, c_w3` (sideways move of the added points, × radius).
+    #[serde(default)]
+    pub widths: [f64; 3],
+    /// Eq. 3's `c_h1, c_h2, c_h3` (their height, × radius), 0 to 10.
+    #[serde(default = "default_heights")]
+    pub heights: [f64; 3],
+}
+
+fn default_heights() -> [f64; 3] {
+    [0.3, 0.0, 0.1]
+}
+
+impl RockField {
+    /// The outline in document coordinates.
+    pub fn outline_at(&self) -> Vec<Point> {
+        self.outline
+            .iter()
+            .map(|p| [self.at[0] + p[0], self.at[1] + p[1]])
+            .collect()
+    }
 }
 
 /// The heightfield's grid. Cell `(c, r)` covers `[c·s, (c+1)·s) × [r·s, (r+1)·s)`, `s` the cell size.
@@ -141,6 +200,7 @@ impl Document {
             note: None,
             grid,
             regions: Vec::new(),
+            rocks: Vec::new(),
         }
     }
 }

@@ -11,7 +11,7 @@ use thiserror::Error;
 use crate::address::{CurvePath, FigurePath};
 use crate::cells::{self, Mask};
 use crate::change::{FigureList, ListChange, Scope};
-use crate::document::{Document, Figure, FigureKind, Point, Region};
+use crate::document::{Document, Figure, FigureKind, Point, Region, RockField};
 use crate::validate::{self, ValidationError};
 
 /// One change to a document. Serialised (in the journal) as an object tagged by `"op"`.
@@ -64,6 +64,18 @@ pub enum Edit {
     /// Several edits made by one gesture (a pull and the slope set while pulling): applied in
     /// order, undone together, one step of the history.
     Group { edits: Vec<Edit> },
+    /// Inserts a rock field at `index`.
+    AddRocks { index: usize, field: RockField },
+    /// Removes rock field `index`.
+    DeleteRocks { index: usize },
+    /// Moves rock field `index` by `by` metres (its `at`): the same rocks, elsewhere.
+    MoveRocks {
+        index: usize,
+        /// Displacement `[dx, dy]`.
+        by: Point,
+    },
+    /// Replaces rock field `index` (its density, sizes, shapes, outline or seed).
+    ReplaceRocks { index: usize, field: RockField },
 }
 
 /// Why an edit was refused. The document is unchanged.
@@ -82,6 +94,9 @@ pub enum EditError {
     /// The edit would make the document invalid.
     #[error("the edit would make the document invalid: {0}")]
     Invalid(#[from] ValidationError),
+    /// No rock field at that index.
+    #[error("there is no rocks[{0}]")]
+    NoRocks(usize),
     /// [`Edit::apply_to`] was given a group, whose edits are applied one at a time.
     #[error("a group of edits is applied edit by edit")]
     Group,
@@ -119,7 +134,20 @@ impl Edit {
     /// ([`EditError::Group`]): its edits are applied one by one, each followed by its terrain
     /// update, which the [`Editor`](crate::Editor) does.
     pub fn apply_to(&self, doc: &mut Document) -> Result<Applied, EditError> {
-        apply(doc, self)
+        let applied = apply(doc, self)?;
+        // A region edit must not leave a rock field outside every region (it would not load).
+        if !doc.rocks.is_empty()
+            && !matches!(
+                self,
+                Edit::AddRocks { .. } | Edit::ReplaceRocks { .. } | Edit::MoveRocks { .. }
+            )
+            && let Err(e) = validate::rock_fields(doc)
+        {
+            // The inverse restores the document exactly.
+            let _ = apply(doc, &applied.inverse);
+            return Err(e.into());
+        }
+        Ok(applied)
     }
 }
 
@@ -294,7 +322,52 @@ fn apply(doc: &mut Document, edit: &Edit) -> Result<Applied, EditError> {
             replace_region(doc, *index, region.clone(), Scope::RegionReplaced(*index))
         }
         Edit::Group { .. } => Err(EditError::Group),
+        Edit::AddRocks { index, field } => {
+            if *index > doc.rocks.len() {
+                return Err(EditError::NoRocks(*index));
+            }
+            doc.rocks.insert(*index, field.clone());
+            if let Err(e) = validate::rock_fields(doc) {
+                doc.rocks.remove(*index);
+                return Err(e.into());
+            }
+            Ok(Applied {
+                inverse: Edit::DeleteRocks { index: *index },
+                scope: Scope::Rocks(*index),
+            })
+        }
+        Edit::DeleteRocks { index } => {
+            if *index >= doc.rocks.len() {
+                return Err(EditError::NoRocks(*index));
+            }
+            let field = doc.rocks.remove(*index);
+            Ok(Applied {
+                inverse: Edit::AddRocks { index: *index, field },
+                scope: Scope::Rocks(*index),
+            })
+        }
+        Edit::MoveRocks { index, by } => {
+            let mut field = doc.rocks.get(*index).ok_or(EditError::NoRocks(*index))?.clone();
+            field.at = [field.at[0] + by[0], field.at[1] + by[1]];
+            replace_rocks(doc, *index, field)
+        }
+        Edit::ReplaceRocks { index, field } => {
+            doc.rocks.get(*index).ok_or(EditError::NoRocks(*index))?;
+            replace_rocks(doc, *index, field.clone())
+        }
     }
+}
+
+fn replace_rocks(doc: &mut Document, index: usize, new: RockField) -> Result<Applied, EditError> {
+    let old = std::mem::replace(&mut doc.rocks[index], new);
+    if let Err(e) = validate::rock_fields(doc) {
+        doc.rocks[index] = old;
+        return Err(e.into());
+    }
+    Ok(Applied {
+        inverse: Edit::ReplaceRocks { index, field: old },
+        scope: Scope::Rocks(index),
+    })
 }
 
 fn no_point(curve: &CurvePath, index: usize) -> EditError {

@@ -517,6 +517,12 @@ impl TerrainEngine {
             return None;
         }
         let rect = match scope {
+            Scope::Rocks(_) => Rect {
+                c0: 0,
+                r0: 0,
+                width: 0,
+                height: 0,
+            },
             Scope::Height(at) => {
                 let (node, figs, base, _) = locate(regions, doc, &FigureList::of(at))?;
                 let k = at.index();

@@ -11,7 +11,7 @@ use atomic_write_file::AtomicWriteFile;
 use serde::Deserialize;
 use thiserror::Error;
 
-use crate::document::{Document, VERSION};
+use crate::document::{Document, OLDEST_VERSION, VERSION};
 use crate::json;
 use crate::validate::{self, Defect, ValidationError};
 
@@ -74,12 +74,19 @@ impl Document {
         // The version decides how to read the rest, so it is checked before the shape.
         let version: VersionOnly = parse(text)?;
         match version.version.as_u64() {
-            Some(v) if v == u64::from(VERSION) => {}
+            Some(v) if (u64::from(OLDEST_VERSION)..=u64::from(VERSION)).contains(&v) => {}
             _ => {
                 return Err(ValidationError::new("version", Defect::Version(version.version.to_string())).into());
             }
         }
-        let doc: Document = parse(text)?;
+        let mut doc: Document = parse(text)?;
+        // Version 1 had no rock fields; it reads as version 2 and is saved as such.
+        if doc.version < 2 {
+            if !doc.rocks.is_empty() {
+                return Err(ValidationError::new("rocks", Defect::NeedsVersion(2)).into());
+            }
+            doc.version = VERSION;
+        }
         validate::document(&doc)?;
         Ok(doc)
     }

@@ -8,5 +8,6 @@ mod examples;
 mod exports;
 mod limits;
 mod properties;
+mod rock_fields;
 mod rocks;
 mod validation;

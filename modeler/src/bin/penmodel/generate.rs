@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use penmodel_terrain::editor::Editor;
+use penmodel_terrain::rocks::cache::Rocks;
 use penmodel_terrain::{Heightmap, export, journal};
 
 /// Arguments of `penmodel generate`: at least one output.
@@ -72,8 +73,14 @@ pub fn run(args: &Args) -> Result<()> {
     let map = editor.heightmap();
     export(map, &args.raw, |m, out| export::write_raw(m, out))?;
     export(map, &args.png, |m, out| export::write_png(m, out).map(|_| ()))?;
-    export(map, &args.obj, |m, out| export::write_obj(m, out))?;
-    export(map, &args.glb, |m, out| export::write_glb(m, out))?;
+    // The document's rock fields stand on the terrain in the meshes (an object or node each).
+    let rocks = if args.obj.is_some() || args.glb.is_some() {
+        Rocks::of(editor.document()).seated(map)
+    } else {
+        Vec::new()
+    };
+    export(map, &args.obj, |m, out| export::write_obj_with(m, &rocks, out))?;
+    export(map, &args.glb, |m, out| export::write_glb_with(m, &rocks, out))?;
     let (lo, hi) = map.range();
     let journal = if report.replayed > 0 {
         format!(", {} journal entries replayed", report.replayed)

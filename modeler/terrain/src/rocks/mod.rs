@@ -16,7 +16,9 @@
 //! diagram per thread, the selected cells' polygons and meshes one rock per task. The selection
 //! is sequential by nature (each diagram sees what the larger ones took).
 
+pub mod cache;
 pub mod delaunay;
+pub mod field;
 pub mod place;
 pub mod poisson;
 pub mod select;

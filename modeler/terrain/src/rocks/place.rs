@@ -5,7 +5,10 @@
 //! for the added points) and takes the ground's height under it, so a rock follows the terrain
 //! when the terrain changes and nothing else about it is recomputed.
 
+use rayon::prelude::*;
+
 use crate::export::Mesh;
+use crate::heightmap::Heightmap;
 
 use super::Scatter;
 
@@ -20,26 +23,68 @@ pub struct Placement {
 
 /// All rocks of `scatter` as one mesh in the exports' frame (`X = x`, `Y` up, `Z = y`, metres),
 /// on the ground `ground(x, y)`; normals averaged over each vertex's triangles, by area.
-pub fn mesh(scatter: &Scatter, at: Placement, ground: impl Fn(f64, f64) -> f64) -> Mesh {
-    let vertices: usize = scatter.rocks.iter().map(|r| r.mesh.vertices.len()).sum();
-    let triangles: usize = scatter.rocks.iter().map(|r| r.mesh.triangles.len()).sum();
-    let mut positions = Vec::with_capacity(vertices);
-    let mut indices = Vec::with_capacity(triangles * 3);
-    for rock in &scatter.rocks {
-        let base = positions.len() as u32;
-        for v in &rock.mesh.vertices {
-            let (x, y) = (at.origin[0] + v[0] * at.cell_size, at.origin[1] + v[1] * at.cell_size);
-            positions.push([x as f32, (ground(x, y) + v[2] * at.cell_size) as f32, y as f32]);
-        }
-        for t in &rock.mesh.triangles {
-            indices.extend(t.iter().map(|i| base + i));
-        }
+pub fn mesh(scatter: &Scatter, at: Placement, ground: impl Fn(f64, f64) -> f64 + Sync) -> Mesh {
+    // Each rock's vertices and triangles, on both cores; then one list.
+    let parts: Vec<Mesh> = scatter
+        .rocks
+        .par_iter()
+        .map(|rock| {
+            let positions: Vec<[f32; 3]> = rock
+                .mesh
+                .vertices
+                .iter()
+                .map(|v| {
+                    let (x, y) = (at.origin[0] + v[0] * at.cell_size, at.origin[1] + v[1] * at.cell_size);
+                    [x as f32, (ground(x, y) + v[2] * at.cell_size) as f32, y as f32]
+                })
+                .collect();
+            let indices: Vec<u32> = rock.mesh.triangles.iter().flatten().copied().collect();
+            let normals = normals(&positions, &indices);
+            Mesh {
+                positions,
+                normals,
+                indices,
+            }
+        })
+        .collect();
+    let vertices: usize = parts.iter().map(|p| p.positions.len()).sum();
+    let triangles: usize = parts.iter().map(|p| p.indices.len()).sum();
+    let mut mesh = Mesh {
+        positions: Vec::with_capacity(vertices),
+        normals: Vec::with_capacity(vertices),
+        indices: Vec::with_capacity(triangles),
+    };
+    for part in parts {
+        let base = mesh.positions.len() as u32;
+        mesh.positions.extend(part.positions);
+        mesh.normals.extend(part.normals);
+        mesh.indices.extend(part.indices.into_iter().map(|i| base + i));
     }
-    let normals = normals(&positions, &indices);
-    Mesh {
-        positions,
-        normals,
-        indices,
+    mesh
+}
+
+/// The terrain's height at `(x, y)` metres, on the surface its mesh draws: heights at cell
+/// centres, two triangles per square of four centres split along the diagonal from the upper
+/// right to the lower left centre (as [`crate::export::Mesh`]); held flat beyond the outer
+/// centres.
+pub fn ground(map: &Heightmap) -> impl Fn(f64, f64) -> f64 + Sync + '_ {
+    let (cols, rows, s) = (map.cols(), map.rows(), map.cell_size());
+    let h = map.heights();
+    move |x: f64, y: f64| {
+        let fx = (x / s - 0.5).clamp(0.0, f64::from(cols - 1));
+        let fy = (y / s - 0.5).clamp(0.0, f64::from(rows - 1));
+        let (c, r) = (
+            (fx as u32).min(cols.saturating_sub(2)),
+            (fy as u32).min(rows.saturating_sub(2)),
+        );
+        let (u, v) = (fx - f64::from(c), fy - f64::from(r));
+        let at = |c: u32, r: u32| f64::from(h[(r.min(rows - 1) * cols + c.min(cols - 1)) as usize]);
+        let (a, b, d, e) = (at(c, r), at(c + 1, r), at(c, r + 1), at(c + 1, r + 1));
+        if u + v <= 1.0 {
+            a + u * (b - a) + v * (d - a)
+        } else {
+            e + (1.0 - u) * (d - e) + (1.0 - v) * (b - e)
+        }
     }
 }
 

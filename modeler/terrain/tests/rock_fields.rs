@@ -1,0 +1,274 @@
+//! Rock fields in the document (version 2): loading old documents, validation naming the
+//! element, edits with undo, and rocks standing on the terrain as it changes — the ground
+//! checked against the terrain's triangles by a computation of the test's own.
+
+use penmodel_terrain::document::{RockField, RockLayer, VERSION};
+use penmodel_terrain::rocks::cache::Rocks;
+use penmodel_terrain::{Document, Edit, Editor, FigurePath, Heightmap, Region};
+
+use crate::common::{document, point, polygon};
+
+fn field(at: [f64; 2]) -> RockField {
+    RockField {
+        at,
+        outline: vec![[0.0, 0.0], [50.0, 0.0], [50.0, 40.0], [0.0, 40.0], [0.0, 0.0]],
+        cell_size: 0.5,
+        layers: vec![
+            RockLayer {
+                radius: 8.0,
+                fraction: Some(0.3),
+                count: None,
+                widths: [0.0, 0.3, 0.3],
+                heights: [0.3, 0.3, 0.1],
+            },
+            RockLayer {
+                radius: 3.0,
+                fraction: Some(0.3),
+                count: None,
+                widths: [0.0, 0.0, 0.0],
+                heights: [0.3, 0.0, 0.1],
+            },
+        ],
+        seed: 7,
+    }
+}
+
+/// A 128 m square grid, one region over most of it with a peak, and a rock field on its flank.
+fn doc() -> Document {
+    let region = Region {
+        boundary: polygon([64.0, 64.0], 60.0, 24, 0.1),
+        figures: vec![point([64.0, 64.0], 30.0, 0.0)],
+    };
+    let mut d = document(128, vec![region]);
+    d.rocks.push(field([40.0, 30.0]));
+    d
+}
+
+#[test]
+fn a_version_1_document_loads_as_version_2() {
+    let text = include_str!("../../examples/04-volcano.json");
+    assert!(text.contains("\"version\": 1"), "the example is a version 1 file");
+    let doc = Document::from_json(text).expect("version 1 loads");
+    assert_eq!(doc.version, VERSION);
+    assert!(doc.rocks.is_empty());
+    assert!(doc.to_json().contains("\"version\": 2"));
+    // Rock fields need version 2.
+    let mut v2 = doc.clone();
+    v2.rocks.push(field([40.0, 30.0]));
+    let with_rocks = v2.to_json().replace("\"version\": 2", "\"version\": 1");
+    let e = Document::from_json(&with_rocks).expect_err("rocks in a version 1 file");
+    assert_eq!(e.to_string(), "rocks: needs document version 2");
+    let e = Document::from_json(&text.replace("\"version\": 1", "\"version\": 3")).expect_err("version 3");
+    assert!(e.to_string().contains("reads versions 1 to 2"), "{e}");
+}
+
+#[test]
+fn a_rock_field_round_trips() {
+    let d = doc();
+    let back = Document::from_json(&d.to_json()).expect("valid");
+    assert_eq!(back, d);
+}
+
+#[test]
+fn bad_fields_are_named() {
+    type Change = Box<dyn Fn(&mut RockField)>;
+    let cases: Vec<(Change, &str)> = vec![
+        (
+            Box::new(|f| f.layers[1].radius = 0.0),
+            "rocks[0].layers[1].radius: 0 must be above 0",
+        ),
+        (
+            Box::new(|f| f.layers[0].radius = 90.0),
+            "rocks[0].layers[0].radius: 90 cells leaves no room for one rock",
+        ),
+        (
+            Box::new(|f| f.layers[1].fraction = Some(0.8)),
+            "rocks[0].layers: the fractions add up to 1.1",
+        ),
+        (
+            Box::new(|f| f.layers[1].count = Some(3)),
+            "rocks[0].layers[1]: give either a fraction or a count",
+        ),
+        (
+            Box::new(|f| f.layers[0].heights[2] = -1.0),
+            "rocks[0].layers[0].heights[2]: -1 must be from 0 to 10",
+        ),
+        (
+            Box::new(|f| f.at = [200.0, 30.0]),
+            "rocks[0].outline[0]: (200, 30) lies outside the grid",
+        ),
+        (
+            Box::new(|f| f.outline.pop().map(|_| ()).unwrap_or(())),
+            "rocks[0].outline: the curve is open",
+        ),
+        (Box::new(|f| f.cell_size = 0.0), "rocks[0].cell_size"),
+    ];
+    for (change, words) in cases {
+        let mut d = doc();
+        change(&mut d.rocks[0]);
+        let e = Document::from_json(&d.to_json()).expect_err(words);
+        assert!(e.to_string().starts_with(words), "{e} — expected {words}");
+    }
+    // Outside every region: a field in a corner the region does not reach.
+    let mut d = doc();
+    d.rocks[0].at = [0.5, 0.5];
+    d.rocks[0].outline = vec![[0.0, 0.0], [8.0, 0.0], [8.0, 8.0], [0.0, 0.0]];
+    d.rocks[0].layers.truncate(1);
+    d.rocks[0].layers[0].radius = 2.0;
+    let e = Document::from_json(&d.to_json()).expect_err("outside");
+    assert_eq!(
+        e.to_string(),
+        "rocks[0]: lies outside every region: draw the field inside a region"
+    );
+}
+
+#[test]
+fn field_edits_undo_and_journal() {
+    let mut d = doc();
+    let f = d.rocks.pop().expect("a field");
+    let mut ed = Editor::new(d.clone()).expect("valid");
+    ed.apply(Edit::AddRocks {
+        index: 0,
+        field: f.clone(),
+    })
+    .expect("added");
+    ed.apply(Edit::MoveRocks {
+        index: 0,
+        by: [5.0, -3.0],
+    })
+    .expect("moved");
+    assert_eq!(ed.document().rocks[0].at, [45.0, 27.0]);
+    let mut denser = ed.document().rocks[0].clone();
+    denser.layers[1].fraction = Some(0.5);
+    ed.apply(Edit::ReplaceRocks {
+        index: 0,
+        field: denser,
+    })
+    .expect("denser");
+    ed.undo().expect("undo");
+    ed.undo().expect("undo");
+    assert_eq!(ed.document().rocks[0], f);
+    ed.undo().expect("undo");
+    assert_eq!(ed.document(), &d);
+    // The edits as the journal writes them.
+    let e = Edit::MoveRocks {
+        index: 0,
+        by: [1.0, 2.0],
+    };
+    let line = serde_json::to_string(&e).expect("json");
+    assert_eq!(line, r#"{"op":"move_rocks","index":0,"by":[1.0,2.0]}"#);
+    assert_eq!(serde_json::from_str::<Edit>(&line).expect("parses"), e);
+    // Deleting the region under a field is refused: the document would not load.
+    let mut ed = Editor::new(doc()).expect("valid");
+    let e = ed.apply(Edit::DeleteRegion { index: 0 }).expect_err("refused");
+    assert!(e.to_string().contains("rocks[0]: lies outside every region"), "{e}");
+    assert_eq!(ed.document(), &doc());
+}
+
+/// The terrain's height at (x, z) on its mesh, found by locating the point in one of the two
+/// triangles of its square and weighting the corners by the areas opposite them.
+fn on_terrain(map: &Heightmap, x: f64, z: f64) -> f64 {
+    let s = map.cell_size();
+    let centre = |c: u32, r: u32| {
+        (
+            (f64::from(c) + 0.5) * s,
+            (f64::from(r) + 0.5) * s,
+            f64::from(map.get(c, r)),
+        )
+    };
+    let c = (((x / s) - 0.5).floor().max(0.0) as u32).min(map.cols() - 2);
+    let r = (((z / s) - 0.5).floor().max(0.0) as u32).min(map.rows() - 2);
+    let (a, b, d, e) = (centre(c, r), centre(c + 1, r), centre(c, r + 1), centre(c + 1, r + 1));
+    let area = |p: (f64, f64, f64), q: (f64, f64, f64), t: (f64, f64)| {
+        ((q.0 - p.0) * (t.1 - p.1) - (q.1 - p.1) * (t.0 - p.0)) / 2.0
+    };
+    for [p, q, t] in [[a, d, b], [b, d, e]] {
+        let whole = area(p, q, (t.0, t.1));
+        let (wp, wq, wt) = (
+            area(q, t, (x, z)) / whole,
+            area(t, p, (x, z)) / whole,
+            area(p, q, (x, z)) / whole,
+        );
+        if wp >= -1e-9 && wq >= -1e-9 && wt >= -1e-9 {
+            return wp * p.2 + wq * q.2 + wt * t.2;
+        }
+    }
+    panic!("({x}, {z}) is in neither triangle of square ({c}, {r})");
+}
+
+/// Checks that every rim vertex (a cell's own, 0 above the ground) of every field stands on the
+/// terrain, and every vertex is at least on it.
+fn check_seated(rocks: &Rocks, map: &Heightmap) -> usize {
+    let seated = rocks.seated(map);
+    let mut rims = 0;
+    for (f, (_, mesh)) in rocks.fields().iter().zip(&seated) {
+        let mut at = 0;
+        for rock in &f.scatter.rocks {
+            for (k, v) in rock.mesh.vertices.iter().enumerate() {
+                let p = mesh.positions[at + k];
+                let ground = on_terrain(map, f64::from(p[0]), f64::from(p[2]));
+                let expected = ground + v[2] * f.field.cell_size;
+                assert!(
+                    (f64::from(p[1]) - expected).abs() < 1e-3,
+                    "vertex at {p:?}: {} on ground {ground}",
+                    p[1]
+                );
+                if k < rock.polygon.len() {
+                    rims += 1;
+                }
+            }
+            at += rock.mesh.vertices.len();
+        }
+        assert_eq!(at, mesh.positions.len());
+    }
+    rims
+}
+
+#[test]
+fn rocks_stand_on_the_terrain_and_follow_it() {
+    let mut ed = Editor::new(doc()).expect("valid");
+    let mut rocks = Rocks::of(ed.document());
+    assert!(!rocks.fields()[0].scatter.rocks.is_empty());
+    assert!(check_seated(&rocks, ed.heightmap()) > 100);
+    // The peak rises: no scattering, the rocks follow.
+    ed.apply(Edit::SetHeight {
+        at: FigurePath::new(0, 0),
+        height: 60.0,
+    })
+    .expect("pulled");
+    assert_eq!(rocks.update(ed.document()), 0);
+    check_seated(&rocks, ed.heightmap());
+    // Moved: the same rocks, shifted.
+    let before = rocks.seated(ed.heightmap());
+    ed.apply(Edit::MoveRocks {
+        index: 0,
+        by: [6.0, 4.0],
+    })
+    .expect("moved");
+    assert_eq!(rocks.update(ed.document()), 0, "a move scatters nothing");
+    let after = rocks.seated(ed.heightmap());
+    for (p, q) in before[0].1.positions.iter().zip(&after[0].1.positions) {
+        assert!((q[0] - p[0] - 6.0).abs() < 1e-3 && (q[2] - p[2] - 4.0).abs() < 1e-3);
+    }
+    check_seated(&rocks, ed.heightmap());
+    // Denser: scattered again.
+    let mut denser = ed.document().rocks[0].clone();
+    denser.layers[1].fraction = Some(0.5);
+    ed.apply(Edit::ReplaceRocks {
+        index: 0,
+        field: denser,
+    })
+    .expect("denser");
+    assert_eq!(rocks.update(ed.document()), 1);
+    // Every kept cell lies inside the outline: its pixels' centres are.
+    let f = &rocks.fields()[0];
+    for rock in &f.scatter.rocks {
+        for v in &rock.polygon {
+            let p = [v[0] * 0.5 + f.image.origin[0], v[1] * 0.5 + f.image.origin[1]];
+            assert!(
+                (-0.6..=50.6).contains(&p[0]) && (-0.6..=40.6).contains(&p[1]),
+                "{p:?} outside the outline"
+            );
+        }
+    }
+}
