@@ -2,7 +2,7 @@
 //!
 //! * [`transport`]: one interface over USB HID (hidapi), the serial link (serialport) and the
 //!   simulated pen in process (cargo feature `sim`); [`source`] chooses one, from a
-//!   `--source` string or the `--serial`/`--hid`/`--sim` flags; [`device`] keeps a session alive across
+//!   `--source` string (`hid`, `serial:PATH`, `sim`, …) every tool takes; [`device`] keeps a session alive across
 //!   unplugging.
 //! * [`sample`]: reports as samples — millimetres, the device clock unwrapped, the host's
 //!   receive time, lost reports counted from sequence numbers.

@@ -1,8 +1,12 @@
-//! Where the pen comes from, chosen in one place for every tool: a [`Source`] from a string
-//! (`penmodel --source`) or from the flags [`DeviceArgs`] declares (`pend`, `penctl`), and how
-//! to (re)open it.
+//! Where the pen comes from, chosen in one place for every tool: a [`Source`] from the string
+//! every tool's `--source` takes (`hid`, `hid:PATH`, `serial:PATH`, `sim`, `sim:SCENARIO`;
+//! penmodel adds its own), the flags [`DeviceArgs`] declares for `pend` and `penctl`, and how to
+//! (re)open it.
 //!
-//! The simulated pen (`--sim`, `sim:SCENARIO`) is there with the cargo feature `sim` only; built
+//! The earlier spellings (`--serial PATH`, `--hid PATH`, pend's `--sim [SCENARIO]`, penctl's
+//! `--sim --scenario NAME`, `--sim-speed`) still work, hidden from `--help` (docs/cli.md).
+//!
+//! The simulated pen (`sim`, `sim:SCENARIO`) is there with the cargo feature `sim` only; built
 //! without it, the flags do not exist and `sim` is an unknown source.
 
 use std::fmt;
@@ -43,6 +47,9 @@ pub enum SourceError {
     /// pen-sim has no scenario of this name.
     #[error("unknown scenario {0:?}; `pen-sim scenarios` lists them")]
     UnknownScenario(String),
+    /// `--speed` is the simulated pen's; a device runs at its own.
+    #[error("--speed is the simulated pen's (--source sim); {0} runs in real time")]
+    SpeedWithoutSim(String),
 }
 
 impl Source {
@@ -95,6 +102,13 @@ impl FromStr for Source {
     type Err = SourceError;
 
     fn from_str(s: &str) -> Result<Source, SourceError> {
+        Source::parse(s, "modeling-session")
+    }
+}
+
+impl Source {
+    /// [`Source::FORMS`], `sim` alone playing `default_scenario` (each tool has its own).
+    pub fn parse(s: &str, default_scenario: &str) -> Result<Source, SourceError> {
         let (kind, arg) = match s.split_once(':') {
             Some((k, a)) => (k, Some(a)),
             None => (s, None),
@@ -104,92 +118,144 @@ impl FromStr for Source {
             ("serial", Some(path)) if !path.is_empty() => Ok(Source::Serial(path.to_string())),
             ("serial", _) => Err(SourceError::SerialWithoutPath),
             #[cfg(feature = "sim")]
-            ("sim", name) => Source::sim(name.unwrap_or("modeling-session"), 1.0),
+            ("sim", name) => Source::sim(name.unwrap_or(default_scenario), 1.0),
             _ => Err(SourceError::UnknownKind { given: s.into() }),
         }
     }
 }
 
-/// Which base station, as `pend` and `penctl` take it: `--serial PATH`, `--hid PATH` (default:
-/// the first base station found) or the simulated pen, whose flags `S` declares — the two tools
-/// spell it differently ([`SimSwitch`], [`SimScenario`]).
+/// `--source`, checked as clap reads it (a usage error otherwise).
+fn source_form(s: &str) -> Result<String, SourceError> {
+    Source::parse(s, "hold").map(|_| s.to_string())
+}
+
+/// `--speed`: device seconds per real second, finite and not negative (every tool's).
+#[cfg(feature = "sim")]
+pub fn speed_value(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v >= 0.0 => Ok(v),
+        _ => Err(format!(
+            "{s:?} is not a speed: device seconds per real second, 0 or more (0: as fast as it is read)"
+        )),
+    }
+}
+
+/// Which base station, as `pend` and `penctl` take it: `--source SOURCE` (default: the first
+/// base station found on USB HID), `--speed` for the simulated pen; `S` says which scenario
+/// `--source sim` plays in this tool, and declares the tool's earlier, hidden spelling of the
+/// simulated pen ([`SimSwitch`], [`SimScenario`]).
 #[derive(Args, Clone, Debug)]
 pub struct DeviceArgs<S: SimFlag> {
-    /// The serial link at PATH instead of USB HID.
-    #[arg(long, value_name = "PATH", conflicts_with = "hid")]
+    /// The base station: hid (the first one found on USB; the default), hid:PATH, serial:PATH,
+    /// or the simulated pen: sim (its scenario for this tool: see the examples), sim:SCENARIO
+    /// (`pen-sim scenarios` lists them).
+    #[arg(long, value_name = "SOURCE", value_parser = source_form)]
+    pub source: Option<String>,
+    /// Earlier spelling of --source serial:PATH.
+    #[arg(long, value_name = "PATH", hide = true, conflicts_with_all = ["source", "hid"])]
     #[cfg_attr(feature = "sim", arg(conflicts_with = "sim"))]
     pub serial: Option<String>,
-    /// A hidraw device instead of the first base station found.
-    #[arg(long, value_name = "PATH")]
+    /// Earlier spelling of --source hid:PATH.
+    #[arg(long, value_name = "PATH", hide = true, conflicts_with = "source")]
     #[cfg_attr(feature = "sim", arg(conflicts_with = "sim"))]
     pub hid: Option<String>,
     #[allow(missing_docs)]
     #[command(flatten)]
     pub sim: S,
-    /// Device seconds per real second for --sim (0: as fast as possible).
+    /// The simulated pen's speed: device seconds per real second (0: as fast as it is read)
+    /// [default: 1].
     #[cfg(feature = "sim")]
-    #[arg(long, default_value_t = 1.0, requires = "sim")]
-    pub sim_speed: f64,
+    #[arg(long = "speed", alias = "sim-speed", value_name = "X", value_parser = speed_value,
+          allow_negative_numbers = true)]
+    pub sim_speed: Option<f64>,
 }
 
 impl<S: SimFlag> DeviceArgs<S> {
     /// The source the flags choose.
     pub fn source(&self) -> Result<Source, SourceError> {
+        #[allow(unused_mut)]
+        let mut source = match (&self.source, self.sim.scenario(), &self.serial) {
+            (Some(s), _, _) => Source::parse(s, S::DEFAULT_SCENARIO)?,
+            #[cfg(feature = "sim")]
+            (None, Some(name), _) => Source::sim(if name.is_empty() { S::DEFAULT_SCENARIO } else { name }, 1.0)?,
+            (None, _, Some(path)) => Source::Serial(path.clone()),
+            _ => Source::Hid(self.hid.clone()),
+        };
         #[cfg(feature = "sim")]
-        if let Some(name) = self.sim.scenario() {
-            return Source::sim(name, self.sim_speed);
+        match (&mut source, self.sim_speed) {
+            (Source::Sim(o), Some(speed)) => o.speed = speed,
+            (other, Some(_)) => return Err(SourceError::SpeedWithoutSim(other.to_string())),
+            (_, None) => {}
         }
-        Ok(match &self.serial {
-            Some(path) => Source::Serial(path.clone()),
-            None => Source::Hid(self.hid.clone()),
-        })
+        Ok(source)
     }
 
     /// Whether the simulated pen was asked for.
     pub fn is_sim(&self) -> bool {
         self.sim.scenario().is_some()
+            || self
+                .source
+                .as_deref()
+                .is_some_and(|s| s == "sim" || s.starts_with("sim:"))
+    }
+
+    /// The simulated pen's speed (`--speed`, 1 by default).
+    #[cfg(feature = "sim")]
+    pub fn speed(&self) -> f64 {
+        self.sim_speed.unwrap_or(1.0)
     }
 }
 
-/// How a tool spells "the simulated pen, playing this scenario".
+/// A tool's simulated pen: the scenario `--source sim` plays, and the tool's earlier, hidden
+/// spelling of "the simulated pen, playing this scenario".
 pub trait SimFlag: Args + Clone + fmt::Debug {
-    /// The scenario, when the simulated pen was asked for.
+    /// What `--source sim` plays in this tool.
+    const DEFAULT_SCENARIO: &'static str;
+
+    /// The scenario the earlier spelling asked for, if it was used ("" for the default).
     fn scenario(&self) -> Option<&str>;
 }
 
-/// penctl's spelling: `--sim`, and `--scenario NAME` (default `hold`).
+/// penctl's: `--source sim` plays `hold` (the pen held still over the display: steady figures
+/// for info, monitor and config); earlier spelled `--sim`, and `--scenario NAME`.
 #[derive(Args, Clone, Debug)]
 pub struct SimSwitch {
-    /// The simulated pen in this process.
+    /// Earlier spelling of --source sim.
     #[cfg(feature = "sim")]
-    #[arg(long)]
+    #[arg(long, hide = true, conflicts_with = "source")]
     sim: bool,
-    /// The session the simulated pen plays (`pen-sim scenarios` lists them).
+    /// Earlier spelling of --source sim:NAME.
     #[cfg(feature = "sim")]
-    #[arg(long, value_name = "NAME", default_value = "hold", requires = "sim")]
-    scenario: String,
+    #[arg(long, value_name = "NAME", hide = true, requires = "sim")]
+    scenario: Option<String>,
 }
 
 impl SimFlag for SimSwitch {
+    const DEFAULT_SCENARIO: &'static str = "hold";
+
     fn scenario(&self) -> Option<&str> {
         #[cfg(feature = "sim")]
         if self.sim {
-            return Some(&self.scenario);
+            return Some(self.scenario.as_deref().unwrap_or(""));
         }
         None
     }
 }
 
-/// pend's spelling: `--sim [SCENARIO]` (default `modeling-session`).
+/// pend's: `--source sim` plays `modeling-session` (a session of modeling gestures: the events
+/// a modeler sees); earlier spelled `--sim [SCENARIO]`.
 #[derive(Args, Clone, Debug)]
 pub struct SimScenario {
-    /// Use the simulated pen, playing SCENARIO (default modeling-session) in real time.
+    /// Earlier spelling of --source sim[:SCENARIO].
     #[cfg(feature = "sim")]
-    #[arg(long, value_name = "SCENARIO", num_args = 0..=1, default_missing_value = "modeling-session")]
+    #[arg(long, value_name = "SCENARIO", num_args = 0..=1, default_missing_value = "", hide = true,
+          conflicts_with = "source")]
     sim: Option<String>,
 }
 
 impl SimFlag for SimScenario {
+    const DEFAULT_SCENARIO: &'static str = "modeling-session";
+
     fn scenario(&self) -> Option<&str> {
         #[cfg(feature = "sim")]
         return self.sim.as_deref();

@@ -6,4 +6,5 @@ mod events;
 mod install;
 mod penctl;
 mod socket;
+mod vocabulary;
 mod waiting;

@@ -56,6 +56,17 @@ impl Session {
         }
     }
 
+    /// Sets the terrain's vertical scale (exaggeration) before the session starts: heights are
+    /// drawn and pulled `scale` times their metres (the pulled figure stays at the pen's tip).
+    pub fn set_vertical_scale(&mut self, scale: f64) {
+        let tuning = *self.interaction.tuning();
+        let view = View {
+            exaggeration: scale,
+            ..*self.interaction.view()
+        };
+        self.interaction = Interaction::new(view, tuning);
+    }
+
     /// Takes one message from the feed; returns what the interaction said about it.
     pub fn feed(&mut self, feed: Feed) -> Vec<String> {
         match feed {
@@ -68,7 +79,11 @@ impl Session {
                 self.calibrating = None;
                 if mm != self.interaction.view().display_mm {
                     let tuning = *self.interaction.tuning();
-                    let view = View::fit(mm, &self.editor.document().grid);
+                    let view = View {
+                        // The vertical scale is the user's, whatever the display.
+                        exaggeration: self.interaction.view().exaggeration,
+                        ..View::fit(mm, &self.editor.document().grid)
+                    };
                     self.interaction = Interaction::new(view, tuning);
                 }
                 Vec::new()
@@ -126,5 +141,22 @@ impl Session {
     /// is reattached).
     pub fn last_event_us(&self) -> Option<u64> {
         self.last_event_us
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_vertical_scale_holds_when_the_display_is_refitted() {
+        let editor = Editor::new(blank_document()).expect("a valid document");
+        let mut session = Session::new(editor, [600.0, 340.0], Tuning::default());
+        session.set_vertical_scale(2.5);
+        assert_eq!(session.interaction.view().exaggeration, 2.5);
+        // The calibration reports another display: the view is fitted to it, the scale kept.
+        session.feed(Feed::Display([500.0, 300.0]));
+        assert_eq!(session.interaction.view().display_mm, [500.0, 300.0]);
+        assert_eq!(session.interaction.view().exaggeration, 2.5);
     }
 }

@@ -116,3 +116,109 @@ fn an_os_error_is_said_once() {
         );
     }
 }
+
+#[test]
+fn render_help_examples_run() {
+    examples_run("render");
+}
+
+/// The PNG `penmodel render` writes for `args` (after the document and `--png`).
+fn render(dir: &Path, name: &str, args: &[&str]) -> Vec<u8> {
+    let doc = repository().join("modeler/examples/04-volcano.json");
+    let png = dir.join(name);
+    let out = penmodel(
+        dir,
+        &[
+            &[
+                "render",
+                doc.to_str().expect("UTF-8"),
+                "--png",
+                png.to_str().expect("UTF-8"),
+                "--size",
+                "160x90",
+            ],
+            args,
+        ]
+        .concat(),
+    );
+    assert!(
+        out.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    std::fs::read(&png).expect("the PNG")
+}
+
+#[test]
+fn sizes_on_the_display_are_millimetres_and_the_earlier_metres_still_read() {
+    let dir = tempfile::tempdir().expect("dir");
+    let mm = render(
+        dir.path(),
+        "mm.png",
+        &["--display-mm", "600x340", "--head-mm", "0,-150,500"],
+    );
+    let m = render(dir.path(), "m.png", &["--display", "0.6x0.34", "--head", "0,-0.15,0.5"]);
+    assert_eq!(mm, m, "the same view in either unit");
+    let orbit = render(dir.path(), "orbit.png", &[]);
+    assert_ne!(mm, orbit, "the tracked view is not the orbit camera's");
+
+    let scaled = render(dir.path(), "v.png", &["--vertical-scale", "3"]);
+    let aliased = render(dir.path(), "e.png", &["--exaggeration", "3"]);
+    assert_eq!(scaled, aliased);
+    assert_ne!(scaled, orbit, "the vertical scale changes the picture");
+}
+
+#[test]
+fn the_shared_flags_refuse_bad_values_as_usage_errors() {
+    let dir = tempfile::tempdir().expect("dir");
+    let doc = repository().join("modeler/examples/04-volcano.json");
+    let doc = doc.to_str().expect("UTF-8");
+    let cases: [(&[&str], &str); 7] = [
+        (&["--vertical-scale", "0"], "is not a vertical scale"),
+        (&["--exaggeration", "-2"], "is not a vertical scale"),
+        (&["--speed", "-1"], "is not a speed"),
+        (&["--head-mm", "1,2"], "expected X,Y,Z in mm"),
+        (
+            &["render", doc, "--png", "x.png", "--display-mm", "600x340"],
+            "--head-mm",
+        ),
+        (
+            &[
+                "render",
+                doc,
+                "--png",
+                "x.png",
+                "--display-mm",
+                "0.6",
+                "--head-mm",
+                "0,0,500",
+            ],
+            "in mm",
+        ),
+        (
+            &["render", doc, "--png", "x.png", "--vertical-scale", "nan"],
+            "is not a vertical scale",
+        ),
+    ];
+    for (args, says) in cases {
+        let out = penmodel(dir.path(), args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(says), "{args:?}: {err}");
+    }
+    // The earlier spelling is read: the session starts and fails only for want of pend.
+    let out = penmodel(
+        dir.path(),
+        &[
+            "--show",
+            "headless",
+            "--exaggeration",
+            "2",
+            "--source",
+            "daemon:nothing.sock",
+        ],
+    );
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("pend is not running"), "{err}");
+}

@@ -17,7 +17,12 @@ use pen_sim::{Simulation, scenarios};
     name = "pen-sim",
     version,
     about = "The simulated 3D pen and base station",
-    propagate_version = true
+    propagate_version = true,
+    after_help = "Examples:\n  \
+    pen-sim scenarios\n  \
+    pen-sim serve --pty --scenario hold --link /tmp/pen   # then: pend --source serial:/tmp/pen\n  \
+    pen-sim accuracy --json\n\
+    The other tools play the same scenarios in process: --source sim:SCENARIO (docs/cli.md)."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -30,6 +35,9 @@ enum Command {
     ///
     /// Prints the device path (/dev/pts/N) on the first line of stdout, then streams the serial
     /// framing there in real time and answers requests, as the base station's serial link does.
+    #[command(after_help = "Examples:\n  \
+    pen-sim serve --pty\n  \
+    pen-sim serve --pty --scenario hold --speed 0 --link /tmp/pen   # then: penctl monitor --source serial:/tmp/pen")]
     Serve {
         /// Create a pseudo-terminal (the only transport so far; required for clarity).
         #[arg(long, required = true)]
@@ -48,6 +56,7 @@ enum Command {
         speed: f64,
     },
     /// Write a trace as JSON lines: a header, then one line per measurement cycle.
+    #[command(after_help = "Example:\n  pen-sim trace --scenario hand-sweep --seconds 2 > sweep.jsonl")]
     Trace {
         /// The session.
         #[arg(long)]
@@ -60,6 +69,7 @@ enum Command {
         seed: u64,
     },
     /// Run the standard scenarios and print their accuracy figures.
+    #[command(after_help = "Examples:\n  pen-sim accuracy\n  pen-sim accuracy --json --scenario echoes")]
     Accuracy {
         /// Print {"scenarios": [...]} as JSON.
         #[arg(long)]
@@ -73,6 +83,7 @@ enum Command {
     },
     /// Replay a scenario's cycles through the core on QEMU's Cortex-M4F (mps2-an386), compare
     /// its reports with this host build's, and print the instructions a fix costs there.
+    #[command(after_help = "Example (needs qemu-system-arm):\n  pen-sim qemu --scenario hand-sweep --seconds 2 --json")]
     Qemu {
         /// The session.
         #[arg(long, default_value = "hand-sweep")]
@@ -88,6 +99,7 @@ enum Command {
         json: bool,
     },
     /// List the scenarios.
+    #[command(after_help = "Example:\n  pen-sim scenarios")]
     Scenarios,
 }
 
@@ -277,5 +289,34 @@ fn main() -> ExitCode {
             eprintln!("pen-sim: {e:#}");
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    /// The commands under `c` (itself included) whose --help gives no example.
+    fn without_examples(c: &clap::Command, path: &str, missing: &mut Vec<String>) {
+        let path = format!("{path} {}", c.get_name()).trim().to_string();
+        let help = [c.get_after_help(), c.get_after_long_help()];
+        if !help.iter().flatten().any(|h| h.to_string().contains("Example")) {
+            missing.push(path.clone());
+        }
+        for sub in c.get_subcommands() {
+            without_examples(sub, &path, missing);
+        }
+    }
+
+    #[test]
+    fn every_help_gives_examples() {
+        let mut missing = Vec::new();
+        without_examples(&super::Cli::command(), "", &mut missing);
+        assert!(missing.is_empty(), "no examples in the --help of {missing:?}");
+    }
+
+    #[test]
+    fn the_command_line_is_well_formed() {
+        super::Cli::command().debug_assert();
     }
 }

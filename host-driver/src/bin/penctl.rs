@@ -33,21 +33,36 @@ macro_rules! outln {
     name = "penctl",
     version,
     about = "Inspect, configure and calibrate the 3D pen",
-    propagate_version = true
+    propagate_version = true,
+    after_help = "Which base station, for every command that talks to one: --source hid (the first found on USB; \
+    the default), hid:PATH, serial:PATH, or the simulated pen: --source sim (here it plays `hold`, the pen held \
+    still over the display), sim:SCENARIO, with --speed (device seconds per second, 0: as fast as read).\n\
+    Examples:\n  \
+    penctl list\n  \
+    penctl info --source serial:/dev/ttyACM0\n  \
+    penctl monitor --source sim --speed 0 --count 5\n  \
+    penctl calibrate --targets 9 --plot residuals.png\n\
+    docs/penctl.md and docs/cli.md (the flags every tool shares)."
 )]
 struct Cli {
     #[command(subcommand)]
     command: Command,
 }
 
-/// Which device: `--serial PATH`, `--hid PATH`, or `--sim` with `--scenario NAME`.
+/// Which device: `--source hid|hid:PATH|serial:PATH|sim|sim:SCENARIO` and `--speed`; `--source sim`
+/// plays `hold`.
 type DeviceArgs = source::DeviceArgs<SimSwitch>;
 
 #[derive(Subcommand)]
 enum Command {
     /// List the base stations attached (HID interfaces and serial links).
+    #[command(after_help = "Example:\n  penctl list")]
     List,
     /// Print the device's information and configuration.
+    #[command(
+        after_help = "Examples:\n  penctl info\n  penctl info --source serial:/dev/ttyACM0 --json\n  \
+                            penctl info --source sim"
+    )]
     Info {
         #[command(flatten)]
         device: DeviceArgs,
@@ -55,7 +70,9 @@ enum Command {
         #[arg(long)]
         json: bool,
     },
-    /// Print samples as they arrive.
+    /// Print samples as they arrive: a header, then a row per sample (or one JSON object per sample).
+    #[command(after_help = "Examples:\n  penctl monitor --count 10\n  \
+                            penctl monitor --source sim --speed 0 --json --count 5")]
     Monitor {
         #[command(flatten)]
         device: DeviceArgs,
@@ -67,11 +84,15 @@ enum Command {
         count: Option<u64>,
     },
     /// Read or change the device's configuration.
+    #[command(
+        after_help = "Examples:\n  penctl config get\n  penctl config set temperature_c=23.5\n  penctl config save"
+    )]
     Config {
         #[command(subcommand)]
         action: ConfigAction,
     },
     /// Restart the device into its ROM USB DFU bootloader (docs/flashing.md).
+    #[command(after_help = "Example:\n  penctl bootloader && sleep 2 && dfu-util -l")]
     Bootloader {
         #[command(flatten)]
         device: DeviceArgs,
@@ -81,6 +102,7 @@ enum Command {
     /// Measure each receiver's transducer delay from the pen held at surveyed points, and write it to the device.
     Delays(pen_host::calibration::delays::cli::DelaysArgs),
     /// Print the USB HID report descriptor as one line of hex.
+    #[command(after_help = "Example:\n  penctl descriptor")]
     Descriptor,
     /// Decode a report given in hex and print it as one JSON object.
     ///
@@ -100,6 +122,7 @@ enum Command {
 #[derive(Subcommand)]
 enum ConfigAction {
     /// Print the configuration.
+    #[command(after_help = "Examples:\n  penctl config get\n  penctl config get --json > config.json")]
     Get {
         #[command(flatten)]
         device: DeviceArgs,
@@ -121,11 +144,13 @@ enum ConfigAction {
         file: Option<PathBuf>,
     },
     /// Save the running configuration to the device's flash.
+    #[command(after_help = "Example:\n  penctl config set temperature_c=23.5 && penctl config save")]
     Save {
         #[command(flatten)]
         device: DeviceArgs,
     },
     /// Replace the running configuration with the firmware's defaults (not saved).
+    #[command(after_help = "Example:\n  penctl config defaults && penctl config save")]
     Defaults {
         #[command(flatten)]
         device: DeviceArgs,
@@ -139,6 +164,14 @@ enum Fit {
 }
 
 #[derive(Args)]
+#[command(
+    after_help = "With --source sim the simulated pen plays the touches itself (on a display placed a little \
+    off, as by hand) and the calibration goes to calibration-sim.toml.\n\
+    Examples:\n  \
+    penctl calibrate --targets 9 --display-mm 600x340 --display-px 2560x1440 --plot residuals.png\n  \
+    penctl calibrate --source serial:/dev/ttyACM0 --write-device\n  \
+    penctl calibrate --source sim --speed 0 --calibration /tmp/sim.toml"
+)]
 struct CalibrateArgs {
     #[command(flatten)]
     device: DeviceArgs,
@@ -156,7 +189,8 @@ struct CalibrateArgs {
     fit: Fit,
     /// Where to save the calibration [default: $XDG_CONFIG_HOME/penscape/calibration.toml;
     /// calibration-sim.toml for the simulated pen, so that it never replaces the real one's].
-    #[arg(long, value_name = "FILE")]
+    /// The file pend reads with the same flag.
+    #[arg(long = "calibration", alias = "out", value_name = "FILE")]
     out: Option<PathBuf>,
     /// Also draw the residuals into this PNG.
     #[arg(long, value_name = "PNG")]
@@ -446,7 +480,7 @@ fn calibration_source(device: &DeviceArgs, targets: &[glam::DVec2]) -> Result<So
     Ok(Source::Sim(pen_host::transport::sim::SimOptions {
         scenario: pen_sim::scenarios::calibration(targets, rig),
         seed: 1,
-        speed: device.sim_speed,
+        speed: device.speed(),
         plug: Default::default(),
     }))
 }
@@ -610,7 +644,7 @@ fn list() -> Result<()> {
     let serials = serial::list();
     if hids.is_empty() && serials.is_empty() {
         let hint = if cfg!(feature = "sim") {
-            "; the simulated pen: --sim"
+            "; the simulated pen: --source sim"
         } else {
             ""
         };
@@ -662,7 +696,8 @@ fn main() -> ExitCode {
         {
             ExitCode::SUCCESS
         }
-        Err(e) if e.downcast_ref::<UsageError>().is_some() => {
+        // Flags that parse but do not go together: a usage error.
+        Err(e) if e.downcast_ref::<UsageError>().is_some() || e.downcast_ref::<source::SourceError>().is_some() => {
             eprintln!("penctl: {e:#}");
             ExitCode::from(2)
         }
@@ -670,5 +705,34 @@ fn main() -> ExitCode {
             eprintln!("penctl: {e:#}");
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    /// The commands under `c` (itself included) whose --help gives no example.
+    fn without_examples(c: &clap::Command, path: &str, missing: &mut Vec<String>) {
+        let path = format!("{path} {}", c.get_name()).trim().to_string();
+        let help = [c.get_after_help(), c.get_after_long_help()];
+        if !help.iter().flatten().any(|h| h.to_string().contains("Example")) {
+            missing.push(path.clone());
+        }
+        for sub in c.get_subcommands() {
+            without_examples(sub, &path, missing);
+        }
+    }
+
+    #[test]
+    fn every_help_gives_examples() {
+        let mut missing = Vec::new();
+        without_examples(&super::Cli::command(), "", &mut missing);
+        assert!(missing.is_empty(), "no examples in the --help of {missing:?}");
+    }
+
+    #[test]
+    fn the_command_line_is_well_formed() {
+        super::Cli::command().debug_assert();
     }
 }

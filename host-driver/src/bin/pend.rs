@@ -1,5 +1,5 @@
-//! `pend`: the pen daemon. Attaches to the base station (USB HID by default, `--serial PATH`, or
-//! `--sim` for the simulated pen), applies the calibration, and serves pen events to any number
+//! `pend`: the pen daemon. Attaches to the base station (USB HID by default, `--source
+//! serial:PATH`, or `--source sim` for the simulated pen), applies the calibration, and serves pen events to any number
 //! of clients (a bounded number at once) on a Unix domain socket as JSON lines (docs/events.md). SIGTERM and SIGINT stop it:
 //! the socket is removed and the exit status is 0.
 
@@ -14,13 +14,22 @@ use clap::Parser;
 use pen_host::calibration::{Calibration, DisplaySize};
 use pen_host::daemon::{self, DEFAULT_MAX_CLIENTS, DEFAULT_QUEUE, Hub};
 use pen_host::pipeline::Pipeline;
-use pen_host::source::{DeviceArgs, SimScenario};
+use pen_host::source::{DeviceArgs, SimScenario, SourceError};
 
 #[derive(Parser)]
 #[command(
     name = "pend",
     version,
-    about = "The 3D pen's daemon: pen events for every program, on a Unix socket"
+    about = "The 3D pen's daemon: pen events for every program, on a Unix socket",
+    after_help = "The simulated pen (--source sim) plays `modeling-session` here: a session of modeling gestures, \
+    the events a modeler sees. While the base station is not there, pend says what it waits for and why every \
+    5 s; access without root: host-driver/udev/70-penscape.rules.\n\
+    Examples:\n  \
+    pend                                     # the first base station on USB\n  \
+    pend --source serial:/dev/ttyACM0        # its serial link\n  \
+    pend --source sim                        # the simulated pen, in real time\n  \
+    pend --source sim:hold --speed 0 --socket /tmp/pend.sock\n\
+    docs/events.md (the socket's lines) and docs/cli.md (the flags every tool shares)."
 )]
 struct Cli {
     /// The socket [default: $XDG_RUNTIME_DIR/penscape/pend.sock].
@@ -29,7 +38,7 @@ struct Cli {
     #[command(flatten)]
     device: DeviceArgs<SimScenario>,
     /// The calibration file [default: $XDG_CONFIG_HOME/penscape/calibration.toml if it exists,
-    /// calibration-sim.toml for --sim; otherwise tracker coordinates are display coordinates].
+    /// calibration-sim.toml for --source sim; otherwise tracker coordinates are display coordinates].
     /// It is applied only to the base station it records.
     #[arg(long, value_name = "FILE")]
     calibration: Option<PathBuf>,
@@ -96,9 +105,44 @@ fn run(cli: Cli) -> Result<()> {
 fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
+        // Flags that parse but do not go together (--speed without the simulated pen): a usage
+        // error.
+        Err(e) if e.downcast_ref::<SourceError>().is_some() => {
+            eprintln!("pend: {e:#} (pend --help)");
+            ExitCode::from(2)
+        }
         Err(e) => {
             eprintln!("pend: {e:#}");
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use clap::CommandFactory;
+
+    /// The commands under `c` (itself included) whose --help gives no example.
+    fn without_examples(c: &clap::Command, path: &str, missing: &mut Vec<String>) {
+        let path = format!("{path} {}", c.get_name()).trim().to_string();
+        let help = [c.get_after_help(), c.get_after_long_help()];
+        if !help.iter().flatten().any(|h| h.to_string().contains("Example")) {
+            missing.push(path.clone());
+        }
+        for sub in c.get_subcommands() {
+            without_examples(sub, &path, missing);
+        }
+    }
+
+    #[test]
+    fn every_help_gives_examples() {
+        let mut missing = Vec::new();
+        without_examples(&super::Cli::command(), "", &mut missing);
+        assert!(missing.is_empty(), "no examples in the --help of {missing:?}");
+    }
+
+    #[test]
+    fn the_command_line_is_well_formed() {
+        super::Cli::command().debug_assert();
     }
 }

@@ -410,7 +410,7 @@ pub fn with_delays(config: &Config, fit: &DelayFit) -> Config {
 }
 
 /// The simulated pen held at `points_mm` by the procedure's scenario (the reference rig,
-/// starting with delays of 0 µs): what `penctl delays --sim` measures.
+/// starting with delays of 0 µs): what `penctl delays --source sim` measures.
 #[cfg(feature = "sim")]
 pub fn sim_source(points_mm: &[DVec3], speed: f64) -> crate::source::Source {
     crate::source::Source::Sim(crate::transport::sim::SimOptions {

@@ -122,7 +122,7 @@ pub fn default_path_for(simulated: bool) -> Option<PathBuf> {
     if simulated { default_sim_path() } else { default_path() }
 }
 
-/// The default calibration file for a source: the simulated pen's own for `--sim`. A simulated
+/// The default calibration file for a source: the simulated pen's own for `--source sim`. A simulated
 /// base station reached over a link (`pen-sim serve --pty`) is known only once attached, by
 /// its ID: [`default_path_for`].
 pub fn default_path_for_source(source: &crate::source::Source) -> Option<PathBuf> {

@@ -141,7 +141,7 @@ fn print_fit(before_us: &[f32], held: &[super::Held], fit: &DelayFit) -> Result<
 #[cfg(feature = "sim")]
 fn sim_or_device(a: &DelaysArgs) -> Result<crate::source::Source> {
     if a.device.is_sim() {
-        return Ok(super::sim_source(&a.points, a.device.sim_speed));
+        return Ok(super::sim_source(&a.points, a.device.speed()));
     }
     Ok(a.device.source()?)
 }

@@ -38,6 +38,7 @@ const WARM_UP: usize = 3;
 
 /// Arguments of `penmodel bench`.
 #[derive(clap::Args)]
+#[command(after_help = "Examples:\n  penmodel bench\n  penmodel bench --json > bench.json")]
 pub struct Args {
     /// Print `{"render": [...], "pull_update": [...]}` on stdout instead of a table.
     #[arg(long)]

@@ -25,7 +25,7 @@ use penmodel_terrain::editor::Editor;
 use penmodel_terrain::{Heightmap, export};
 use serde_json::json;
 
-use crate::render::{StereoArg, head, size};
+use crate::render::{StereoArg, head, head_mm, size, vertical_scale};
 
 /// How the session is shown.
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -41,15 +41,17 @@ pub enum Show {
 /// Options of a modeling session.
 #[derive(clap::Args, Clone)]
 pub struct LiveArgs {
-    /// The pen: sim (the built-in demo), none (keyboard only), daemon, daemon:SOCKET, hid,
-    /// hid:PATH, serial:PATH or sim:SCENARIO [default: daemon if pend is running; else sim for a
-    /// new session, none for `open` in a window].
+    /// The pen: daemon (pend's), daemon:SOCKET, hid (the first base station on USB), hid:PATH,
+    /// serial:PATH, none (keyboard only), sim (the built-in demo: the simulated pen calibrates on
+    /// nine targets, then plays modeling-session) or sim:SCENARIO (a pen-sim scenario,
+    /// uncalibrated) [default: daemon if pend is running; else sim for a new session, none for
+    /// `open` in a window].
     #[arg(long, value_name = "SOURCE", value_parser = source)]
     source: Option<String>,
     /// Window, files, or a window when there is a display.
     #[arg(long, value_enum, default_value = "auto")]
     show: Show,
-    /// The folder for frames and results.
+    /// The folder for frames and results (always a folder: the document, the terrain, renders).
     #[arg(long, value_name = "DIR", default_value = "out")]
     out: PathBuf,
     /// Frame size in pixels [default: 1280x720 in a window, 960x540 for files].
@@ -70,9 +72,9 @@ pub struct LiveArgs {
     /// Also write the terrain as meshes: OUT/terrain.obj and OUT/terrain.glb (large).
     #[arg(long)]
     meshes: bool,
-    /// The demo's speed: device seconds per second [default: 1 in a window, as fast as frames
-    /// are drawn when headless].
-    #[arg(long)]
+    /// The simulated pen's speed (sim, sim:SCENARIO): device seconds per second, 0 as fast as
+    /// frames are drawn [default: 1 in a window, 0 when headless].
+    #[arg(long, value_name = "X", value_parser = pen_host::source::speed_value, allow_negative_numbers = true)]
     speed: Option<f64>,
     /// The demo's randomness.
     #[arg(long, default_value_t = 1)]
@@ -80,13 +82,18 @@ pub struct LiveArgs {
     /// Stereo mode.
     #[arg(long, value_enum, default_value = "none")]
     stereo: StereoArg,
-    /// The viewer's head in the display's frame, metres (x right, y up the display, z out).
-    #[arg(long, value_name = "X,Y,Z", value_parser = head, allow_hyphen_values = true)]
+    /// The viewer's head in the display's frame, mm from its centre (x right, y up the display,
+    /// z out of it towards the viewer) [default: 0,-350,700].
+    #[arg(long, value_name = "X,Y,Z", value_parser = head_mm, allow_hyphen_values = true)]
+    head_mm: Option<[f64; 3]>,
+    /// Earlier spelling of --head-mm, in metres.
+    #[arg(long, value_name = "X,Y,Z", value_parser = head, allow_hyphen_values = true, hide = true,
+          conflicts_with = "head_mm")]
     head: Option<[f64; 3]>,
-    /// Vertical exaggeration of the terrain (a pull's height follows it: the figure stays at
-    /// the pen's tip).
-    #[arg(long, default_value_t = 1.0)]
-    exaggeration: f64,
+    /// Vertical scale of the terrain (exaggeration; 1: true heights). A pull follows it: the
+    /// figure stays at the pen's tip.
+    #[arg(long, default_value_t = 1.0, value_parser = vertical_scale, alias = "exaggeration", allow_negative_numbers = true)]
+    vertical_scale: f64,
     /// The document's file for a new session [default: OUT/document.json].
     #[arg(long, value_name = "DOC.json")]
     doc: Option<PathBuf>,
@@ -189,9 +196,6 @@ fn default_source(open: Option<&Path>, window: bool) -> Result<String> {
 
 /// A new session (`doc` = None) or `penmodel open DOC`.
 pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
-    if !(args.exaggeration.is_finite() && args.exaggeration > 0.0) {
-        bail!("--exaggeration must be a positive number");
-    }
     let window_wanted = match args.show {
         Show::Headless => false,
         Show::Window => true,
@@ -262,7 +266,8 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
     let tuning = Tuning::default();
     let mut session = Session::new(editor, [600.0, 340.0], tuning);
     let mut look = Look::default();
-    if let Some(h) = args.head {
+    session.set_vertical_scale(args.vertical_scale);
+    if let Some(h) = args.head_mm.or(args.head) {
         look.head_m = h;
     }
     look.stereo = match args.stereo {

@@ -27,7 +27,9 @@ use clap::{Parser, Subcommand};
     Examples:\n  penmodel                              # the demo: a window, or files in ./out without a display\n  \
     penmodel --show headless --out run1   # the demo written to run1/\n  \
     penmodel --source daemon              # the pen from pend\n  \
-    penmodel open out/document.json       # continue a document"
+    penmodel --source sim:hold --speed 0  # a pen-sim scenario, uncalibrated\n  \
+    penmodel open out/document.json       # continue a document\n\
+    Flags every tool shares (--source, --speed, --vertical-scale, --display-mm, --head-mm, --out): docs/cli.md."
 )]
 struct Cli {
     #[command(subcommand)]
@@ -39,6 +41,14 @@ struct Cli {
 #[derive(Subcommand)]
 enum Command {
     /// Continue modeling a saved document with the pen.
+    #[command(
+        after_help = "Without pend or --source, a window opens the document with no pen (keyboard only); \
+    headless it is refused.\n\
+    Examples:\n  \
+    penmodel open out/document.json                         # with pend's pen, or none\n  \
+    penmodel open out/document.json --source serial:/dev/ttyACM0\n  \
+    penmodel open out/document.json --show headless --source daemon --out run2"
+    )]
     Open {
         /// The document (JSON); its journal, if any, is replayed first.
         #[arg(value_name = "DOC.json")]
@@ -78,6 +88,25 @@ fn main() -> ExitCode {
 #[cfg(test)]
 mod tests {
     use clap::CommandFactory;
+
+    /// The commands under `c` (itself included) whose --help gives no example.
+    fn without_examples(c: &clap::Command, path: &str, missing: &mut Vec<String>) {
+        let path = format!("{path} {}", c.get_name()).trim().to_string();
+        let help = [c.get_after_help(), c.get_after_long_help()];
+        if !help.iter().flatten().any(|h| h.to_string().contains("Example")) {
+            missing.push(path.clone());
+        }
+        for sub in c.get_subcommands() {
+            without_examples(sub, &path, missing);
+        }
+    }
+
+    #[test]
+    fn every_help_gives_examples() {
+        let mut missing = Vec::new();
+        without_examples(&super::Cli::command(), "", &mut missing);
+        assert!(missing.is_empty(), "no examples in the --help of {missing:?}");
+    }
 
     #[test]
     fn the_command_line_is_well_formed() {

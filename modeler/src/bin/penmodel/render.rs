@@ -32,7 +32,7 @@ pub fn size(s: &str) -> Result<(u32, u32), String> {
     Ok((w, h))
 }
 
-/// `W×H` in metres.
+/// `W×H` in metres (the earlier `--display`).
 fn display(s: &str) -> Result<[f64; 2], String> {
     let (w, h) = s
         .split_once(['x', 'X', '×'])
@@ -45,7 +45,7 @@ fn display(s: &str) -> Result<[f64; 2], String> {
     Ok([w, h])
 }
 
-/// `X,Y,Z` in metres.
+/// `X,Y,Z` in metres (the earlier `--head`).
 pub fn head(s: &str) -> Result<[f64; 3], String> {
     let v: Vec<f64> = s
         .split(',')
@@ -57,12 +57,37 @@ pub fn head(s: &str) -> Result<[f64; 3], String> {
     }
 }
 
+/// `W×H` in millimetres, as every tool gives a display's size; in metres.
+fn display_mm(s: &str) -> Result<[f64; 2], String> {
+    let [w, h] = display(s).map_err(|e| e.replace("in metres", "in mm"))?;
+    Ok([w / 1000.0, h / 1000.0])
+}
+
+/// `X,Y,Z` in millimetres, as every tool gives a position in the display's frame; in metres.
+pub fn head_mm(s: &str) -> Result<[f64; 3], String> {
+    let [x, y, z] = head(s).map_err(|e| e.replace("in metres", "in mm"))?;
+    Ok([x / 1000.0, y / 1000.0, z / 1000.0])
+}
+
+/// A vertical scale: a positive, finite factor.
+pub fn vertical_scale(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v > 0.0 => Ok(v),
+        _ => Err(format!(
+            "{s:?} is not a vertical scale: a factor above 0 (1: true heights)"
+        )),
+    }
+}
+
 /// Arguments of `penmodel render`.
 #[derive(clap::Args)]
 #[command(
-    after_help = "Examples:\n  penmodel render modeler/examples/04-volcano.json --png volcano.png --size 1280x720\n  \
-    penmodel render DOC.json --png a.png --size 1280x720 --stereo anaglyph --tilt 20\n  \
-    penmodel render DOC.json --png t.png --size 1920x1080 --display 1.9x1.07 --head 0,-0.4,0.8"
+    group(clap::ArgGroup::new("tracked_display").args(["display_mm", "display"])),
+    group(clap::ArgGroup::new("tracked_head").args(["head_mm", "head"])),
+    after_help = "Examples (from the repository's folder):\n  \
+    penmodel render modeler/examples/04-volcano.json --png volcano.png --size 1280x720\n  \
+    penmodel render modeler/examples/04-volcano.json --png a.png --size 640x360 --stereo anaglyph --tilt 20\n  \
+    penmodel render modeler/examples/04-volcano.json --png t.png --size 640x360 --display-mm 600x340 --head-mm 0,-150,500"
 )]
 pub struct Args {
     /// The document (JSON). A pending journal beside it is replayed, read-only.
@@ -92,15 +117,23 @@ pub struct Args {
     /// Tilt of the ground plane towards the viewer, degrees.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     tilt: f64,
-    /// Vertical exaggeration of the heights.
-    #[arg(long, default_value_t = 1.0)]
-    vertical_scale: f32,
-    /// Tracked view instead of the orbit camera: the display's size in metres; the terrain is
-    /// fitted onto it.
-    #[arg(long, value_name = "WxH", value_parser = display, requires = "head")]
+    /// Vertical scale of the heights (exaggeration; 1: true heights).
+    #[arg(long, default_value_t = 1.0, value_parser = vertical_scale, alias = "exaggeration", allow_negative_numbers = true)]
+    vertical_scale: f64,
+    /// Tracked view instead of the orbit camera: the display's size in mm; the terrain is fitted
+    /// onto it.
+    #[arg(long, value_name = "WxH", value_parser = display_mm, requires = "tracked_head")]
+    display_mm: Option<[f64; 2]>,
+    /// Earlier spelling of --display-mm, in metres.
+    #[arg(long, value_name = "WxH", value_parser = display, requires = "tracked_head", hide = true)]
     display: Option<[f64; 2]>,
-    /// Tracked view: the head in the display's frame, metres (x right, y up the display, z out).
-    #[arg(long, value_name = "X,Y,Z", value_parser = head, allow_hyphen_values = true, requires = "display")]
+    /// Tracked view: the head in the display's frame, mm from its centre (x right, y up the
+    /// display, z out of it towards the viewer).
+    #[arg(long, value_name = "X,Y,Z", value_parser = head_mm, allow_hyphen_values = true, requires = "tracked_display")]
+    head_mm: Option<[f64; 3]>,
+    /// Earlier spelling of --head-mm, in metres.
+    #[arg(long, value_name = "X,Y,Z", value_parser = head, allow_hyphen_values = true, requires = "tracked_display",
+          hide = true)]
     head: Option<[f64; 3]>,
     /// Leave out the figures and region boundaries.
     #[arg(long)]
@@ -127,7 +160,7 @@ pub fn run(args: &Args) -> Result<()> {
     let map = editor.heightmap();
     let grid = editor.document().grid;
     let extent = [grid.width(), grid.height()];
-    let view = match (args.display, args.head) {
+    let view = match (args.display_mm.or(args.display), args.head_mm.or(args.head)) {
         (Some(display), Some(head)) => {
             let mut t = Tracked::fit(display, extent, head[2]);
             t.head = head;
@@ -157,7 +190,7 @@ pub fn run(args: &Args) -> Result<()> {
     );
     scene.overlays = &overlays;
     scene.mode = &args.mode;
-    scene.vertical_scale = args.vertical_scale;
+    scene.vertical_scale = args.vertical_scale as f32;
     scene.style.ramp_top = ramp_top(hi);
     scene.stereo = match args.stereo {
         StereoArg::None => Stereo::None,
