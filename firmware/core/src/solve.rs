@@ -14,7 +14,11 @@
 //! 4. **Reject.** The sum of squared residuals is tested against the χ² distribution of range
 //!    noise of [`RANGE_SIGMA_MM`] with n − 3 degrees of freedom at 99.9 %. A fix that fails has
 //!    a bad range (a late echo, a glitch). With five or more receivers it is redone without each
-//!    receiver in turn and the best subset kept if that passes; otherwise the cycle has no fix.
+//!    receiver in turn and the best subset kept if that passes; with six or more and no single
+//!    receiver to blame, without each pair (two echoes in one cycle still leave four ranges),
+//!    where a receiver left out must be late, as an echo is, and subsets whose receivers stand
+//!    in one plane other than the display's are skipped (their mirror images fit alike);
+//!    otherwise the cycle has no fix.
 //!    A single residual threshold would not do: least squares spreads one bad range over all
 //!    residuals, most thinly where the geometry controls that receiver least. When more than
 //!    one subset passes and their solutions disagree (four receivers leave one degree of
@@ -221,6 +225,17 @@ impl Problem<'_> {
         (c, if normal.dot(front) < 0.0 { -normal } else { normal })
     }
 
+    /// The receivers in `mask` lie within [`COPLANAR_MM`] of a plane other than the display's:
+    /// a point and its mirror image in that plane fit their ranges equally, both in front of
+    /// the display, and nothing tells them apart. (In the display's plane the mirror image is
+    /// behind it, and [`solve_subset`](Self::solve_subset) takes the one in front.)
+    fn mirror_ambiguous(&self, mask: u8, front: Vec3, height: &dyn Fn(Vec3) -> f32) -> bool {
+        let (c, normal) = self.plane(mask, front);
+        let flat = self.used(mask).all(|(p, _)| (p - c).dot(normal).abs() < COPLANAR_MM);
+        let display_plane = normal.dot(front) > 0.9 && height(c).abs() < COPLANAR_MM + BEHIND_MARGIN_MM;
+        flat && !display_plane
+    }
+
     /// In front of the receivers' centroid at the distance the ranges imply.
     fn centroid_start(&self, mask: u8, n: usize, front: Vec3) -> Vec3 {
         let inv_n = 1.0 / n as f32;
@@ -311,6 +326,76 @@ const OUTLIER_SIGMAS: f32 = 4.0;
 /// (σ_range · DOP) are the same answer.
 const SAME_POINT_SIGMAS: f32 = 6.0;
 
+/// Receivers closer than this to a common plane cannot tell a point from its mirror image, mm.
+const COPLANAR_MM: f32 = 20.0;
+
+/// Most subsets tried at once: every pair left out of eight receivers.
+const MAX_SUBSETS: usize = MAX_RECEIVERS * (MAX_RECEIVERS - 1) / 2;
+
+/// Solves the subsets of `mask` without `k` (1 or 2) of its receivers and keeps those that
+/// pass: the subset fits, and every receiver it leaves out misses its solution (otherwise the
+/// subset fits only by chance and a bad range is among those it kept). When the passing subsets
+/// disagree, the one nearest `hint` wins; without a hint the cycle is ambiguous.
+fn leave_out(
+    problem: &Problem<'_>,
+    geometry: &Geometry<'_>,
+    mask: u8,
+    k: u32,
+    height: &dyn Fn(Vec3) -> f32,
+    hint: Option<Vec3>,
+) -> Result<(u8, Solution), NoFix> {
+    let n = mask.count_ones() as usize;
+    let mut candidates: [Option<(u8, Solution)>; MAX_SUBSETS] = [None; MAX_SUBSETS];
+    let mut count = 0;
+    // Every `out` of `k` receivers of `mask`, in increasing order.
+    for out in (1u16..256)
+        .map(|o| o as u8)
+        .filter(|&o| o & !mask == 0 && o.count_ones() == k)
+    {
+        let m = mask & !out;
+        if problem.mirror_ambiguous(m, geometry.front, height) {
+            continue;
+        }
+        let Ok(s) = problem.solve_subset(m, geometry.front, height, SUBSET_ITERATIONS) else {
+            continue;
+        };
+        let misses = (0..MAX_RECEIVERS).filter(|i| out & (1 << i) != 0).all(|i| {
+            problem.ranges[i].is_some_and(|r| {
+                let excess = r - (s.x - geometry.receivers[i]).length();
+                // With two left out, only late arrivals count: an echo's path is always longer,
+                // and with one degree of freedom left a wrong subset often fits a point that
+                // some good range misses from the short side.
+                excess > OUTLIER_SIGMAS * RANGE_SIGMA_MM || (k == 1 && -excess > OUTLIER_SIGMAS * RANGE_SIGMA_MM)
+            })
+        });
+        if consistent(s.sse, n - k as usize) && misses && count < MAX_SUBSETS {
+            candidates[count] = Some((m, s));
+            count += 1;
+        }
+    }
+    let mut passing = candidates.iter().flatten();
+    let Some(&first) = passing.next() else {
+        return Err(NoFix::Inconsistent);
+    };
+    let lowest = passing.fold(first, |b, &c| if c.1.sse < b.1.sse { c } else { b });
+    let same = SAME_POINT_SIGMAS * RANGE_SIGMA_MM * problem.dop(lowest.1.x, lowest.0);
+    let agree = candidates
+        .iter()
+        .flatten()
+        .all(|(_, s)| (s.x - lowest.1.x).length() <= same);
+    if agree {
+        return Ok(lowest);
+    }
+    let Some(h) = hint else {
+        return Err(NoFix::Ambiguous);
+    };
+    let dist = |c: &(u8, Solution)| (c.1.x - h).length();
+    Ok(candidates
+        .iter()
+        .flatten()
+        .fold(first, |b, &c| if dist(&c) < dist(&b) { c } else { b }))
+}
+
 /// Solves one cycle. `ranges[i]` is receiver i's range in mm, `None` without an arrival;
 /// `height` gives a point's signed distance in front of the display, mm; `hint` is where the
 /// emitter probably is (the previous fix), used only to choose between ambiguous subsets.
@@ -342,45 +427,16 @@ pub fn solve(
                 Err(e) => e,
             });
         }
-        // Leave each receiver out in turn; keep the subsets that pass.
-        let mut candidates: [Option<(u8, Solution)>; MAX_RECEIVERS] = [None; MAX_RECEIVERS];
-        for i in (0..MAX_RECEIVERS).filter(|i| mask & (1 << i) != 0) {
-            let m = mask & !(1 << i);
-            // The subset must fit, and the receiver left out must not: otherwise the subset
-            // fits only by chance and the bad range is among those it kept.
-            if let Ok(s) = problem.solve_subset(m, geometry.front, height, SUBSET_ITERATIONS)
-                && consistent(s.sse, n as usize - 1)
-                && let Some(r) = ranges[i]
-                && ((s.x - geometry.receivers[i]).length() - r).abs() > OUTLIER_SIGMAS * RANGE_SIGMA_MM
-            {
-                candidates[i] = Some((m, s));
-            }
+        // Leave each receiver out in turn; with six or more, then each pair (two echoes in one
+        // cycle still leave four ranges, one more than a fix needs).
+        let mut found = leave_out(&problem, geometry, mask, 1, height, hint);
+        if matches!(found, Err(NoFix::Inconsistent)) && n >= 6 {
+            // Every pair: trying only the latest arrivals' pairs (3 or 4 suspects) was cheaper
+            // but fixed fewer echo cycles (150.7 and 151.2 a second against 152.0). The cost:
+            // up to 285 000 instructions in a worst cycle (docs/firmware.md).
+            found = leave_out(&problem, geometry, mask, 2, height, hint);
         }
-        let mut passing = candidates.iter().flatten();
-        let Some(&first) = passing.next() else {
-            return Err(NoFix::Inconsistent);
-        };
-        let lowest = candidates
-            .iter()
-            .flatten()
-            .fold(first, |b, &c| if c.1.sse < b.1.sse { c } else { b });
-        let same = SAME_POINT_SIGMAS * RANGE_SIGMA_MM * problem.dop(lowest.1.x, lowest.0);
-        let agree = candidates
-            .iter()
-            .flatten()
-            .all(|(_, s)| (s.x - lowest.1.x).length() <= same);
-        let (m, s) = if agree {
-            lowest
-        } else {
-            let Some(h) = hint else {
-                return Err(NoFix::Ambiguous);
-            };
-            let dist = |c: &(u8, Solution)| (c.1.x - h).length();
-            candidates
-                .iter()
-                .flatten()
-                .fold(first, |b, &c| if dist(&c) < dist(&b) { c } else { b })
-        };
+        let (m, s) = found?;
         mask = m;
         best = Ok(s);
     }
