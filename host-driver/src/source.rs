@@ -108,6 +108,7 @@ impl FromStr for Source {
 
 impl Source {
     /// [`Source::FORMS`], `sim` alone playing `default_scenario` (each tool has its own).
+    #[cfg_attr(not(feature = "sim"), allow(unused_variables))]
     pub fn parse(s: &str, default_scenario: &str) -> Result<Source, SourceError> {
         let (kind, arg) = match s.split_once(':') {
             Some((k, a)) => (k, Some(a)),
@@ -146,10 +147,8 @@ pub fn speed_value(s: &str) -> Result<f64, String> {
 /// simulated pen ([`SimSwitch`], [`SimScenario`]).
 #[derive(Args, Clone, Debug)]
 pub struct DeviceArgs<S: SimFlag> {
-    /// The base station: hid (the first one found on USB; the default), hid:PATH, serial:PATH,
-    /// or the simulated pen: sim (its scenario for this tool: see the examples), sim:SCENARIO
-    /// (`pen-sim scenarios` lists them).
-    #[arg(long, value_name = "SOURCE", value_parser = source_form)]
+    /// The base station: hid, hid:PATH, serial:PATH, sim or sim:SCENARIO ([`SimFlag::SOURCE_HELP`]).
+    #[arg(long, value_name = "SOURCE", value_parser = source_form, help = S::SOURCE_HELP)]
     pub source: Option<String>,
     /// Earlier spelling of --source serial:PATH.
     #[arg(long, value_name = "PATH", hide = true, conflicts_with_all = ["source", "hid"])]
@@ -212,9 +211,16 @@ pub trait SimFlag: Args + Clone + fmt::Debug {
     /// What `--source sim` plays in this tool.
     const DEFAULT_SCENARIO: &'static str;
 
+    /// `--source`'s help in this tool, naming [`Self::DEFAULT_SCENARIO`].
+    const SOURCE_HELP: &'static str;
+
     /// The scenario the earlier spelling asked for, if it was used ("" for the default).
     fn scenario(&self) -> Option<&str>;
 }
+
+/// `--source`'s help in a build without the simulated pen.
+#[cfg(not(feature = "sim"))]
+const NO_SIM_HELP: &str = "The base station: hid (the first one found on USB; the default), hid:PATH or serial:PATH";
 
 /// penctl's: `--source sim` plays `hold` (the pen held still over the display: steady figures
 /// for info, monitor and config); earlier spelled `--sim`, and `--scenario NAME`.
@@ -232,6 +238,12 @@ pub struct SimSwitch {
 
 impl SimFlag for SimSwitch {
     const DEFAULT_SCENARIO: &'static str = "hold";
+    #[cfg(not(feature = "sim"))]
+    const SOURCE_HELP: &'static str = NO_SIM_HELP;
+    #[cfg(feature = "sim")]
+    const SOURCE_HELP: &'static str = "The base station: hid (the first one found on USB; the default), hid:PATH, \
+        serial:PATH, or the simulated pen: sim (playing `hold`, the pen held still over the display), sim:SCENARIO \
+        (`pen-sim scenarios` lists them)";
 
     fn scenario(&self) -> Option<&str> {
         #[cfg(feature = "sim")]
@@ -255,6 +267,12 @@ pub struct SimScenario {
 
 impl SimFlag for SimScenario {
     const DEFAULT_SCENARIO: &'static str = "modeling-session";
+    #[cfg(not(feature = "sim"))]
+    const SOURCE_HELP: &'static str = NO_SIM_HELP;
+    #[cfg(feature = "sim")]
+    const SOURCE_HELP: &'static str = "The base station: hid (the first one found on USB; the default), hid:PATH, \
+        serial:PATH, or the simulated pen: sim (playing `modeling-session`, the events a modeler sees), \
+        sim:SCENARIO (`pen-sim scenarios` lists them)";
 
     fn scenario(&self) -> Option<&str> {
         #[cfg(feature = "sim")]

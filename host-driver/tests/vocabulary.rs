@@ -59,6 +59,10 @@ fn the_help_shows_one_spelling() {
         help.contains("--source <SOURCE>") && help.contains("--speed <X>"),
         "{help}"
     );
+    assert!(
+        help.contains("sim (playing `hold`"),
+        "each tool says what its sim plays: {help}"
+    );
     for old in ["--serial", "--hid", "--sim ", "--sim-speed", "--scenario"] {
         assert!(!help.contains(old), "{old} in:\n{help}");
     }
@@ -72,6 +76,7 @@ fn the_help_shows_one_spelling() {
         "{help}"
     );
     assert!(help.contains("plays `modeling-session` here"), "{help}");
+    assert!(help.contains("sim (playing `modeling-session`"), "{help}");
     for old in ["--serial", "--hid", "--sim ", "--sim-speed"] {
         assert!(!help.contains(old), "{old} in:\n{help}");
     }

@@ -16,12 +16,9 @@ use pen_host::daemon::{self, DEFAULT_MAX_CLIENTS, DEFAULT_QUEUE, Hub};
 use pen_host::pipeline::Pipeline;
 use pen_host::source::{DeviceArgs, SimScenario, SourceError};
 
-#[derive(Parser)]
-#[command(
-    name = "pend",
-    version,
-    about = "The 3D pen's daemon: pen events for every program, on a Unix socket",
-    after_help = "The simulated pen (--source sim) plays `modeling-session` here: a session of modeling gestures, \
+/// `pend --help`'s end: what the defaults mean, and examples.
+#[cfg(feature = "sim")]
+const AFTER_HELP: &str = "The simulated pen (--source sim) plays `modeling-session` here: a session of modeling gestures, \
     the events a modeler sees. While the base station is not there, pend says what it waits for and why every \
     5 s; access without root: host-driver/udev/70-penscape.rules.\n\
     Examples:\n  \
@@ -29,7 +26,22 @@ use pen_host::source::{DeviceArgs, SimScenario, SourceError};
     pend --source serial:/dev/ttyACM0        # its serial link\n  \
     pend --source sim                        # the simulated pen, in real time\n  \
     pend --source sim:hold --speed 0 --socket /tmp/pend.sock\n\
-    docs/events.md (the socket's lines) and docs/cli.md (the flags every tool shares)."
+    docs/events.md (the socket's lines) and docs/cli.md (the flags every tool shares).";
+/// `pend --help`'s end, in a build without the simulated pen.
+#[cfg(not(feature = "sim"))]
+const AFTER_HELP: &str = "While the base station is not there, pend says what it waits for and why every 5 s; access without \
+root: host-driver/udev/70-penscape.rules.\n\
+Examples:\n  \
+pend                                     # the first base station on USB\n  \
+pend --source serial:/dev/ttyACM0        # its serial link\n\
+docs/events.md (the socket's lines) and docs/cli.md (the flags every tool shares).";
+
+#[derive(Parser)]
+#[command(
+    name = "pend",
+    version,
+    about = "The 3D pen's daemon: pen events for every program, on a Unix socket",
+    after_help = AFTER_HELP
 )]
 struct Cli {
     /// The socket [default: $XDG_RUNTIME_DIR/penscape/pend.sock].
