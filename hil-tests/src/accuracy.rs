@@ -141,7 +141,7 @@ pub fn evaluate(scenario: &Scenario, records: &[CycleRecord]) -> Metrics {
     errors.sort_by(f64::total_cmp);
     let seconds = records
         .last()
-        .map_or(0.0, |r| r.sent.last().map_or(r.t0_us, |s| s.t_us) as f64 * 1e-6);
+        .map_or(0.0, |r| r.sent.last().map_or(r.t0_us, |s| s.t_us) as f64 / 1e6);
     let (false_switch_events, missed_switch_events) =
         switch_errors(scenario.timeline.events(), &reported_transitions(records), seconds);
     Metrics {

@@ -198,3 +198,11 @@ fn reports_are_the_device_bytes() {
         records.last().map(|r| r.sent[0].bytes.len()).unwrap_or(0)
     );
 }
+
+#[test]
+fn the_session_length_is_the_device_clock_in_whole_microseconds() {
+    // `pen-sim accuracy --json` prints it: 10.002, not 10.001999999999999 (issue 19.7).
+    let m = metrics("hold");
+    let us = (m.seconds * 1e6).round();
+    assert_eq!(m.seconds, us / 1e6, "{}", m.seconds);
+}
