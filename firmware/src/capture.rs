@@ -2,16 +2,17 @@
 //!
 //! * TIM1 channel 1 (PA8) drives the transducer's gate driver with a burst of
 //!   [`BURST_CYCLES`] periods at 40 kHz, in one-pulse mode with the repetition counter, so the
-//!   burst length is exact and needs no interrupt. PWM mode 2 keeps the pin low at rest.
-//! * TIM1's trigger output fires when its counter is enabled; TIM2 and TIM3 take it as a reset
-//!   (slave reset mode, ITR0), so their counters restart at the burst in hardware and a capture
-//!   value is the time of flight itself.
+//!   burst length is exact and needs no interrupt. PWM mode 2 keeps the pin low at rest; the
+//!   first rising edge comes 12.49 µs after the counter starts, and is subtracted.
+//! * TIM1's trigger output fires when its counter is enabled; TIM2 and TIM3 take it as a start
+//!   (trigger mode, ITR0) and run in one-pulse mode to the end of the listening window, so their
+//!   counters start at the burst in hardware, stop when the window closes, and a capture value
+//!   is the time since the trigger.
 //! * TIM2 (32-bit, 96 MHz, 10.4 ns per tick) captures receivers 0–3 on PA15, PB3, PB10, PA3;
-//!   TIM3 (16-bit, prescaled to 8 MHz, 125 ns, wrapping after 8.2 ms, beyond the 5 ms window)
-//!   captures receivers 4–7 on PA6, PA7, PB0, PB1.
+//!   TIM3 (16-bit, prescaled to 8 MHz, 125 ns) captures receivers 4–7 on PA6, PA7, PB0, PB1.
 //! * Each receiver's comparator output rises on the first arrival. The capture interrupt
-//!   stores the first capture of each channel and disables that channel, so later echoes cannot
-//!   overwrite it.
+//!   ignores edges in the first 230 µs (pickup from the burst), stores the first capture after
+//!   it and disables that channel, so later echoes cannot overwrite it.
 
 use core::sync::atomic::{AtomicU32, Ordering};
 
@@ -27,8 +28,8 @@ use embassy_stm32::timer::low_level::{
 use embassy_stm32::timer::simple_pwm::PwmPin;
 use embassy_stm32::timer::{Ch1, Ch2, Ch3, Ch4, Channel};
 use embassy_stm32::{Peri, interrupt, pac};
-use pen_core::Ranging;
 use pen_core::ranging::{SLOW_TIMER_HZ, ns_per_tick, ticks_to_ns};
+use pen_core::{LISTEN_US, Ranging};
 use pen_protocol::MAX_RECEIVERS;
 
 /// Periods of 40 kHz per burst: long enough for the transducer to ring up, short enough to end
@@ -40,21 +41,53 @@ const BURST_HZ: u32 = 40_000;
 const NO_CAPTURE: u32 = u32::MAX;
 /// The first capture of each receiver since the last burst, in timer ticks.
 static CAPTURES: [AtomicU32; MAX_RECEIVERS] = [const { AtomicU32::new(NO_CAPTURE) }; MAX_RECEIVERS];
+/// Captures earlier than this many ticks of TIM2 / TIM3 after the trigger are the burst's own
+/// electrical and acoustic pickup, not an arrival: ignored, the channel stays armed. Set once by
+/// [`BoardRanging::new`] before the interrupts are enabled.
+static BLANK_TICKS: [AtomicU32; 2] = [const { AtomicU32::new(0) }; 2];
+
+/// How long after the trigger an edge is pickup from the burst, ns: the burst's first rising
+/// edge (12.49 µs), its eight periods (200 µs), and ringing. A pen nearer a receiver than
+/// 230 µs of flight (79 mm) is not measured by it.
+const BLANK_NS: u32 = 230_000;
 
 const CHANNELS: [Channel; 4] = [Channel::Ch1, Channel::Ch2, Channel::Ch3, Channel::Ch4];
 
-/// Stores the first capture of each channel of a timer and disables the channel.
-fn on_capture(regs: pac::timer::TimGp16, first_receiver: usize) {
+/// The capture interrupt of one timer: `sr` and `ccr` read it, `first_receiver` is its channel 1's
+/// receiver. A capture after the blanking time is the first arrival: stored, and its channel
+/// disabled so that echoes cannot overwrite it. One earlier is pickup from the burst: dropped,
+/// the channel left armed. The counter stops (one-pulse mode) at the end of the listening
+/// window and reads 0 after it, so an edge however late is blanked too, never aliased.
+///
+/// Reading CCR clears its capture flag in hardware, so SR is written only for overcapture, and
+/// then with 0 in the handled bit alone: SR is clear-by-writing-0, and a read-modify-write
+/// would clear a capture latched between the read and the write, whose channel would then take
+/// a later echo as its first arrival.
+fn on_capture(regs: pac::timer::TimGp16, ccr: impl Fn(usize) -> u32, first_receiver: usize, blank: u32) {
     let sr = regs.sr().read();
-    for ch in 0..4 {
-        if sr.ccif(ch) {
-            CAPTURES[first_receiver + ch].store(regs.ccr(ch).read().ccr() as u32, Ordering::Relaxed);
-            regs.ccer().modify(|w| w.set_cce(ch, false));
-            regs.dier().modify(|w| w.set_ccie(ch, false));
+    let mut overcaptured = pac::timer::regs::SrGp16(u32::MAX);
+    for ch in (0..4).filter(|&ch| sr.ccif(ch)) {
+        let ticks = ccr(ch);
+        if sr.ccof(ch) {
+            // Two edges before this interrupt ran (it was held off): CCR holds the later one,
+            // and the first arrival is lost. Better no range than an echo's.
+            overcaptured.set_ccof(ch, false);
+            if ticks >= blank {
+                regs.ccer().modify(|w| w.set_cce(ch, false));
+                regs.dier().modify(|w| w.set_ccie(ch, false));
+            }
+            continue;
         }
+        if ticks < blank {
+            continue;
+        }
+        CAPTURES[first_receiver + ch].store(ticks, Ordering::Relaxed);
+        regs.ccer().modify(|w| w.set_cce(ch, false));
+        regs.dier().modify(|w| w.set_ccie(ch, false));
     }
-    // Flags are cleared by writing 0; the ones written as read stay as they are.
-    regs.sr().modify(|w| (0..4).for_each(|ch| w.set_ccif(ch, false)));
+    if overcaptured.0 != u32::MAX {
+        regs.sr().write_value(overcaptured);
+    }
 }
 
 /// TIM2's capture interrupt: receivers 0–3.
@@ -62,17 +95,12 @@ pub struct Tim2Captures;
 
 impl Handler<interrupt::typelevel::TIM2> for Tim2Captures {
     unsafe fn on_interrupt() {
-        // TIM2's capture registers are 32 bits wide; read through the 32-bit view.
-        let regs = pac::TIM2;
-        let sr = regs.sr().read();
-        for (ch, capture) in CAPTURES.iter().enumerate().take(4) {
-            if sr.ccif(ch) {
-                capture.store(regs.ccr(ch).read(), Ordering::Relaxed);
-                regs.ccer().modify(|w| w.set_cce(ch, false));
-                regs.dier().modify(|w| w.set_ccie(ch, false));
-            }
-        }
-        regs.sr().modify(|w| (0..4).for_each(|ch| w.set_ccif(ch, false)));
+        // TIM2's capture registers are 32 bits wide: read through the 32-bit view; its other
+        // registers are laid out as a 16-bit timer's.
+        // SAFETY: TIM2 is a general-purpose timer at the same address in both views.
+        let regs = unsafe { pac::timer::TimGp16::from_ptr(pac::TIM2.as_ptr()) };
+        let blank = BLANK_TICKS[0].load(Ordering::Relaxed);
+        on_capture(regs, |ch| pac::TIM2.ccr(ch).read(), 0, blank);
     }
 }
 
@@ -81,7 +109,8 @@ pub struct Tim3Captures;
 
 impl Handler<interrupt::typelevel::TIM3> for Tim3Captures {
     unsafe fn on_interrupt() {
-        on_capture(pac::TIM3, 4);
+        let blank = BLANK_TICKS[1].load(Ordering::Relaxed);
+        on_capture(pac::TIM3, |ch| pac::TIM3.ccr(ch).read().ccr() as u32, 4, blank);
     }
 }
 
@@ -116,6 +145,8 @@ pub struct BoardRanging<'d> {
     receivers: usize,
     ns_per_tick_tim2: f32,
     ns_per_tick_tim3: f32,
+    /// The burst's first rising edge after the trigger, ns.
+    edge_ns: u32,
     _pins: Pins<'d>,
 }
 
@@ -158,17 +189,38 @@ impl<'d> BoardRanging<'d> {
             tim3.set_input_capture_filter(ch, FilterValue::FCK_INT_N8);
             tim3.set_input_capture_mode(ch, InputCaptureMode::Rising);
         }
-        tim2.set_slave_mode(SlaveMode::RESET_MODE);
+        // The listening window in hardware: each capture counter runs from the burst's trigger
+        // (trigger mode starts it, from 0) to the end of the window and stops there (one-pulse
+        // mode: the update event clears CEN and leaves the counter at 0). However late
+        // `collect()` runs — a flash erase stalls the CPU for seconds — an edge after the window
+        // captures 0 and is blanked; TIM3 can no longer wrap (8.19 ms) and alias a late edge
+        // to a short flight.
+        let fast_hz = tim2.get_clock_frequency().0;
+        let window_ticks = |hz: u32| (LISTEN_US * hz as u64 / 1_000_000) as u32;
+        tim2.regs_gp32().arr().write_value(window_ticks(fast_hz));
+        tim3.regs_gp16()
+            .arr()
+            .write(|w| w.set_arr(window_ticks(SLOW_TIMER_HZ).min(u16::MAX as u32) as u16));
+        tim2.regs_gp32().cr1().modify(|w| w.set_opm(true));
+        tim3.regs_gp16().cr1().modify(|w| w.set_opm(true));
+        tim2.set_slave_mode(SlaveMode::TRIGGER_MODE);
         tim2.set_trigger_source(TriggerSource::ITR0);
-        tim3.set_slave_mode(SlaveMode::RESET_MODE);
+        tim3.set_slave_mode(SlaveMode::TRIGGER_MODE);
         tim3.set_trigger_source(TriggerSource::ITR0);
+        // Load ARR and the prescaler; the counters stay stopped at 0 until the first burst.
         tim2.generate_update_event();
         tim3.generate_update_event();
-        tim2.start();
-        tim3.start();
         // The clock tree gives TIM2 the 96 MHz the core's FAST_TIMER_HZ assumes.
-        let ns_per_tick_tim2 = ns_per_tick(tim2.get_clock_frequency().0);
+        let ns_per_tick_tim2 = ns_per_tick(fast_hz);
         let ns_per_tick_tim3 = ns_per_tick(SLOW_TIMER_HZ);
+        let blank_ticks = |hz: u32| (BLANK_NS as u64 * hz as u64 / 1_000_000_000) as u32;
+        BLANK_TICKS[0].store(blank_ticks(fast_hz), Ordering::Relaxed);
+        BLANK_TICKS[1].store(blank_ticks(SLOW_TIMER_HZ), Ordering::Relaxed);
+        // PWM mode 2 keeps the pin low until the counter reaches the compare value: the burst's
+        // first rising edge, where the sound starts, comes `half` ticks of TIM1 after the
+        // trigger that starts the capture counters (12.49 µs at 96 MHz, 4.3 mm of range).
+        // Subtracted from every capture, so times of flight start at the sound.
+        let edge_ns = (half as u64 * 1_000_000_000 / burst.get_clock_frequency().0 as u64) as u32;
         interrupt::typelevel::TIM2::unpend();
         interrupt::typelevel::TIM3::unpend();
         // SAFETY: the handlers are bound in main's `bind_interrupts!` and touch only the
@@ -184,6 +236,7 @@ impl<'d> BoardRanging<'d> {
             receivers: receivers.min(MAX_RECEIVERS),
             ns_per_tick_tim2,
             ns_per_tick_tim3,
+            edge_ns,
             _pins: pins,
         }
     }
@@ -196,14 +249,22 @@ impl<'d> BoardRanging<'d> {
     fn arm(&mut self, enable: bool) {
         for (i, ch) in CHANNELS.into_iter().enumerate() {
             let on = enable && i < self.receivers;
-            self.tim2.clear_input_interrupt(ch);
             self.tim2.enable_channel(ch, on);
             self.tim2.enable_input_interrupt(ch, on);
             let on = enable && i + 4 < self.receivers;
-            self.tim3.clear_input_interrupt(ch);
             self.tim3.enable_channel(ch, on);
             self.tim3.enable_input_interrupt(ch, on);
         }
+        // Stale capture and overcapture flags from the last window, all at once. Writing 0
+        // clears a flag and 1 leaves it (SR is clear-by-writing-0), so the update flag and the
+        // rest are written 1 rather than read and written back.
+        let mut stale = pac::timer::regs::SrGp16(u32::MAX);
+        for ch in 0..4 {
+            stale.set_ccif(ch, false);
+            stale.set_ccof(ch, false);
+        }
+        self.tim2.regs_gp16().sr().write_value(stale);
+        self.tim3.regs_gp16().sr().write_value(stale);
     }
 }
 
@@ -229,7 +290,7 @@ impl Ranging for BoardRanging<'_> {
                 } else {
                     self.ns_per_tick_tim3
                 };
-                *slot = Some(ticks_to_ns(ticks, ns_per_tick));
+                *slot = ticks_to_ns(ticks, ns_per_tick).checked_sub(self.edge_ns);
             }
         }
         out

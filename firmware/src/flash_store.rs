@@ -33,8 +33,41 @@ impl FlashRegion for ConfigSector<'_> {
     }
 
     fn erase(&mut self) -> Result<(), StoreError> {
-        self.flash
+        let result = self
+            .flash
             .blocking_erase(SECTOR_7, SECTOR_7 + SECTOR_7_SIZE)
-            .map_err(|_| StoreError::Flash)
+            .map_err(|_| StoreError::Flash);
+        // The caches may hold lines of the erased sector (the data cache, the store's reads);
+        // RM0383 §3.4.2: reset them, disabled, after an erase.
+        reset_caches();
+        result
     }
+}
+
+/// Turns on the flash accelerator: prefetch, instruction cache, data cache (RM0383 §3.4).
+pub fn enable_accelerator() {
+    embassy_stm32::pac::FLASH.acr().modify(|w| {
+        w.set_prften(true);
+        w.set_icen(true);
+        w.set_dcen(true);
+    });
+}
+
+/// Empties the instruction and data caches: each is disabled, reset, and enabled again (a cache
+/// may be reset only while disabled).
+fn reset_caches() {
+    let acr = embassy_stm32::pac::FLASH.acr();
+    acr.modify(|w| {
+        w.set_icen(false);
+        w.set_dcen(false);
+    });
+    acr.modify(|w| {
+        w.set_icrst(true);
+        w.set_dcrst(true);
+    });
+    acr.modify(|w| {
+        w.set_icrst(false);
+        w.set_dcrst(false);
+    });
+    enable_accelerator();
 }

@@ -48,9 +48,11 @@ bind_interrupts!(struct Irqs {
     TIM3 => capture::Tim3Captures;
 });
 
-/// The watchdog resets the board if the station stops for this long. Longer than a flash
-/// sector erase (about 1 s, 2 s at most), the longest the CPU ever stalls.
-const WATCHDOG_US: u32 = 4_000_000;
+/// The watchdog resets the board if the station stops for this long. The longest the CPU ever
+/// stalls is a 128 KiB flash sector erase, which embassy runs at 8-bit parallelism (PSIZE is
+/// left 0): 2 s typical, 4 s at most (DS10314, t_ERASE128KB). The IWDG runs from the LSI, 17–47
+/// kHz against the nominal 32: 12 s nominal is 8.2 s at the fastest LSI, twice the worst erase.
+const WATCHDOG_US: u32 = 12_000_000;
 
 /// Parses a decimal version component at compile time.
 const fn parse_u8(s: &str) -> u8 {
@@ -101,6 +103,13 @@ async fn main(_spawner: Spawner) {
     }
     let p = embassy_stm32::init(config);
     info!("pen base station, firmware {}, protocol {}", FIRMWARE, PROTOCOL_VERSION);
+    // The flash accelerator: embassy sets the wait states (3 at 96 MHz) and nothing else. Without
+    // prefetch and the instruction and data caches, every fetch waits them out and the core runs
+    // about half as fast as docs/firmware.md's figures assume (RM0383 §3.4).
+    flash_store::enable_accelerator();
+    // Freeze the watchdog while a debugger halts the core, so that probe-rs can read a panic's
+    // backtrace without the chip resetting under it.
+    embassy_stm32::pac::DBGMCU.apb1fzr().modify(|w| w.set_iwdg(true));
 
     let mut watchdog = IndependentWatchdog::new(p.IWDG, WATCHDOG_US);
     watchdog.unleash();
@@ -151,7 +160,9 @@ async fn main(_spawner: Spawner) {
     let mut device = embassy_usb::Config::new(USB_VID, USB_PID);
     device.manufacturer = Some("penscape");
     device.product = Some("3D pen base station");
-    device.serial_number = None;
+    // The chip's unique ID, so that the host can tell two base stations apart (and a
+    // calibration can name the one it belongs to).
+    device.serial_number = Some(uid::uid_hex());
     device.max_power = 100;
     device.max_packet_size_0 = 64;
     device.supports_remote_wakeup = true;
@@ -203,6 +214,9 @@ async fn main(_spawner: Spawner) {
     let usb_task = async {
         loop {
             usb.run_until_suspend().await;
+            // A request raised before this suspend (during the last wakeup, say) is stale: only a
+            // press during this suspend wakes the host.
+            usb::WAKE_HOST.reset();
             if let Either::Second(()) = select(usb.wait_resume(), usb::WAKE_HOST.wait()).await
                 && let Err(e) = usb.remote_wakeup().await
             {
@@ -220,17 +234,23 @@ async fn main(_spawner: Spawner) {
     let mut station = Station::new(&engine, ranging, switches, BoardClock, sink);
     let station_task = async {
         let mut next_log = Instant::now();
+        // The tip as last seen during suspend: a wakeup needs a new press (released, then
+        // pressed), so that a pen standing tip-down does not keep the host awake.
+        let mut tip_was_down = true;
         loop {
             watchdog.pet();
             if usb::SUSPENDED.load(core::sync::atomic::Ordering::Relaxed) {
-                // No bursts during suspend; a press of the tip wakes the host.
+                // No bursts during suspend; a new press of the tip wakes the host.
                 use pen_core::Switches;
-                if station.switches.read()[0] {
+                let tip = station.switches.read()[0];
+                if tip && !tip_was_down {
                     usb::WAKE_HOST.signal(());
                 }
+                tip_was_down = tip;
                 Timer::after_millis(10).await;
                 continue;
             }
+            tip_was_down = true;
             let receivers = engine.lock(|e| e.borrow().settings().count);
             station.ranging.set_receivers(receivers);
             station.cycle().await;

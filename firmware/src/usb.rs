@@ -158,6 +158,10 @@ impl ReportSink for BoardSink<'_, '_> {
 /// Writes queued reports to the HID interrupt endpoint.
 pub async fn hid_writer<'d, D: Driver<'d>>(mut writer: HidWriter<'d, D, HID_PACKET>, queue: &HidQueue) -> ! {
     loop {
+        // Before the host configures the device the endpoint is disabled and every write fails
+        // at once: wait for it instead of failing (and logging) 150–300 times a second. Reports
+        // queued meanwhile are dropped and counted by the sink.
+        writer.ready().await;
         let packet = queue.receive().await;
         if let Err(e) = writer.write(&packet.buf[..packet.len]).await {
             warn!("HID report not sent: {}", e);
