@@ -152,20 +152,16 @@ impl Picture {
         } else {
             format!("calibrating: all {count} targets taken, fitting")
         };
-        Picture {
-            overlays,
-            selection: None,
-            slope_bar: None,
-            mode,
-            camera: camera(view, look.head_m),
-            vertical_scale: view.exaggeration as f32,
-            look: look.clone(),
-        }
+        Picture::plain(overlays, view, mode, look)
     }
 
     /// The document alone through `view`: no pen, no highlight, `mode` as the text line.
     pub fn document(doc: &Document, view: &View, mode: String, look: &Look) -> Picture {
-        let overlays = document_overlays(doc);
+        Picture::plain(document_overlays(doc), view, mode, look)
+    }
+
+    /// `overlays` through `view`, nothing selected, no slope bar.
+    fn plain(overlays: Vec<Overlay>, view: &View, mode: String, look: &Look) -> Picture {
         Picture {
             overlays,
             selection: None,
