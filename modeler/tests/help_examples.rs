@@ -173,7 +173,15 @@ fn the_shared_flags_refuse_bad_values_as_usage_errors() {
     let dir = tempfile::tempdir().expect("dir");
     let doc = repository().join("modeler/examples/04-volcano.json");
     let doc = doc.to_str().expect("UTF-8");
-    let cases: [(&[&str], &str); 7] = [
+    let cases: [(&[&str], &str); 9] = [
+        (
+            &["--show", "headless", "--source", "serial:/dev/x", "--speed", "2"],
+            "--speed is the simulated pen's",
+        ),
+        (
+            &["--show", "headless", "--source", "daemon", "--speed", "0"],
+            "daemon runs in real time",
+        ),
         (&["--vertical-scale", "0"], "is not a vertical scale"),
         (&["--exaggeration", "-2"], "is not a vertical scale"),
         (&["--speed", "-1"], "is not a speed"),
@@ -205,6 +213,11 @@ fn the_shared_flags_refuse_bad_values_as_usage_errors() {
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
         assert!(err.contains(says), "{args:?}: {err}");
+        assert_eq!(
+            std::fs::read_dir(dir.path()).expect("dir").count(),
+            0,
+            "{args:?} wrote something"
+        );
     }
     // The earlier spelling is read: the session starts and fails only for want of pend.
     let out = penmodel(

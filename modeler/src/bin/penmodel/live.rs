@@ -208,6 +208,22 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
     let speed = args.speed.unwrap_or(if window_wanted { 1.0 } else { 0.0 });
     let mut source = PenSource::parse(&source_name, speed).map_err(anyhow::Error::msg)?;
     let demo = matches!(source, PenSource::Demo { .. });
+    let simulated = demo
+        || matches!(
+            source,
+            PenSource::Device {
+                source: pen_host::source::Source::Sim(_),
+                ..
+            }
+        );
+    if args.speed.is_some() && !simulated {
+        // As in pend and penctl: a usage error (2), before anything is created.
+        clap::Error::raw(
+            clap::error::ErrorKind::ArgumentConflict,
+            format!("--speed is the simulated pen's (--source sim); {source_name} runs in real time\n"),
+        )
+        .exit();
+    }
     if let PenSource::Demo { seed, .. } = &mut source {
         *seed = args.seed;
     }
