@@ -7,12 +7,17 @@
 //! Duo 2.66 GHz. The peer (scipy's `qmc.PoissonDisk`) is timed by `scripts/rocks_peer.py`,
 //! which runs this machine's `penmodel rocks` on the same radius and area in the same run.
 //!
+//! `reseat/fig1/512`: fig. 1's rocks stood again on a changed 512² terrain (the edit target:
+//! one frame, ≤ 5 ms).
+//!
 //! Run: `cargo bench -p penmodel-terrain --bench rocks` (filter with e.g. `-- fig1`).
 
 use std::hint::black_box;
 use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
+use penmodel_terrain::Heightmap;
+use penmodel_terrain::rocks::place::{self, Placement};
 use penmodel_terrain::rocks::{self, Amount, Layer, Recipe, Sampler, Shape, poisson, scatter};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -66,6 +71,32 @@ fn bench(c: &mut Criterion) {
             b.iter(|| poisson::darts(SIDE, SIDE, r, throws, &mut rng))
         });
     }
+    // Re-seating: fig. 1's rocks stood again on a changed 512² terrain (what a pull under a
+    // field, or moving it, costs; nothing is scattered).
+    let heights: Vec<f32> = (0..SIDE * SIDE)
+        .map(|i| {
+            let (x, y) = (f64::from(i % SIDE), f64::from(i / SIDE));
+            (20.0 * (x / 40.0).sin() * (y / 55.0).cos()) as f32
+        })
+        .collect();
+    let map = Heightmap::from_heights(SIDE, SIDE, 1.0, heights).expect("512² heights");
+    let at = Placement {
+        origin: [0.0, 0.0],
+        cell_size: 1.0,
+    };
+    let flat = place::Flat::of(&once);
+    let mut seated = flat.seat(at, place::ground(&map));
+    let t = std::time::Instant::now();
+    flat.seat_into(at, place::ground(&map), &mut seated);
+    eprintln!(
+        "reseat/fig1/512: {} vertices, {} triangles, once {:.2} ms",
+        flat.vertices.len(),
+        flat.indices.len() / 3,
+        t.elapsed().as_secs_f64() * 1e3
+    );
+    g.bench_function("reseat/fig1/512", |b| {
+        b.iter(|| black_box(&flat).seat_into(at, place::ground(&map), &mut seated))
+    });
     // The rocks' triangulations alone: ours against delaunator on the same point sets.
     let sets: Vec<(Vec<[f64; 2]>, usize)> = once
         .rocks

@@ -13,7 +13,7 @@ use crate::export::Mesh;
 use crate::heightmap::Heightmap;
 
 use super::field::{self, Image};
-use super::place::{self, Placement};
+use super::place::{self, Flat, Placement};
 use super::{Scatter, scatter};
 
 /// One field's rocks.
@@ -25,6 +25,8 @@ pub struct Field {
     pub image: Image,
     /// Its rocks in field coordinates (shared: scattering is the expensive part).
     pub scatter: Arc<Scatter>,
+    /// The same, flattened for seating.
+    pub flat: Arc<Flat>,
 }
 
 /// The rock fields of a document.
@@ -76,6 +78,7 @@ impl Rocks {
                     Field {
                         field: f.clone(),
                         image,
+                        flat: Arc::new(Flat::of(&s)),
                         scatter: Arc::new(s),
                     }
                 }
@@ -101,7 +104,7 @@ impl Rocks {
                     origin: [f.field.at[0] + f.image.origin[0], f.field.at[1] + f.image.origin[1]],
                     cell_size: f.field.cell_size,
                 };
-                (format!("rocks {i}"), place::mesh(&f.scatter, at, &ground))
+                (format!("rocks {i}"), f.flat.seat(at, &ground))
             })
             .collect()
     }

@@ -24,43 +24,114 @@ pub struct Placement {
 /// All rocks of `scatter` as one mesh in the exports' frame (`X = x`, `Y` up, `Z = y`, metres),
 /// on the ground `ground(x, y)`; normals averaged over each vertex's triangles, by area.
 pub fn mesh(scatter: &Scatter, at: Placement, ground: impl Fn(f64, f64) -> f64 + Sync) -> Mesh {
-    // Each rock's vertices and triangles, on both cores; then one list.
-    let parts: Vec<Mesh> = scatter
-        .rocks
-        .par_iter()
-        .map(|rock| {
-            let positions: Vec<[f32; 3]> = rock
-                .mesh
-                .vertices
-                .iter()
-                .map(|v| {
-                    let (x, y) = (at.origin[0] + v[0] * at.cell_size, at.origin[1] + v[1] * at.cell_size);
-                    [x as f32, (ground(x, y) + v[2] * at.cell_size) as f32, y as f32]
-                })
-                .collect();
-            let indices: Vec<u32> = rock.mesh.triangles.iter().flatten().copied().collect();
-            let normals = normals(&positions, &indices);
-            Mesh {
-                positions,
-                normals,
-                indices,
+    Flat::of(scatter).seat(at, ground)
+}
+
+/// A field's rocks as flat lists in field coordinates, ready to stand on any ground: made once
+/// per scatter, seated at every change of the terrain or the field's place.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Flat {
+    /// `[x, y, height above the ground]` per vertex, field cells.
+    pub vertices: Vec<[f64; 3]>,
+    /// Three vertex indices per triangle.
+    pub indices: Vec<u32>,
+    /// Blocks of whole rocks, about [`BLOCK`] vertices each: `(first vertex, first index)`, with
+    /// the ends last. Normals are computed block by block on all cores.
+    blocks: Vec<(usize, usize)>,
+}
+
+/// Vertices per block of rocks for the parallel normals.
+pub const BLOCK: usize = 8192;
+
+impl Flat {
+    /// The rocks of `scatter`, flattened.
+    pub fn of(scatter: &Scatter) -> Flat {
+        let n: usize = scatter.rocks.iter().map(|r| r.mesh.vertices.len()).sum();
+        let t: usize = scatter.rocks.iter().map(|r| r.mesh.triangles.len()).sum();
+        let mut f = Flat {
+            vertices: Vec::with_capacity(n),
+            indices: Vec::with_capacity(3 * t),
+            blocks: vec![(0, 0)],
+        };
+        for rock in &scatter.rocks {
+            let base = f.vertices.len() as u32;
+            f.vertices.extend_from_slice(&rock.mesh.vertices);
+            f.indices.extend(rock.mesh.triangles.iter().flatten().map(|i| base + i));
+            let start = f.blocks.last().map_or(0, |b| b.0);
+            if f.vertices.len() - start >= BLOCK {
+                f.blocks.push((f.vertices.len(), f.indices.len()));
             }
-        })
-        .collect();
-    let vertices: usize = parts.iter().map(|p| p.positions.len()).sum();
-    let triangles: usize = parts.iter().map(|p| p.indices.len()).sum();
-    let mut mesh = Mesh {
-        positions: Vec::with_capacity(vertices),
-        normals: Vec::with_capacity(vertices),
-        indices: Vec::with_capacity(triangles),
-    };
-    for part in parts {
-        let base = mesh.positions.len() as u32;
-        mesh.positions.extend(part.positions);
-        mesh.normals.extend(part.normals);
-        mesh.indices.extend(part.indices.into_iter().map(|i| base + i));
+        }
+        if f.blocks.last() != Some(&(f.vertices.len(), f.indices.len())) {
+            f.blocks.push((f.vertices.len(), f.indices.len()));
+        }
+        f
     }
-    mesh
+
+    /// The rocks standing on `ground` at `at`.
+    pub fn seat(&self, at: Placement, ground: impl Fn(f64, f64) -> f64 + Sync) -> Mesh {
+        let mut mesh = Mesh {
+            positions: Vec::new(),
+            normals: Vec::new(),
+            indices: self.indices.clone(),
+        };
+        self.seat_into(at, ground, &mut mesh);
+        mesh
+    }
+
+    /// Stands the rocks on `ground` at `at` in `mesh`, reusing its memory: its positions and
+    /// normals are rewritten (re-seating a field after the terrain changed allocates nothing).
+    /// `mesh` is one this `Flat` seated before, or empty: its indices are taken as they are when
+    /// their count matches.
+    pub fn seat_into(&self, at: Placement, ground: impl Fn(f64, f64) -> f64 + Sync, mesh: &mut Mesh) {
+        if mesh.indices.len() != self.indices.len() {
+            mesh.indices.clone_from(&self.indices);
+        }
+        mesh.positions.resize(self.vertices.len(), [0.0; 3]);
+        mesh.normals.resize(self.vertices.len(), [0.0; 3]);
+        // Disjoint slices of the outputs, one per block of whole rocks.
+        let mut parts = Vec::with_capacity(self.blocks.len());
+        let (mut positions, mut normals) = (&mut mesh.positions[..], &mut mesh.normals[..]);
+        for w in self.blocks.windows(2) {
+            let len = w[1].0 - w[0].0;
+            let (p, rest_p) = std::mem::take(&mut positions).split_at_mut(len);
+            let (n, rest_n) = std::mem::take(&mut normals).split_at_mut(len);
+            (positions, normals) = (rest_p, rest_n);
+            parts.push((w[0], w[1], p, n));
+        }
+        parts.into_par_iter().for_each(|((v0, i0), (v1, i1), out, norms)| {
+            for (o, v) in out.iter_mut().zip(&self.vertices[v0..v1]) {
+                let (x, y) = (at.origin[0] + v[0] * at.cell_size, at.origin[1] + v[1] * at.cell_size);
+                *o = [x as f32, (ground(x, y) + v[2] * at.cell_size) as f32, y as f32];
+            }
+            norms.fill([0.0; 3]);
+            let base = v0 as u32;
+            for t in self.indices[i0..i1].chunks_exact(3) {
+                let [a, b, c] = [t[0], t[1], t[2]].map(|i| (i - base) as usize);
+                let (pa, pb, pc) = (out[a], out[b], out[c]);
+                let u = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
+                let w = [pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]];
+                let n = [
+                    u[1] * w[2] - u[2] * w[1],
+                    u[2] * w[0] - u[0] * w[2],
+                    u[0] * w[1] - u[1] * w[0],
+                ];
+                for k in [a, b, c] {
+                    let s = &mut norms[k];
+                    *s = [s[0] + n[0], s[1] + n[1], s[2] + n[2]];
+                }
+            }
+            let _ = v1;
+            for s in norms.iter_mut() {
+                let len = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+                *s = if len > 0.0 {
+                    [s[0] / len, s[1] / len, s[2] / len]
+                } else {
+                    [0.0, 1.0, 0.0]
+                };
+            }
+        });
+    }
 }
 
 /// The terrain's height at `(x, y)` metres, on the surface its mesh draws: heights at cell
