@@ -87,6 +87,12 @@ impl Device {
         }
     }
 
+    /// The same session saying that it waits every `every` instead of [`notice_every`].
+    pub fn with_notice_every(mut self, every: Duration) -> Device {
+        self.notice_every = every;
+        self
+    }
+
     #[allow(missing_docs)]
     pub fn source(&self) -> &Source {
         &self.source

@@ -227,3 +227,79 @@ fn permission_denied_is_shown_with_the_fix() {
     );
     says_how_to_get_access(&err);
 }
+
+/// The notices a session on an unplugged simulated pen gives in `for_`, each with when it came.
+fn notices(device: &mut pen_host::device::Device, for_: Duration) -> Vec<(Duration, String)> {
+    use pen_host::device::DeviceEvent;
+    let start = std::time::Instant::now();
+    let mut said = Vec::new();
+    while start.elapsed() < for_ {
+        match device.next(Duration::from_millis(20)) {
+            Some(DeviceEvent::Waiting(m)) => said.push((start.elapsed(), m)),
+            Some(DeviceEvent::Found(_)) => said.push((start.elapsed(), "found".into())),
+            _ => {}
+        }
+    }
+    said
+}
+
+#[test]
+fn a_session_says_it_waits_at_once_then_every_interval_and_after_a_loss_only_later() {
+    use pen_host::device::{Device, DeviceEvent, RETRY_EVERY};
+    use pen_host::source::Source;
+    use pen_host::transport::sim::{SimOptions, SimPlug};
+
+    let plug = SimPlug::default();
+    plug.set(false);
+    let options = SimOptions {
+        scenario: pen_sim::scenarios::by_name("hold").expect("hold"),
+        seed: 1,
+        speed: 0.0,
+        plug: plug.clone(),
+    };
+    let every = Duration::from_millis(500);
+    let mut device = Device::new(Source::Sim(options)).with_notice_every(every);
+
+    let said = notices(&mut device, Duration::from_millis(1600));
+    // Retries every 200 ms would be 8; a notice every 500 ms is 3 or 4.
+    assert!((3..=4).contains(&said.len()), "{said:?}");
+    assert!(RETRY_EVERY < every);
+    assert!(said[0].0 < Duration::from_millis(100), "the first at once: {said:?}");
+    assert_eq!(
+        said[0].1,
+        "waiting for the simulated pen: no device found: the simulated pen is unplugged"
+    );
+    for (at, m) in &said[1..] {
+        assert!(m.starts_with("still waiting for the simulated pen ("), "{m}");
+        assert!(*at >= every, "{at:?}: {m}");
+    }
+    for pair in said.windows(2) {
+        assert!(pair[1].0 - pair[0].0 >= every - Duration::from_millis(30), "{said:?}");
+    }
+
+    // Plugged in: found; unplugged: lost, which says it waits; the next notice only after
+    // the interval, and as "still waiting".
+    plug.set(true);
+    assert_eq!(
+        notices(&mut device, Duration::from_millis(300))
+            .last()
+            .map(|n| n.1.as_str()),
+        Some("found")
+    );
+    plug.set(false);
+    let guard = std::time::Instant::now() + Duration::from_secs(10);
+    let lost = loop {
+        if let Some(DeviceEvent::Lost(why)) = device.next(Duration::from_millis(50)) {
+            break why;
+        }
+        assert!(std::time::Instant::now() < guard, "the unplugging was never noticed");
+    };
+    assert_eq!(lost, "unplugged");
+    let said = notices(&mut device, Duration::from_millis(800));
+    assert!(!said.is_empty(), "still said after the loss");
+    assert!(
+        said[0].0 >= every - Duration::from_millis(30),
+        "not at once after the loss: {said:?}"
+    );
+    assert!(said[0].1.starts_with("still waiting for the simulated pen"), "{said:?}");
+}
