@@ -122,3 +122,19 @@ fn a_client_pend_refuses_is_told_why_and_writes_nothing() {
     assert!(!err.contains("pend socket: pend socket"), "{err}");
     assert!(!dir.path().join("run").exists());
 }
+
+#[test]
+fn a_document_that_cannot_be_created_leaves_no_folder_behind() {
+    let dir = tempfile::tempdir().expect("dir");
+    let out = penmodel(
+        dir.path(),
+        &["--source", "sim", "--doc", "missing/d.json", "--out", "run"],
+    )
+    .output()
+    .expect("penmodel runs");
+    let err = stderr(&out);
+    assert_eq!(out.status.code(), Some(1), "{err}");
+    assert!(err.contains("cannot write missing/d.json"), "{err}");
+    assert_eq!(err.matches("os error 2").count(), 1, "{err}");
+    assert!(!dir.path().join("run").exists(), "the --out folder made for it is gone");
+}

@@ -266,7 +266,14 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
                     path.display()
                 );
             }
-            let editor = Editor::create(&path, blank_document())?;
+            let editor = match Editor::create(&path, blank_document()) {
+                Ok(editor) => editor,
+                Err(e) => {
+                    // The --out folder made for it goes again.
+                    created.remove()?;
+                    return Err(e.into());
+                }
+            };
             created.document = Some(path.clone());
             if demo && args.doc.is_none() {
                 std::fs::write(&demo_mark, DEMO_MARK_TEXT)
