@@ -1,41 +1,49 @@
-//! The configuration's flash region: sector 7, the last 128 KiB of the STM32F411CE's 512 KiB.
-//! `memory.x` gives the program sectors 0–6 only, so the two can never overlap.
+//! The configuration's flash regions: sectors 6 and 7, the last 256 KiB of the STM32F411CE's
+//! 512 KiB, used in turn by the store (pen-core's `store.rs`). The linker script gives the
+//! program the first 64 KiB only, so the two can never overlap.
+
+use core::cell::RefCell;
 
 use embassy_stm32::flash::{Blocking, Flash};
 use pen_core::{FlashRegion, StoreError};
 
-/// Offset of sector 7 from the start of flash.
-const SECTOR_7: u32 = 0x6_0000;
-/// Its size.
-const SECTOR_7_SIZE: u32 = 0x2_0000;
+/// Offsets of sectors 6 and 7 from the start of flash.
+pub const SECTORS: [u32; 2] = [0x4_0000, 0x6_0000];
+/// Their size.
+const SECTOR_SIZE: u32 = 0x2_0000;
 
-/// Sector 7 through embassy's blocking flash driver. Programming stalls the CPU for a few
-/// microseconds per word; erasing, which the store does once per 655 saves, for about a second.
+/// One configuration sector through embassy's blocking flash driver, which both sectors share.
+/// Programming stalls the CPU for a few microseconds per word; erasing, which the store does
+/// once per 655 saves, for 2 s (4 s at most: embassy erases at 8-bit parallelism).
 pub struct ConfigSector<'d> {
-    pub flash: Flash<'d, Blocking>,
+    pub flash: &'d RefCell<Flash<'d, Blocking>>,
+    pub offset: u32,
 }
 
 impl FlashRegion for ConfigSector<'_> {
     fn size(&self) -> usize {
-        SECTOR_7_SIZE as usize
+        SECTOR_SIZE as usize
     }
 
     fn read(&mut self, offset: usize, buf: &mut [u8]) -> Result<(), StoreError> {
         self.flash
-            .blocking_read(SECTOR_7 + offset as u32, buf)
+            .borrow_mut()
+            .blocking_read(self.offset + offset as u32, buf)
             .map_err(|_| StoreError::Flash)
     }
 
     fn write(&mut self, offset: usize, bytes: &[u8]) -> Result<(), StoreError> {
         self.flash
-            .blocking_write(SECTOR_7 + offset as u32, bytes)
+            .borrow_mut()
+            .blocking_write(self.offset + offset as u32, bytes)
             .map_err(|_| StoreError::Flash)
     }
 
     fn erase(&mut self) -> Result<(), StoreError> {
         let result = self
             .flash
-            .blocking_erase(SECTOR_7, SECTOR_7 + SECTOR_7_SIZE)
+            .borrow_mut()
+            .blocking_erase(self.offset, self.offset + SECTOR_SIZE)
             .map_err(|_| StoreError::Flash);
         // The caches may hold lines of the erased sector (the data cache, the store's reads);
         // RM0383 §3.4.2: reset them, disabled, after an erase.

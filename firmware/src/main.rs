@@ -12,6 +12,7 @@ mod bootloader;
 mod capture;
 mod clock;
 mod flash_store;
+mod stack;
 mod switches;
 mod usb;
 
@@ -78,6 +79,8 @@ const FIRMWARE: FirmwareVersion = FirmwareVersion {
 async fn main(_spawner: Spawner) {
     // A restart into the ROM bootloader must happen before anything is initialised.
     bootloader::enter_if_requested();
+    // Before anything else runs deep: the stack's high-water mark is logged every 10 s.
+    stack::paint();
 
     // Clocks: 25 MHz crystal → PLL: 96 MHz system clock, 48 MHz for USB; APB1 48 MHz (its
     // timers 96 MHz), APB2 96 MHz.
@@ -115,9 +118,10 @@ async fn main(_spawner: Spawner) {
     watchdog.unleash();
 
     // The configuration: the newest saved one, or the defaults.
-    let store = Mutex::new(RefCell::new(LogStore::new(ConfigSector {
-        flash: Flash::new_blocking(p.FLASH),
-    })));
+    let flash = RefCell::new(Flash::new_blocking(p.FLASH));
+    let store = Mutex::new(RefCell::new(LogStore::new(
+        flash_store::SECTORS.map(|offset| ConfigSector { flash: &flash, offset }),
+    )));
     let saved = store.lock(|s| s.borrow_mut().load());
     if saved.is_none() {
         info!("no saved configuration: using the defaults");
@@ -264,6 +268,8 @@ async fn main(_spawner: Spawner) {
                     usb::BAD_FRAMES.load(core::sync::atomic::Ordering::Relaxed)
                 );
                 info!("{}", c);
+                let (used, size) = stack::high_water();
+                info!("stack: {} of {} bytes used at most", used, size);
             }
         }
     };
