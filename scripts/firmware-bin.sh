@@ -29,16 +29,17 @@ bin=firmware/target/pen-firmware.bin
 # The tool links against the toolchain's own LLVM library, which lives in the sysroot.
 LD_LIBRARY_PATH="$sysroot/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" "$objcopy" -O binary "$elf" "$bin"
 
-# Word 0: the initial stack pointer, the top of RAM (0x2000_0000 + 128 KiB); word 1: the reset
-# handler, a Thumb address (odd) inside the program's flash sectors 0–6 (below 0x0806_0000).
+# Word 0: the initial stack pointer, the top of the RAM the linker gives the program
+# (0x2000_0000 + 16 KiB, firmware/stm32f411ce.x); word 1: the reset handler, a Thumb address
+# (odd) inside the program's flash, sectors 0–3 (below 0x0801_0000).
 read -r sp reset < <(od -A n -t x4 -N 8 --endian=little "$bin")
 size=$(stat -c %s "$bin")
-if [ "$sp" != 20020000 ] || (( (16#$reset & 1) == 0 || 16#$reset < 0x08000000 || 16#$reset >= 0x08060000 )); then
+if [ "$sp" != 20004000 ] || (( (16#$reset & 1) == 0 || 16#$reset < 0x08000000 || 16#$reset >= 0x08010000 )); then
     echo "firmware-bin: $bin does not start with the board's vector table (stack $sp, reset $reset)" >&2
     exit 1
 fi
-if (( size > 0x60000 )); then
-    echo "firmware-bin: $bin is $size bytes, more than sectors 0–6 (384 KiB) hold" >&2
+if (( size > 0x10000 )); then
+    echo "firmware-bin: $bin is $size bytes, more than sectors 0–3 (64 KiB) hold" >&2
     exit 1
 fi
 echo "$bin: $size bytes (stack 0x$sp, reset 0x$reset)"
