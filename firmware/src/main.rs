@@ -33,7 +33,7 @@ use embassy_time::{Duration, Instant, Timer};
 use embassy_usb::Builder;
 use embassy_usb::class::cdc_acm::{self, CdcAcmClass};
 use embassy_usb::class::hid::{self, HidBootProtocol, HidSubclass, HidWriter};
-use pen_core::{ConfigStore, Engine, LogStore, Station};
+use pen_core::{ConfigStore, Engine, LogStore, Station, WakeOnPress};
 use pen_protocol::{FirmwareVersion, PROTOCOL_VERSION, REPORT_DESCRIPTOR, USB_PID, USB_VID};
 use {defmt_rtt as _, panic_probe as _};
 
@@ -238,23 +238,24 @@ async fn main(_spawner: Spawner) {
     let mut station = Station::new(&engine, ranging, switches, BoardClock, sink);
     let station_task = async {
         let mut next_log = Instant::now();
-        // The tip as last seen during suspend: a wakeup needs a new press (released, then
-        // pressed), so that a pen standing tip-down does not keep the host awake.
-        let mut tip_was_down = true;
+        let mut wake = WakeOnPress::default();
+        let mut was_suspended = false;
         loop {
             watchdog.pet();
             if usb::SUSPENDED.load(core::sync::atomic::Ordering::Relaxed) {
                 // No bursts during suspend; a new press of the tip wakes the host.
                 use pen_core::Switches;
-                let tip = station.switches.read()[0];
-                if tip && !tip_was_down {
+                if !was_suspended {
+                    wake.suspended();
+                    was_suspended = true;
+                }
+                if wake.sample(station.switches.read()[0]) {
                     usb::WAKE_HOST.signal(());
                 }
-                tip_was_down = tip;
                 Timer::after_millis(10).await;
                 continue;
             }
-            tip_was_down = true;
+            was_suspended = false;
             let receivers = engine.lock(|e| e.borrow().settings().count);
             station.ranging.set_receivers(receivers);
             station.cycle().await;

@@ -37,5 +37,5 @@ pub use math::Vec3;
 pub use report::{Action, Counters, Cycle, CycleResult, Engine, LISTEN_US, MIN_CYCLE_US, TICK_US};
 pub use settings::{DisplayFrame, Settings, default_config};
 pub use solve::{Fix, NoFix};
-pub use station::{Clock, Ranging, ReportSink, SharedEngine, Station, Switches};
+pub use station::{Clock, Ranging, ReportSink, SharedEngine, Station, Switches, WakeOnPress};
 pub use store::{ConfigStore, FlashRegion, LogStore, StoreError};

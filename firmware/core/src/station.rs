@@ -45,6 +45,29 @@ pub trait ReportSink {
     fn tof(&mut self, report: &TofReport) -> impl Future<Output = ()>;
 }
 
+/// When to wake a suspended host: on a new press of the tip during this suspend. A pen left
+/// standing on its tip must not keep the host awake, nor a press that began before the bus was
+/// suspended wake it straight after.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct WakeOnPress {
+    /// The tip could have been down since the suspend began: a press counts once it was up.
+    armed: bool,
+}
+
+impl WakeOnPress {
+    /// A suspend begins: the tip's first release arms the wakeup.
+    pub fn suspended(&mut self) {
+        self.armed = false;
+    }
+
+    /// Takes a sample of the raw tip switch during suspend; true: wake the host now.
+    pub fn sample(&mut self, tip: bool) -> bool {
+        let wake = tip && self.armed;
+        self.armed = !tip;
+        wake
+    }
+}
+
 /// The engine behind a mutex, shared with the USB request handlers.
 pub type SharedEngine<M> = Mutex<M, RefCell<Engine>>;
 

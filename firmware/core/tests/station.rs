@@ -155,3 +155,20 @@ fn cycles_fire_sample_collect_and_report_on_time() {
     );
     assert!(pens.windows(2).all(|p| p[1].1.seq == p[0].1.seq.wrapping_add(1)));
 }
+
+#[test]
+fn a_suspended_host_wakes_on_a_new_press_only() {
+    use pen_core::WakeOnPress;
+    let mut wake = WakeOnPress::default();
+    // Suspended with the pen standing on its tip: no wakeup however long it stands.
+    wake.suspended();
+    assert!((0..100).all(|_| !wake.sample(true)));
+    // Lifted and pressed: one wakeup, at the press.
+    assert!(!wake.sample(false));
+    assert!(wake.sample(true));
+    assert!(!wake.sample(true), "held: no second wakeup");
+    // A new suspend forgets the release seen in the last one.
+    assert!(!wake.sample(false));
+    wake.suspended();
+    assert!(!wake.sample(true));
+}
