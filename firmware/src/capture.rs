@@ -241,11 +241,6 @@ impl<'d> BoardRanging<'d> {
         }
     }
 
-    /// Receivers in use (from the configuration).
-    pub fn set_receivers(&mut self, receivers: usize) {
-        self.receivers = receivers.min(MAX_RECEIVERS);
-    }
-
     fn arm(&mut self, enable: bool) {
         for (i, ch) in CHANNELS.into_iter().enumerate() {
             let on = enable && i < self.receivers;
@@ -269,6 +264,11 @@ impl<'d> BoardRanging<'d> {
 }
 
 impl Ranging for BoardRanging<'_> {
+    /// Channels beyond `count` stay disabled.
+    fn set_receivers(&mut self, count: usize) {
+        self.receivers = count.min(MAX_RECEIVERS);
+    }
+
     fn fire(&mut self) {
         for c in &CAPTURES {
             c.store(NO_CAPTURE, Ordering::Relaxed);

@@ -256,8 +256,6 @@ async fn main(_spawner: Spawner) {
                 continue;
             }
             was_suspended = false;
-            let receivers = engine.lock(|e| e.borrow().settings().count);
-            station.ranging.set_receivers(receivers);
             station.cycle().await;
             if Instant::now() >= next_log {
                 next_log += Duration::from_secs(10);

@@ -16,6 +16,10 @@ use crate::report::{Cycle, CycleResult, Engine, LISTEN_US, TICK_US};
 
 /// The ultrasonic front end: a burst from the pen and the receivers' first arrivals.
 pub trait Ranging {
+    /// Receivers in use from now on (the configuration's count); the station tells it before
+    /// every burst, so a configuration change takes effect at the next cycle. Front ends that
+    /// listen to every receiver anyway need not care.
+    fn set_receivers(&mut self, _count: usize) {}
     /// Fires a burst; the capture time base starts with it.
     fn fire(&mut self);
     /// The first arrival at each receiver since the last burst, ns after it; `None` for a
@@ -119,7 +123,8 @@ where
     /// when the next cycle may start.
     pub async fn cycle(&mut self) -> CycleResult {
         let t0 = self.clock.now_us();
-        let period = self.with(|e| e.cycle_period_us());
+        let (period, receivers) = self.with(|e| (e.cycle_period_us(), e.settings().count));
+        self.ranging.set_receivers(receivers);
         self.ranging.fire();
         let mut result = None;
         // Ticks at t0, t0 + TICK_US, … up to the end of the period.

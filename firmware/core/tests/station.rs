@@ -14,6 +14,8 @@ use pen_protocol::{FirmwareVersion, MAX_RECEIVERS, PenReport, TofReport};
 struct World {
     now_us: u64,
     fired_at: Vec<u64>,
+    /// The receiver count the station gave the front end before each burst.
+    armed: Vec<usize>,
     collected_at: Vec<u64>,
     sampled_at: Vec<u64>,
     sent: Vec<(u64, Result<PenReport, TofReport>)>,
@@ -29,6 +31,9 @@ struct FakeRanging {
 }
 
 impl Ranging for FakeRanging {
+    fn set_receivers(&mut self, count: usize) {
+        self.world.borrow_mut().armed.push(count);
+    }
     fn fire(&mut self) {
         let mut w = self.world.borrow_mut();
         let t = w.now_us;
@@ -85,6 +90,18 @@ impl ReportSink for Sink {
     }
 }
 
+/// A configuration store that keeps nothing (the test saves nothing).
+struct NoStore;
+
+impl pen_core::ConfigStore for NoStore {
+    fn load(&mut self) -> Option<pen_protocol::Config> {
+        None
+    }
+    fn save(&mut self, _: &pen_protocol::Config) -> Result<(), pen_core::StoreError> {
+        Err(pen_core::StoreError::Flash)
+    }
+}
+
 #[test]
 fn cycles_fire_sample_collect_and_report_on_time() {
     let world: Shared = Rc::default();
@@ -121,10 +138,23 @@ fn cycles_fire_sample_collect_and_report_on_time() {
         Sink(world.clone()),
     );
     let results: Vec<_> = (0..10).map(|_| block_on(station.cycle())).collect();
+    // A configuration with three receivers applies from the next burst.
+    let mut three = config;
+    three.receiver_count = 3;
+    three.receivers_mm[3] = [0.0; 3];
+    three.transducer_delay_us[3] = 0.0;
+    let mut bytes = [0u8; pen_protocol::MAX_PAYLOAD];
+    let n = pen_protocol::Report::encode(&three, &mut bytes).expect("fits");
+    let mut store = NoStore;
+    let (status, _) = engine.lock(|e| e.borrow_mut().set_feature(&bytes[..n], &mut store));
+    assert_eq!(status, pen_protocol::Status::ok(pen_protocol::ReportId::Config as u8));
+    block_on(station.cycle());
+    assert_eq!(world.borrow().armed, [[4; 10].as_slice(), &[3]].concat());
+    let results = &results[..];
 
     let w = world.borrow();
-    assert_eq!(w.now_us, 10 * period, "each cycle lasts one period");
-    assert_eq!(w.fired_at, (0..10).map(|k| k * period).collect::<Vec<_>>());
+    assert_eq!(w.now_us, 11 * period, "each cycle lasts one period");
+    assert_eq!(w.fired_at, (0..11).map(|k| k * period).collect::<Vec<_>>());
     assert_eq!(
         w.collected_at,
         w.fired_at.iter().map(|t| t + LISTEN_US).collect::<Vec<_>>()
@@ -140,8 +170,8 @@ fn cycles_fire_sample_collect_and_report_on_time() {
     // report; plus one for each SW1 edge between cycles.
     let pens: Vec<_> = w.sent.iter().filter_map(|(t, r)| r.ok().map(|r| (*t, r))).collect();
     let tofs = w.sent.iter().filter(|(_, r)| r.is_err()).count();
-    assert_eq!(tofs, 10);
-    assert_eq!(pens.len(), 12);
+    assert_eq!(tofs, 11);
+    assert_eq!(pens.len(), 13);
     let edges: Vec<_> = pens
         .windows(2)
         .filter(|p| p[0].1.sw1 != p[1].1.sw1)
