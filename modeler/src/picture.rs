@@ -4,9 +4,12 @@
 //! figure being drawn or moved, the pen, the slope bar and the mode line.
 
 use penmodel_render::{Camera, Overlay, Rgba, Scene, SlopeBar, Stereo, Style, Tracked};
+use std::sync::Arc;
+
 use penmodel_terrain::Heightmap;
 use penmodel_terrain::address::{CurvePath, FigurePath};
 use penmodel_terrain::document::{Document, Figure, FigureKind, Point};
+use penmodel_terrain::export::Mesh;
 
 use crate::feed::Calibrating;
 use crate::interaction::{Interaction, View};
@@ -79,6 +82,8 @@ pub struct Picture {
     camera: Camera,
     vertical_scale: f32,
     look: Look,
+    /// The rock fields standing on the terrain.
+    rocks: Arc<Vec<(String, Mesh)>>,
 }
 
 fn dot(at: Point, height: Option<f64>, colour: Rgba, width: f32) -> Overlay {
@@ -107,7 +112,13 @@ impl Picture {
             }
             crate::session::State::Running => ui.status(doc),
         };
-        Picture::from_parts(ui, doc, mode, look)
+        Picture::from_parts(ui, doc, mode, look).with_rocks(session.editor.rocks().shared())
+    }
+
+    /// The picture with the rock fields `rocks` (an editor's, [`penmodel_terrain::Editor::rocks`]).
+    pub fn with_rocks(mut self, rocks: Arc<Vec<(String, Mesh)>>) -> Picture {
+        self.rocks = rocks;
+        self
     }
 
     /// The calibration procedure: its targets on the display as rings (taken green, the next
@@ -170,6 +181,7 @@ impl Picture {
             camera: camera(view, look.head_m),
             vertical_scale: view.exaggeration as f32,
             look: look.clone(),
+            rocks: Arc::default(),
         }
     }
 
@@ -217,6 +229,7 @@ impl Picture {
             camera: camera(view, look.head_m),
             vertical_scale: view.exaggeration as f32,
             look: look.clone(),
+            rocks: Arc::default(),
         }
     }
 
@@ -267,6 +280,7 @@ impl Picture {
             terrain,
             vertical_scale: self.vertical_scale,
             overlays: &self.overlays,
+            rocks: &self.rocks,
             selection: self.selection,
             slope_bar: self.slope_bar.clone(),
             mode: &self.mode,

@@ -28,6 +28,7 @@ pub mod clip;
 pub mod frame;
 pub mod overlay;
 pub mod rasterise;
+pub mod rocks;
 pub mod scene;
 pub mod shade;
 pub mod stereo;
@@ -71,6 +72,7 @@ pub const TILE_ROWS: usize = 32;
 struct EyeBuffers {
     projected: Projected,
     capsules: Vec<Capsule>,
+    rocks: rocks::Projected,
 }
 
 /// Renders scenes into frames, keeping its buffers from one frame to the next.
@@ -211,6 +213,14 @@ impl Renderer {
             &mut self.eye.projected,
         );
         overlay::capsules(scene, &projection, &mut self.eye.capsules);
+        self.eye.rocks.project(
+            scene.rocks,
+            &affine,
+            scene.terrain.cell_size(),
+            near,
+            &scene.style,
+            (height as usize, self.tile_rows),
+        );
         (affine, near)
     }
 
@@ -229,6 +239,7 @@ impl Renderer {
         };
         tiles::render(
             &pass,
+            &self.eye.rocks,
             &self.eye.capsules,
             &ramp,
             &scene.style,

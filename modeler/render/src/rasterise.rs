@@ -75,6 +75,8 @@ pub struct Sample {
     pub hw: f32,
     /// Light / w.
     pub lw: f32,
+    /// A rock's surface (drawn in the rock colour), not the terrain's.
+    pub rock: bool,
 }
 
 /// Where covered pixels go.
@@ -99,7 +101,12 @@ impl Sink for DepthSink<'_> {
         let i = (y - self.y0) as usize * self.width + x as usize;
         let s = &mut self.samples[i];
         if invw > s.invw {
-            *s = Sample { invw, hw, lw };
+            *s = Sample {
+                invw,
+                hw,
+                lw,
+                rock: false,
+            };
         }
     }
 }

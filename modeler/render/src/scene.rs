@@ -7,6 +7,7 @@ use super::camera::Camera;
 use super::frame::Rgba;
 use penmodel_terrain::Heightmap;
 use penmodel_terrain::Point;
+use penmodel_terrain::export::Mesh;
 
 /// How the two eyes' images are combined.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -87,6 +88,8 @@ pub struct Style {
     pub text_colour: Rgba,
     /// Text size: pixels per font pixel.
     pub text_scale: u32,
+    /// Colour of rocks, before light.
+    pub rock_colour: Rgba,
 }
 
 impl Default for Style {
@@ -105,6 +108,8 @@ impl Default for Style {
             overlay_bias: 0.01,
             text_colour: [255, 255, 255, 255],
             text_scale: 2,
+            // Weathered granite, a little warmer than the terrain's grey.
+            rock_colour: [158, 148, 136, 255],
         }
     }
 }
@@ -118,6 +123,9 @@ pub struct Scene<'a> {
     pub vertical_scale: f32,
     /// Lines on the terrain.
     pub overlays: &'a [Overlay],
+    /// Meshes standing on the terrain (rock fields), in the exports' frame (X, Y up, Z; metres),
+    /// drawn in [`Style::rock_colour`].
+    pub rocks: &'a [(String, Mesh)],
     /// The index in `overlays` of the selected one, drawn in the selection colour and width.
     pub selection: Option<usize>,
     /// The slope bar, when shown.
@@ -139,6 +147,7 @@ impl<'a> Scene<'a> {
             terrain,
             vertical_scale: 1.0,
             overlays: &[],
+            rocks: &[],
             selection: None,
             slope_bar: None,
             mode: "",

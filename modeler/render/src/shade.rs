@@ -179,7 +179,12 @@ pub fn resolve(
         for (s, p) in srow[x0..x1].iter().zip(&mut prow[x0..x1]) {
             if s.invw > 0.0 {
                 let w = 1.0 / s.invw;
-                let c = ramp.get(s.hw * w);
+                let c = if s.rock {
+                    let r = style.rock_colour;
+                    [f32::from(r[0]), f32::from(r[1]), f32::from(r[2])]
+                } else {
+                    ramp.get(s.hw * w)
+                };
                 let l = (s.lw * w).clamp(0.0, 1.0);
                 *p = [(c[0] * l) as u8, (c[1] * l) as u8, (c[2] * l) as u8, 255];
             } else {

@@ -111,6 +111,7 @@ impl EyePass<'_> {
 #[allow(clippy::too_many_arguments)]
 pub fn render(
     pass: &EyePass,
+    rocks: &super::rocks::Projected,
     capsules: &[Capsule],
     ramp: &Ramp,
     style: &Style,
@@ -145,6 +146,7 @@ pub fn render(
                 y0: bounds.y0,
             };
             pass.terrain(&bounds, &mut sink);
+            rocks.draw(&bounds, smp, width, pass.near);
             shade::resolve(smp, pix, width, (x0, x1), y0, frame_height, ramp, style);
             let (top, bottom) = (bounds.y0 as f32, bounds.y1 as f32);
             for cap in capsules {

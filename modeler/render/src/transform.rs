@@ -67,6 +67,22 @@ impl Affine {
     }
 }
 
+impl Affine {
+    /// The clip-space vertex at fractional column and row `(c, r)` (a point off the grid's
+    /// centres: a rock's vertex), height `h`, light `l`.
+    #[inline]
+    pub fn clip_point(&self, c: f32, r: f32, h: f32, l: f32) -> ClipVertex {
+        let at = |i: usize| self.base[i] + c * self.dc[i] + r * self.dr[i] + h * self.dh[i];
+        ClipVertex {
+            x: at(0),
+            y: at(1),
+            w: at(2),
+            h,
+            l,
+        }
+    }
+}
+
 /// A clip-space vertex after the perspective division.
 #[inline]
 pub fn project(v: &ClipVertex) -> Vtx {

@@ -1,3 +1,4 @@
 //! The integration tests of penmodel-render, in one binary: a module per area.
 mod outputs;
 mod render;
+mod rocks;

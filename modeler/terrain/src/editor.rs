@@ -27,6 +27,7 @@ use crate::engine::{Rect, TerrainEngine};
 use crate::heightmap::Heightmap;
 use crate::journal::{self, Entry, JournalError, Replay, UndoStep, Writer};
 use crate::persist::{self, LoadError, SaveError};
+use crate::rocks::cache::Seated;
 use crate::validate::ValidationError;
 
 /// The most undo steps kept; older ones are forgotten.
@@ -138,6 +139,8 @@ pub struct Editor {
     redo: Vec<UndoStep>,
     store: Option<Store>,
     preview: Option<Preview>,
+    /// The rock fields standing on the terrain, following every change.
+    rocks: Seated,
 }
 
 fn journal_io(path: &Path) -> impl FnOnce(io::Error) -> EditorError + '_ {
@@ -167,8 +170,10 @@ fn set(at: FigurePath, property: Property, value: f64) -> Edit {
 impl Editor {
     /// Edits `doc` in memory, without a file (until [`Editor::save_as`]).
     pub fn new(doc: Document) -> Result<Editor, ValidationError> {
+        let terrain = TerrainEngine::new(&doc)?;
         Ok(Editor {
-            terrain: TerrainEngine::new(&doc)?,
+            rocks: Seated::of(&doc, terrain.heightmap()),
+            terrain,
             doc,
             undo: Vec::new(),
             redo: Vec::new(),
@@ -281,6 +286,11 @@ impl Editor {
         self.terrain.heightmap()
     }
 
+    /// The document's rock fields standing on [`Editor::heightmap`], one mesh each.
+    pub fn rocks(&self) -> &Seated {
+        &self.rocks
+    }
+
     /// Applies `edit` to the document and the terrain, with no history or journal. On error
     /// nothing changes.
     fn change(&mut self, edit: &Edit) -> Result<Outcome, EditError> {
@@ -289,6 +299,7 @@ impl Editor {
         }
         let applied = edit.apply_to(&mut self.doc)?;
         let changed = self.terrain.update(&self.doc, &applied.scope);
+        self.rocks.follow(&self.doc, self.terrain.heightmap());
         Ok(Outcome {
             inverse: applied.inverse,
             changed,

@@ -778,10 +778,10 @@ fn write_results(
     let (mut obj, mut glb) = (None, None);
     if meshes {
         bytes.clear();
-        export::write_obj(map, &mut bytes)?;
+        export::write_obj_with(map, session.editor.rocks().meshes(), &mut bytes)?;
         obj = Some(write("terrain.obj", &bytes)?);
         bytes.clear();
-        export::write_glb(map, &mut bytes)?;
+        export::write_glb_with(map, session.editor.rocks().meshes(), &mut bytes)?;
         glb = Some(write("terrain.glb", &bytes)?);
     }
     // The final state, without the pen or a highlight, the ground level: as the display shows
@@ -792,7 +792,8 @@ fn write_results(
     };
     let (lo, hi) = map.range();
     let mode = format!("penmodel: final terrain, {lo:.0} to {hi:.0} m");
-    let picture = Picture::document(session.editor.document(), &view, mode, look);
+    let picture =
+        Picture::document(session.editor.document(), &view, mode, look).with_rocks(session.editor.rocks().shared());
     bytes.clear();
     output::encode_png(painter.plain(&picture, map)?, &mut bytes)?;
     let display = write("display.png", &bytes)?;

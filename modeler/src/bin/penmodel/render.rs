@@ -189,6 +189,7 @@ pub fn run(args: &Args) -> Result<()> {
         },
     );
     scene.overlays = &overlays;
+    scene.rocks = editor.rocks().meshes();
     scene.mode = &args.mode;
     scene.vertical_scale = args.vertical_scale as f32;
     scene.style.ramp_top = ramp_top(hi);

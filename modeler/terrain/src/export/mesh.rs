@@ -4,7 +4,7 @@ use super::ExportError;
 use crate::heightmap::Heightmap;
 
 /// Vertices at the cell centres (Y up), normals, and triangles as vertex indices.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, Default, PartialEq)]
 pub struct Mesh {
     /// `[X, Y, Z]` = `[x, height, y]` per cell, row-major.
     pub positions: Vec<[f32; 3]>,

@@ -109,3 +109,62 @@ impl Rocks {
             .collect()
     }
 }
+
+/// A document's rocks standing on its terrain, kept up to date edit by edit: the editor's
+/// (`Editor::rocks`). After each change the fields whose recipe changed are scattered again and
+/// every field is re-seated in place (the terrain may have changed under any of them).
+#[derive(Debug, Clone, Default)]
+pub struct Seated {
+    rocks: Rocks,
+    /// Shared with the pictures being drawn; copied on write only while one holds it.
+    meshes: Arc<Vec<(String, Mesh)>>,
+}
+
+impl Seated {
+    /// The rocks of `doc` on `map`.
+    pub fn of(doc: &Document, map: &Heightmap) -> Seated {
+        let mut s = Seated::default();
+        s.follow(doc, map);
+        s
+    }
+
+    /// Brings the rocks up to date with `doc` and `map`.
+    pub fn follow(&mut self, doc: &Document, map: &Heightmap) {
+        if doc.rocks.is_empty() && self.meshes.is_empty() {
+            return;
+        }
+        self.rocks.update(doc);
+        let meshes = Arc::make_mut(&mut self.meshes);
+        meshes.truncate(self.rocks.fields.len());
+        let ground = place::ground(map);
+        for (i, f) in self.rocks.fields.iter().enumerate() {
+            let at = Placement {
+                origin: [f.field.at[0] + f.image.origin[0], f.field.at[1] + f.image.origin[1]],
+                cell_size: f.field.cell_size,
+            };
+            if i == meshes.len() {
+                meshes.push((format!("rocks {i}"), Mesh::default()));
+            }
+            let mesh = &mut meshes[i].1;
+            if mesh.indices.len() != f.flat.indices.len() || mesh.indices != f.flat.indices {
+                *mesh = Mesh::default();
+            }
+            f.flat.seat_into(at, &ground, mesh);
+        }
+    }
+
+    /// Each field's rocks as a mesh named `rocks N`, in the exports' frame.
+    pub fn meshes(&self) -> &[(String, Mesh)] {
+        &self.meshes
+    }
+
+    /// The same, shared (for a picture that outlives the next edit).
+    pub fn shared(&self) -> Arc<Vec<(String, Mesh)>> {
+        Arc::clone(&self.meshes)
+    }
+
+    /// The fields as scattered.
+    pub fn fields(&self) -> &[Field] {
+        self.rocks.fields()
+    }
+}
