@@ -164,4 +164,22 @@ fn demo(seed: u64) {
         100.0 * rms / peak
     );
     assert!(rms <= 0.02 * peak, "terrain RMS {rms:.2} m against a {peak:.0} m peak");
+
+    // The rock field (issue 11): drawn with the rock tool where the session drew it, slid as far
+    // as the hand slid it, and its rocks standing on the terrain.
+    let rock = pen_sim::session::rock_step();
+    assert_eq!(got.rocks.len(), 1, "one rock field");
+    let mut outline: Vec<Point> = rock.outline.iter().map(|p| to_ground(&view, *p + rock.slide)).collect();
+    outline.push(outline[0]);
+    let field_mm = shape_error(&got.rocks[0].outline_at(), &outline) * view.scale;
+    assert!(field_mm <= 2.5, "the rock field's outline is off by {field_mm:.2} mm");
+    let seated = session.editor.rocks();
+    let rocks = seated.fields()[0].scatter.rocks.len();
+    assert!(rocks > 100, "{rocks} rocks");
+    assert_eq!(seated.meshes().len(), 1);
+    println!("rock field within {field_mm:.2} mm, {rocks} rocks");
+}
+
+fn to_ground(view: &View, p: glam::DVec2) -> Point {
+    view.to_ground(p.x, p.y)
 }

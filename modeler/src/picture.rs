@@ -12,9 +12,16 @@ use penmodel_terrain::document::{Document, Figure, FigureKind, Point};
 use penmodel_terrain::export::Mesh;
 
 use crate::feed::Calibrating;
+use crate::interaction::rocks::{self, Tool};
 use crate::interaction::{Interaction, View};
 use crate::session::Session;
 
+/// Colour of a rock field's outline.
+pub const ROCK_FIELD_COLOUR: Rgba = [200, 170, 130, 255];
+/// Colour of the palette button while the rock tool is on.
+pub const PALETTE_ON_COLOUR: Rgba = [255, 200, 90, 255];
+/// Colour of the palette button while figures are drawn.
+pub const PALETTE_OFF_COLOUR: Rgba = [170, 170, 170, 255];
 /// Colour of the figure being drawn.
 pub const DRAWING_COLOUR: Rgba = [64, 224, 255, 255];
 /// Colour of a figure or vertex being moved.
@@ -199,6 +206,35 @@ impl Picture {
                 overlays[i].colour = if m.deleting { DELETING_COLOUR } else { MOVING_COLOUR };
             }
         }
+        // Rock fields' outlines (the held one where the pen takes it), the palette button.
+        let moving_field = ui.field_moving(doc);
+        for (i, f) in doc.rocks.iter().enumerate() {
+            let (points, colour) = match &moving_field {
+                Some((m, pts)) if *m == i => (pts.clone(), MOVING_COLOUR),
+                _ => (f.outline_at(), ROCK_FIELD_COLOUR),
+            };
+            if ui.tool() == Tool::Rocks && ui.field_hover() == Some(i) {
+                selection = Some(overlays.len());
+            }
+            overlays.push(Overlay {
+                points,
+                closed: true,
+                colour,
+                width: 2.0,
+                height: None,
+            });
+        }
+        overlays.push(Overlay {
+            points: rocks::palette_outline(view),
+            closed: true,
+            colour: if ui.tool() == Tool::Rocks {
+                PALETTE_ON_COLOUR
+            } else {
+                PALETTE_OFF_COLOUR
+            },
+            width: if ui.tool() == Tool::Rocks { 5.0 } else { 2.0 },
+            height: None,
+        });
         if let Some(drawn) = ui.drawing() {
             overlays.push(Overlay {
                 points: drawn.to_vec(),

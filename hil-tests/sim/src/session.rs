@@ -86,6 +86,38 @@ pub fn steps() -> Vec<ModelingStep> {
     ]
 }
 
+/// The session's rock field (issue 11): the palette button tapped (the rock tool), an outline
+/// drawn on the flank of the first peak, the field grabbed and slid along, and the palette
+/// tapped again (back to figures).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RockStep {
+    /// The palette button's centre, display mm (the modeler's button is the square from 8 to 28
+    /// mm in the display's corner).
+    pub palette: DVec2,
+    /// The field's outline, display mm (closed back to the first point).
+    pub outline: Vec<DVec2>,
+    /// Where the field is grabbed, and how far it is slid, mm.
+    pub grab: DVec2,
+    /// The slide.
+    pub slide: DVec2,
+}
+
+/// The rock field of the demo's session, after [`steps`].
+pub fn rock_step() -> RockStep {
+    RockStep {
+        palette: v(18.0, 18.0),
+        outline: vec![
+            v(90.0, 95.0),
+            v(200.0, 85.0),
+            v(215.0, 150.0),
+            v(160.0, 175.0),
+            v(95.0, 160.0),
+        ],
+        grab: v(150.0, 130.0),
+        slide: v(15.0, 10.0),
+    }
+}
+
 /// The hand's timeline for `steps`, from and back to `home`.
 pub fn timeline(steps: &[ModelingStep], home: glam::DVec3) -> Timeline {
     let mut s = Script::new(home);
@@ -108,6 +140,16 @@ pub fn timeline(steps: &[ModelingStep], home: glam::DVec3) -> Timeline {
             s.click(SW3).hold(0.3);
         }
     }
+    let rock = rock_step();
+    // The rock tool: tap the palette, draw the field, slide it, tap the palette again.
+    s.hover(rock.palette).touch().lift(8.0);
+    s.draw_closed(&rock.outline);
+    s.grab(rock.grab)
+        .drag_to(rock.grab + rock.slide)
+        .hold(0.3)
+        .lift(8.0)
+        .let_go();
+    s.hover(rock.palette).touch().lift(8.0);
     s.move_to(home);
     s.build()
 }

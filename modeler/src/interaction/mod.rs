@@ -13,6 +13,10 @@
 //! | SW3 click (nothing drawn or grabbed) | undo |
 //! | SW2 held + SW3 click (not touching) | redo |
 //! | SW3 held, move (nothing drawn or grabbed) | pans the ground with the pen; up and down zooms |
+//! | SW1 tap on the palette button (display corner) | picks the rock tool, or back to figures ([`rocks`]) |
+//! | rock tool: SW1 outline, SW3 | a closed outline becomes a rock field, its rocks on the terrain |
+//! | rock tool: SW2 + touch in a field, slide | moves the field (the same rocks) |
+//! | rock tool: field held, SW3 held, move | sideways: density; up and down: rock size; release SW3 sets both |
 //!
 //! [`KeyCommand`]s give the same edits to a keyboard or a script. Times come from the device clock
 //! that reports carry (a click is timed the same at any replay speed); events that are not from
@@ -20,6 +24,7 @@
 //! A refused edit is a message and a count, never a lost document: the editor keeps it valid.
 
 pub mod pick;
+pub mod rocks;
 pub mod stroke;
 pub mod view;
 
@@ -120,6 +125,8 @@ pub struct Stats {
     pub figures: u32,
     /// Generation regions drawn and added.
     pub regions: u32,
+    /// Rock fields drawn and added.
+    pub rock_fields: u32,
     /// Grabs committed with a height change.
     pub pulls: u32,
     /// Grabs committed with a slope change.
@@ -173,6 +180,10 @@ enum State {
     /// SW2 held, nothing grabbed.
     Armed,
     Grabbed(Grab),
+    /// The tip on the palette button: the tool was switched; nothing more until it lifts.
+    Palette,
+    /// A rock field held with SW2.
+    Field(rocks::FieldGrab),
     /// SW3 held with nothing drawn or grabbed: a click (undo) or a pan.
     Sw3 {
         t0: u64,
@@ -209,6 +220,9 @@ pub struct Interaction {
     stats: Stats,
     messages: Vec<String>,
     last_message: Option<(u64, String)>,
+    tool: rocks::Tool,
+    /// The rock field under the pen, with the rock tool.
+    field_hover: Option<usize>,
 }
 
 /// The event's time on the device's clock, µs; `None` for events not from a report (device
@@ -248,7 +262,29 @@ impl Interaction {
             stats: Stats::default(),
             messages: Vec::new(),
             last_message: None,
+            tool: rocks::Tool::Figures,
+            field_hover: None,
         }
+    }
+
+    /// The tool SW1 draws with.
+    pub fn tool(&self) -> rocks::Tool {
+        self.tool
+    }
+
+    /// The rock field under the pen (rock tool), or held.
+    pub fn field_hover(&self) -> Option<usize> {
+        match &self.state {
+            State::Field(g) => Some(g.index),
+            _ => self.field_hover,
+        }
+    }
+
+    /// The held rock field's outline where the pen is taking it (ground metres, closed).
+    pub fn field_moving(&self, doc: &Document) -> Option<(usize, Vec<Point>)> {
+        let State::Field(g) = &self.state else { return None };
+        let f = doc.rocks.get(g.index)?;
+        Some((g.index, f.outline_at().into_iter().map(|p| plus(p, g.by)).collect()))
     }
 
     /// The view: how the display shows the ground.
@@ -350,6 +386,25 @@ impl Interaction {
     /// One line saying what the pen is doing and what it can do next.
     pub fn status(&self, doc: &Document) -> String {
         let line = match &self.state {
+            State::Idle if self.tool == rocks::Tool::Rocks => match self.field_hover {
+                Some(i) => format!("rocks: rock field {i}: SW2 + touch grabs it | tap the palette for figures"),
+                None => "rocks: draw a field's outline | SW3 ends it | tap the palette for figures".to_string(),
+            },
+            State::Armed if self.tool == rocks::Tool::Rocks => {
+                "rocks: SW2: touch a rock field to grab it | SW3: redo".to_string()
+            }
+            State::Palette => match self.tool {
+                rocks::Tool::Rocks => "rock tool".to_string(),
+                rocks::Tool::Figures => "figures".to_string(),
+            },
+            State::Field(g) => match g.tuning {
+                Some((_, d, z)) => format!(
+                    "rock field {}: density ×{d:.2}, size ×{z:.2} | sideways: density, up/down: size",
+                    g.index
+                ),
+                None if g.moving => format!("moving rock field {} | lift to drop", g.index),
+                None => format!("rock field {}: slide to move | SW3 + move: density, size", g.index),
+            },
             State::Idle => match &self.hover {
                 Some(h) => format!("{}: SW2 + touch grabs it", describe(doc, &h.curve)),
                 None => "draw with the tip | SW3 ends a figure | SW3 click: undo".to_string(),
@@ -496,8 +551,24 @@ impl Interaction {
         let Some((g, p)) = self.ground() else { return };
         let s = self.tuning;
         match &mut self.state {
+            State::Idle | State::Armed if self.tool == rocks::Tool::Rocks => {
+                self.hover = None;
+                self.field_hover = rocks::field_at(editor.document(), g);
+            }
             State::Idle | State::Armed => {
                 self.hover = pick::pick(editor.document(), g, self.view.metres(s.pick_mm));
+            }
+            State::Palette => {}
+            State::Field(grab) => {
+                let slid = (p.u_mm - grab.at_mm[0]).hypot(p.v_mm - grab.at_mm[1]);
+                if let Some((start, _, _)) = grab.tuning {
+                    let density = ((p.u_mm - start[0]) * rocks::GAIN_PER_MM).exp();
+                    let size = ((p.h_mm - start[1]) * rocks::GAIN_PER_MM).exp();
+                    grab.tuning = Some((start, density, size));
+                } else if self.sw[0] && (grab.moving || slid > s.move_mm) {
+                    grab.moving = true;
+                    grab.by = minus(g, self.view.to_ground(grab.at_mm[0], grab.at_mm[1]));
+                }
             }
             State::Drawing { positions, touching } => {
                 if *touching {
@@ -591,12 +662,37 @@ impl Interaction {
     fn on_tip_down(&mut self, editor: &mut Editor) {
         let Some((g, p)) = self.ground() else { return };
         match &mut self.state {
+            State::Idle if rocks::on_palette(p.u_mm, p.v_mm) => {
+                self.tool = match self.tool {
+                    rocks::Tool::Figures => rocks::Tool::Rocks,
+                    rocks::Tool::Rocks => rocks::Tool::Figures,
+                };
+                self.hover = None;
+                self.field_hover = None;
+                self.state = State::Palette;
+                self.say(match self.tool {
+                    rocks::Tool::Rocks => "rock tool: draw a field's outline, SW3 ends it".into(),
+                    rocks::Tool::Figures => "figures: draw with the tip".into(),
+                });
+            }
             State::Idle => {
                 self.state = State::Drawing {
                     positions: vec![g],
                     touching: true,
                 }
             }
+            State::Armed if self.tool == rocks::Tool::Rocks => match rocks::field_at(editor.document(), g) {
+                Some(index) => {
+                    self.state = State::Field(rocks::FieldGrab {
+                        index,
+                        at_mm: [p.u_mm, p.v_mm],
+                        by: [0.0, 0.0],
+                        moving: false,
+                        tuning: None,
+                    })
+                }
+                None => self.say("no rock field here to grab".into()),
+            },
             State::Drawing { positions, touching } => {
                 *touching = true;
                 positions.push(g);
@@ -618,7 +714,7 @@ impl Interaction {
                     None => self.say("nothing here to grab".into()),
                 }
             }
-            State::Grabbed(_) | State::Sw3 { .. } => {}
+            State::Grabbed(_) | State::Sw3 { .. } | State::Palette | State::Field(_) => {}
         }
     }
 
@@ -647,7 +743,27 @@ impl Interaction {
                 }
                 _ => {}
             },
+            State::Palette => self.state = State::Idle,
+            State::Field(grab) if grab.moving => {
+                self.drop_field(editor);
+                self.state = State::Armed;
+            }
             _ => {}
+        }
+    }
+
+    /// Drops the held rock field where the pen has taken it.
+    fn drop_field(&mut self, editor: &mut Editor) {
+        let State::Field(grab) = &self.state else { return };
+        if !grab.moving || grab.by == [0.0, 0.0] {
+            return;
+        }
+        let edit = Edit::MoveRocks {
+            index: grab.index,
+            by: grab.by,
+        };
+        if self.commit(editor, edit, "moving the rock field") {
+            self.stats.moves += 1;
         }
     }
 
@@ -658,6 +774,11 @@ impl Interaction {
     }
 
     fn on_sw2_up(&mut self, editor: &mut Editor) {
+        if let State::Field(_) = &self.state {
+            self.drop_field(editor);
+            self.state = State::Idle;
+            return;
+        }
         let State::Grabbed(grab) = &self.state else {
             if self.state == State::Armed {
                 self.state = State::Idle;
@@ -702,7 +823,12 @@ impl Interaction {
                     grab.action = Action::Slope { u0: at_mm[0], s0 };
                 }
             }
-            State::Sw3 { .. } => {}
+            State::Field(grab) => {
+                if let Some(p) = self.pen {
+                    grab.tuning = Some(([p.u_mm, p.h_mm], 1.0, 1.0));
+                }
+            }
+            State::Sw3 { .. } | State::Palette => {}
         }
     }
 
@@ -711,6 +837,23 @@ impl Interaction {
             State::Grabbed(grab) => {
                 if let Action::Slope { .. } = grab.action {
                     grab.action = if grab.pulled { Action::Pull } else { Action::Pending };
+                }
+            }
+            State::Field(grab) => {
+                let Some((_, density, size)) = grab.tuning.take() else {
+                    return;
+                };
+                let index = grab.index;
+                let Some(field) = editor.document().rocks.get(index) else {
+                    return;
+                };
+                let field = rocks::tuned(field, density, size);
+                if self.commit(
+                    editor,
+                    Edit::ReplaceRocks { index, field },
+                    "the rock field's density and size",
+                ) {
+                    self.say(format!("rock field {index}: density ×{density:.2}, size ×{size:.2}"));
                 }
             }
             State::Sw3 { t0, moved, .. } => {
@@ -726,6 +869,10 @@ impl Interaction {
 
     fn on_lost(&mut self, editor: &mut Editor, reason: &str) {
         match &mut self.state {
+            State::Field(_) => {
+                self.say(format!("pen lost ({reason}): the rock field stays where it was"));
+                self.state = State::Idle;
+            }
             State::Grabbed(_) => {
                 if let Err(e) = editor.cancel_preview() {
                     self.say(format!("cannot restore the grabbed figure: {e}"));
@@ -869,6 +1016,9 @@ impl Interaction {
         let Some(shape) = stroke::classify(positions, &tol) else {
             return;
         };
+        if self.tool == rocks::Tool::Rocks {
+            return self.finish_field(editor, shape);
+        }
         let doc = editor.document();
         let edit = match pick::container(doc, &shape.points) {
             Some(at) => Edit::AddFigure {
@@ -909,6 +1059,28 @@ impl Interaction {
                 self.stats.figures += 1;
             }
             self.say(format!("added {name}"));
+        }
+    }
+}
+
+impl Interaction {
+    /// A closed outline drawn with the rock tool becomes a rock field.
+    fn finish_field(&mut self, editor: &mut Editor, shape: Shape) {
+        if shape.kind != FigureKind::Closed {
+            self.stats.refused += 1;
+            self.say(format!(
+                "a rock field needs a closed outline (this was a {}): come back to the start",
+                shape.kind.name()
+            ));
+            return;
+        }
+        let doc = editor.document();
+        let index = doc.rocks.len();
+        let field = rocks::new_field(&shape.points, &self.view, index as u64 + 1);
+        if self.commit(editor, Edit::AddRocks { index, field }, &format!("rock field {index}")) {
+            self.stats.rock_fields += 1;
+            let n = editor.rocks().fields().get(index).map_or(0, |f| f.scatter.rocks.len());
+            self.say(format!("added rock field {index}: {n} rocks"));
         }
     }
 }
