@@ -370,3 +370,72 @@ fn losing_the_pen_mid_pull_cancels_the_pull_and_keeps_the_document() {
     assert_eq!(pen.doc(), &before);
     assert!(pen.ui.view().tilt < 0.01, "tilt {}", pen.ui.view().tilt);
 }
+
+/// The rock tool (issue 11): tapping the palette button picks it; an outline becomes a rock field.
+#[test]
+fn the_rock_tool_draws_moves_and_tunes_a_field() {
+    use penmodel::interaction::rocks::Tool;
+    let mut pen = Pen::new(blank());
+    pen.closed(&REGION);
+    // A tap on the palette button (8 to 28 mm in the corner) picks the rock tool.
+    pen.hover(18.0, 18.0).touch().lift(HOVER);
+    assert_eq!(pen.ui.tool(), Tool::Rocks);
+    let outline = [(150.0, 100.0), (260.0, 100.0), (260.0, 180.0), (150.0, 180.0)];
+    pen.closed(&outline);
+    assert_eq!(pen.doc().rocks.len(), 1, "{:?}", pen.ui.take_messages());
+    assert_eq!(pen.doc().regions[0].figures.len(), 0, "the outline is no figure");
+    let field = pen.doc().rocks[0].clone();
+    for (p, &(u, v)) in field.outline_at().iter().zip(&outline) {
+        assert!(near(*p, pen.ground(u, v), 10.0), "{p:?} vs {:?}", (u, v));
+    }
+    let rocks = pen.editor.rocks().fields()[0].scatter.rocks.len();
+    assert!(rocks > 100, "{rocks} rocks");
+    assert_eq!(pen.ui.stats().rock_fields, 1);
+
+    // SW2 + touch inside it and a slide moves it by the slide: the same rocks.
+    pen.grab(200.0, 140.0).drag_to(230.0, 150.0).lift(HOVER).let_go();
+    let moved = &pen.doc().rocks[0];
+    let by = [moved.at[0] - field.at[0], moved.at[1] - field.at[1]];
+    let expected = {
+        let (a, b) = (pen.ground(200.0, 140.0), pen.ground(230.0, 150.0));
+        [b[0] - a[0], b[1] - a[1]]
+    };
+    assert!(near(by, expected, 5.0), "moved by {by:?}, slid {expected:?}");
+    assert_eq!(moved.outline, field.outline);
+    assert_eq!(
+        pen.editor.rocks().fields()[0].scatter.rocks.len(),
+        rocks,
+        "a move scatters nothing new"
+    );
+
+    // Held, SW3 and a move right and up: denser and bigger, one edit.
+    pen.grab(215.0, 145.0);
+    pen.set(2, true).set(0, false);
+    let to = pen.at + DVec3::new(35.0, 0.0, 20.0);
+    pen.move_to(to).set(2, false).let_go();
+    let tuned = &pen.doc().rocks[0];
+    let density = (35.0f64 * 0.02).exp();
+    for (a, b) in tuned.layers.iter().zip(&field.layers) {
+        assert!(a.radius > b.radius * 1.3, "radius {} from {}", a.radius, b.radius);
+        let (fa, fb) = (a.fraction.unwrap_or(0.0), b.fraction.unwrap_or(0.0));
+        // Fig. 1's fractions sum to 1: denser is capped at the whole field.
+        assert!(fa <= fb * density + 1e-9, "fraction {fa} from {fb}");
+    }
+    // Undo: the density and size, then the move, then the field.
+    pen.editor.undo().expect("undo");
+    assert_eq!(pen.doc().rocks[0].layers, field.layers);
+    pen.editor.undo().expect("undo");
+    assert_eq!(pen.doc().rocks[0], field);
+
+    // Back to figures: a tap on the palette again; an open stroke with the rock tool is refused.
+    pen.hover(18.0, 18.0).touch().lift(HOVER);
+    assert_eq!(pen.ui.tool(), Tool::Figures);
+    pen.hover(18.0, 18.0).touch().lift(HOVER);
+    pen.stroke(&[(300.0, 200.0), (400.0, 220.0)]);
+    assert_eq!(pen.doc().rocks.len(), 1);
+    let messages = pen.ui.take_messages();
+    assert!(
+        messages.iter().any(|m| m.contains("needs a closed outline")),
+        "{messages:?}"
+    );
+}

@@ -565,7 +565,7 @@ impl Interaction {
                     let density = ((p.u_mm - start[0]) * rocks::GAIN_PER_MM).exp();
                     let size = ((p.h_mm - start[1]) * rocks::GAIN_PER_MM).exp();
                     grab.tuning = Some((start, density, size));
-                } else if self.sw[0] && (grab.moving || slid > s.move_mm) {
+                } else if self.sw[0] && !grab.tuned && (grab.moving || slid > s.move_mm) {
                     grab.moving = true;
                     grab.by = minus(g, self.view.to_ground(grab.at_mm[0], grab.at_mm[1]));
                 }
@@ -689,6 +689,7 @@ impl Interaction {
                         by: [0.0, 0.0],
                         moving: false,
                         tuning: None,
+                        tuned: false,
                     })
                 }
                 None => self.say("no rock field here to grab".into()),
@@ -824,8 +825,11 @@ impl Interaction {
                 }
             }
             State::Field(grab) => {
-                if let Some(p) = self.pen {
+                if let Some(p) = self.pen
+                    && !grab.moving
+                {
                     grab.tuning = Some(([p.u_mm, p.h_mm], 1.0, 1.0));
+                    grab.tuned = true;
                 }
             }
             State::Sw3 { .. } | State::Palette => {}

@@ -119,6 +119,8 @@ pub struct FieldGrab {
     pub moving: bool,
     /// The density and size gesture: the pen's `(u, h)` when SW3 went down, and the factors.
     pub tuning: Option<([f64; 2], f64, f64)>,
+    /// Whether this grab has tuned the field: it then no longer moves it.
+    pub tuned: bool,
 }
 
 /// Applies an edit for the rock tool; a refusal is the message returned.
