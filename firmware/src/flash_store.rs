@@ -14,7 +14,7 @@ const SECTOR_SIZE: u32 = 0x2_0000;
 
 /// One configuration sector through embassy's blocking flash driver, which both sectors share.
 /// Programming stalls the CPU for a few microseconds per word; erasing, which the store does
-/// once per 655 saves, for 2 s (4 s at most: embassy erases at 8-bit parallelism).
+/// once per 630 saves, for 2 s (4 s at most: embassy erases at 8-bit parallelism).
 pub struct ConfigSector<'d> {
     pub flash: &'d RefCell<Flash<'d, Blocking>>,
     pub offset: u32,

@@ -34,7 +34,7 @@ use embassy_usb::Builder;
 use embassy_usb::class::cdc_acm::{self, CdcAcmClass};
 use embassy_usb::class::hid::{self, HidBootProtocol, HidSubclass, HidWriter};
 use pen_core::{ConfigStore, Engine, LogStore, Station, WakeOnPress};
-use pen_protocol::{FirmwareVersion, PROTOCOL_VERSION, REPORT_DESCRIPTOR, USB_PID, USB_VID};
+use pen_protocol::{FirmwareVersion, PROTOCOL_VERSION, USB_PID, USB_VID, report_descriptor};
 use {defmt_rtt as _, panic_probe as _};
 
 use crate::capture::{BoardRanging, Pins, burst_pin, capture_pin};
@@ -176,6 +176,9 @@ async fn main(_spawner: Spawner) {
     device.device_sub_class = 0x02;
     device.device_protocol = 0x01;
 
+    // The OS pen collection spans the saved calibration's display: its logical ranges are the
+    // display's size, fixed at enumeration (a new size saved restarts the device).
+    let descriptor = report_descriptor(engine.lock(|e| e.borrow().os_extent()));
     // Everything the USB stack borrows is declared before the builder, so it outlives it.
     let mut features = FeatureHandler {
         engine: &engine,
@@ -199,7 +202,7 @@ async fn main(_spawner: Spawner) {
     );
     builder.handler(&mut bus_state);
     let hid_config = hid::Config {
-        report_descriptor: &REPORT_DESCRIPTOR,
+        report_descriptor: descriptor.bytes(),
         request_handler: Some(&mut features),
         poll_ms: 1,
         max_packet_size: HID_PACKET as u16,
@@ -273,12 +276,21 @@ async fn main(_spawner: Spawner) {
         }
     };
 
-    // Restart into the bootloader once the request's answer has gone out.
+    // Restart into the bootloader, or restart the firmware, once the request's answer has gone
+    // out.
     let bootloader_task = async {
-        usb::BOOTLOADER.wait().await;
-        info!("restarting into the DFU bootloader");
-        Timer::after_millis(50).await;
-        bootloader::restart_into_bootloader()
+        match select(usb::BOOTLOADER.wait(), usb::RESTART.wait()).await {
+            Either::First(()) => {
+                info!("restarting into the DFU bootloader");
+                Timer::after_millis(50).await;
+                bootloader::restart_into_bootloader()
+            }
+            Either::Second(()) => {
+                info!("restarting: the saved display size needs a new USB descriptor");
+                Timer::after_millis(50).await;
+                cortex_m::peripheral::SCB::sys_reset()
+            }
+        }
     };
 
     join(

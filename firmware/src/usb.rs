@@ -15,7 +15,7 @@ use embassy_usb::class::hid::{HidWriter, ReportId as HidReportId, RequestHandler
 use embassy_usb::control::OutResponse;
 use embassy_usb::driver::Driver;
 use pen_core::{Action, LogStore, ReportSink, SharedEngine};
-use pen_protocol::{FrameDecoder, MAX_FRAME, MAX_PAYLOAD, PenReport, Report, TofReport, encode_frame};
+use pen_protocol::{FrameDecoder, MAX_FRAME, MAX_PAYLOAD, OsPenReport, PenReport, Report, TofReport, encode_frame};
 
 use crate::flash_store::ConfigSector;
 
@@ -39,8 +39,8 @@ pub struct SerialFrame {
     buf: [u8; MAX_FRAME],
 }
 
-/// Reports waiting for the HID endpoint.
-pub type HidQueue = Channel<ThreadModeRawMutex, HidPacket, 8>;
+/// Reports waiting for the HID endpoint: the pen and the OS pen report of each cycle.
+pub type HidQueue = Channel<ThreadModeRawMutex, HidPacket, 16>;
 /// Frames waiting for the serial link.
 pub type SerialQueue = Channel<ThreadModeRawMutex, SerialFrame, 8>;
 
@@ -57,10 +57,15 @@ pub static SUSPENDED: AtomicBool = AtomicBool::new(false);
 pub static WAKE_HOST: Signal<ThreadModeRawMutex, ()> = Signal::new();
 /// Raised when a request asked for the bootloader; main restarts once the answer is out.
 pub static BOOTLOADER: Signal<ThreadModeRawMutex, ()> = Signal::new();
+/// Raised when a saved configuration needs a new USB descriptor; main restarts once the answer
+/// is out.
+pub static RESTART: Signal<ThreadModeRawMutex, ()> = Signal::new();
 
 fn act(action: Option<Action>) {
-    if let Some(Action::EnterBootloader) = action {
-        BOOTLOADER.signal(());
+    match action {
+        Some(Action::EnterBootloader) => BOOTLOADER.signal(()),
+        Some(Action::Restart) => RESTART.signal(()),
+        None => {}
     }
 }
 
@@ -116,7 +121,7 @@ pub struct BoardSink<'a, 'd> {
 }
 
 impl BoardSink<'_, '_> {
-    fn send<R: Report>(&mut self, report: &R) {
+    fn send_hid<R: Report>(&mut self, report: &R) {
         let mut packet = HidPacket {
             len: 0,
             buf: [0; HID_PACKET],
@@ -127,6 +132,10 @@ impl BoardSink<'_, '_> {
                 DROPPED_HID.fetch_add(1, Ordering::Relaxed);
             }
         }
+    }
+
+    fn send<R: Report>(&mut self, report: &R) {
+        self.send_hid(report);
         if self.serial_control.dtr() {
             let mut payload = [0u8; HID_PACKET];
             let mut frame = SerialFrame {
@@ -152,6 +161,11 @@ impl ReportSink for BoardSink<'_, '_> {
 
     async fn tof(&mut self, report: &TofReport) {
         self.send(report);
+    }
+
+    /// HID only: the serial link's host reads the project's own reports.
+    async fn os_pen(&mut self, report: &OsPenReport) {
+        self.send_hid(report);
     }
 }
 

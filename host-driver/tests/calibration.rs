@@ -158,7 +158,7 @@ fn a_calibration_written_to_the_device_makes_it_report_display_coordinates() {
     let touched = collect_touches(&mut device, &targets, Duration::from_secs(30), |_| {}).expect("touches");
     let cal = fit(&targets, &touched, FitKind::Similarity, DisplaySize::REFERENCE).expect("fit");
     let config = pen_protocol::Config {
-        display: Some(cal.transform.to_device()),
+        display: Some(cal.to_device()),
         report_display_frame: true,
         ..original
     };

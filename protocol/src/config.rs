@@ -49,7 +49,12 @@ impl Filter {
 /// `p_display = scale · R(rotation) · p_tracker + translation`, where the display frame has u, v
 /// in the display surface and h along its normal, towards the user.
 ///
-/// JSON (feature `serde`): `{"rotation_wxyz", "translation_mm", "scale"}`.
+/// With it, the display's size: the display frame's u runs 0…width to the right and v 0…height
+/// up across the display's active area, from its bottom-left corner; the operating system's pen
+/// report spans it (with Y = height − v, down from the top, as screens count).
+///
+/// JSON (feature `serde`): `{"rotation_wxyz", "translation_mm", "scale", "size_mm"}`;
+/// `size_mm` may be left out (unknown).
 #[derive(Debug, Clone, Copy, PartialEq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 #[cfg_attr(
@@ -70,6 +75,10 @@ pub struct DisplayPose {
     /// Scale (1 for a rigid transform).
     #[cfg_attr(feature = "serde", serde(serialize_with = "crate::wide::wide"))]
     pub scale: f32,
+    /// The display's active area, width × height, mm; `[0, 0]` when unknown (the operating
+    /// system's pen is then never in range).
+    #[cfg_attr(feature = "serde", serde(default, serialize_with = "crate::wide::wide_array"))]
+    pub size_mm: [f32; 2],
 }
 
 /// The base station's configuration.
@@ -110,7 +119,7 @@ const FLAG_BITS: u8 = FIXED_SPEED | HAS_DISPLAY | DISPLAY_FRAME | STREAM_TOF;
 
 impl Report for Config {
     const ID: ReportId = ReportId::Config;
-    const LEN: usize = 187;
+    const LEN: usize = 195;
 
     fn write_body(&self, w: &mut Writer<'_>) {
         let count = (self.receiver_count as usize).min(MAX_RECEIVERS);
@@ -145,10 +154,12 @@ impl Report for Config {
             rotation: [0.0; 4],
             translation_mm: [0.0; 3],
             scale: 0.0,
+            size_mm: [0.0; 2],
         });
         pose.rotation.iter().for_each(|&v| w.f32(v));
         pose.translation_mm.iter().for_each(|&v| w.f32(v));
         w.f32(pose.scale);
+        pose.size_mm.iter().for_each(|&v| w.f32(v));
     }
 
     fn read_body(r: &mut Reader<'_>) -> Result<Self, DecodeError> {
@@ -215,6 +226,7 @@ impl Report for Config {
                 rotation: [0.0; 4],
                 translation_mm: [0.0; 3],
                 scale: 0.0,
+                size_mm: [0.0; 2],
             };
             for v in pose.rotation.iter_mut() {
                 *v = r.f32("display.rotation")?;
@@ -223,9 +235,12 @@ impl Report for Config {
                 *v = r.f32("display.translation_mm")?;
             }
             pose.scale = r.f32("display.scale")?;
+            for v in pose.size_mm.iter_mut() {
+                *v = r.f32("display.size_mm")?;
+            }
             Some(pose)
         } else {
-            for _ in 0..8 {
+            for _ in 0..10 {
                 r.zero_f32("display (absent)")?;
             }
             None
@@ -397,6 +412,9 @@ pub mod limits {
     pub const BETA: (f32, f32) = (0.0, 10.0);
     /// Allowed deviation of the rotation quaternion's norm from 1.
     pub const QUATERNION_NORM_TOLERANCE: f32 = 1e-3;
+    /// A display's width and height, mm, when known: 50 mm to 3.2768 m (the OS pen report's 0.1 mm
+    /// units in 15 bits).
+    pub const DISPLAY_SIZE_MM: (f32, f32) = (50.0, 3276.7);
     /// Largest display translation magnitude per axis, mm.
     pub const MAX_TRANSLATION_MM: f32 = 10_000.0;
     /// Similarity scale range.
@@ -500,7 +518,9 @@ impl Config {
                 return fail(ConfigField::Display, Problem::Degenerate);
             }
             let t_ok = pose.translation_mm.iter().all(|v| v.abs() <= MAX_TRANSLATION_MM);
-            if !t_ok || !within(pose.scale, SCALE) {
+            // Unknown (both 0) or a real display: the OS report's 0.1 mm units must fit u16.
+            let size_ok = pose.size_mm == [0.0; 2] || pose.size_mm.iter().all(|&v| within(v, DISPLAY_SIZE_MM));
+            if !t_ok || !within(pose.scale, SCALE) || !size_ok {
                 return fail(ConfigField::Display, Problem::OutOfRange);
             }
         } else if self.report_display_frame {

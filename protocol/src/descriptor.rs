@@ -10,9 +10,15 @@
 //!
 //! Two application collections:
 //!
-//! * Digitizer / Pen: report 0x01, what the operating system's pen stack understands.
-//! * Vendor 0xFF00 / 0x01: the diagnostics input report 0x02 and the feature reports 0x03–0x06,
-//!   opaque byte arrays whose layout the report codecs define.
+//! * Digitizer / Pen: report 0x07 ([`OsPenReport`](crate::OsPenReport)), what the operating system's pen stack
+//!   takes: tip, barrels, in range, X and Y on the display. Its logical ranges are the
+//!   calibrated display's width and height in 0.1 mm, so the descriptor is built for the
+//!   display ([`report_descriptor`]) when the device starts.
+//! * Vendor 0xFF00 / 0x01: the project's own pen report 0x01 (3D, tracker or display frame,
+//!   with its quality), described field by field as before but where no OS pen stack binds
+//!   (Windows and Linux take input only from Generic Desktop, Digitizer and Consumer
+//!   application collections); the diagnostics input report 0x02 and the feature reports
+//!   0x03–0x06, opaque byte arrays whose layout the report codecs define.
 
 use usbd_hid::descriptor::{AsInputReport, BufferOverflow, SerializedDescriptor};
 use usbd_hid_descriptors::{GlobalItemKind as G, ItemType, LocalItemKind as L, MainItemKind as M};
@@ -21,6 +27,7 @@ use crate::ReportId;
 use crate::codec::Report;
 use crate::config::Config;
 use crate::info::DeviceInfo;
+
 use crate::pen::{POSITION_LOGICAL_MAX, PenReport};
 use crate::status::{Command, Status};
 use crate::tof::TofReport;
@@ -96,7 +103,7 @@ mod unit {
 }
 
 /// Room for the descriptor; the builder fails to compile if it overflows.
-const CAPACITY: usize = 256;
+const CAPACITY: usize = 384;
 
 /// A `const` HID report descriptor builder: each method appends one item.
 #[derive(Clone, Copy)]
@@ -228,21 +235,57 @@ impl Builder {
         }
     }
 
-    const fn descriptor(self) -> Self {
+    const fn descriptor(self, extent: [u16; 2]) -> Self {
         use usage::*;
         let max = POSITION_LOGICAL_MAX as i32;
+        let (w, h) = (extent[0] as i32, extent[1] as i32);
         self.usage_page(PAGE_DIGITIZER)
             .usage(PEN)
             .collection(collection::APPLICATION)
-            .report_id(ReportId::Pen)
+            .report_id(ReportId::OsPen)
             .usage(STYLUS)
             .collection(collection::PHYSICAL)
-            // Byte 1: SW1, SW2, SW3, In Range, display-frame flag, 3 bits padding.
+            // Byte 1: Tip, Barrel, Secondary Barrel, In Range, 4 bits padding.
             .usage(TIP_SWITCH)
             .usage(BARREL_SWITCH)
             .usage(SECONDARY_BARREL_SWITCH)
             .usage(IN_RANGE)
             .logical(0, 1)
+            .fields(1, 4)
+            .input(flags::DATA_VAR_ABS)
+            .fields(1, 4)
+            .input(flags::CONST_VAR_ABS)
+            // Bytes 2–5: X and Y on the display, 0.1 mm (centimetres × 10⁻²), from its top-left
+            // corner; the logical and physical ranges are the display's width and height.
+            .usage_page(PAGE_GENERIC_DESKTOP)
+            .usage(X)
+            .logical(0, w)
+            .physical(0, w)
+            .unit(unit::CENTIMETRE, -2)
+            .fields(16, 1)
+            .input(flags::DATA_VAR_ABS)
+            .usage(Y)
+            .logical(0, h)
+            .physical(0, h)
+            .input(flags::DATA_VAR_ABS)
+            .end_collection()
+            .end_collection()
+            // The vendor collection: the project's pen report, diagnostics and feature reports.
+            .usage_page(PAGE_VENDOR)
+            .usage(VENDOR_COLLECTION)
+            .collection(collection::APPLICATION)
+            .report_id(ReportId::Pen)
+            .usage(STYLUS)
+            .collection(collection::PHYSICAL)
+            // Byte 1: SW1, SW2, SW3, In Range, display-frame flag, 3 bits padding.
+            .usage_page(PAGE_DIGITIZER)
+            .usage(TIP_SWITCH)
+            .usage(BARREL_SWITCH)
+            .usage(SECONDARY_BARREL_SWITCH)
+            .usage(IN_RANGE)
+            .logical(0, 1)
+            .physical(0, 0)
+            .unit(unit::NONE, 0)
             .fields(1, 4)
             .input(flags::DATA_VAR_ABS)
             .usage_page(PAGE_VENDOR)
@@ -293,11 +336,7 @@ impl Builder {
             .unit(unit::NONE, 0)
             .input(flags::DATA_VAR_ABS)
             .end_collection()
-            .end_collection()
-            // The vendor collection: diagnostics and feature reports as byte arrays.
-            .usage_page(PAGE_VENDOR)
-            .usage(VENDOR_COLLECTION)
-            .collection(collection::APPLICATION)
+            // Diagnostics and feature reports as byte arrays.
             .vendor_bytes(ReportId::Tof, TofReport::LEN, false)
             .vendor_bytes(ReportId::DeviceInfo, DeviceInfo::LEN, true)
             .vendor_bytes(ReportId::Config, Config::LEN, true)
@@ -319,13 +358,55 @@ impl Builder {
     }
 }
 
-const BUILT: Builder = Builder::new().descriptor();
+/// The OS pen's extent before a calibration gives the display's size, 0.1 mm: a 600 × 340 mm
+/// display, the reference build's (the pen is never in range for the OS then).
+const UNKNOWN_EXTENT: [u16; 2] = [6000, 3400];
 
-/// The report descriptor's length in bytes.
+/// The OS pen's logical X and Y maxima, 0.1 mm, for a display of `size_mm` (width, height);
+/// `None` while the size is unknown (zero) or unusable.
+pub fn os_extent(size_mm: [f32; 2]) -> Option<[u16; 2]> {
+    let tenths = |mm: f32| {
+        let t = mm * 10.0;
+        // At least 50 mm (the configuration's limit), and within the 15 bits the logical
+        // maximum's two-byte item holds; NaN fails both.
+        (t >= 500.0 && t <= i16::MAX as f32).then_some(t as u16)
+    };
+    Some([tenths(size_mm[0])?, tenths(size_mm[1])?])
+}
+
+const BUILT: Builder = Builder::new().descriptor(UNKNOWN_EXTENT);
+
+/// The report descriptor's length in bytes, whatever the display (every valid extent takes a
+/// two-byte logical and physical maximum).
 pub const REPORT_DESCRIPTOR_LEN: usize = BUILT.len;
 
-/// The report descriptor the device presents and the host parses.
+/// The report descriptor of a device that knows no display size yet; the host's tests parse it.
 pub const REPORT_DESCRIPTOR: [u8; REPORT_DESCRIPTOR_LEN] = BUILT.take();
+
+/// A report descriptor built for a display.
+#[derive(Clone, Copy)]
+pub struct Descriptor {
+    bytes: [u8; REPORT_DESCRIPTOR_LEN],
+}
+
+impl Descriptor {
+    /// The descriptor's bytes.
+    pub fn bytes(&self) -> &[u8] {
+        &self.bytes
+    }
+}
+
+/// The report descriptor for a display whose OS pen extent is `extent` ([`os_extent`]), or
+/// [`REPORT_DESCRIPTOR`] when there is none.
+pub fn report_descriptor(extent: Option<[u16; 2]>) -> Descriptor {
+    // Both maxima of a valid extent lie in 500..=32767: two-byte items, the constant length.
+    let extent = extent
+        .filter(|e| e.iter().all(|&v| (500..=i16::MAX as u16).contains(&v)))
+        .unwrap_or(UNKNOWN_EXTENT);
+    Descriptor {
+        bytes: Builder::new().descriptor(extent).take(),
+    }
+}
 
 impl SerializedDescriptor for PenReport {
     fn desc() -> &'static [u8] {

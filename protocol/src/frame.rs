@@ -13,7 +13,7 @@ use core::fmt;
 use crate::codec::Report;
 use crate::error::EncodeError;
 
-/// The largest payload a frame carries. Version 1's largest report has 187 bytes; the margin
+/// The largest payload a frame carries. Version 2's largest report has 195 bytes; the margin
 /// leaves room for minor versions.
 pub const MAX_PAYLOAD: usize = 256;
 /// Bytes of the CRC that follows the payload.

@@ -302,6 +302,21 @@ impl Serialize for Status {
     }
 }
 
+/// The OS pen report: its fields, positions in mm.
+#[derive(Serialize)]
+struct OsPenJson {
+    report_id: u8,
+    report: &'static str,
+    tip: bool,
+    barrel: bool,
+    secondary_barrel: bool,
+    in_range: bool,
+    #[serde(serialize_with = "tenths")]
+    x_mm: u16,
+    #[serde(serialize_with = "tenths")]
+    y_mm: u16,
+}
+
 #[derive(Serialize)]
 struct CommandJson {
     report_id: u8,
@@ -351,6 +366,17 @@ impl Serialize for Message {
                 report_id: ReportId::Command as u8,
                 report: ReportId::Command.name(),
                 command: *c,
+            }
+            .serialize(s),
+            Message::OsPen(r) => OsPenJson {
+                report_id: ReportId::OsPen as u8,
+                report: ReportId::OsPen.name(),
+                tip: r.tip,
+                barrel: r.barrel,
+                secondary_barrel: r.secondary_barrel,
+                in_range: r.in_range,
+                x_mm: r.x,
+                y_mm: r.y,
             }
             .serialize(s),
             Message::GetFeature(r) => r.json(tag).serialize(s),

@@ -10,6 +10,7 @@ mod frame;
 mod info;
 #[cfg(feature = "serde")]
 mod json;
+mod os_pen;
 mod pen;
 mod status;
 mod tof;
@@ -20,13 +21,14 @@ use core::fmt;
 
 pub use codec::{Reader, Report, Writer};
 pub use config::{Config, ConfigError, ConfigField, DisplayPose, Filter, Problem, limits};
-pub use descriptor::{REPORT_DESCRIPTOR, REPORT_DESCRIPTOR_LEN, usage};
+pub use descriptor::{Descriptor, REPORT_DESCRIPTOR, REPORT_DESCRIPTOR_LEN, os_extent, report_descriptor, usage};
 pub use error::{DecodeError, EncodeError};
 pub use frame::{CRC, CRC_LEN, FrameDecoder, FrameError, MAX_FRAME, MAX_PAYLOAD, encode_frame, encode_report_frame};
 pub use info::SUPPORTED_MAJOR_VERSIONS;
 pub use info::{DeviceInfo, FirmwareVersion, PROTOCOL_VERSION, UnsupportedVersion, Version, check_version};
 #[cfg(feature = "serde")]
 pub use json::{ConfigChanges, PerReceiver};
+pub use os_pen::OsPenReport;
 pub use pen::{MAX_RECEIVERS, POSITION_LOGICAL_MAX, PenReport, Position, Quality, UNITS_PER_MM};
 pub use status::{Command, GetFeature, Status, StatusCode};
 pub use tof::{NO_ARRIVAL, TofReport};
@@ -54,19 +56,22 @@ pub enum ReportId {
     Status = 0x05,
     /// Feature, write-only: [`Command`].
     Command = 0x06,
+    /// Input, USB HID only: [`OsPenReport`], the operating system's pen.
+    OsPen = 0x07,
     /// Serial only, host to device: [`GetFeature`].
     GetFeature = 0x80,
 }
 
 impl ReportId {
     /// All IDs, in order.
-    pub const ALL: [ReportId; 7] = [
+    pub const ALL: [ReportId; 8] = [
         ReportId::Pen,
         ReportId::Tof,
         ReportId::DeviceInfo,
         ReportId::Config,
         ReportId::Status,
         ReportId::Command,
+        ReportId::OsPen,
         ReportId::GetFeature,
     ];
 
@@ -92,6 +97,7 @@ impl ReportId {
             ReportId::Config => "configuration",
             ReportId::Status => "status",
             ReportId::Command => "command",
+            ReportId::OsPen => "OS pen",
             ReportId::GetFeature => "get-feature request",
         }
     }
@@ -114,6 +120,7 @@ pub enum Message {
     Config(Config),
     Status(Status),
     Command(Command),
+    OsPen(OsPenReport),
     GetFeature(GetFeature),
 }
 
@@ -129,6 +136,7 @@ impl Message {
             ReportId::Config => Message::Config(Config::decode(bytes)?),
             ReportId::Status => Message::Status(Status::decode(bytes)?),
             ReportId::Command => Message::Command(Command::decode(bytes)?),
+            ReportId::OsPen => Message::OsPen(OsPenReport::decode(bytes)?),
             ReportId::GetFeature => Message::GetFeature(GetFeature::decode(bytes)?),
         })
     }
@@ -142,6 +150,7 @@ impl Message {
             Message::Config(r) => r.encode(out),
             Message::Status(r) => r.encode(out),
             Message::Command(r) => r.encode(out),
+            Message::OsPen(r) => r.encode(out),
             Message::GetFeature(r) => r.encode(out),
         }
     }
@@ -155,6 +164,7 @@ impl Message {
             Message::Config(_) => ReportId::Config,
             Message::Status(_) => ReportId::Status,
             Message::Command(_) => ReportId::Command,
+            Message::OsPen(_) => ReportId::OsPen,
             Message::GetFeature(_) => ReportId::GetFeature,
         }
     }

@@ -1,5 +1,6 @@
 //! The report descriptor, parsed by an independent parser (hidreport, from the hid-tools
-//! maintainers), against the report codecs: every field's offset and size, every report's length.
+//! maintainers), against the report codecs: every field's offset and size, every report's length;
+//! and the OS's pen collection read as an OS pen stack reads it.
 
 use crate::common;
 
@@ -57,11 +58,12 @@ fn every_report_has_the_codec_length() {
     };
     let inputs: Vec<&dyn HidReport> = rd.input_reports().iter().map(|r| r as &dyn HidReport).collect();
     let features: Vec<&dyn HidReport> = rd.feature_reports().iter().map(|r| r as &dyn HidReport).collect();
-    assert_eq!(inputs.len(), 2);
+    assert_eq!(inputs.len(), 3);
     assert_eq!(features.len(), 4);
     assert!(rd.output_reports().is_empty());
     assert_eq!(len(&inputs, ReportId::Pen), PenReport::LEN);
     assert_eq!(len(&inputs, ReportId::Tof), TofReport::LEN);
+    assert_eq!(len(&inputs, ReportId::OsPen), OsPenReport::LEN);
     assert_eq!(len(&features, ReportId::DeviceInfo), DeviceInfo::LEN);
     assert_eq!(len(&features, ReportId::Config), Config::LEN);
     assert_eq!(len(&features, ReportId::Status), Status::LEN);
@@ -91,10 +93,11 @@ fn pen_fields_have_the_documented_usages_and_units() {
             (PAGE_VENDOR, VENDOR_DOP),
         ]
     );
-    // The application collection is Digitizer / Pen.
+    // The project's own report sits in the vendor application collection, where no OS pen
+    // stack binds: its tracker-frame X/Y/Z never reach the OS's pointer.
     let app = &fields[0].collections[0];
-    assert_eq!(app.usages()[0].usage_page, 0x0D.into());
-    assert_eq!(app.usages()[0].usage_id, 0x02.into());
+    assert_eq!(app.usages()[0].usage_page, 0xFF00.into());
+    assert_eq!(app.usages()[0].usage_id, 0x01.into());
     for axis in &fields[5..8] {
         assert_eq!(i32::from(axis.logical_minimum), -32767);
         assert_eq!(i32::from(axis.logical_maximum), 32767);
@@ -217,5 +220,228 @@ fn sample_reports_are_recognised_by_their_ids() {
             .expect("config recognised")
             .size_in_bytes(),
         config.len()
+    );
+}
+
+/// The OS pen report's fields as a parsed descriptor declares them.
+fn os_fields(rd: &ReportDescriptor) -> Vec<VariableField> {
+    let report = rd
+        .input_reports()
+        .iter()
+        .find(|r| r.report_id().map(u8::from) == Some(ReportId::OsPen as u8))
+        .expect("OS pen input report");
+    report
+        .fields()
+        .iter()
+        .filter_map(|f| match f {
+            Field::Variable(v) => Some(v.clone()),
+            _ => None,
+        })
+        .collect()
+}
+
+#[test]
+fn the_os_pen_collection_spans_the_calibrated_display() {
+    use usage::*;
+    // A 600 × 340 mm display, as a calibration writes it.
+    let extent = os_extent([600.0, 340.0]).expect("a valid size");
+    assert_eq!(extent, [6000, 3400]);
+    let descriptor = report_descriptor(Some(extent));
+    assert_eq!(descriptor.bytes().len(), REPORT_DESCRIPTOR_LEN);
+    let rd = ReportDescriptor::try_from(descriptor.bytes()).expect("parses");
+    let fields = os_fields(&rd);
+    let usages: Vec<(u16, u16)> = fields.iter().map(usage_of).collect();
+    assert_eq!(
+        usages,
+        [
+            (PAGE_DIGITIZER, TIP_SWITCH),
+            (PAGE_DIGITIZER, BARREL_SWITCH),
+            (PAGE_DIGITIZER, SECONDARY_BARREL_SWITCH),
+            (PAGE_DIGITIZER, IN_RANGE),
+            (PAGE_GENERIC_DESKTOP, X),
+            (PAGE_GENERIC_DESKTOP, Y),
+        ]
+    );
+    // The Digitizer / Pen application collection holds it, and only it.
+    let app = &fields[0].collections[0];
+    assert_eq!(
+        (app.usages()[0].usage_page, app.usages()[0].usage_id),
+        (0x0D.into(), 0x02.into())
+    );
+    let in_pen_collection = rd
+        .input_reports()
+        .iter()
+        .flat_map(|r| r.fields())
+        .filter_map(|f| match f {
+            Field::Variable(v) => Some(v),
+            _ => None,
+        })
+        .filter(|v| {
+            v.collections
+                .first()
+                .is_some_and(|c| c.usages()[0].usage_page == 0x0D.into())
+        })
+        .count();
+    assert_eq!(in_pen_collection, 6);
+    // X and Y: 0…W and 0…H in 0.1 mm, physical the same, unsigned.
+    for (axis, max) in [(&fields[4], 6000), (&fields[5], 3400)] {
+        assert_eq!(i32::from(axis.logical_minimum), 0);
+        assert_eq!(i32::from(axis.logical_maximum), max);
+        assert_eq!(axis.physical_minimum.map(i32::from), Some(0));
+        assert_eq!(axis.physical_maximum.map(i32::from), Some(max));
+        assert_eq!(axis.unit.map(u32::from), Some(0x11));
+        assert_eq!(axis.unit_exponent.map(|e| e.exponent()), Some(-2));
+        assert!(!axis.is_signed());
+    }
+    // Every valid display size gives the same length; an unknown one the placeholder.
+    for size in [[50.0, 50.0], [3276.7, 3276.7], [1200.0, 675.0]] {
+        let d = report_descriptor(os_extent(size));
+        assert_eq!(d.bytes().len(), REPORT_DESCRIPTOR_LEN, "{size:?}");
+    }
+    assert_eq!(os_extent([0.0, 0.0]), None);
+    assert_eq!(os_extent([f32::NAN, 340.0]), None);
+    assert_eq!(report_descriptor(None).bytes(), &REPORT_DESCRIPTOR[..]);
+}
+
+/// What an OS pen stack makes of a report, read as libinput does from the evdev device the
+/// kernel builds from the descriptor: the axis's absinfo (minimum, maximum, resolution in units
+/// per mm from the physical range and unit) and the value; the pointer's place on a screen is
+/// (value − min) / (max − min) of the screen's width or height.
+struct Axis {
+    min: i32,
+    max: i32,
+    units_per_mm: f64,
+}
+
+impl Axis {
+    fn from_field(f: &VariableField) -> Axis {
+        let (min, max) = (i32::from(f.logical_minimum), i32::from(f.logical_maximum));
+        let physical = (
+            f.physical_minimum.map(i32::from).unwrap_or(min),
+            f.physical_maximum.map(i32::from).unwrap_or(max),
+        );
+        // The kernel's hidinput_calc_abs_res: centimetres with the exponent, to units per mm.
+        assert_eq!(f.unit.map(u32::from), Some(0x11), "centimetres");
+        let exponent = f.unit_exponent.map(|e| e.exponent()).unwrap_or(0);
+        let physical_mm = (physical.1 - physical.0) as f64 * 10f64.powi(exponent as i32) * 10.0;
+        Axis {
+            min,
+            max,
+            units_per_mm: (max - min) as f64 / physical_mm,
+        }
+    }
+
+    /// Where `raw` puts the pointer across a screen `pixels` wide.
+    fn screen(&self, raw: u64, pixels: f64) -> f64 {
+        (raw as f64 - self.min as f64) / (self.max - self.min) as f64 * pixels
+    }
+}
+
+#[test]
+fn the_os_reads_the_pen_where_it_is_on_the_display() {
+    let extent = os_extent([600.0, 340.0]).expect("valid");
+    let rd = ReportDescriptor::try_from(report_descriptor(Some(extent)).bytes()).expect("parses");
+    let fields = os_fields(&rd);
+    let (x, y) = (Axis::from_field(&fields[4]), Axis::from_field(&fields[5]));
+    // libinput's tablet size is (max − min) / resolution: the display's own millimetres.
+    assert!(((x.max - x.min) as f64 / x.units_per_mm - 600.0).abs() < 1e-9);
+    assert!(((y.max - y.min) as f64 / y.units_per_mm - 340.0).abs() < 1e-9);
+    // A pen at (150 mm, 85 mm) from the display's top-left corner, tip down: a quarter of the
+    // way across and down a 1920 × 1080 screen, tip and proximity both set.
+    let report = OsPenReport {
+        tip: true,
+        barrel: false,
+        secondary_barrel: false,
+        in_range: true,
+        x: 1500,
+        y: 850,
+    };
+    let mut bytes = [0u8; OsPenReport::LEN];
+    report.encode(&mut bytes).expect("fits");
+    let found = rd.find_input_report(&bytes).expect("recognised by its ID");
+    assert_eq!(found.size_in_bytes(), OsPenReport::LEN);
+    let value = |f: &VariableField| u32::from(&f.extract(&bytes).expect("extract")) as u64;
+    assert_eq!(value(&fields[0]), 1, "BTN_TOUCH");
+    assert_eq!(value(&fields[3]), 1, "BTN_TOOL_PEN (in range)");
+    assert!((x.screen(value(&fields[4]), 1920.0) - 480.0).abs() < 1e-9);
+    assert!((y.screen(value(&fields[5]), 1080.0) - 270.0).abs() < 1e-9);
+}
+
+/// hid-tools (the Linux HID maintainers' Python tools: `pip install hid-tools`) parses the
+/// descriptor a calibrated device presents and decodes an OS pen report with it, as
+/// `hid-decode` and `hid-recorder` do. Skipped, with a message, where Python or hid-tools is
+/// missing.
+#[test]
+fn hid_tools_parses_the_descriptor_and_decodes_the_os_pen() {
+    const SCRIPT: &str = r#"
+import sys
+from hidtools.hid import ReportDescriptor
+rdesc_hex, report_hex = sys.stdin.read().split()
+rd = ReportDescriptor.from_bytes(bytes.fromhex(rdesc_hex))
+report = bytes.fromhex(report_hex)
+r = rd.get(report[0], len(report))
+for f in r.fields:
+    print("field", f.usage_name, f.logical_min, f.logical_max, f.physical_min, f.physical_max, f.unit, f.unit_exp)
+print("decoded", rd.format_report(report))
+"#;
+    let extent = os_extent([600.0, 340.0]).expect("valid");
+    let descriptor = report_descriptor(Some(extent));
+    let report = OsPenReport {
+        tip: true,
+        barrel: false,
+        secondary_barrel: true,
+        in_range: true,
+        x: 1500,
+        y: 850,
+    };
+    let mut bytes = [0u8; OsPenReport::LEN];
+    report.encode(&mut bytes).expect("fits");
+    let hex = |b: &[u8]| b.iter().map(|b| format!("{b:02x}")).collect::<String>();
+    let child = std::process::Command::new("python3")
+        .args(["-c", SCRIPT])
+        .stdin(std::process::Stdio::piped())
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn();
+    let Ok(mut child) = child else {
+        eprintln!("skipped: no python3 (hid-tools runs on it)");
+        return;
+    };
+    {
+        use std::io::Write;
+        let mut stdin = child.stdin.take().expect("piped");
+        write!(stdin, "{} {}", hex(descriptor.bytes()), hex(&bytes)).expect("write");
+    }
+    let out = child.wait_with_output().expect("python3 ran");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    if stderr.contains("No module named 'hidtools'") {
+        eprintln!("skipped: hid-tools is not installed (pip install hid-tools)");
+        return;
+    }
+    assert!(out.status.success(), "hid-tools failed: {stderr}");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let fields: Vec<&str> = stdout.lines().filter_map(|l| l.strip_prefix("field ")).collect();
+    // Usage, logical min and max, physical min and max, unit (0x11: cm), unit exponent.
+    assert_eq!(
+        fields,
+        [
+            "Tip Switch 0 1 0 0 0 0",
+            "Barrel Switch 0 1 0 0 0 0",
+            "Secondary Barrel Switch 0 1 0 0 0 0",
+            "In Range 0 1 0 0 0 0",
+            "Undefined 0 1 0 0 0 0",
+            "X 0 6000 0 6000 17 -2",
+            "Y 0 3400 0 3400 17 -2",
+        ],
+        "{stdout}"
+    );
+    let decoded = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("decoded "))
+        .expect("a decoded line");
+    let words: String = decoded.split_whitespace().collect::<Vec<_>>().join(" ");
+    assert_eq!(
+        words,
+        "ReportID: 7 / Tip Switch: 1 | Barrel Switch: 0 | Secondary Barrel Switch: 1 | In Range: 1 | # | X: 1500 | Y: 850"
     );
 }

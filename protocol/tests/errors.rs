@@ -9,7 +9,7 @@ use pen_protocol::*;
 fn empty_and_unknown() {
     assert_eq!(Message::decode(&[]), Err(DecodeError::Empty));
     assert_eq!(PenReport::decode(&[]), Err(DecodeError::Empty));
-    assert_eq!(Message::decode(&[0x07, 1, 2]), Err(DecodeError::UnknownReportId(0x07)));
+    assert_eq!(Message::decode(&[0x08, 1, 2]), Err(DecodeError::UnknownReportId(0x08)));
     assert_eq!(Message::decode(&[0x00]), Err(DecodeError::UnknownReportId(0x00)));
     let tof = [0x02u8; TofReport::LEN];
     assert_eq!(
@@ -290,6 +290,7 @@ fn config_values() {
                 rotation: [0.5, 0.0, 0.0, 0.0],
                 translation_mm: [0.0; 3],
                 scale: 1.0,
+                size_mm: [0.0; 2],
             })
         },
         ConfigField::Display,
@@ -301,11 +302,37 @@ fn config_values() {
                 rotation: [1.0, 0.0, 0.0, 0.0],
                 translation_mm: [0.0; 3],
                 scale: 3.0,
+                size_mm: [0.0; 2],
             })
         },
         ConfigField::Display,
         Problem::OutOfRange,
     );
+    // A display size: unknown (both 0) or both within 50 mm … 3276.7 mm.
+    for size in [
+        [600.0, 0.0],
+        [20.0, 300.0],
+        [4000.0, 300.0],
+        [f32::NAN, 300.0],
+        [-600.0, 340.0],
+    ] {
+        fails(
+            &|c| {
+                if let Some(d) = c.display.as_mut() {
+                    d.size_mm = size;
+                }
+            },
+            ConfigField::Display,
+            Problem::OutOfRange,
+        );
+    }
+    for size in [[0.0, 0.0], [600.0, 340.0], [50.0, 3276.7]] {
+        let mut c = good;
+        if let Some(d) = c.display.as_mut() {
+            d.size_mm = size;
+        }
+        assert_eq!(c.validate(), Ok(()), "{size:?}");
+    }
     fails(
         &|c| {
             c.display = None;
@@ -341,10 +368,12 @@ fn status_names_the_field() {
 #[test]
 fn versions() {
     assert_eq!(check_version(PROTOCOL_VERSION), Ok(()));
-    assert_eq!(check_version(Version { major: 1, minor: 9 }), Ok(()));
-    let err = check_version(Version { major: 2, minor: 0 }).unwrap_err();
+    assert_eq!(check_version(Version { major: 2, minor: 9 }), Ok(()));
+    // Protocol 1's configuration report was 8 bytes shorter: a version 1 device is refused.
+    let err = check_version(Version { major: 1, minor: 0 }).unwrap_err();
     assert_eq!(
         err.to_string(),
-        "the device speaks protocol 2.0, this host understands 1.x; update the host software or the firmware"
+        "the device speaks protocol 1.0, this host understands 2.x; update the host software or the firmware"
     );
+    assert!(check_version(Version { major: 3, minor: 0 }).is_err());
 }

@@ -90,7 +90,24 @@ fn config() {
          00004841 00004841 00005041 00004041 00000000 00000000 00000000 00000000
          0000803f 00000000 00000000 00000000
          000020c1 0000a041 00000000
-         0000803f",
+         0000803f
+         00001644 0000aa43",
+    );
+}
+
+#[test]
+fn os_pen_report() {
+    // id, tip + in range, x 3000 (300.0 mm), y 1700 (170.0 mm)
+    check(
+        Message::OsPen(OsPenReport {
+            tip: true,
+            barrel: false,
+            secondary_barrel: false,
+            in_range: true,
+            x: 3000,
+            y: 1700,
+        }),
+        "07 09 b80b a406",
     );
 }
 
@@ -142,11 +159,11 @@ fn frames() {
 
 #[test]
 fn descriptor_starts_with_the_pen_collection() {
-    // Usage Page (Digitizer), Usage (Pen), Collection (Application), Report ID (1),
-    // Usage (Stylus), Collection (Physical), Usage (Tip Switch).
+    // Usage Page (Digitizer), Usage (Pen), Collection (Application), Report ID (7, the OS's
+    // pen), Usage (Stylus), Collection (Physical), Usage (Tip Switch).
     assert_eq!(
         REPORT_DESCRIPTOR[..13],
-        hex("05 0d 09 02 a1 01 85 01 09 20 a1 00 09")[..]
+        hex("05 0d 09 02 a1 01 85 07 09 20 a1 00 09")[..]
     );
     assert_eq!(REPORT_DESCRIPTOR[13], 0x42);
     assert_eq!(REPORT_DESCRIPTOR.last(), Some(&0xc0));

@@ -36,8 +36,12 @@ fn every_report_as_penctl_prints_it() {
         r#"{"report_id":3,"report":"device information","protocol":"1.0","firmware":"0.1.0","receiver_count":4,"max_receivers":8,"fix_rate_hz":150,"unique_id":"000102030405060708090a0b"}"#,
     );
     golden(
+        decoded("07 0b b80b a406"),
+        r#"{"report_id":7,"report":"OS pen","tip":true,"barrel":true,"secondary_barrel":false,"in_range":true,"x_mm":300.0,"y_mm":170.0}"#,
+    );
+    golden(
         Message::Config(sample_config()),
-        r#"{"report_id":4,"report":"configuration","receiver_count":4,"receivers_mm":[[0.0,0.0,0.0],[600.0,0.0,0.0],[0.0,400.0,150.0],[600.0,400.0,150.0]],"transducer_delay_us":[12.5,12.5,13.0,12.0],"temperature_c":21.5,"speed_of_sound_m_s":null,"report_rate_hz":150,"filter":{"kind":"one_euro","min_cutoff_hz":1.0,"beta":0.02,"d_cutoff_hz":1.0},"debounce_ms":5,"display":{"rotation_wxyz":[1.0,0.0,0.0,0.0],"translation_mm":[-10.0,20.0,0.0],"scale":1.0},"report_display_frame":false,"stream_tof":true}"#,
+        r#"{"report_id":4,"report":"configuration","receiver_count":4,"receivers_mm":[[0.0,0.0,0.0],[600.0,0.0,0.0],[0.0,400.0,150.0],[600.0,400.0,150.0]],"transducer_delay_us":[12.5,12.5,13.0,12.0],"temperature_c":21.5,"speed_of_sound_m_s":null,"report_rate_hz":150,"filter":{"kind":"one_euro","min_cutoff_hz":1.0,"beta":0.02,"d_cutoff_hz":1.0},"debounce_ms":5,"display":{"rotation_wxyz":[1.0,0.0,0.0,0.0],"translation_mm":[-10.0,20.0,0.0],"scale":1.0,"size_mm":[600.0,340.0]},"report_display_frame":false,"stream_tof":true}"#,
     );
     golden(
         decoded("05 04 03 12"),

@@ -6,7 +6,8 @@
 //! through this module. Little-endian:
 //!
 //! ```text
-//! header: "PRPL"  version u32 = 1  configuration report (Config::LEN = 187 bytes)
+//! header: "PRPL"  version u32 = 2  configuration report (Config::LEN = 195 bytes; version 1
+//!         had protocol 1's 187)
 //! cycle:  burst time u64 µs
 //!         8 × capture time u32 ns after the burst (0xFFFF_FFFF: nothing heard)
 //!         switch-sample count u16
@@ -22,7 +23,7 @@ use pen_protocol::{Config, MAX_RECEIVERS, NO_ARRIVAL, Report};
 /// The file's first four bytes.
 pub const MAGIC: [u8; 4] = *b"PRPL";
 /// The format version this build reads and writes.
-pub const VERSION: u32 = 1;
+pub const VERSION: u32 = 2;
 /// Bytes before the first cycle.
 pub const HEADER_LEN: usize = 4 + 4 + Config::LEN;
 /// Bytes of a cycle before its switch samples.

@@ -5,8 +5,8 @@
 //! it reports.
 
 use pen_protocol::{
-    Command, Config, DeviceInfo, Filter, FirmwareVersion, GetFeature, MAX_RECEIVERS, Message, NO_ARRIVAL,
-    PROTOCOL_VERSION, PenReport, Position, Quality, Report, ReportId, Status, StatusCode, TofReport,
+    Command, Config, DeviceInfo, Filter, FirmwareVersion, GetFeature, MAX_RECEIVERS, Message, NO_ARRIVAL, OsPenReport,
+    PROTOCOL_VERSION, PenReport, Position, Quality, Report, ReportId, Status, StatusCode, TofReport, os_extent,
 };
 
 use crate::debounce::Debouncer;
@@ -36,6 +36,9 @@ pub const MAX_REPORTED_DOP: f32 = 10.0;
 /// cycles: long enough to ride out a run of bad cycles, short enough that a pen taken away is
 /// out of range before a user notices.
 pub const IN_RANGE_HOLD_US: u64 = 100_000;
+/// How far beyond the display's edges the OS's pen stays in range (at the edge), mm: a stroke
+/// drawn to the edge does not break on the last millimetre's noise.
+pub const OS_EDGE_MARGIN_MM: f32 = 20.0;
 
 /// One measurement cycle as the receivers heard it.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -65,6 +68,10 @@ pub struct CycleResult {
 pub enum Action {
     /// Restart into the ROM DFU bootloader (after the status has been sent).
     EnterBootloader,
+    /// Restart the firmware (after the status has been sent): the saved configuration's display
+    /// size differs from the one the USB descriptor was built for, and the OS must enumerate the
+    /// device again to map its pen onto the new display.
+    Restart,
 }
 
 /// Counters since start-up.
@@ -124,6 +131,8 @@ pub struct Engine {
     latch: SwitchLatch,
     firmware: FirmwareVersion,
     unique_id: [u8; 12],
+    /// The OS pen's extent the USB descriptor was built with, at start-up (0.1 mm).
+    os_extent: Option<[u16; 2]>,
     status: Status,
     // The latest cycle.
     /// The latest reportable fix, smoothed, tracker frame.
@@ -144,6 +153,11 @@ pub struct Engine {
     seq: u16,
     last_report_us: Option<u64>,
     counters: Counters,
+}
+
+/// The OS pen's extent for a configuration's display, if its size is known.
+fn display_extent(config: &Config) -> Option<[u16; 2]> {
+    config.display.and_then(|d| os_extent(d.size_mm))
 }
 
 fn smoother_for(filter: Filter) -> Smoother {
@@ -168,8 +182,10 @@ impl Engine {
             .and_then(|c| Settings::new(c).ok())
             .or_else(|| Settings::new(default_config()).ok())
             .unwrap_or_else(|| unreachable!("the default configuration is valid (tested)"));
+        let os_extent = display_extent(&settings.config);
         Engine {
             smoother: smoother_for(settings.config.filter),
+            os_extent,
             settings,
             track: Track::new(),
             debouncer: Debouncer::new(),
@@ -394,6 +410,51 @@ impl Engine {
             .is_some_and(|t| tip || now_us.saturating_sub(t) <= IN_RANGE_HOLD_US)
     }
 
+    /// The OS pen's extent (0.1 mm) the USB descriptor is to be built with: the display size of
+    /// the configuration the engine started with; `None` before a calibration gave one.
+    pub fn os_extent(&self) -> Option<[u16; 2]> {
+        self.os_extent
+    }
+
+    /// The operating system's pen report that goes with `pen` (just polled): the pen's point on
+    /// the display — X = u from the left edge, Y = height − v down from the top edge, 0.1 mm —
+    /// in range while `pen` is and
+    /// the point lies over the display (within [`OS_EDGE_MARGIN_MM`], clamped to the edge). Out
+    /// of range without a display size, or when the running display size differs from the one
+    /// the descriptor was built with (until the restart that follows saving it).
+    pub fn os_report(&self, pen: &PenReport) -> OsPenReport {
+        let out = OsPenReport {
+            barrel: pen.sw2,
+            secondary_barrel: pen.sw3,
+            ..OsPenReport::default()
+        };
+        let (Some(extent), Some(display), Some(p)) = (self.os_extent, &self.settings.display, self.smoothed) else {
+            return out;
+        };
+        if !pen.in_range || display_extent(&self.settings.config) != Some(extent) {
+            return out;
+        }
+        let on = if pen.sw1 { display.onto_surface(p) } else { p };
+        let q = display.to_display(on);
+        let margin = OS_EDGE_MARGIN_MM * 10.0;
+        let axis = |mm: f32, max: u16| {
+            let t = mm * 10.0;
+            (t >= -margin && t <= max as f32 + margin).then(|| t.clamp(0.0, max as f32) as u16)
+        };
+        // The display frame's v runs up from the bottom edge; the OS's Y runs down from the top.
+        let down_mm = extent[1] as f32 / 10.0 - q.y;
+        match (axis(q.x, extent[0]), axis(down_mm, extent[1])) {
+            (Some(x), Some(y)) => OsPenReport {
+                tip: pen.sw1,
+                in_range: true,
+                x,
+                y,
+                ..out
+            },
+            _ => out,
+        }
+    }
+
     /// The time-of-flight report of the latest cycle, when the configuration streams them.
     pub fn tof_report(&self) -> Option<TofReport> {
         self.settings.config.stream_tof.then_some(self.tof)
@@ -458,6 +519,10 @@ impl Engine {
         let request = ReportId::Command as u8;
         match command {
             Command::SaveConfig => match store.save(&self.settings.config) {
+                // A new display size takes a new USB descriptor: restart to enumerate again.
+                Ok(()) if display_extent(&self.settings.config) != self.os_extent => {
+                    (Status::ok(request), Some(Action::Restart))
+                }
                 Ok(()) => (Status::ok(request), None),
                 Err(_) => (Status::failed(request, StatusCode::StorageFailed), None),
             },

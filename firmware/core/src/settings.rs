@@ -38,6 +38,8 @@ pub fn default_config() -> Config {
             rotation: [1.0, 0.0, 0.0, 0.0],
             translation_mm: [0.0; 3],
             scale: 1.0,
+            // Unknown until a calibration says: the OS's pen stays out of range until then.
+            size_mm: [0.0; 2],
         }),
         report_display_frame: false,
         stream_tof: false,
@@ -199,6 +201,7 @@ mod tests {
             rotation: [h, 0.0, 0.0, h],
             translation_mm: [10.0, 20.0, 30.0],
             scale: 2.0,
+            size_mm: [0.0; 2],
         };
         let d = DisplayFrame::new(&pose);
         let p = d.to_display(Vec3::new(1.0, 0.0, 5.0));

@@ -10,7 +10,7 @@ use core::ops::Deref;
 
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::RawMutex;
-use pen_protocol::{MAX_RECEIVERS, PenReport, TofReport};
+use pen_protocol::{MAX_RECEIVERS, OsPenReport, PenReport, TofReport};
 
 use crate::report::{Cycle, CycleResult, Engine, LISTEN_US, TICK_US};
 
@@ -47,6 +47,12 @@ pub trait ReportSink {
     fn pen(&mut self, report: &PenReport) -> impl Future<Output = ()>;
     /// Sends a time-of-flight diagnostics report.
     fn tof(&mut self, report: &TofReport) -> impl Future<Output = ()>;
+    /// Sends the operating system's pen report that goes with the pen report just sent (USB
+    /// HID only; other sinks have no OS to tell).
+    fn os_pen(&mut self, report: &OsPenReport) -> impl Future<Output = ()> {
+        let _ = report;
+        async {}
+    }
 }
 
 /// When to wake a suspended host: on a new press of the tip during this suspend. A pen left
@@ -145,6 +151,8 @@ where
             }
             while let Some(report) = self.with(|e| e.poll_report(t)) {
                 self.sink.pen(&report).await;
+                let os = self.with(|e| e.os_report(&report));
+                self.sink.os_pen(&os).await;
             }
             if let Some(tof) = tof {
                 self.sink.tof(&tof).await;

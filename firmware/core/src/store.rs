@@ -8,20 +8,21 @@
 //! when it is full the next record goes to the other region, erased first, so a power cut
 //! during that erase (or during any write) still leaves the newest complete record readable.
 //!
-//! Record layout (little-endian, 200 bytes, a multiple of the flash's 4-byte write unit):
-//! magic `PCFG` (u32), sequence (u32), the configuration report (187 bytes), the layout version
-//! (one byte: [`LAYOUT`]; 0 in records written before it existed, which have the same layout),
-//! CRC-32 of the preceding 196 bytes (u32). A record of another layout is skipped, never
-//! misread.
+//! Record layout 2 (little-endian, 208 bytes, a multiple of the flash's 4-byte write unit):
+//! magic `PCFG` (u32), sequence (u32), the configuration report (protocol 2: 195 bytes), the
+//! layout version (one byte, [`LAYOUT`]), CRC-32 of the preceding 204 bytes (u32). A record of
+//! another layout is skipped, never misread: layout 1's 200-byte records (protocol 1's
+//! configuration, no version byte) fail the CRC at this stride, and a record whose CRC holds
+//! with another version byte is skipped by that byte.
 
 use pen_protocol::{CRC, Config, Report};
 
 /// Bytes of one record.
-pub const RECORD_LEN: usize = 200;
+pub const RECORD_LEN: usize = 208;
 const MAGIC: u32 = u32::from_le_bytes(*b"PCFG");
 const BODY: usize = RECORD_LEN - 4;
 /// The records' layout version, in the byte before the CRC.
-pub const LAYOUT: u8 = 1;
+pub const LAYOUT: u8 = 2;
 const LAYOUT_AT: usize = BODY - 1;
 const _: () = assert!(
     8 + Config::LEN <= LAYOUT_AT,
@@ -95,7 +96,7 @@ impl<F: FlashRegion> LogStore<F> {
             return Ok(Slot::Erased);
         }
         let word = |at: usize| u32::from_le_bytes([rec[at], rec[at + 1], rec[at + 2], rec[at + 3]]);
-        if word(0) != MAGIC || word(BODY) != CRC.checksum(&rec[..BODY]) || !matches!(rec[LAYOUT_AT], 0 | LAYOUT) {
+        if word(0) != MAGIC || word(BODY) != CRC.checksum(&rec[..BODY]) || rec[LAYOUT_AT] != LAYOUT {
             return Ok(Slot::Invalid);
         }
         match Config::decode(&rec[8..8 + Config::LEN]) {

@@ -58,11 +58,12 @@ fn damaged_replays_are_named() {
         Err(ReplayError::NotAReplay)
     );
 
-    let mut version_2 = bytes.clone();
-    version_2[4] = 2;
+    // Version 1 held protocol 1's shorter configuration.
+    let mut version_1 = bytes.clone();
+    version_1[4] = 1;
     assert_eq!(
-        replay::read_header(&mut version_2.as_slice()),
-        Err(ReplayError::Version(2))
+        replay::read_header(&mut version_1.as_slice()),
+        Err(ReplayError::Version(1))
     );
 
     let mut bad_config = bytes.clone();

@@ -197,6 +197,7 @@ fn display_frame_reports() {
         rotation: [1.0, 0.0, 0.0, 0.0],
         translation_mm: [-100.0, 0.0, 0.0],
         scale: 1.0,
+        size_mm: [0.0; 2],
     });
     config.report_display_frame = true;
     let mut store = RamStore::default();
@@ -361,4 +362,79 @@ fn an_invalid_stored_configuration_falls_back_to_the_defaults() {
     bad.receiver_count = 2;
     let e = Engine::new(Some(bad), FIRMWARE, [0; 12]);
     assert_eq!(e.config(), &default_config());
+}
+
+/// An engine started with a calibration for a 600 × 340 mm display (the display frame is the
+/// tracker frame: the default pose).
+fn calibrated() -> Engine {
+    let mut config = default_config();
+    if let Some(d) = config.display.as_mut() {
+        d.size_mm = [600.0, 340.0];
+    }
+    Engine::new(Some(config), FIRMWARE, [7; 12])
+}
+
+#[test]
+fn the_os_pen_is_where_the_pen_is_on_the_display() {
+    let mut e = calibrated();
+    assert_eq!(e.os_extent(), Some([6000, 3400]));
+    // 300 mm from the left edge, 170 mm up from the bottom (v up): X 300 mm, Y 170 mm down.
+    let hover = run(&mut e, 0, 3, Vec3::new(300.0, 100.0, 80.0));
+    let os = e.os_report(hover.last().expect("reports"));
+    assert!(os.in_range && !os.tip, "{os:?}");
+    assert_eq!((os.x, os.y), (3000, 2400));
+    // Tip down: Tip and In Range together.
+    e.on_switches(3 * PERIOD_US, [true, false, false]);
+    let down = run(&mut e, 3 * PERIOD_US, 10, Vec3::new(150.0, 255.0, 6.0));
+    let os = e.os_report(down.last().expect("reports"));
+    assert!(os.in_range && os.tip, "{os:?}");
+    assert!(
+        (os.x as i32 - 1500).abs() <= 2 && (os.y as i32 - 850).abs() <= 2,
+        "{os:?}"
+    );
+    // Off the display by more than 20 mm: out of range for the OS, never Tip without it.
+    let off = run(&mut e, 13 * PERIOD_US, 40, Vec3::new(700.0, 200.0, 6.0));
+    let os = e.os_report(off.last().expect("reports"));
+    assert!(!os.in_range && !os.tip, "{os:?}");
+    // Within 20 mm of an edge: in range, clamped to it.
+    let edge = run(&mut e, 53 * PERIOD_US, 40, Vec3::new(610.0, -10.0, 6.0));
+    let os = e.os_report(edge.last().expect("reports"));
+    assert!(os.in_range, "{os:?}");
+    assert_eq!((os.x, os.y), (6000, 3400));
+}
+
+#[test]
+fn before_a_calibration_the_os_pen_is_never_in_range() {
+    let mut e = engine();
+    assert_eq!(e.os_extent(), None);
+    e.on_switches(0, [true, false, true]);
+    for r in run(&mut e, 0, 10, Vec3::new(300.0, 170.0, 6.0)) {
+        let os = e.os_report(&r);
+        assert!(!os.in_range && !os.tip, "{os:?}");
+        assert!(os.secondary_barrel, "the barrels are reported whatever the range");
+    }
+}
+
+#[test]
+fn a_new_display_size_saved_restarts_the_device() {
+    let mut e = calibrated();
+    let mut store = RamStore::default();
+    let save = encode(&Message::Command(Command::SaveConfig));
+    // The size the descriptor was built with: saved, no restart.
+    assert_eq!(e.set_feature(&save, &mut store).1, None);
+    // Another size: the OS pen is out of range until the restart, which saving it asks for.
+    let mut config = *e.config();
+    if let Some(d) = config.display.as_mut() {
+        d.size_mm = [520.0, 290.0];
+    }
+    let (status, _) = e.set_feature(&encode(&Message::Config(config)), &mut store);
+    assert_eq!(status, Status::ok(ReportId::Config as u8));
+    let reports = run(&mut e, 0, 3, Vec3::new(300.0, 100.0, 80.0));
+    assert!(!e.os_report(reports.last().expect("reports")).in_range);
+    assert_eq!(e.set_feature(&save, &mut store).1, Some(Action::Restart));
+    // After the restart the engine starts from the saved configuration: in range again.
+    let mut e = Engine::new(store.load(), FIRMWARE, [7; 12]);
+    assert_eq!(e.os_extent(), Some([5200, 2900]));
+    let reports = run(&mut e, 0, 3, Vec3::new(300.0, 100.0, 80.0));
+    assert!(e.os_report(reports.last().expect("reports")).in_range);
 }

@@ -199,11 +199,13 @@ fn records_carry_their_layout_and_another_layout_is_skipped() {
     rec[RECORD_LEN - 4..].copy_from_slice(&crc.to_le_bytes());
     let mut store = LogStore::new([a, b]);
     assert_eq!(store.load(), Some(config(20.0)));
-    // A record written before the layout byte existed (0 there) still loads.
-    let [mut a, b] = store.into_inner();
-    let rec = &mut a.bytes[first];
-    rec[RECORD_LEN - 5] = 0;
-    let crc = CRC.checksum(&rec[..RECORD_LEN - 4]);
-    rec[RECORD_LEN - 4..].copy_from_slice(&crc.to_le_bytes());
-    assert_eq!(LogStore::new([a, b]).load(), Some(config(20.0)));
+    // The layout before (1: 200-byte records of protocol 1's configuration) is not misread.
+    let [_, b] = store.into_inner();
+    let mut a = RamFlash::new(4, &power);
+    let mut old = vec![0u8; 200];
+    old[..4].copy_from_slice(b"PCFG");
+    let crc = CRC.checksum(&old[..196]);
+    old[196..].copy_from_slice(&crc.to_le_bytes());
+    a.bytes[..200].copy_from_slice(&old);
+    assert_eq!(LogStore::new([a, b]).load(), None);
 }

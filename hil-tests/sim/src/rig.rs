@@ -119,6 +119,9 @@ impl Rig {
             rotation: [q.w as f32, q.x as f32, q.y as f32, q.z as f32],
             translation_mm: [t.x as f32, t.y as f32, t.z as f32],
             scale: 1.0,
+            // Not calibrated to a display: the OS's pen stays out of range (the host's own
+            // reports carry the pen).
+            size_mm: [0.0; 2],
         });
         c
     }

@@ -603,7 +603,7 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
     let t = transport(&mut device)?;
     let restored = if a.write_device {
         Config {
-            display: Some(cal.transform.to_device()),
+            display: Some(cal.to_device()),
             report_display_frame: true,
             ..original
         }

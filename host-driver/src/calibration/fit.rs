@@ -194,13 +194,15 @@ impl Transform {
         self.rotation * p * self.scale + self.translation_mm
     }
 
-    /// The pose the device takes to report display coordinates itself.
-    pub fn to_device(&self) -> DisplayPose {
+    /// The pose the device takes to report display coordinates itself, for a display of
+    /// `size_mm` (width, height; the OS's pen collection spans it).
+    pub fn to_device(&self, size_mm: [f64; 2]) -> DisplayPose {
         let (q, t) = (self.rotation, self.translation_mm);
         DisplayPose {
             rotation: [q.w as f32, q.x as f32, q.y as f32, q.z as f32],
             translation_mm: [t.x as f32, t.y as f32, t.z as f32],
             scale: self.scale as f32,
+            size_mm: size_mm.map(|v| v as f32),
         }
     }
 }
@@ -234,6 +236,13 @@ pub struct Calibration {
 }
 
 impl Calibration {
+    /// The pose and display size the device takes to report display coordinates itself, and
+    /// the operating system's pen to span the display.
+    pub fn to_device(&self) -> DisplayPose {
+        self.transform
+            .to_device([self.display.width_mm, self.display.height_mm])
+    }
+
     /// The uncalibrated pass-through: tracker coordinates taken as display coordinates.
     pub fn identity(display: DisplaySize) -> Calibration {
         Calibration {

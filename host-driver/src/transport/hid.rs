@@ -95,6 +95,8 @@ impl Transport for HidTransport {
         }
         match Message::decode(&buf[..n]) {
             Ok(m @ (Message::Pen(_) | Message::Tof(_))) => Ok(Some(m)),
+            // The OS's pen report, for the OS's pen stack: the pen report carries all of it.
+            Ok(Message::OsPen(_)) => Ok(None),
             _ => {
                 self.dropped += 1;
                 Ok(None)

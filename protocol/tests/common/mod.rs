@@ -55,6 +55,7 @@ pub fn sample_config() -> Config {
             rotation: [1.0, 0.0, 0.0, 0.0],
             translation_mm: [-10.0, 20.0, 0.0],
             scale: 1.0,
+            size_mm: [600.0, 340.0],
         }),
         report_display_frame: false,
         stream_tof: true,
@@ -170,11 +171,13 @@ fn pose() -> impl Strategy<Value = Option<DisplayPose>> {
             [finite(), finite(), finite(), finite()],
             [finite(), finite(), finite()],
             finite(),
+            [finite(), finite()],
         )
-            .prop_map(|(rotation, translation_mm, scale)| DisplayPose {
+            .prop_map(|(rotation, translation_mm, scale, size_mm)| DisplayPose {
                 rotation,
                 translation_mm,
                 scale,
+                size_mm,
             }),
     )
 }
