@@ -23,6 +23,7 @@ import numpy as np
 
 import circuit
 import values as v
+from analysis import chain_gain, chain_peak, db
 
 HERE = pathlib.Path(__file__).resolve().parent
 OUT = HERE.parent
@@ -38,61 +39,6 @@ def check(name, ok, detail=""):
     print(f"{'ok  ' if ok else 'FAIL'} {name}{': ' + detail if detail else ''}")
 
 
-# --- Receiver chain: small-signal nodal analysis ----------------------------------------------
-
-
-def chain_gain(f, gbw=v.OPAMP_GBW, a0=1e5):
-    """|V(AMP2)| / V(transducer) at `f` Hz: the transducer (its 2.55 nF in series with its
-    open-circuit voltage) into stage 1 and stage 2 as built, VREF and the supplies AC ground,
-    each op-amp a single-pole amplifier of DC gain `a0` and gain-bandwidth `gbw`."""
-    s = 2j * math.pi * f
-    nodes = ["src", "in1", "fb1", "g1", "out1", "a2", "m2", "out2"]
-    idx = {n: i for i, n in enumerate(nodes)}
-    size = len(nodes) + 3  # + the source's and two op-amps' output currents
-    m = np.zeros((size, size), complex)
-    rhs = np.zeros(size, complex)
-
-    def y(a, b, adm):
-        for p, q in ((a, b), (b, a)):
-            if p is not None:
-                m[idx[p], idx[p]] += adm
-                if q is not None:
-                    m[idx[p], idx[q]] -= adm
-
-    R = lambda a, b, r: y(a, b, 1 / r)  # noqa: E731
-    C = lambda a, b, c: y(a, b, s * c)  # noqa: E731
-    C("src", "in1", v.TRANSDUCER_C)
-    R("in1", None, v.RB1)
-    R("out1", "fb1", v.RF1)
-    C("out1", "fb1", v.CF1)
-    R("fb1", "g1", v.RG1)
-    C("g1", None, v.CG1)
-    R("out1", "a2", v.R1_2)
-    R("a2", None, v.R3_2)
-    C("a2", "m2", v.C2)
-    C("a2", "out2", v.C2)
-    R("m2", "out2", v.R2_2)
-    gain = a0 / (1 + s * a0 / (2 * math.pi * gbw))
-    # The source: V(src) = 1.
-    k = len(nodes)
-    m[idx["src"], k] += 1
-    m[k, idx["src"]] = 1
-    rhs[k] = 1
-    # Op-amps: V(out) = A·(V+ − V−), each output's current an unknown.
-    for j, (out, plus, minus) in enumerate((("out1", "in1", "fb1"), ("out2", None, "m2")), start=1):
-        m[idx[out], k + j] += 1
-        m[k + j, idx[out]] = 1
-        if plus is not None:
-            m[k + j, idx[plus]] -= gain
-        m[k + j, idx[minus]] += gain
-    x = np.linalg.solve(m, rhs)
-    return abs(x[idx["out2"]])
-
-
-def db(x):
-    return 20 * math.log10(x)
-
-
 def check_chain():
     g40 = db(chain_gain(v.F0))
     check("receiver chain: gain at 40 kHz 60 ± 3 dB", abs(g40 - 60) <= 3, f"{g40:.1f} dB")
@@ -104,6 +50,10 @@ def check_chain():
     width = band[-1] - band[0]
     check("receiver chain: −3 dB band 4–10 kHz (passes an 8-period burst, rejects the rest)",
           4e3 <= width <= 10e3, f"{band[0] / 1e3:.1f}–{band[-1] / 1e3:.1f} kHz")
+    alt_peak, alt_gain = chain_peak(v.OPAMP_ALT_GBW)
+    check(f"receiver chain with the alternative op-amp ({v.OPAMP_ALT_GBW / 1e6:.0f} MHz): 60 ± 3 dB, peak 40 ± 2 kHz",
+          abs(db(chain_gain(v.F0, gbw=v.OPAMP_ALT_GBW)) - 60) <= 3 and abs(alt_peak - v.F0) <= 2e3,
+          f"{db(chain_gain(v.F0, gbw=v.OPAMP_ALT_GBW)):.1f} dB at 40 kHz, peak {alt_peak / 1e3:.1f} kHz")
     rejection = db(chain_gain(v.F0)) - max(db(chain_gain(20e3)), db(chain_gain(80e3)))
     check("receiver chain: ≥ 15 dB less at 20 and 80 kHz", rejection >= 15, f"{rejection:.1f} dB")
     return g40, peak, band

@@ -119,11 +119,20 @@ TRANSDUCER_RX = two_pin("MA40S4R", "LS", "penscape:Murata_MA40S4", "ultrasonic r
                         "Murata MA40S4R", "any 40 kHz 10 mm open receiver (e.g. from an HC-SR04)", 3.50)
 TACT = two_pin("SW_Push", "SW", "Button_Switch_SMD:SW_SPST_B3U-1000P", "tact switch 3 × 2.5 mm, 1.2 N",
                "Omron B3U-1000P", "Panasonic EVQ-P7 (side push, for the barrel)", 0.60)
+def _alternative_opamp():
+    from analysis import chain_gain, chain_peak, db
+
+    peak, _ = chain_peak(v.OPAMP_ALT_GBW)
+    loss = db(chain_gain(v.F0)) - db(chain_gain(v.F0, gbw=v.OPAMP_ALT_GBW))
+    return (f"ADI {v.OPAMP_ALT}ARZ ({v.OPAMP_ALT_GBW / 1e6:.0f} MHz: the band's centre moves to {peak / 1e3:.1f} kHz, "
+            f"{loss:.1f} dB less at 40 kHz)")
+
+
 OPAMP = template(v.OPAMP, "U", "Package_SO:SOIC-8_3.9x4.9mm_P1.27mm",
                  [(1, "OUTA", P.OUTPUT), (2, "-INA", P.INPUT), (3, "+INA", P.INPUT), (4, "V-", P.PWRIN),
                   (5, "+INB", P.INPUT), (6, "-INB", P.INPUT), (7, "OUTB", P.OUTPUT), (8, "V+", P.PWRIN)],
                  "dual op-amp 50 MHz, rail-to-rail, 2.2–5.5 V", "TI OPA2365AIDR",
-                 "ADI AD8606 (8 MHz: about 4 dB less gain at 40 kHz), MCP6292 (10 MHz)", 1.60)
+                 _alternative_opamp(), 1.60)
 COMPARATOR = template("TLV3501", "U", "Package_TO_SOT_SMD:SOT-23-6",
                       [(1, "OUT", P.OUTPUT), (2, "V-", P.PWRIN), (3, "+IN", P.INPUT), (4, "-IN", P.INPUT),
                        (5, "SHDN", P.INPUT), (6, "V+", P.PWRIN)],

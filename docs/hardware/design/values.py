@@ -46,6 +46,8 @@ F0 = 40e3             # the transducers' resonance, Hz
 GAIN_TARGET_DB = 60   # the issue's "≈ 60 dB"; 30 dB per stage
 OPAMP = "OPA2365"     # dual, 50 MHz gain-bandwidth, rail-to-rail, 2.2–5.5 V
 OPAMP_GBW = 50e6
+OPAMP_ALT = "AD8606"  # the alternative the bill of materials names: 8 MHz, rail-to-rail, 2.7–5.5 V
+OPAMP_ALT_GBW = 8e6
 
 # Mid-supply reference: both op-amp stages and the detector sit on it. A 10 k / 10 k divider
 # from 3.3 V, decoupled with 10 µF (corner 3 Hz): 1.65 V.
