@@ -100,7 +100,7 @@ BLACK_PILL = template("WeAct_BlackPill_F411CE", "A", "penscape:WeAct_BlackPill_2
 MT3608 = template("MT3608", "U", "Package_TO_SOT_SMD:SOT-23-6",
                   [(1, "SW", P.PASSIVE), (2, "GND", P.PWRIN), (3, "FB", P.INPUT), (4, "EN", P.INPUT),
                    (5, "IN", P.PWRIN), (6, "NC", P.NOCONNECT)],
-                  "boost converter 2 A, 1.2 MHz", "Aerosemi MT3608", "TI TPS61040 (lower current); an MT3608 module", 0.10)
+                  "boost converter 2 A, 1.2 MHz", "Aerosemi MT3608", "an MT3608 module set to 12 V; TI TPS61040 (0.4 A switch, 1.233 V reference: another divider)", 0.10)
 L_BOOST = two_pin("L", "L", "Inductor_SMD:L_Bourns_SRR1260", "inductor 22 µH, 1.5 A", "Bourns SRR1260-220M",
                   "Sunlord SWPA6045S220MT", 0.40)
 SCHOTTKY = two_pin("D_Schottky", "D", "Diode_SMD:D_SMA", "Schottky diode 40 V 3 A", "SS34",
@@ -136,7 +136,7 @@ OPAMP = template(v.OPAMP, "U", "Package_SO:SOIC-8_3.9x4.9mm_P1.27mm",
 COMPARATOR = template("TLV3501", "U", "Package_TO_SOT_SMD:SOT-23-6",
                       [(1, "OUT", P.OUTPUT), (2, "V-", P.PWRIN), (3, "+IN", P.INPUT), (4, "-IN", P.INPUT),
                        (5, "SHDN", P.INPUT), (6, "V+", P.PWRIN)],
-                      "comparator 4.5 ns, push-pull output", "TI TLV3501AIDBVR", "TLV3201 (40 ns), ADCMP600", 1.90)
+                      "comparator 4.5 ns, push-pull output", "TI TLV3501AIDBVR", "TI TLV3201 (40 ns, SOT-23-5 without shutdown: another footprint), ADI ADCMP600", 1.90)
 BAT54 = template("BAT54", "D", "Package_TO_SOT_SMD:SOT-23",
                  [(1, "A", P.PASSIVE), (2, "NC", P.NOCONNECT), (3, "K", P.PASSIVE)],
                  "Schottky diode 30 V 200 mA", "Nexperia BAT54", "BAT43 (through-hole), 1N5711", 0.05)
