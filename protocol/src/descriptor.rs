@@ -110,6 +110,8 @@ const CAPACITY: usize = 384;
 struct Builder {
     buf: [u8; CAPACITY],
     len: usize,
+    /// Where the OS pen's X and Y logical and physical maxima items start.
+    marks: [usize; 4],
 }
 
 impl Builder {
@@ -117,7 +119,24 @@ impl Builder {
         Builder {
             buf: [0; CAPACITY],
             len: 0,
+            marks: [0; 4],
         }
+    }
+
+    /// Remembers where the next item starts, as mark `i`.
+    const fn mark(mut self, i: usize) -> Self {
+        self.marks[i] = self.len;
+        self
+    }
+
+    /// `logical(0, max)` and `physical(0, max)`, the maxima's items marked `i` and `i + 1`.
+    const fn extent(self, max: i32, i: usize) -> Self {
+        self.global_signed(G::LogicalMin, 0)
+            .mark(i)
+            .global_signed(G::LogicalMax, max)
+            .global_signed(G::PhysicalMin, 0)
+            .mark(i + 1)
+            .global_signed(G::PhysicalMax, max)
     }
 
     const fn byte(mut self, b: u8) -> Self {
@@ -259,14 +278,12 @@ impl Builder {
             // corner; the logical and physical ranges are the display's width and height.
             .usage_page(PAGE_GENERIC_DESKTOP)
             .usage(X)
-            .logical(0, w)
-            .physical(0, w)
+            .extent(w, 0)
             .unit(unit::CENTIMETRE, -2)
             .fields(16, 1)
             .input(flags::DATA_VAR_ABS)
             .usage(Y)
-            .logical(0, h)
-            .physical(0, h)
+            .extent(h, 2)
             .input(flags::DATA_VAR_ABS)
             .end_collection()
             .end_collection()
@@ -396,17 +413,24 @@ impl Descriptor {
     }
 }
 
+/// Where the OS pen's X and Y logical and physical maxima items start in the descriptor.
+const EXTENT_ITEMS: [usize; 4] = BUILT.marks;
+
 /// The report descriptor for a display whose OS pen extent is `extent` ([`os_extent`]), or
 /// [`REPORT_DESCRIPTOR`] when there is none.
 pub fn report_descriptor(extent: Option<[u16; 2]>) -> Descriptor {
-    // Both maxima of a valid extent lie in 500..=32767: two-byte items, the constant length.
-    let extent = extent
-        .filter(|e| e.iter().all(|&v| (500..=i16::MAX as u16).contains(&v)))
-        .unwrap_or(UNKNOWN_EXTENT);
-    Descriptor {
-        bytes: Builder::new().descriptor(extent).take(),
+    let mut bytes = REPORT_DESCRIPTOR;
+    // Every valid maximum (500…32767) is a two-byte item, as the placeholder's are: the four
+    // items' data are rewritten in place rather than the descriptor built again (which would
+    // cost the firmware the builder's code, 4 KiB).
+    if let Some([w, h]) = extent.filter(|e| e.iter().all(|&v| (500..=i16::MAX as u16).contains(&v))) {
+        for (at, v) in EXTENT_ITEMS.into_iter().zip([w, w, h, h]) {
+            bytes[at + 1..at + 3].copy_from_slice(&v.to_le_bytes());
+        }
     }
+    Descriptor { bytes }
 }
+
 
 impl SerializedDescriptor for PenReport {
     fn desc() -> &'static [u8] {
@@ -423,5 +447,19 @@ impl AsInputReport for PenReport {
 impl AsInputReport for TofReport {
     fn serialize(&self, buffer: &mut [u8]) -> Result<usize, BufferOverflow> {
         self.encode(buffer).map_err(|_| BufferOverflow)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn patched_extents_equal_built_ones() {
+        for extent in [[500, 500], [6000, 3400], [12000, 6750], [32767, 32767]] {
+            let built: [u8; REPORT_DESCRIPTOR_LEN] = Builder::new().descriptor(extent).take();
+            assert_eq!(report_descriptor(Some(extent)).bytes(), &built[..], "{extent:?}");
+        }
+        assert_eq!(report_descriptor(Some([499, 3400])).bytes(), &REPORT_DESCRIPTOR[..]);
     }
 }
