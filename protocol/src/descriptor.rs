@@ -431,7 +431,6 @@ pub fn report_descriptor(extent: Option<[u16; 2]>) -> Descriptor {
     Descriptor { bytes }
 }
 
-
 impl SerializedDescriptor for PenReport {
     fn desc() -> &'static [u8] {
         &REPORT_DESCRIPTOR
