@@ -69,6 +69,29 @@ fn the_simulated_pens_delays_are_recovered_and_written() {
     }
 }
 
+/// Late echoes (5 % of arrivals) and dropouts (2 %) do not move the delays: each point's
+/// arrival time is a median over its cycles.
+#[test]
+fn echoes_and_dropouts_do_not_move_the_delays() {
+    let points = points();
+    let mut scenario = pen_sim::scenarios::transducer_delays(&points);
+    scenario.acoustics = pen_sim::acoustics::Acoustics::with_echoes(0.05, 0.02);
+    let mut device = Device::new(pen_host::source::Source::Sim(pen_host::transport::sim::SimOptions {
+        scenario,
+        seed: 7,
+        speed: 0.0,
+        plug: Default::default(),
+    }));
+    attach(&mut device, Duration::from_secs(2)).expect("attach");
+    let config = delays::read_config(&mut device).expect("config");
+    let held = delays::collect(&mut device, &config, &points, Duration::from_secs(30), |_| {}).expect("held");
+    let fit = delays::fit(&delays::receivers(&config), &held).expect("fit");
+    let truth = Rig::reference().delays_us;
+    let errors: Vec<f64> = fit.delays_us.iter().zip(&truth).map(|(g, t)| g - t).collect();
+    eprintln!("with echoes, delay errors, µs: {errors:.3?}");
+    assert!(errors.iter().all(|e| e.abs() <= TOLERANCE_US), "errors {errors:?}");
+}
+
 fn penctl(args: &[&str]) -> std::process::Output {
     let home = tempfile::tempdir().expect("a temporary home");
     std::process::Command::new(env!("CARGO_BIN_EXE_penctl"))
