@@ -13,6 +13,8 @@
 //! * [`daemon`]: `pend`, serving events to any number of clients on a Unix socket; [`client`]
 //!   reads them; [`wire`] is the socket's line format, shared by both.
 //!
+//! * [`help`]: what every tool's `--help` promises (examples), checked by each tool's tests.
+//!
 //! Every byte layout comes from `pen-protocol`; nothing here re-implements it.
 #![cfg_attr(not(test), warn(clippy::unwrap_used))]
 
@@ -21,6 +23,7 @@ pub mod client;
 pub mod daemon;
 pub mod device;
 pub mod events;
+pub mod help;
 pub mod hex;
 pub mod pipeline;
 pub mod sample;

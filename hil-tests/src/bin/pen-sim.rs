@@ -296,22 +296,9 @@ fn main() -> ExitCode {
 mod tests {
     use clap::CommandFactory;
 
-    /// The commands under `c` (itself included) whose --help gives no example.
-    fn without_examples(c: &clap::Command, path: &str, missing: &mut Vec<String>) {
-        let path = format!("{path} {}", c.get_name()).trim().to_string();
-        let help = [c.get_after_help(), c.get_after_long_help()];
-        if !help.iter().flatten().any(|h| h.to_string().contains("Example")) {
-            missing.push(path.clone());
-        }
-        for sub in c.get_subcommands() {
-            without_examples(sub, &path, missing);
-        }
-    }
-
     #[test]
     fn every_help_gives_examples() {
-        let mut missing = Vec::new();
-        without_examples(&super::Cli::command(), "", &mut missing);
+        let missing = pen_host::help::without_examples(&super::Cli::command());
         assert!(missing.is_empty(), "no examples in the --help of {missing:?}");
     }
 

@@ -1,0 +1,34 @@
+//! What every tool's command line promises: an example in each command's `--help`. The tools
+//! (pend, penctl, penmodel, pen-sim) check it over all their commands with [`without_examples`].
+
+/// The commands under `command` (itself included, as `"tool sub sub"`) whose `--help` gives no
+/// example: no "Example" in their after-help text.
+pub fn without_examples(command: &clap::Command) -> Vec<String> {
+    fn walk(c: &clap::Command, path: &str, missing: &mut Vec<String>) {
+        let path = format!("{path} {}", c.get_name()).trim().to_string();
+        let help = [c.get_after_help(), c.get_after_long_help()];
+        if !help.iter().flatten().any(|h| h.to_string().contains("Example")) {
+            missing.push(path.clone());
+        }
+        for sub in c.get_subcommands() {
+            walk(sub, &path, missing);
+        }
+    }
+    let mut missing = Vec::new();
+    walk(command, "", &mut missing);
+    missing
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_command_without_an_example_is_named() {
+        let tool = clap::Command::new("tool")
+            .after_help("Examples:\n  tool run")
+            .subcommand(clap::Command::new("run").after_long_help("Example: tool run"))
+            .subcommand(clap::Command::new("bare"));
+        assert_eq!(without_examples(&tool), ["tool bare"]);
+    }
+}
