@@ -104,7 +104,7 @@ fn penctl(args: &[&str]) -> std::process::Output {
 
 #[test]
 fn penctl_delays_prints_the_delays_and_residuals_and_writes_them() {
-    let mut args = vec!["delays", "--sim", "--sim-speed", "0"];
+    let mut args = vec!["delays", "--source", "sim", "--speed", "0"];
     let at: Vec<String> = points().iter().map(|p| format!("{},{},{}", p.x, p.y, p.z)).collect();
     for a in &at {
         args.extend(["--at", a]);
@@ -137,12 +137,13 @@ fn penctl_delays_prints_the_delays_and_residuals_and_writes_them() {
 
 #[test]
 fn penctl_delays_refuses_bad_points_before_measuring() {
-    let out = penctl(&["delays", "--sim", "--at", "1,2"]);
+    let out = penctl(&["delays", "--source", "sim", "--at", "1,2"]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("is not X,Y,Z"));
     let out = penctl(&[
         "delays",
-        "--sim",
+        "--source",
+        "sim",
         "--at",
         "100,60,40",
         "--at",
@@ -152,12 +153,13 @@ fn penctl_delays_refuses_bad_points_before_measuring() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("not a finite number"));
-    let out = penctl(&["delays", "--sim", "--at", "100,60,40", "--at", "500,60,120"]);
+    let out = penctl(&["delays", "--source", "sim", "--at", "100,60,40", "--at", "500,60,120"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("2 point(s) given, 3 needed"));
     let out = penctl(&[
         "delays",
-        "--sim",
+        "--source",
+        "sim",
         "--at",
         "100,60,40",
         "--at",
