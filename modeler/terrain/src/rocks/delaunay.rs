@@ -22,8 +22,17 @@ fn c(p: [f64; 2]) -> Coord<f64> {
 /// Triangles with their neighbours: `adj[t][e]` is across edge `e` = `(v[e], v[e+1])`.
 struct Mesh<'a> {
     points: &'a [[f64; 2]],
+    tri: &'a mut Vec<[u32; 3]>,
+    adj: &'a mut Vec<[u32; 3]>,
+}
+
+/// Working memory for [`triangulate_with`], reused from one rock to the next (a field's rocks
+/// would otherwise allocate and free it tens of thousands of times).
+#[derive(Debug, Default)]
+pub struct Scratch {
     tri: Vec<[u32; 3]>,
     adj: Vec<[u32; 3]>,
+    stack: Vec<(u32, usize)>,
 }
 
 impl Mesh<'_> {
@@ -80,16 +89,20 @@ impl Mesh<'_> {
 /// triangulation of `points`, whose first `hull` points are a convex polygon with positive area
 /// in order and whose others lie strictly inside it. Empty when `hull < 3`.
 pub fn triangulate(points: &[[f64; 2]], hull: usize) -> Vec<[u32; 3]> {
+    triangulate_with(points, hull, &mut Scratch::default()).to_vec()
+}
+
+/// [`triangulate`] in `scratch`'s memory; the triangles are valid until its next use.
+pub fn triangulate_with<'a>(points: &[[f64; 2]], hull: usize, scratch: &'a mut Scratch) -> &'a [[u32; 3]] {
+    scratch.tri.clear();
+    scratch.adj.clear();
+    scratch.stack.clear();
     if hull < 3 {
-        return Vec::new();
+        return &scratch.tri;
     }
     let n = points.len();
-    let count = 2 * n - hull - 2;
-    let mut m = Mesh {
-        points,
-        tri: Vec::with_capacity(count),
-        adj: Vec::with_capacity(count),
-    };
+    let Scratch { tri, adj, stack } = scratch;
+    let mut m = Mesh { points, tri, adj };
     // The fan from vertex 0: triangle i is (0, i+1, i+2).
     let fan = hull - 2;
     for i in 0..fan {
@@ -98,12 +111,11 @@ pub fn triangulate(points: &[[f64; 2]], hull: usize) -> Vec<[u32; 3]> {
         let after = if i + 1 == fan { NONE } else { i as u32 + 1 };
         m.adj.push([before, NONE, after]);
     }
-    let mut stack = Vec::with_capacity(16);
     for t in 0..fan as u32 {
         stack.push((t, 0));
         stack.push((t, 2));
     }
-    m.settle(&mut stack);
+    m.settle(stack);
     for v in hull..n {
         let v = v as u32;
         let pv = m.p(v);
@@ -129,7 +141,7 @@ pub fn triangulate(points: &[[f64; 2]], hull: usize) -> Vec<[u32; 3]> {
         m.repoint(nb, t, t1);
         m.repoint(nc, t, t2);
         stack.extend([(t, 0), (t1, 0), (t2, 0)]);
-        m.settle(&mut stack);
+        m.settle(stack);
     }
-    m.tri
+    &scratch.tri
 }

@@ -48,7 +48,7 @@ fn flag(flags: &mut [bool], width: u32, height: u32, x: u32, y: u32, offsets: &[
 }
 
 /// Seeds by visiting every pixel once in random order (maximal, see the module doc). Pixel
-/// indices `y·width + x`, in the order they were kept.
+/// indices `y·width + x`, in the order they were kept (the field sorts them into pixel order).
 pub fn saturate(width: u32, height: u32, radius: f64, rng: &mut impl Rng) -> Vec<u32> {
     let n = width as usize * height as usize;
     let offsets = disk(radius);

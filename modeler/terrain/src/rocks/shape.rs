@@ -62,26 +62,45 @@ fn inside(cell: &[[f64; 2]], fan: &[f64], rng: &mut impl Rng) -> [f64; 2] {
 
 /// The rock of convex cell `cell` (at least 3 vertices) of a diagram of radius `radius`.
 pub fn rock(cell: &[[f64; 2]], radius: f64, shape: &Shape, rng: &mut impl Rng) -> RockMesh {
+    SCRATCH.with_borrow_mut(|scratch| rock_with(cell, radius, shape, rng, scratch))
+}
+
+/// Working memory of [`rock`], one per thread.
+#[derive(Debug, Default)]
+struct Scratch {
+    fan: Vec<f64>,
+    points: Vec<[f64; 2]>,
+    delaunay: super::delaunay::Scratch,
+}
+
+thread_local! {
+    static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::default();
+}
+
+fn rock_with(cell: &[[f64; 2]], radius: f64, shape: &Shape, rng: &mut impl Rng, scratch: &mut Scratch) -> RockMesh {
     let k = cell.len();
-    let mut fan = Vec::with_capacity(k.saturating_sub(2));
+    let fan = &mut scratch.fan;
+    fan.clear();
     let mut sum = 0.0;
     for t in 0..k.saturating_sub(2) {
         sum += cross(cell[0], cell[t + 1], cell[t + 2]).abs() * 0.5;
         fan.push(sum);
     }
     let added: Vec<[f64; 2]> = if sum > 0.0 {
-        (0..k).map(|_| inside(cell, &fan, rng)).collect()
+        (0..k).map(|_| inside(cell, fan, rng)).collect()
     } else {
         Vec::new()
     };
-    let points: Vec<[f64; 2]> = cell.iter().chain(&added).copied().collect();
+    let points = &mut scratch.points;
+    points.clear();
+    points.extend(cell.iter().chain(&added));
     // Counter-clockwise in (x, y) from the triangulation; turned clockwise (see `triangles`).
     let triangles: Vec<[u32; 3]> = if added.is_empty() {
         Vec::new()
     } else {
-        super::delaunay::triangulate(&points, k)
-            .into_iter()
-            .map(|[a, b, c]| [a, c, b])
+        super::delaunay::triangulate_with(points, k, &mut scratch.delaunay)
+            .iter()
+            .map(|&[a, b, c]| [a, c, b])
             .collect()
     };
     let n = added.len().max(1) as f64;
