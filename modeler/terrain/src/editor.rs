@@ -299,7 +299,7 @@ impl Editor {
         }
         let applied = edit.apply_to(&mut self.doc)?;
         let changed = self.terrain.update(&self.doc, &applied.scope);
-        self.rocks.follow(&self.doc, self.terrain.heightmap());
+        self.rocks.follow(&self.doc, self.terrain.heightmap(), Some(changed));
         Ok(Outcome {
             inverse: applied.inverse,
             changed,

@@ -272,3 +272,63 @@ fn rocks_stand_on_the_terrain_and_follow_it() {
         }
     }
 }
+
+#[test]
+fn an_edit_away_from_a_field_leaves_its_rocks_alone() {
+    let square = |x0: f64| vec![[x0, 5.0], [x0 + 90.0, 5.0], [x0 + 90.0, 95.0], [x0, 95.0], [x0, 5.0]];
+    let mut d = Document::new(penmodel_terrain::Grid {
+        cols: 200,
+        rows: 100,
+        cell_size: 1.0,
+    });
+    d.regions.push(Region {
+        boundary: square(5.0),
+        figures: vec![point([50.0, 50.0], 30.0, 0.0)],
+    });
+    d.regions.push(Region {
+        boundary: square(105.0),
+        figures: vec![point([150.0, 50.0], 30.0, 0.0)],
+    });
+    d.rocks.push(field([20.0, 20.0]));
+    let mut ed = Editor::new(d).expect("valid");
+    let before = ed.rocks().shared();
+    // The other region's peak: its terrain is not under the field.
+    ed.apply(Edit::SetHeight {
+        at: FigurePath::new(1, 0),
+        height: 50.0,
+    })
+    .expect("pulled");
+    assert!(
+        std::sync::Arc::ptr_eq(&before, &ed.rocks().shared()),
+        "re-seated for a change elsewhere"
+    );
+    // The field's own region: its rocks follow.
+    ed.apply(Edit::SetHeight {
+        at: FigurePath::new(0, 0),
+        height: 50.0,
+    })
+    .expect("pulled");
+    let after = ed.rocks().shared();
+    assert!(!std::sync::Arc::ptr_eq(&before, &after));
+    assert_ne!(before[0].1.positions, after[0].1.positions);
+    check_seated(&Rocks::of(ed.document()), ed.heightmap());
+    // What the editor keeps up to date is what seating everything afresh gives.
+    assert_eq!(
+        ed.rocks().meshes(),
+        &Rocks::of(ed.document()).seated(ed.heightmap())[..]
+    );
+    ed.apply(Edit::SetHeight {
+        at: FigurePath::new(1, 0),
+        height: 10.0,
+    })
+    .expect("pulled");
+    ed.apply(Edit::MoveRocks {
+        index: 0,
+        by: [3.0, 2.0],
+    })
+    .expect("moved");
+    assert_eq!(
+        ed.rocks().meshes(),
+        &Rocks::of(ed.document()).seated(ed.heightmap())[..]
+    );
+}

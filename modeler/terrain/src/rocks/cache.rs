@@ -9,6 +9,7 @@
 use std::sync::Arc;
 
 use crate::document::{Document, RockField};
+use crate::engine::Rect;
 use crate::export::Mesh;
 use crate::heightmap::Heightmap;
 
@@ -116,6 +117,8 @@ impl Rocks {
 #[derive(Debug, Clone, Default)]
 pub struct Seated {
     rocks: Rocks,
+    /// Per mesh, the rocks and the place it was seated with.
+    seated_as: Vec<Option<(Arc<Flat>, Placement)>>,
     /// Shared with the pictures being drawn; copied on write only while one holds it.
     meshes: Arc<Vec<(String, Mesh)>>,
 }
@@ -124,33 +127,80 @@ impl Seated {
     /// The rocks of `doc` on `map`.
     pub fn of(doc: &Document, map: &Heightmap) -> Seated {
         let mut s = Seated::default();
-        s.follow(doc, map);
+        s.follow(doc, map, None);
         s
     }
 
-    /// Brings the rocks up to date with `doc` and `map`.
-    pub fn follow(&mut self, doc: &Document, map: &Heightmap) {
+    /// Brings the rocks up to date with `doc` and `map`, whose heights changed in `changed` (grid
+    /// cells; `None`: anywhere). A field whose rocks and place are as they were and whose ground
+    /// is outside `changed` is left as it is.
+    pub fn follow(&mut self, doc: &Document, map: &Heightmap, changed: Option<Rect>) {
         if doc.rocks.is_empty() && self.meshes.is_empty() {
             return;
         }
         self.rocks.update(doc);
-        let meshes = Arc::make_mut(&mut self.meshes);
-        meshes.truncate(self.rocks.fields.len());
+        let n = self.rocks.fields.len();
+        self.seated_as.resize(n, None);
         let ground = place::ground(map);
-        for (i, f) in self.rocks.fields.iter().enumerate() {
-            let at = Placement {
+        let s = map.cell_size();
+        let placements: Vec<Placement> = self
+            .rocks
+            .fields
+            .iter()
+            .map(|f| Placement {
                 origin: [f.field.at[0] + f.image.origin[0], f.field.at[1] + f.image.origin[1]],
                 cell_size: f.field.cell_size,
-            };
-            if i == meshes.len() {
-                meshes.push((format!("rocks {i}"), Mesh::default()));
+            })
+            .collect();
+        let due: Vec<bool> = self
+            .rocks
+            .fields
+            .iter()
+            .zip(&placements)
+            .enumerate()
+            .map(|(i, (f, at))| {
+                let same = self.seated_as[i]
+                    .as_ref()
+                    .is_some_and(|(flat, was)| Arc::ptr_eq(flat, &f.flat) && was == at);
+                // The grid cells whose heights the field's ground reads (one more each side
+                // for the interpolation).
+                let touched = changed.is_none_or(|r| {
+                    let w = f64::from(f.image.width) * at.cell_size;
+                    let h = f64::from(f.image.height) * at.cell_size;
+                    let (c0, r0) = ((at.origin[0] / s).floor() - 1.0, (at.origin[1] / s).floor() - 1.0);
+                    let (c1, r1) = (
+                        ((at.origin[0] + w) / s).ceil() + 1.0,
+                        ((at.origin[1] + h) / s).ceil() + 1.0,
+                    );
+                    r.width > 0
+                        && r.height > 0
+                        && c0 < f64::from(r.c0 + r.width)
+                        && f64::from(r.c0) < c1
+                        && r0 < f64::from(r.r0 + r.height)
+                        && f64::from(r.r0) < r1
+                });
+                !same || touched || i >= self.meshes.len()
+            })
+            .collect();
+        if due.iter().any(|&d| d) || self.meshes.len() > n {
+            let meshes = Arc::make_mut(&mut self.meshes);
+            meshes.truncate(n);
+            for (i, f) in self.rocks.fields.iter().enumerate() {
+                if !due[i] {
+                    continue;
+                }
+                if i >= meshes.len() {
+                    meshes.push((format!("rocks {i}"), Mesh::default()));
+                }
+                let mesh = &mut meshes[i].1;
+                if mesh.indices.len() != f.flat.indices.len() || mesh.indices != f.flat.indices {
+                    *mesh = Mesh::default();
+                }
+                f.flat.seat_into(placements[i], &ground, mesh);
+                self.seated_as[i] = Some((Arc::clone(&f.flat), placements[i]));
             }
-            let mesh = &mut meshes[i].1;
-            if mesh.indices.len() != f.flat.indices.len() || mesh.indices != f.flat.indices {
-                *mesh = Mesh::default();
-            }
-            f.flat.seat_into(at, &ground, mesh);
         }
+        self.seated_as.truncate(n);
     }
 
     /// Each field's rocks as a mesh named `rocks N`, in the exports' frame.
