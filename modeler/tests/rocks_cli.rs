@@ -178,3 +178,35 @@ fn generate_puts_a_documents_rocks_into_the_meshes() {
     let glb = std::fs::read(dir.path().join("d.glb")).expect("glb");
     assert!(String::from_utf8_lossy(&glb).contains("\"name\":\"rocks 0\""));
 }
+
+#[test]
+fn generate_names_a_bad_rock_field() {
+    let dir = tempfile::tempdir().expect("dir");
+    let volcano = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/04-volcano.json"))
+        .expect("example");
+    let end = volcano.rfind('}').expect("an object");
+    for (layers, words) in [
+        (
+            r#"[{"radius": 0.0, "fraction": 0.3}]"#,
+            "rocks[0].layers[0].radius: 0 must be above 0",
+        ),
+        (
+            r#"[{"radius": 8.0, "fraction": 0.7}, {"radius": 3.0, "fraction": 0.4}]"#,
+            "rocks[0].layers: the fractions add up to 1.1",
+        ),
+        (
+            r#"[{"radius": 500.0, "count": 3}]"#,
+            "rocks[0].layers[0].radius: 500 cells leaves no room",
+        ),
+    ] {
+        let field = format!(
+            r#""rocks": [{{"at": [120.0, 110.0], "outline": [[0.0, 0.0], [80.0, 0.0], [80.0, 60.0], [0.0, 0.0]], "cell_size": 0.5, "layers": {layers}}}]"#
+        );
+        let doc = format!("{},\n{field}\n}}\n", volcano[..end].trim_end()).replace("\"version\": 1", "\"version\": 2");
+        std::fs::write(dir.path().join("d.json"), doc).expect("write");
+        let out = penmodel(dir.path(), &["generate", "d.json", "--obj", "d.obj"]);
+        assert_eq!(out.status.code(), Some(1), "{}", text(&out.stderr));
+        assert!(text(&out.stderr).contains(words), "{}", text(&out.stderr));
+        assert!(!dir.path().join("d.obj").exists());
+    }
+}
