@@ -203,7 +203,11 @@ fn check_seated(rocks: &Rocks, map: &Heightmap) -> usize {
     let mut rims = 0;
     for (f, (_, mesh)) in rocks.fields().iter().zip(&seated) {
         let mut at = 0;
-        for rock in &f.scatter.rocks {
+        // The mesh lists the rocks in the flat order (by place); every rock once.
+        let mut seen = f.flat.order.clone();
+        seen.sort_unstable();
+        assert!(seen.iter().copied().eq(0..f.scatter.rocks.len() as u32));
+        for rock in f.flat.order.iter().map(|&i| &f.scatter.rocks[i as usize]) {
             for (k, v) in rock.mesh.vertices.iter().enumerate() {
                 let p = mesh.positions[at + k];
                 let ground = on_terrain(map, f64::from(p[0]), f64::from(p[2]));
