@@ -4,13 +4,15 @@
 # Debian packages the scripts need: binutils for `size` (firmware image figures), QEMU for the
 # firmware core's run on an emulated Cortex-M4F (hil-tests/tests/qemu.rs).
 DEB_PACKAGES=(binutils qemu-system-arm)
-# The board's target; clippy and rustfmt for the checks.
-RUST_TARGETS=(thumbv7em-none-eabihf)
+# The board's target, the bench rig's (Raspberry Pi Pico, hil-tests/rig); clippy and rustfmt for
+# the checks.
+RUST_TARGETS=(thumbv7em-none-eabihf thumbv6m-none-eabi)
 RUST_COMPONENTS=(clippy rustfmt)
 # SETUP=firmware (scripts/firmware-bin.sh): only what building the board's image needs, the
 # target — no Debian packages, no emulator.
 if [ "${SETUP:-}" = firmware ]; then
     DEB_PACKAGES=()
+    RUST_TARGETS=(thumbv7em-none-eabihf)
     RUST_COMPONENTS=()
 fi
 

@@ -60,6 +60,7 @@ fn packages(manifest: &Path) -> Vec<Package> {
 fn all_packages() -> Vec<Package> {
     let mut list = packages(&root().join("Cargo.toml"));
     list.extend(packages(&root().join("firmware/Cargo.toml")));
+    list.extend(packages(&root().join("hil-tests/rig/Cargo.toml")));
     list
 }
 

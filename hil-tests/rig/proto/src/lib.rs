@@ -14,6 +14,8 @@ pub mod schedule;
 
 pub use message::{DecodeError, ErrorCode, HostMessage, Info, MAX_MESSAGE, RigMessage, RigStatus};
 pub use schedule::{ScheduleError, edge_ns, word};
+// The frames are the base station's serial framing; re-exported so both ends use the same.
+pub use pen_protocol::{FrameDecoder, FrameError, MAX_FRAME, encode_frame};
 
 /// USB vendor ID of the rig: pid.codes, as the base station's.
 pub const RIG_VID: u16 = pen_protocol::USB_VID;
