@@ -1,8 +1,9 @@
 //! The hardware-in-the-loop harness around the simulated pen (`pen-sim`).
 //!
 //! Three ways to reach the real code with the simulated pen's bytes: over a pseudo-terminal like
-//! a real serial device ([`pty`]), and the firmware core itself on an emulated Cortex-M4F
-//! ([`qemu`]); [`accuracy`] measures the tracker against the Cramér–Rao bound and [`trace`]
+//! a real serial device ([`pty`]), the firmware core itself on an emulated Cortex-M4F
+//! ([`qemu`]), and the real board, its receiver inputs and switches driven by the bench rig
+//! ([`rig`]); [`accuracy`] measures the tracker against the Cramér–Rao bound and [`trace`]
 //! records a run. The `pen-sim` program exposes them; `tests/` holds the whole-chain tests.
 //! Nothing depends on this crate.
 #![cfg_attr(not(test), warn(clippy::unwrap_used))]
@@ -10,4 +11,5 @@
 pub mod accuracy;
 pub mod pty;
 pub mod qemu;
+pub mod rig;
 pub mod trace;

@@ -5,4 +5,5 @@ mod flashing;
 mod hil;
 mod pty;
 mod qemu;
+mod rig;
 mod serial;
