@@ -18,6 +18,9 @@ fn garbage_on_the_line_never_yields_a_wrong_sample() {
     let path = slave.name().expect("the pty's path");
     drop(slave);
     master.set_timeout(Duration::from_secs(1)).expect("timeout");
+    // Opened before anything is written: opening sets the line up and may discard what waits
+    // in it (a frame written first was lost when the open came late on a loaded machine).
+    let mut port = SerialTransport::open(&path).expect("the pty opens as a serial port");
 
     // The device side: a simulation's report bytes, framed, with garbage between the frames.
     let scenario = pen_sim::scenarios::by_name("hand-sweep").expect("scenario");
@@ -26,8 +29,6 @@ fn garbage_on_the_line_never_yields_a_wrong_sample() {
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(1);
         let mut sent: HashMap<u16, PenReport> = HashMap::new();
         let mut garbage_bytes = 0;
-        // Give the reader time to open its end.
-        std::thread::sleep(Duration::from_millis(200));
         while sent.len() < 600 {
             for s in sim.step().sent {
                 let Ok(Message::Pen(p)) = Message::decode(&s.bytes) else {
@@ -50,7 +51,6 @@ fn garbage_on_the_line_never_yields_a_wrong_sample() {
         (sent, garbage_bytes)
     });
 
-    let mut port = SerialTransport::open(&path).expect("the pty opens as a serial port");
     let mut received = Vec::new();
     // Until the writer is done and the line has been quiet for 2 s: a loaded machine (the
     // simulation runs unoptimised beside other tests) only makes it slower, never wrong. The
