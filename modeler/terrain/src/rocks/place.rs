@@ -31,8 +31,9 @@ pub fn mesh(scatter: &Scatter, at: Placement, ground: impl Fn(f64, f64) -> f64 +
 /// per scatter, seated at every change of the terrain or the field's place.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct Flat {
-    /// `[x, y, height above the ground]` per vertex, field cells.
-    pub vertices: Vec<[f64; 3]>,
+    /// `[x, y, height above the ground]` per vertex, field cells; `f32` like the meshes made
+    /// from it (half the memory to read at every re-seat).
+    pub vertices: Vec<[f32; 3]>,
     /// Three vertex indices per triangle.
     pub indices: Vec<u32>,
     /// The rocks in the order of these lists, as indices into the scatter's rocks: in bands of
@@ -76,7 +77,8 @@ impl Flat {
         for &i in &f.order {
             let rock = &scatter.rocks[i as usize];
             let base = f.vertices.len() as u32;
-            f.vertices.extend_from_slice(&rock.mesh.vertices);
+            f.vertices
+                .extend(rock.mesh.vertices.iter().map(|v| v.map(|c| c as f32)));
             f.indices.extend(rock.mesh.triangles.iter().flatten().map(|i| base + i));
             let start = f.blocks.last().map_or(0, |b| b.0);
             if f.vertices.len() - start >= BLOCK {
@@ -122,6 +124,7 @@ impl Flat {
         }
         parts.into_par_iter().for_each(|((v0, i0), (v1, i1), out, norms)| {
             for (o, v) in out.iter_mut().zip(&self.vertices[v0..v1]) {
+                let v = v.map(f64::from);
                 let (x, y) = (at.origin[0] + v[0] * at.cell_size, at.origin[1] + v[1] * at.cell_size);
                 *o = [x as f32, (ground(x, y) + v[2] * at.cell_size) as f32, y as f32];
             }
