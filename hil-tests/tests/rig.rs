@@ -4,6 +4,7 @@
 //! and passes; with a rig but no base station it fails, since the bench is then set up wrong.
 
 use std::path::{Path, PathBuf};
+use std::sync::{Mutex, MutexGuard};
 use std::time::{Duration, Instant};
 
 use pen_hil::rig::{self, BenchRig};
@@ -13,8 +14,14 @@ use pen_protocol::{Command, Message, NO_ARRIVAL, PenReport, ReportId, StatusCode
 use pen_rig_proto::HostMessage;
 use pen_sim::{Scenario, Simulation, scenarios};
 
-/// The rig and the base station it is wired to, or `None` (the skip line printed) without a rig.
-fn bench() -> Option<(BenchRig, HidTransport)> {
+/// One bench, one test at a time: the tests run in parallel threads of one binary.
+static BENCH: Mutex<()> = Mutex::new(());
+
+/// The rig and the base station it is wired to, held for the test, or `None` (the skip line
+/// printed) without a rig.
+fn bench() -> Option<(BenchRig, HidTransport, MutexGuard<'static, ()>)> {
+    // A test that failed while holding the bench leaves it usable for the next.
+    let guard = BENCH.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     let rig = match BenchRig::attached() {
         Ok(Some(rig)) => rig,
         Ok(None) => {
@@ -29,7 +36,7 @@ fn bench() -> Option<(BenchRig, HidTransport)> {
             rig.name()
         )
     });
-    Some((rig, board))
+    Some((rig, board, guard))
 }
 
 /// Configures the board as the scenario's device and returns the scenario's cycles for the rig.
@@ -79,7 +86,9 @@ fn sysfs_device(vid: u16, pid: u16) -> Option<PathBuf> {
 
 #[test]
 fn the_rig_sees_every_burst_of_the_board() {
-    let Some((mut rig, mut board)) = bench() else { return };
+    let Some((mut rig, mut board, _bench)) = bench() else {
+        return;
+    };
     let Message::DeviceInfo(info) = board.get_feature(ReportId::DeviceInfo).expect("device info") else {
         panic!("not a device info report");
     };
@@ -97,7 +106,9 @@ fn the_rig_sees_every_burst_of_the_board() {
 
 #[test]
 fn capture_and_solve_through_the_real_board() {
-    let Some((mut rig, mut board)) = bench() else { return };
+    let Some((mut rig, mut board, _bench)) = bench() else {
+        return;
+    };
     let scenario = scenarios::by_name("hold").expect("the hold scenario");
     let cycles = prepare(&mut rig, &mut board, &scenario, 4.0);
     let receivers = scenario.rig.receivers_mm.len();
@@ -167,7 +178,9 @@ fn capture_and_solve_through_the_real_board() {
 
 #[test]
 fn feature_reports_through_the_real_board() {
-    let Some((mut rig, mut board)) = bench() else { return };
+    let Some((mut rig, mut board, _bench)) = bench() else {
+        return;
+    };
     let scenario = scenarios::by_name("hold").expect("the hold scenario");
     prepare(&mut rig, &mut board, &scenario, 0.01);
     let Message::Config(back) = board.get_feature(ReportId::Config).expect("config") else {
@@ -182,7 +195,9 @@ fn feature_reports_through_the_real_board() {
 
 #[test]
 fn a_flash_erase_does_not_trip_the_watchdog() {
-    let Some((mut rig, mut board)) = bench() else { return };
+    let Some((mut rig, mut board, _bench)) = bench() else {
+        return;
+    };
     let scenario = scenarios::by_name("hold").expect("the hold scenario");
     let cycles = prepare(&mut rig, &mut board, &scenario, 12.0);
     let streamer = std::thread::spawn(move || rig.stream(&cycles, Duration::from_secs(20)));
@@ -217,7 +232,9 @@ fn a_flash_erase_does_not_trip_the_watchdog() {
 
 #[test]
 fn a_new_press_wakes_the_suspended_host_and_a_held_tip_does_not() {
-    let Some((mut rig, board)) = bench() else { return };
+    let Some((mut rig, board, _bench)) = bench() else {
+        return;
+    };
     let Some(dev) = sysfs_device(USB_VID, USB_PID) else {
         panic!("the base station is open over HID but not in /sys/bus/usb/devices");
     };
@@ -264,7 +281,9 @@ fn a_new_press_wakes_the_suspended_host_and_a_held_tip_does_not() {
 #[test]
 #[ignore = "leaves the board in DFU mode; run on its own with --ignored"]
 fn the_dfu_command_restarts_into_the_rom_bootloader() {
-    let Some((_rig, mut board)) = bench() else { return };
+    let Some((_rig, mut board, _bench)) = bench() else {
+        return;
+    };
     // The command is answered, then the board detaches: an error here is the detach.
     let _ = board.set_feature(&Message::Command(Command::EnterBootloader));
     drop(board);

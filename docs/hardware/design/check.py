@@ -116,6 +116,25 @@ def net_of(part, pin_name):
     return p.net.name if p.net is not None else None
 
 
+def check_rig():
+    """The bench rig's picture (pictures.RIG_WIRES) against the board and the rig's firmware:
+    its Black Pill pins are the schematic's burst, capture and switch pins, in order, and its
+    Pico pins are those hil-tests/rig/src/main.rs hands to the PIO blocks and the switch lines."""
+    import pictures
+
+    wires = [w for w in pictures.RIG_WIRES if w[0] != "GND"]
+    pill = []
+    for pin, _, _, _ in wires:
+        if pin not in pill:
+            pill.append(pin)
+    want = [circuit.PIN_BURST] + list(circuit.PINS_CAPTURE) + list(circuit.PINS_SWITCH)
+    check("rig picture: its Black Pill pins are the schematic's", pill == want, f"picture {pill}")
+    text = (ROOT / "hil-tests/rig/src/main.rs").read_text()
+    used = [f"GP{a or b}" for a, b in re.findall(r"make_pio_pin\(p\.PIN_(\d+)\)|Flex::new\(p\.PIN_(\d+)\)", text)]
+    pico = [gp for _, _, gp, _ in wires]
+    check("rig picture: its Pico pins are the rig firmware's, in order", pico == used, f"picture {pico}, main.rs {used}")
+
+
 def check_pins(pill):
     burst, captures, switches = firmware_pins()
     check("firmware: burst pin is the schematic's", burst == [circuit.PIN_BURST], f"main.rs {burst}")
@@ -180,6 +199,7 @@ def main():
     check_chain()
     check_comparator()
     check_power_and_switches()
+    check_rig()
 
     import pictures
 

@@ -2,6 +2,8 @@
 
 * receiver.svg, transmitter.svg, switches.svg — schematics (schemdraw, its own SVG writer);
 * pen.svg, post.svg — the pen and a receiver post, dimensioned (matplotlib);
+* rig.svg — the bench rig's wiring: a Raspberry Pi Pico on the Black Pill's burst, receiver and
+  switch pins (docs/hil-rig.md; the pins are hil-tests/rig/src/main.rs's, listed in RIG_WIRES);
 * beam.svg — the pen's sound against its tilt: the angle between the fan of sound round the pen
   and each receiver, over the workspace, for tilts 0–60° (matplotlib, computed here).
 
@@ -229,6 +231,58 @@ def switches():
     return _svg(d)
 
 
+# The bench rig (docs/hil-rig.md): (Black Pill pin, what it is, Pico pin, what the rig does).
+RIG_WIRES = [
+    ("PA8", "burst", "GP2", "burst in (PIO0)"),
+    ("PA8", "burst", "GP3", "burst in (PIO1)"),
+    ("PA15", "receiver 0", "GP6", "receiver 0 out"),
+    ("PB3", "receiver 1", "GP7", "receiver 1 out"),
+    ("PB10", "receiver 2", "GP8", "receiver 2 out"),
+    ("PA3", "receiver 3", "GP9", "receiver 3 out"),
+    ("PA6", "receiver 4", "GP10", "receiver 4 out"),
+    ("PA7", "receiver 5", "GP11", "receiver 5 out"),
+    ("PB0", "receiver 6", "GP12", "receiver 6 out"),
+    ("PB1", "receiver 7", "GP13", "receiver 7 out"),
+    ("PB12", "SW1 (tip)", "GP18", "SW1, open drain"),
+    ("PB14", "SW2", "GP19", "SW2, open drain"),
+    ("PB15", "SW3", "GP20", "SW3, open drain"),
+    ("GND", "", "GND", ""),
+]
+
+
+def rig():
+    """The two boards side by side, one wire per signal, as the rig's firmware assigns them."""
+    rows = len(RIG_WIRES)
+    fig, ax = plt.subplots(figsize=(8.4, 0.36 * rows + 1.6))
+    ax.set_xlim(-4.2, 16.5)
+    ax.set_ylim(-rows - 0.6, 2.0)
+    ax.axis("off")
+    box = dict(fill=False, linewidth=1.4)
+    ax.add_patch(plt.Rectangle((0, -rows + 0.5), 3.2, rows + 0.2, **box))
+    ax.add_patch(plt.Rectangle((9.5, -rows + 0.5), 3.2, rows + 0.2, **box))
+    ax.text(1.6, 1.3, "Black Pill: base station\n(STM32F411, 3.3 V)", ha="center", va="center", fontsize=10)
+    ax.text(11.1, 1.3, "Raspberry Pi Pico: bench rig\n(RP2040, 3.3 V)", ha="center", va="center", fontsize=10)
+    first = {}
+    for i, (pin, what, gp, does) in enumerate(RIG_WIRES):
+        y = -i
+        if pin in first:
+            # The same Black Pill pin again (the burst to both PIO blocks): a branch, not a pin.
+            ax.plot([6.2, 6.2, 9.5], [first[pin], y, y], color="black", linewidth=1)
+            ax.plot([6.2], [first[pin]], "o", color="black", markersize=4)
+        else:
+            first[pin] = y
+            ax.plot([3.2, 9.5], [y, y], color="black", linewidth=1)
+            ax.text(3.0, y, pin, ha="right", va="center", fontsize=9)
+            ax.text(-0.2, y, what, ha="right", va="center", fontsize=8, color="#444444")
+        ax.text(9.7, y, gp, ha="left", va="center", fontsize=9)
+        ax.text(12.9, y, does, ha="left", va="center", fontsize=8, color="#444444")
+    ax.text(6.35, -rows + 0.3,
+            "Receiver modules and pen cable unplugged: the rig is their outputs. Switch lines: pulled low\n"
+            "for pressed, let go for released (the base station's 4.7 k pull-ups). Ground wire short, beside the signals.",
+            ha="center", va="top", fontsize=8)
+    return _fig_svg(fig)
+
+
 # --- Mechanics -----------------------------------------------------------------------------------
 
 EMITTER_MM = 8.0      # the sound's centre above the tip (pen-sim's emitter_offset_mm)
@@ -393,4 +447,5 @@ def all_pictures():
         (OUT / "pen.svg", pen()),
         (OUT / "post.svg", post()),
         (OUT / "beam.svg", beam()),
+        (OUT / "rig.svg", rig()),
     ]
