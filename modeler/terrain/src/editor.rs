@@ -299,7 +299,8 @@ impl Editor {
         }
         let applied = edit.apply_to(&mut self.doc)?;
         let changed = self.terrain.update(&self.doc, &applied.scope);
-        self.rocks.follow(&self.doc, self.terrain.heightmap(), Some(changed));
+        let cells = (changed.c0, changed.r0, changed.width, changed.height);
+        self.rocks.follow(&self.doc, self.terrain.heightmap(), Some(cells));
         Ok(Outcome {
             inverse: applied.inverse,
             changed,

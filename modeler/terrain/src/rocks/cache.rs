@@ -9,7 +9,6 @@
 use std::sync::Arc;
 
 use crate::document::{Document, RockField};
-use crate::engine::Rect;
 use crate::export::Mesh;
 use crate::heightmap::Heightmap;
 
@@ -132,9 +131,11 @@ impl Seated {
     }
 
     /// Brings the rocks up to date with `doc` and `map`, whose heights changed in `changed` (grid
-    /// cells; `None`: anywhere). A field whose rocks and place are as they were and whose ground
-    /// is outside `changed` is left as it is.
-    pub fn follow(&mut self, doc: &Document, map: &Heightmap, changed: Option<Rect>) {
+    /// cells `(first column, first row, columns, rows)`, the engine's changed rectangle; `None`:
+    /// anywhere). A field whose rocks and place are as they were and whose ground is outside
+    /// `changed` is left as it is. (A plain tuple, not the engine's type: the engine's validation
+    /// knows rock fields, so rocks do not import the engine.)
+    pub fn follow(&mut self, doc: &Document, map: &Heightmap, changed: Option<(u32, u32, u32, u32)>) {
         if doc.rocks.is_empty() && self.meshes.is_empty() {
             return;
         }
@@ -164,7 +165,7 @@ impl Seated {
                     .is_some_and(|(flat, was)| Arc::ptr_eq(flat, &f.flat) && was == at);
                 // The grid cells whose heights the field's ground reads (one more each side
                 // for the interpolation).
-                let touched = changed.is_none_or(|r| {
+                let touched = changed.is_none_or(|(rc0, rr0, rw, rh)| {
                     let w = f64::from(f.image.width) * at.cell_size;
                     let h = f64::from(f.image.height) * at.cell_size;
                     let (c0, r0) = ((at.origin[0] / s).floor() - 1.0, (at.origin[1] / s).floor() - 1.0);
@@ -172,12 +173,12 @@ impl Seated {
                         ((at.origin[0] + w) / s).ceil() + 1.0,
                         ((at.origin[1] + h) / s).ceil() + 1.0,
                     );
-                    r.width > 0
-                        && r.height > 0
-                        && c0 < f64::from(r.c0 + r.width)
-                        && f64::from(r.c0) < c1
-                        && r0 < f64::from(r.r0 + r.height)
-                        && f64::from(r.r0) < r1
+                    rw > 0
+                        && rh > 0
+                        && c0 < f64::from(rc0 + rw)
+                        && f64::from(rc0) < c1
+                        && r0 < f64::from(rr0 + rh)
+                        && f64::from(rr0) < r1
                 });
                 !same || touched || i >= self.meshes.len()
             })
