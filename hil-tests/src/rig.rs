@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 
 use pen_protocol::MAX_RECEIVERS;
 use pen_rig_proto::{
-    DecodeError, ErrorCode, FrameDecoder, FrameError, HostMessage, Info, MAX_FRAME, MAX_MESSAGE, RIG_PID, RIG_PRODUCT,
+    DecodeError, ErrorCode, FrameDecoder, HostMessage, Info, MAX_FRAME, MAX_MESSAGE, RIG_PID, RIG_PRODUCT,
     RIG_PROTOCOL_VERSION, RIG_VID, RigMessage, RigStatus, ScheduleError, encode_frame, word,
 };
 use pen_sim::CycleRecord;
@@ -33,9 +33,6 @@ pub enum RigError {
     /// No answer in time.
     #[error("the rig did not answer within {0:?} (unplugged, or its firmware stopped)")]
     Timeout(Duration),
-    /// The answer's frame was damaged.
-    #[error("bad frame from the rig: {0}")]
-    Frame(FrameError),
     /// The answer's payload is not a rig message.
     #[error("bad message from the rig: {0:?}")]
     Decode(DecodeError),
@@ -204,9 +201,11 @@ impl BenchRig {
             };
             for (i, &b) in buf[..got].iter().enumerate() {
                 if let Some(frame) = self.decoder.push(b) {
-                    // One answer per message: bytes after it belong to nothing we asked.
-                    let answer = frame.map_err(RigError::Frame)?;
+                    // Noise on the line (a half frame from an earlier session) spoils only
+                    // itself: the answer is the next intact frame.
+                    let Ok(answer) = frame else { continue };
                     let answer = RigMessage::decode(answer).map_err(RigError::Decode)?;
+                    // One answer per message: bytes after it belong to nothing we asked.
                     if buf[i + 1..got].iter().any(|&b| b != 0) {
                         return Err(RigError::Unexpected(answer));
                     }
@@ -310,6 +309,99 @@ mod tests {
         }
         // The scenario drops 2 % of arrivals: the stream carries them as "heard nothing".
         assert!(dropouts > 0, "no dropout in {} cycles", records.len());
+    }
+
+    /// A rig in software on the far side of a pseudo-terminal: it answers as the firmware does
+    /// (pen-rig-proto's messages in the base station's frames), refuses each cycle once with
+    /// QueueFull, and puts line noise before its first answer. Returns the cycles it queued.
+    fn software_rig(mut port: serialport::TTYPort, version: u8) -> std::thread::JoinHandle<Vec<u32>> {
+        std::thread::spawn(move || {
+            let mut decoder = FrameDecoder::new();
+            let mut status = RigStatus::default();
+            let mut queued = Vec::new();
+            let mut refused = None;
+            let mut noise = true;
+            let mut buf = [0; 64];
+            loop {
+                let n = match port.read(&mut buf) {
+                    Ok(0) => return queued,
+                    Ok(n) => n,
+                    Err(e) if e.kind() == std::io::ErrorKind::TimedOut => continue,
+                    Err(_) => return queued,
+                };
+                for &b in &buf[..n] {
+                    let Some(frame) = decoder.push(b) else { continue };
+                    let answer = match HostMessage::decode(frame.unwrap()).unwrap() {
+                        HostMessage::Hello => RigMessage::Info(Info {
+                            version,
+                            receivers: 8,
+                            pio_hz: 125_000_000,
+                            queue_capacity: 64,
+                        }),
+                        HostMessage::Cycle { seq, .. } if refused != Some(seq) => {
+                            refused = Some(seq);
+                            RigMessage::Error(ErrorCode::QueueFull)
+                        }
+                        HostMessage::Cycle { seq, .. } => {
+                            queued.push(seq);
+                            status.played += 1;
+                            status.last_played = seq;
+                            RigMessage::Status(status)
+                        }
+                        _ => RigMessage::Status(status),
+                    };
+                    let mut payload = [0; MAX_MESSAGE];
+                    let len = answer.encode(&mut payload);
+                    let mut out = [0; MAX_FRAME];
+                    let len = encode_frame(&payload[..len], &mut out).unwrap();
+                    if std::mem::take(&mut noise) {
+                        // A half frame left over from an earlier session, then the answer.
+                        port.write_all(&[0x13, 0x37, 0x42]).unwrap();
+                    }
+                    if port.write_all(&out[..len]).is_err() {
+                        return queued;
+                    }
+                }
+            }
+        })
+    }
+
+    #[test]
+    fn the_host_side_streams_to_a_rig_over_a_serial_line() {
+        let (host, mut far) = serialport::TTYPort::pair().expect("a pseudo-terminal pair");
+        far.set_timeout(Duration::from_millis(20)).unwrap();
+        let rig_thread = software_rig(far, RIG_PROTOCOL_VERSION);
+        let mut rig = BenchRig::over(Box::new(host), "pty").expect("the rig answers Hello");
+        assert_eq!(rig.info().queue_capacity, 64);
+        let stream: Vec<HostMessage> = (1..=20)
+            .map(|seq| {
+                cycle_message(
+                    0,
+                    seq,
+                    &[Some(400_000), None, Some(1_200_000)],
+                    [seq % 2 == 0, false, false],
+                )
+                .unwrap()
+            })
+            .collect();
+        // Each cycle is refused once (queue full) and sent again: all twenty arrive, in order.
+        let status = rig.stream(&stream, Duration::from_secs(5)).expect("the stream plays");
+        assert_eq!(status.last_played, 20);
+        assert_eq!(status.played, 20);
+        drop(rig);
+        assert_eq!(rig_thread.join().unwrap(), (1..=20).collect::<Vec<u32>>());
+    }
+
+    #[test]
+    fn a_rig_of_another_version_is_refused() {
+        let (host, mut far) = serialport::TTYPort::pair().expect("a pseudo-terminal pair");
+        far.set_timeout(Duration::from_millis(20)).unwrap();
+        let _rig_thread = software_rig(far, RIG_PROTOCOL_VERSION + 1);
+        match BenchRig::over(Box::new(host), "pty") {
+            Err(RigError::Version(v)) => assert_eq!(v, RIG_PROTOCOL_VERSION + 1),
+            Err(e) => panic!("wrong error: {e}"),
+            Ok(_) => panic!("a rig of another version was accepted"),
+        }
     }
 
     #[test]

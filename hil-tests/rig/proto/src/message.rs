@@ -35,7 +35,8 @@ pub enum HostMessage {
     },
     /// Sets the switch lines now (pressed = pulled low), outside any cycle: suspend and wake.
     Switches(u8),
-    /// Empties the queue, releases the switches; the receivers hear nothing until new cycles.
+    /// Empties the queue, releases the switches, zeroes the play counters; the receivers hear
+    /// nothing until new cycles (but the cycle already handed to the state machines).
     Stop,
     /// The rig's counters: the rig answers [`RigMessage::Status`].
     Status,
@@ -55,7 +56,8 @@ pub struct Info {
     pub queue_capacity: u16,
 }
 
-/// The rig's counters since start-up or the last [`HostMessage::Stop`].
+/// The rig's counters: `bursts` and `bad_frames` since start-up, the others since the last
+/// [`HostMessage::Stop`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub struct RigStatus {
