@@ -210,6 +210,7 @@ impl Picture {
         let moving_field = ui.field_moving(doc);
         for (i, f) in doc.rocks.iter().enumerate() {
             let (points, colour) = match &moving_field {
+                Some((m, pts)) if *m == i && rocks::outside_every_region(doc, pts) => (pts.clone(), DELETING_COLOUR),
                 Some((m, pts)) if *m == i => (pts.clone(), MOVING_COLOUR),
                 _ => (f.outline_at(), ROCK_FIELD_COLOUR),
             };

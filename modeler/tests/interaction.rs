@@ -427,6 +427,13 @@ fn the_rock_tool_draws_moves_and_tunes_a_field() {
     pen.editor.undo().expect("undo");
     assert_eq!(pen.doc().rocks[0], field);
 
+    // Delete (the keyboard's) removes the highlighted field; undo brings it back.
+    pen.hover(215.0, 145.0);
+    pen.ui.command(&mut pen.editor, KeyCommand::Delete);
+    assert!(pen.doc().rocks.is_empty());
+    pen.ui.command(&mut pen.editor, KeyCommand::Undo);
+    assert_eq!(pen.doc().rocks.len(), 1);
+
     // Back to figures: a tap on the palette again; an open stroke with the rock tool is refused.
     pen.hover(18.0, 18.0).touch().lift(HOVER);
     assert_eq!(pen.ui.tool(), Tool::Figures);
@@ -438,4 +445,20 @@ fn the_rock_tool_draws_moves_and_tunes_a_field() {
         messages.iter().any(|m| m.contains("needs a closed outline")),
         "{messages:?}"
     );
+}
+
+/// A rock field dropped outside every region is deleted, as a figure dropped outside its region.
+#[test]
+fn a_rock_field_dropped_outside_every_region_goes() {
+    let mut pen = Pen::new(blank());
+    pen.closed(&[(200.0, 100.0), (400.0, 100.0), (400.0, 250.0), (200.0, 250.0)]);
+    pen.hover(18.0, 18.0).touch().lift(HOVER);
+    pen.closed(&[(250.0, 150.0), (320.0, 150.0), (320.0, 200.0), (250.0, 200.0)]);
+    assert_eq!(pen.doc().rocks.len(), 1, "{:?}", pen.ui.take_messages());
+    // Slid 250 mm to the right: every vertex beyond the region's right edge.
+    pen.grab(285.0, 175.0).drag_to(535.0, 175.0).lift(HOVER).let_go();
+    assert!(pen.doc().rocks.is_empty(), "{:?}", pen.ui.take_messages());
+    assert_eq!(pen.ui.stats().deletes, 1);
+    pen.editor.undo().expect("undo");
+    assert_eq!(pen.doc().rocks.len(), 1);
 }

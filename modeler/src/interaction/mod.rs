@@ -507,6 +507,16 @@ impl Interaction {
         match command {
             KeyCommand::Undo => self.undo(editor),
             KeyCommand::Redo => self.redo(editor),
+            KeyCommand::Delete if self.tool == rocks::Tool::Rocks => {
+                let Some(index) = self.field_hover() else {
+                    self.say("no rock field highlighted to delete".into());
+                    return;
+                };
+                if self.commit(editor, Edit::DeleteRocks { index }, "delete") {
+                    self.stats.deletes += 1;
+                    self.field_hover = None;
+                }
+            }
             KeyCommand::Delete => {
                 let Some(hit) = self.hover().cloned() else {
                     self.say("nothing highlighted to delete".into());
@@ -759,10 +769,19 @@ impl Interaction {
         if !grab.moving || grab.by == [0.0, 0.0] {
             return;
         }
-        let edit = Edit::MoveRocks {
-            index: grab.index,
-            by: grab.by,
-        };
+        let index = grab.index;
+        let outside = self
+            .field_moving(editor.document())
+            .is_some_and(|(_, outline)| rocks::outside_every_region(editor.document(), &outline));
+        // As a figure dropped outside its region, a field dropped outside every region goes.
+        if outside {
+            if self.commit(editor, Edit::DeleteRocks { index }, "delete") {
+                self.stats.deletes += 1;
+                self.say(format!("rock field {index} deleted"));
+            }
+            return;
+        }
+        let edit = Edit::MoveRocks { index, by: grab.by };
         if self.commit(editor, edit, "moving the rock field") {
             self.stats.moves += 1;
         }

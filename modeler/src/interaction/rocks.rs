@@ -62,6 +62,14 @@ pub fn field_at(doc: &Document, g: Point) -> Option<usize> {
         .find(|&i| locate(&doc.rocks[i].outline_at(), g) == Side::Inside)
 }
 
+/// Whether a field with `outline` (ground metres, closed) would lie outside every region: none
+/// of its vertices inside a top-level region (the document's own rule for fields).
+pub fn outside_every_region(doc: &Document, outline: &[Point]) -> bool {
+    !doc.regions
+        .iter()
+        .any(|r| outline.iter().any(|&p| locate(&r.boundary, p) == Side::Inside))
+}
+
 /// A new field with the seed's fig. 1 recipe inside `outline` (ground metres, closed), its cell
 /// size such that the largest rocks are [`LARGEST_ROCK_MM`] across on the display.
 pub fn new_field(outline: &[Point], view: &View, seed: u64) -> RockField {
