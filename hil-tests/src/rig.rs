@@ -11,8 +11,8 @@ use std::time::{Duration, Instant};
 
 use pen_protocol::MAX_RECEIVERS;
 use pen_rig_proto::{
-    DecodeError, ErrorCode, FrameDecoder, HostMessage, Info, MAX_FRAME, MAX_MESSAGE, RIG_PID, RIG_PRODUCT,
-    RIG_PROTOCOL_VERSION, RIG_VID, RigMessage, RigStatus, ScheduleError, encode_frame, word,
+    DecodeError, Edges, ErrorCode, FrameDecoder, HostMessage, Info, MAX_FRAME, MAX_MESSAGE, RIG_PID, RIG_PRODUCT,
+    RIG_PROTOCOL_VERSION, RIG_VID, RigMessage, RigStatus, ScheduleError, encode_frame, words,
 };
 use pen_sim::CycleRecord;
 use serialport::{SerialPort, SerialPortType};
@@ -85,27 +85,35 @@ pub fn switch_bits(switches: [bool; 3]) -> u8 {
 }
 
 /// One burst's message: `arrival_ns` per receiver (after the burst's first edge, as the
-/// simulator's `Heard::arrival_ns` and the board's captures count), checked playable.
+/// simulator's `Heard::arrival_ns` and the board's captures count), one comparator pulse each,
+/// checked playable.
 pub fn cycle_message(
     index: usize,
     seq: u32,
     arrival_ns: &[Option<u32>],
     switches: [bool; 3],
 ) -> Result<HostMessage, RigError> {
-    let mut arrivals = [None; MAX_RECEIVERS];
-    let count = arrival_ns.len().min(MAX_RECEIVERS);
-    for (receiver, (slot, &a)) in arrivals.iter_mut().zip(arrival_ns).enumerate() {
-        word(a).map_err(|error| RigError::Unplayable {
+    let edges: Vec<Edges> = arrival_ns.iter().map(|&a| Edges::arrival(a)).collect();
+    pulses_message(index, seq, &edges, switches)
+}
+
+/// One burst's message with any pulses per receiver (pickup, arrivals, echoes, late edges: up
+/// to `MAX_EDGES` each), checked playable; receivers past the eighth are left out.
+pub fn pulses_message(index: usize, seq: u32, edges: &[Edges], switches: [bool; 3]) -> Result<HostMessage, RigError> {
+    let mut all = [Edges::NONE; MAX_RECEIVERS];
+    let count = edges.len().min(MAX_RECEIVERS);
+    for (receiver, (slot, e)) in all.iter_mut().zip(edges).enumerate() {
+        words(e).map_err(|error| RigError::Unplayable {
             cycle: index,
             receiver,
             error,
         })?;
-        *slot = a;
+        *slot = *e;
     }
     Ok(HostMessage::Cycle {
         seq,
         switches: switch_bits(switches),
-        arrival_ns: arrivals,
+        edges: all,
         count: count as u8,
     })
 }
@@ -274,6 +282,7 @@ impl BenchRig {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use pen_rig_proto::Edge;
     use pen_sim::{Simulation, scenarios};
 
     #[test]
@@ -295,7 +304,7 @@ mod tests {
             let HostMessage::Cycle {
                 seq,
                 switches,
-                arrival_ns,
+                edges,
                 count,
             } = *m
             else {
@@ -304,8 +313,12 @@ mod tests {
             assert_eq!(seq, i as u32 + 1);
             assert_eq!(usize::from(count), receivers);
             assert_eq!(switches, switch_bits(r.intended_switches));
-            assert_eq!(&arrival_ns[..receivers], &r.heard.arrival_ns[..receivers]);
-            dropouts += arrival_ns[..receivers].iter().filter(|a| a.is_none()).count();
+            for (e, a) in edges[..receivers].iter().zip(&r.heard.arrival_ns[..receivers]) {
+                // One comparator pulse per arrival, as long as the burst's envelope.
+                assert_eq!(*e, Edges::arrival(*a));
+                assert_eq!(e.first_ns(), *a);
+            }
+            dropouts += edges[..receivers].iter().filter(|e| e.first_ns().is_none()).count();
         }
         // The scenario drops 2 % of arrivals: the stream carries them as "heard nothing".
         assert!(dropouts > 0, "no dropout in {} cycles", records.len());
@@ -406,7 +419,7 @@ mod tests {
 
     #[test]
     fn an_arrival_the_rig_cannot_play_is_refused_before_sending() {
-        let late = pen_rig_proto::schedule::MAX_ARRIVAL_NS + 8;
+        let late = pen_rig_proto::schedule::MAX_END_NS - pen_rig_proto::schedule::PULSE_NS + 8;
         let err = cycle_message(3, 4, &[Some(1_000_000), Some(late)], [false; 3]).unwrap_err();
         assert!(
             matches!(
@@ -420,5 +433,19 @@ mod tests {
             "{err}"
         );
         assert!(cycle_message(0, 1, &[None, Some(300_000)], [true, false, false]).is_ok());
+        // Several pulses on one receiver: out of order is refused, naming the receiver.
+        let backwards = Edges::new(&[Edge::arrival(2_000_000), Edge::arrival(1_000_000)]).unwrap();
+        let err = pulses_message(5, 6, &[Edges::NONE, Edges::NONE, backwards], [false; 3]).unwrap_err();
+        assert!(
+            matches!(
+                err,
+                RigError::Unplayable {
+                    cycle: 5,
+                    receiver: 2,
+                    error: ScheduleError::TooClose { at_ns: 1_000_000 }
+                }
+            ),
+            "{err}"
+        );
     }
 }

@@ -117,7 +117,7 @@ fn capture_and_solve_through_the_real_board() {
             cycles
                 .iter()
                 .filter_map(|c| match c {
-                    HostMessage::Cycle { arrival_ns, .. } => arrival_ns[i].map(f64::from),
+                    HostMessage::Cycle { edges, .. } => edges[i].first_ns().map(f64::from),
                     _ => None,
                 })
                 .collect()

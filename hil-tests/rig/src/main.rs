@@ -2,8 +2,8 @@
 //!
 //! The base station's burst pin (PA8) comes in on GP2 (and GP3, jumpered to it: each PIO block
 //! needs the pin in its own pin mapping). Eight PIO state machines, one per receiver input, wait
-//! for a burst's first rising edge and raise their receiver line after the delay the host asked
-//! for, in 8 ns steps; the switch lines SW1–SW3 are pulled low (pressed) or let go (released).
+//! for a burst's first rising edge and play the pulses the host asked for on their receiver
+//! line (up to three per burst: pickup, the arrival, an echo), in 8 ns steps; the switch lines SW1–SW3 are pulled low (pressed) or let go (released).
 //! The host sends one cycle per burst over USB serial (pen-rig-proto's messages); after each
 //! burst the rig hands the state machines the next cycle's words, so a cycle is always waiting
 //! in the FIFOs when its burst comes. Pins and wiring: docs/hil-rig.md.
@@ -19,7 +19,9 @@ use embassy_futures::join::join3;
 use embassy_rp::bind_interrupts;
 use embassy_rp::gpio::{Flex, Level, Pull};
 use embassy_rp::peripherals::{PIO0, PIO1, USB};
-use embassy_rp::pio::{self, Direction, Instance, LoadedProgram, Pio, ShiftConfig, ShiftDirection, StateMachine};
+use embassy_rp::pio::{
+    self, Direction, FifoJoin, Instance, LoadedProgram, Pio, ShiftConfig, ShiftDirection, StateMachine,
+};
 use embassy_rp::usb::{self, Driver};
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use embassy_sync::channel::Channel;
@@ -28,10 +30,11 @@ use embassy_usb::driver::EndpointError;
 use embassy_usb::{Builder, Config};
 use panic_probe as _;
 use pen_rig_proto::message::SWITCH_MASK;
+use pen_rig_proto::schedule::MAX_WORDS;
 use pen_rig_proto::schedule::PIO_HZ;
 use pen_rig_proto::{
     ErrorCode, FrameDecoder, HostMessage, Info, MAX_FRAME, MAX_MESSAGE, RECEIVERS, RIG_PID, RIG_PRODUCT,
-    RIG_PROTOCOL_VERSION, RIG_VID, RigMessage, RigStatus, encode_frame, word,
+    RIG_PROTOCOL_VERSION, RIG_VID, RigMessage, RigStatus, encode_frame, words,
 };
 
 bind_interrupts!(struct Irqs {
@@ -43,16 +46,18 @@ bind_interrupts!(struct Irqs {
 /// Cycles the rig holds: at the base station's ~150 cycles/s, 0.4 s of slack for the host.
 const QUEUE: usize = 64;
 
-/// One cycle, ready for the state machines.
+/// One cycle, ready for the state machines: per receiver its count word and edge words, and
+/// how many of them are used.
 struct Queued {
     seq: u32,
     switches: u8,
-    words: [u32; RECEIVERS],
+    words: [([u32; MAX_WORDS], usize); RECEIVERS],
 }
 
-/// The receiver program, the same on every state machine. IN and JMP pin: the burst; OUT and
-/// SET pin: the receiver line. The cycle counts matter: pen-rig-proto's `schedule` relies on
-/// them (`LATENCY_CYCLES`, the delay and hold loops) — change both together.
+/// The receiver program, the same on every state machine. IN and JMP pin: the burst; SET pin:
+/// the receiver line. The cycle counts matter: pen-rig-proto's `schedule` relies on them
+/// (`FIRST_LATENCY_CYCLES`, `GAP_LATENCY_CYCLES`, the delay and hold loops) — change both
+/// together. Per burst it takes a count word, then that many edge words (delay, length).
 fn receiver_program() -> pio::program::Program<32> {
     pio::program::pio_asm!(
         ".wrap_target",
@@ -66,20 +71,33 @@ fn receiver_program() -> pio::program::Program<32> {
         "    jmp pin rearm",
         "    jmp y-- inner [4]",
         "    jmp x-- outer",
-        // What `pull noblock` gives when the FIFO is empty: word 0, no arrival.
+        // What `pull noblock` gives when the FIFO is empty: a count of 0, no pulse.
         "    set x, 0",
         "    wait 1 pin 0",
         "    pull noblock",
-        // Tells the CPU the words are taken: time to hand over the next cycle's.
+        // Tells the CPU the count words are taken: time to queue the next cycle's words
+        // behind this cycle's edge words (the joined FIFO holds both).
         "    irq nowait 0",
-        "    out x, 20",
+        "    out y, 32",
+        "count:",
+        "    jmp y-- edge",
+        "    jmp rearm",
+        "edge:",
+        // The hold loop needs y: the pulses still to play wait in the unused ISR.
+        "    mov isr, y",
+        // Blocking: the CPU queued this cycle's words whole before its burst, so this never
+        // waits; were one missing, waiting keeps the words in step rather than playing 0.
+        "    pull block",
+        "    out x, 22",
         "delay:",
         "    jmp x-- delay",
-        "    out pins, 1",
-        "    out y, 11",
+        "    set pins, 1",
+        "    out y, 10",
         "hold:",
         "    jmp y-- hold [31]",
         "    set pins, 0",
+        "    mov y, isr",
+        "    jmp count",
         ".wrap",
     )
     .program
@@ -96,9 +114,11 @@ fn start<'d, P: Instance, const SM: usize>(
     cfg.use_program(program, &[]);
     cfg.set_in_pins(&[burst]);
     cfg.set_jmp_pin(burst);
-    cfg.set_out_pins(&[rx]);
     cfg.set_set_pins(&[rx]);
-    // The word's fields come out least significant first: delay, level, pulse length.
+    // A cycle is up to four words and the next cycle's are queued while this one's pulses play:
+    // eight words, the TX FIFO joined with the unused RX FIFO.
+    cfg.fifo_join = FifoJoin::TxOnly;
+    // The words' fields come out least significant first: delay, then pulse length.
     cfg.shift_out = ShiftConfig {
         threshold: 32,
         direction: ShiftDirection::Right,
@@ -113,10 +133,14 @@ fn start<'d, P: Instance, const SM: usize>(
     sm.set_enable(true);
 }
 
-/// Hands one word to a state machine whose FIFO the last burst emptied; false if it was full
-/// (the state machine did not take the last word: the burst input is stuck or miswired).
-fn hand<P: Instance, const SM: usize>(sm: &mut StateMachine<'_, P, SM>, word: u32) -> bool {
-    sm.tx().try_push(word)
+/// Queues one cycle's words (count word first) for a state machine that has just taken the
+/// last cycle's count word; false if its FIFO was full (it did not take its words: the burst
+/// input is stuck or miswired, or the host let a pulse run into the next burst).
+fn hand<P: Instance, const SM: usize>(
+    sm: &mut StateMachine<'_, P, SM>,
+    (words, len): &([u32; MAX_WORDS], usize),
+) -> bool {
+    words.iter().take(*len).all(|&w| sm.tx().try_push(w))
 }
 
 /// A switch line: pressed pulls it low; released lets the base station's pull-up have it, as
@@ -250,17 +274,19 @@ async fn main(_spawner: Spawner) {
                 None => {}
             }
             if let Ok(next) = queue.try_receive() {
-                let w = next.words;
-                let taken = hand(&mut sm0, w[0])
-                    & hand(&mut sm1, w[1])
-                    & hand(&mut sm2, w[2])
-                    & hand(&mut sm3, w[3])
-                    & hand(&mut sm4, w[4])
-                    & hand(&mut sm5, w[5])
-                    & hand(&mut sm6, w[6])
-                    & hand(&mut sm7, w[7]);
+                let w = &next.words;
+                let taken = hand(&mut sm0, &w[0])
+                    & hand(&mut sm1, &w[1])
+                    & hand(&mut sm2, &w[2])
+                    & hand(&mut sm3, &w[3])
+                    & hand(&mut sm4, &w[4])
+                    & hand(&mut sm5, &w[5])
+                    & hand(&mut sm6, &w[6])
+                    & hand(&mut sm7, &w[7]);
                 if !taken {
-                    warn!("a state machine's FIFO was full: is GP3 jumpered to GP2?");
+                    warn!(
+                        "a state machine's FIFO was full: is GP3 jumpered to GP2, or did a pulse run into the next burst?"
+                    );
                 }
                 pending = Some((next.seq, next.switches));
             }
@@ -333,14 +359,11 @@ fn handle(
             });
         }
         HostMessage::Cycle {
-            seq,
-            switches,
-            arrival_ns,
-            ..
+            seq, switches, edges, ..
         } => {
-            let mut words = [0; RECEIVERS];
-            for (w, a) in words.iter_mut().zip(arrival_ns) {
-                match word(a) {
+            let mut all = [([0; MAX_WORDS], 1); RECEIVERS];
+            for (w, e) in all.iter_mut().zip(&edges) {
+                match words(e) {
                     Ok(x) => *w = x,
                     Err(_) => return RigMessage::Error(ErrorCode::Unplayable),
                 }
@@ -348,7 +371,7 @@ fn handle(
             let cycle = Queued {
                 seq,
                 switches: switches & SWITCH_MASK,
-                words,
+                words: all,
             };
             if queue.try_send(cycle).is_err() {
                 return RigMessage::Error(ErrorCode::QueueFull);

@@ -13,7 +13,7 @@ pub mod message;
 pub mod schedule;
 
 pub use message::{DecodeError, ErrorCode, HostMessage, Info, MAX_MESSAGE, RigMessage, RigStatus};
-pub use schedule::{ScheduleError, edge_ns, word};
+pub use schedule::{Edge, Edges, MAX_EDGES, ScheduleError, words};
 // The frames are the base station's serial framing; re-exported so both ends use the same.
 pub use pen_protocol::{FrameDecoder, FrameError, MAX_FRAME, encode_frame};
 
@@ -31,4 +31,5 @@ pub const RIG_PRODUCT: &str = "penscape bench rig";
 pub const RECEIVERS: usize = pen_protocol::MAX_RECEIVERS;
 
 /// Version of the messages below; [`Info`] carries it and the host refuses another.
-pub const RIG_PROTOCOL_VERSION: u8 = 1;
+/// 2: a cycle carries up to [`MAX_EDGES`] pulses per receiver.
+pub const RIG_PROTOCOL_VERSION: u8 = 2;

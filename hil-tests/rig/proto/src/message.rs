@@ -7,10 +7,12 @@
 //! and learns from each [`RigStatus`] how full the rig's queue is.
 
 use crate::RECEIVERS;
-use pen_protocol::NO_ARRIVAL;
+use crate::schedule::{Edge, Edges, MAX_EDGES};
 
-/// The largest payload of either direction (a cycle with every receiver).
-pub const MAX_MESSAGE: usize = 7 + 4 * RECEIVERS;
+/// The largest payload of either direction (a cycle with every receiver's every pulse).
+pub const MAX_MESSAGE: usize = 7 + (1 + 8 * MAX_EDGES) * RECEIVERS;
+// One frame of the base station's framing carries it.
+const _: () = assert!(MAX_MESSAGE <= pen_protocol::MAX_PAYLOAD);
 
 /// Switch bits as the base station's reports carry them: SW1 (tip) = 1, SW2 = 2, SW3 = 4.
 pub const SWITCH_MASK: u8 = 0b111;
@@ -18,6 +20,10 @@ pub const SWITCH_MASK: u8 = 0b111;
 /// From the host.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[allow(
+    clippy::large_enum_variant,
+    reason = "no_std without an allocator: a cycle (~200 bytes) cannot be boxed, and one message is decoded at a time"
+)]
 pub enum HostMessage {
     /// Who is there: the rig answers [`RigMessage::Info`].
     Hello,
@@ -27,9 +33,9 @@ pub enum HostMessage {
         seq: u32,
         /// Switch lines to hold from that burst on (bits as [`SWITCH_MASK`]).
         switches: u8,
-        /// Arrival per receiver, ns after the burst's first rising edge; `None` heard nothing.
-        /// Receivers past `count` hear nothing.
-        arrival_ns: [Option<u32>; RECEIVERS],
+        /// Each receiver's pulses, rises in ns after the burst's first rising edge (none:
+        /// heard nothing). Receivers past `count` hear nothing.
+        edges: [Edges; RECEIVERS],
         /// Receivers carried on the wire.
         count: u8,
     },
@@ -188,14 +194,18 @@ impl HostMessage {
             HostMessage::Cycle {
                 seq,
                 switches,
-                arrival_ns,
+                ref edges,
                 count,
             } => {
                 out.put(&[kind::CYCLE]);
                 out.put(&seq.to_le_bytes());
                 out.put(&[switches, count]);
-                for a in arrival_ns.iter().take(usize::from(count)) {
-                    out.put(&a.unwrap_or(NO_ARRIVAL).to_le_bytes());
+                for e in edges.iter().take(usize::from(count)) {
+                    out.put(&[e.as_slice().len() as u8]);
+                    for edge in e.as_slice() {
+                        out.put(&edge.at_ns.to_le_bytes());
+                        out.put(&edge.length_ns.to_le_bytes());
+                    }
                 }
             }
             HostMessage::Switches(bits) => out.put(&[kind::SWITCHES, bits]),
@@ -227,15 +237,26 @@ impl HostMessage {
                     if usize::from(count) > RECEIVERS {
                         return Err(DecodeError::Field("count"));
                     }
-                    let mut arrival_ns = [None; RECEIVERS];
-                    for a in arrival_ns.iter_mut().take(usize::from(count)) {
-                        let Some(t) = input.u32() else { return Ok(None) };
-                        *a = (t != NO_ARRIVAL).then_some(t);
+                    let mut edges = [Edges::NONE; RECEIVERS];
+                    for e in edges.iter_mut().take(usize::from(count)) {
+                        let Some(n) = input.u8() else { return Ok(None) };
+                        let mut list = [Edge::default(); MAX_EDGES];
+                        let Some(list) = list.get_mut(..usize::from(n)) else {
+                            return Err(DecodeError::Field("edges"));
+                        };
+                        for edge in list.iter_mut() {
+                            let (Some(at_ns), Some(length_ns)) = (input.u32(), input.u32()) else {
+                                return Ok(None);
+                            };
+                            *edge = Edge { at_ns, length_ns };
+                        }
+                        // At most MAX_EDGES, as checked just above.
+                        *e = Edges::new(list).ok_or(DecodeError::Field("edges"))?;
                     }
                     Some(HostMessage::Cycle {
                         seq,
                         switches,
-                        arrival_ns,
+                        edges,
                         count,
                     })
                 }
@@ -327,15 +348,28 @@ mod tests {
     }
 
     fn cycle(count: u8) -> HostMessage {
-        let mut arrival_ns = [None; RECEIVERS];
-        for (i, a) in arrival_ns.iter_mut().enumerate().take(usize::from(count)) {
-            // A dropout at receiver 2; zeros in the times, which COBS must carry.
-            *a = (i != 2).then_some(1_000_000 + i as u32 * 256);
+        let mut edges = [Edges::NONE; RECEIVERS];
+        for (i, e) in edges.iter_mut().enumerate().take(usize::from(count)) {
+            // A dropout at receiver 2, pickup and an echo around receiver 3's arrival; zeros
+            // in the times, which COBS must carry.
+            *e = match i {
+                2 => Edges::NONE,
+                3 => Edges::new(&[
+                    Edge {
+                        at_ns: 20_000,
+                        length_ns: 100_000,
+                    },
+                    Edge::arrival(1_000_000 + i as u32 * 256),
+                    Edge::arrival(1_600_000),
+                ])
+                .unwrap(),
+                _ => Edges::arrival(Some(1_000_000 + i as u32 * 256)),
+            };
         }
         HostMessage::Cycle {
             seq: 0x0100_00FF,
             switches: 0b101,
-            arrival_ns,
+            edges,
             count,
         }
     }
@@ -391,15 +425,25 @@ mod tests {
         assert_eq!(
             &buf[..n],
             &[
-                0x02, 0xFF, 0, 0, 0x01, 0b101, 4, // type, seq, switches, count
-                0x40, 0x42, 0x0F, 0, // 1 000 000
-                0x40, 0x43, 0x0F, 0, // 1 000 256
-                0xFF, 0xFF, 0xFF, 0xFF, // no arrival
-                0x40, 0x45, 0x0F, 0, // 1 000 768
+                0x02, 0xFF, 0, 0, 0x01, 0b101, 4, // type, seq, switches, receivers
+                1, 0x40, 0x42, 0x0F, 0, 0x40, 0x0D, 0x03, 0, // 1 pulse: 1 000 000 ns, 200 000 ns
+                1, 0x40, 0x43, 0x0F, 0, 0x40, 0x0D, 0x03, 0, // 1 000 256 ns
+                0, // heard nothing
+                3, // pickup, arrival, echo
+                0x20, 0x4E, 0, 0, 0xA0, 0x86, 0x01, 0, // 20 000 ns, 100 000 ns
+                0x40, 0x45, 0x0F, 0, 0x40, 0x0D, 0x03, 0, // 1 000 768 ns
+                0x00, 0x6A, 0x18, 0, 0x40, 0x0D, 0x03, 0, // 1 600 000 ns
             ]
         );
-        let n = cycle(RECEIVERS as u8).encode(&mut buf);
-        assert_eq!(n, MAX_MESSAGE);
+        // Every receiver with every pulse fills the largest payload exactly.
+        let full = HostMessage::Cycle {
+            seq: 1,
+            switches: 0,
+            edges: [Edges::new(&[Edge::arrival(1); MAX_EDGES]).unwrap(); RECEIVERS],
+            count: RECEIVERS as u8,
+        };
+        assert_eq!(full.encode(&mut buf), MAX_MESSAGE);
+        assert_eq!(through_the_wire_host(full), full);
     }
 
     #[test]
@@ -423,6 +467,15 @@ mod tests {
         assert_eq!(
             HostMessage::decode(&[0x02, 0, 0, 0, 0, 0, RECEIVERS as u8 + 1]),
             Err(DecodeError::Field("count"))
+        );
+        // One receiver with MAX_EDGES + 1 pulses: refused, not cut short.
+        let mut too_many = [0u8; 8 + 8 * (MAX_EDGES + 1)];
+        too_many[..8].copy_from_slice(&[0x02, 0, 0, 0, 0, 0, 1, MAX_EDGES as u8 + 1]);
+        assert_eq!(HostMessage::decode(&too_many), Err(DecodeError::Field("edges")));
+        // A pulse cut in the middle of its length.
+        assert_eq!(
+            HostMessage::decode(&[0x02, 0, 0, 0, 0, 0, 1, 1, 0x40, 0x42, 0x0F, 0, 0x40]),
+            Err(DecodeError::Length { kind: 0x02, len: 13 })
         );
         // A rig message is not a host message, and the other way round.
         assert_eq!(HostMessage::decode(&[0x85]), Err(DecodeError::UnknownType(0x85)));
