@@ -27,12 +27,13 @@ use pen_sim::{Scenario, Simulation, scenarios};
 /// One bench, one test at a time: the tests run in parallel threads of one binary.
 static BENCH: Mutex<()> = Mutex::new(());
 
-/// The base station over HID. The first [`prepare`] keeps the configuration it found, and
+/// The base station over HID. The first [`configure`] keeps the configuration it found, and
 /// dropping the board writes that back (a test that fails too), so the bench's board is left
-/// as it was, time-of-flight streaming included.
+/// as it was, time-of-flight streaming included; and saves it again if the test saved its own.
 struct Board {
     hid: HidTransport,
     original: Option<Config>,
+    saved: bool,
 }
 
 impl Deref for Board {
@@ -54,6 +55,12 @@ impl Drop for Board {
             // Best effort: a board that no longer answers has nothing to restore.
             if let Err(e) = self.hid.set_feature(&Message::Config(original)) {
                 eprintln!("could not restore the board's configuration: {e}");
+                return;
+            }
+            if self.saved
+                && let Err(e) = self.hid.set_feature(&Message::Command(Command::SaveConfig))
+            {
+                eprintln!("could not save the board's configuration back: {e}");
             }
         }
     }
@@ -83,6 +90,7 @@ fn bench() -> Option<(BenchRig, Board, MutexGuard<'static, ()>)> {
         Board {
             hid: board,
             original: None,
+            saved: false,
         },
         guard,
     ))
@@ -555,6 +563,7 @@ fn a_flash_erase_does_not_trip_the_watchdog() {
     // Each save erases a 128 KiB sector (2 s typical, 4 s at most): five in a row, reports read
     // between them; a watchdog reset restarts the device's clock, which the timestamps show.
     let mut pens = Vec::new();
+    board.saved = true;
     for _ in 0..5 {
         let status = board
             .set_feature(&Message::Command(Command::SaveConfig))
