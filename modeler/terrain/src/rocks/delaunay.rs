@@ -9,9 +9,13 @@
 //! locally Delaunay, with two allocations — about 4 times faster on fig. 1
 //! (`cargo bench -p penmodel-terrain --bench rocks -- delaunay`). The predicates are the
 //! `robust` crate's exact `orient2d` and `incircle` (Shewchuk's adaptive arithmetic), so the
-//! flips end, and the result is Delaunay, even for cocircular cell vertices.
+//! flips end, and the result is Delaunay, even for cocircular cell vertices; `incircle` goes
+//! through [`super::predicates`], which skips `robust`'s costly set-up on the cocircular cells
+//! that are common here and returns the same values.
 
-use robust::{Coord, incircle, orient2d};
+use robust::{Coord, orient2d};
+
+use super::predicates::incircle;
 
 const NONE: u32 = u32::MAX;
 
@@ -61,7 +65,8 @@ impl Mesh<'_> {
             return;
         };
         let q = self.tri[u as usize][(f + 2) % 3];
-        if incircle(self.p(a), self.p(b), self.p(p), self.p(q)) <= 0.0 {
+        let pt = |i: u32| self.points[i as usize];
+        if incircle(pt(a), pt(b), pt(p), pt(q)) <= 0.0 {
             return;
         }
         let ta = self.adj[t as usize][(e + 2) % 3];

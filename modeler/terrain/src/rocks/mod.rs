@@ -21,6 +21,7 @@ pub mod delaunay;
 pub mod field;
 pub mod place;
 pub mod poisson;
+mod predicates;
 pub mod select;
 pub mod shape;
 pub mod top_view;
