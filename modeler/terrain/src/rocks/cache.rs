@@ -194,7 +194,12 @@ impl Seated {
                     meshes.push((format!("rocks {i}"), Mesh::default()));
                 }
                 let mesh = &mut meshes[i].1;
-                if mesh.indices.len() != f.flat.indices.len() || mesh.indices != f.flat.indices {
+                // The mesh holds this field's triangles when these rocks were seated into it
+                // before (comparing the indices instead read 16 MB for fig. 1 at every edit).
+                let same_rocks = self.seated_as[i]
+                    .as_ref()
+                    .is_some_and(|(flat, _)| Arc::ptr_eq(flat, &f.flat));
+                if !same_rocks {
                     *mesh = Mesh::default();
                 }
                 f.flat.seat_into(placements[i], &ground, mesh);

@@ -41,9 +41,16 @@ pub struct Flat {
     /// ground reads the heightmap in step (in the scatter's order, random, the height reads
     /// missed the cache and took most of the time).
     pub order: Vec<u32>,
-    /// Blocks of whole rocks, about [`BLOCK`] vertices each: `(first vertex, first index)`, with
-    /// the ends last. Normals are computed block by block on all cores.
+    /// Blocks of whole rocks, about [`BLOCK`] vertices each: `(first vertex, first rock)` in
+    /// [`Flat::order`], with the ends last. Blocks are seated on all cores.
     blocks: Vec<(usize, usize)>,
+    /// Per rock in [`Flat::order`]: its first vertex and its first triangle in `local`; then
+    /// the ends.
+    starts: Vec<(u32, u32)>,
+    /// The triangles again, with indices into their own rock's vertices. Seating walks the
+    /// rocks one by one, each rock's vertices and normals a few hundred bytes in L1: half the
+    /// memory of `indices` to read at every re-seat, and no index beyond the rock to check.
+    local: Vec<[u16; 3]>,
 }
 
 /// Vertices per block of rocks for the parallel normals.
@@ -73,20 +80,32 @@ impl Flat {
             indices: Vec::with_capacity(3 * t),
             order,
             blocks: vec![(0, 0)],
+            starts: Vec::with_capacity(scatter.rocks.len() + 1),
+            local: Vec::with_capacity(t),
         };
-        for &i in &f.order {
+        for (k, &i) in f.order.iter().enumerate() {
             let rock = &scatter.rocks[i as usize];
+            let start = f.blocks.last().map_or(0, |b| b.0);
+            if f.vertices.len() - start >= BLOCK {
+                f.blocks.push((f.vertices.len(), k));
+            }
             let base = f.vertices.len() as u32;
+            f.starts.push((base, f.local.len() as u32));
             f.vertices
                 .extend(rock.mesh.vertices.iter().map(|v| v.map(|c| c as f32)));
             f.indices.extend(rock.mesh.triangles.iter().flatten().map(|i| base + i));
-            let start = f.blocks.last().map_or(0, |b| b.0);
-            if f.vertices.len() - start >= BLOCK {
-                f.blocks.push((f.vertices.len(), f.indices.len()));
-            }
+            // A cell has a vertex per cutting neighbour, seeds more than r ≥ 1 pixel apart
+            // around it within the field (at most 2²⁴ pixels): far below 2¹⁵ vertices.
+            f.local.extend(
+                rock.mesh
+                    .triangles
+                    .iter()
+                    .map(|t| t.map(|i| u16::try_from(i).expect("a rock has fewer than 65 536 vertices"))),
+            );
         }
-        if f.blocks.last() != Some(&(f.vertices.len(), f.indices.len())) {
-            f.blocks.push((f.vertices.len(), f.indices.len()));
+        f.starts.push((f.vertices.len() as u32, f.local.len() as u32));
+        if f.blocks.last() != Some(&(f.vertices.len(), f.order.len())) {
+            f.blocks.push((f.vertices.len(), f.order.len()));
         }
         f
     }
@@ -122,39 +141,65 @@ impl Flat {
             (positions, normals) = (rest_p, rest_n);
             parts.push((w[0], w[1], p, n));
         }
-        parts.into_par_iter().for_each(|((v0, i0), (v1, i1), out, norms)| {
-            for (o, v) in out.iter_mut().zip(&self.vertices[v0..v1]) {
-                let v = v.map(f64::from);
-                let (x, y) = (at.origin[0] + v[0] * at.cell_size, at.origin[1] + v[1] * at.cell_size);
-                *o = [x as f32, (ground(x, y) + v[2] * at.cell_size) as f32, y as f32];
-            }
-            norms.fill([0.0; 3]);
-            let base = v0 as u32;
-            for t in self.indices[i0..i1].chunks_exact(3) {
-                let [a, b, c] = [t[0], t[1], t[2]].map(|i| (i - base) as usize);
-                let (pa, pb, pc) = (out[a], out[b], out[c]);
-                let u = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
-                let w = [pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]];
-                let n = [
-                    u[1] * w[2] - u[2] * w[1],
-                    u[2] * w[0] - u[0] * w[2],
-                    u[0] * w[1] - u[1] * w[0],
-                ];
-                for k in [a, b, c] {
-                    let s = &mut norms[k];
-                    *s = [s[0] + n[0], s[1] + n[1], s[2] + n[2]];
-                }
-            }
-            let _ = v1;
-            for s in norms.iter_mut() {
-                let len = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
-                *s = if len > 0.0 {
-                    [s[0] / len, s[1] / len, s[2] / len]
-                } else {
-                    [0.0, 1.0, 0.0]
-                };
+        parts.into_par_iter().for_each(|((v0, k0), (_, k1), out, norms)| {
+            for w in self.starts[k0..=k1].windows(2) {
+                let ((a, t0), (b, t1)) = (w[0], w[1]);
+                let (a, b) = (a as usize - v0, b as usize - v0);
+                let verts = &self.vertices[a + v0..b + v0];
+                seat_rock(
+                    at,
+                    &ground,
+                    verts,
+                    &self.local[t0 as usize..t1 as usize],
+                    &mut out[a..b],
+                    &mut norms[a..b],
+                );
             }
         });
+    }
+}
+
+/// Stands one rock: its vertices on `ground`, then its normals from its triangles (indices into
+/// its own vertices, so every access stays within a few hundred bytes), summed in triangle
+/// order and normalised.
+#[inline]
+fn seat_rock(
+    at: Placement,
+    ground: &impl Fn(f64, f64) -> f64,
+    verts: &[[f32; 3]],
+    tris: &[[u16; 3]],
+    out: &mut [[f32; 3]],
+    norms: &mut [[f32; 3]],
+) {
+    for (o, v) in out.iter_mut().zip(verts) {
+        let v = v.map(f64::from);
+        let (x, y) = (at.origin[0] + v[0] * at.cell_size, at.origin[1] + v[1] * at.cell_size);
+        *o = [x as f32, (ground(x, y) + v[2] * at.cell_size) as f32, y as f32];
+    }
+    norms.fill([0.0; 3]);
+    let out = &*out;
+    for t in tris {
+        let [a, b, c] = t.map(usize::from);
+        let (pa, pb, pc) = (out[a], out[b], out[c]);
+        let u = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
+        let w = [pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]];
+        let n = [
+            u[1] * w[2] - u[2] * w[1],
+            u[2] * w[0] - u[0] * w[2],
+            u[0] * w[1] - u[1] * w[0],
+        ];
+        for k in [a, b, c] {
+            let s = &mut norms[k];
+            *s = [s[0] + n[0], s[1] + n[1], s[2] + n[2]];
+        }
+    }
+    for s in norms.iter_mut() {
+        let len = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+        *s = if len > 0.0 {
+            [s[0] / len, s[1] / len, s[2] / len]
+        } else {
+            [0.0, 1.0, 0.0]
+        };
     }
 }
 
@@ -165,16 +210,26 @@ impl Flat {
 pub fn ground(map: &Heightmap) -> impl Fn(f64, f64) -> f64 + Sync + '_ {
     let (cols, rows, s) = (map.cols(), map.rows(), map.cell_size());
     let h = map.heights();
+    let (last_c, last_r) = (f64::from(cols - 1), f64::from(rows - 1));
+    let (max_c, max_r) = (cols.saturating_sub(2), rows.saturating_sub(2));
+    // With two or more columns and rows, the square's four corners are in the grid as they are
+    // (`c ≤ cols − 2`); only a grid one cell wide needs its indices held in.
+    let wide = cols >= 2 && rows >= 2;
+    let stride = cols as usize;
     move |x: f64, y: f64| {
-        let fx = (x / s - 0.5).clamp(0.0, f64::from(cols - 1));
-        let fy = (y / s - 0.5).clamp(0.0, f64::from(rows - 1));
-        let (c, r) = (
-            (fx as u32).min(cols.saturating_sub(2)),
-            (fy as u32).min(rows.saturating_sub(2)),
-        );
+        let fx = (x / s - 0.5).clamp(0.0, last_c);
+        let fy = (y / s - 0.5).clamp(0.0, last_r);
+        let (c, r) = ((fx as u32).min(max_c), (fy as u32).min(max_r));
         let (u, v) = (fx - f64::from(c), fy - f64::from(r));
-        let at = |c: u32, r: u32| f64::from(h[(r.min(rows - 1) * cols + c.min(cols - 1)) as usize]);
-        let (a, b, d, e) = (at(c, r), at(c + 1, r), at(c, r + 1), at(c + 1, r + 1));
+        let (a, b, d, e) = if wide {
+            let i = r as usize * stride + c as usize;
+            let (top, bottom) = (&h[i..i + 2], &h[i + stride..i + stride + 2]);
+            (top[0], top[1], bottom[0], bottom[1])
+        } else {
+            let at = |c: u32, r: u32| h[(r.min(rows - 1) * cols + c.min(cols - 1)) as usize];
+            (at(c, r), at(c + 1, r), at(c, r + 1), at(c + 1, r + 1))
+        };
+        let (a, b, d, e) = (f64::from(a), f64::from(b), f64::from(d), f64::from(e));
         if u + v <= 1.0 {
             a + u * (b - a) + v * (d - a)
         } else {
