@@ -60,19 +60,30 @@ impl Mesh<'_> {
         if u == NONE {
             return;
         }
-        let [a, b, p] = [0, 1, 2].map(|k| self.tri[t as usize][(e + k) % 3]);
-        let Some(f) = self.adj[u as usize].iter().position(|&x| x == t) else {
+        // Edge indices one and two on from `e` (a table, not `% 3`: this runs a few dozen
+        // times per rock).
+        const NEXT: [usize; 3] = [1, 2, 0];
+        const AFTER: [usize; 3] = [2, 0, 1];
+        let tt = self.tri[t as usize];
+        let [a, b, p] = [tt[e], tt[NEXT[e]], tt[AFTER[e]]];
+        let au = self.adj[u as usize];
+        let f = if au[0] == t {
+            0
+        } else if au[1] == t {
+            1
+        } else if au[2] == t {
+            2
+        } else {
             return;
         };
-        let q = self.tri[u as usize][(f + 2) % 3];
+        let q = self.tri[u as usize][AFTER[f]];
         let pt = |i: u32| self.points[i as usize];
         if incircle(pt(a), pt(b), pt(p), pt(q)) <= 0.0 {
             return;
         }
-        let ta = self.adj[t as usize][(e + 2) % 3];
-        let tb = self.adj[t as usize][(e + 1) % 3];
-        let ua = self.adj[u as usize][(f + 1) % 3];
-        let ub = self.adj[u as usize][(f + 2) % 3];
+        let at = self.adj[t as usize];
+        let (ta, tb) = (at[AFTER[e]], at[NEXT[e]]);
+        let (ua, ub) = (au[NEXT[f]], au[AFTER[f]]);
         self.tri[t as usize] = [a, q, p];
         self.adj[t as usize] = [ua, u, ta];
         self.tri[u as usize] = [q, b, p];

@@ -243,7 +243,8 @@ pub struct Timing {
     pub seeds_and_diagrams: f64,
     /// Of which the seeds alone, per diagram summed (CPU time across threads).
     pub seeds: f64,
-    /// Of which the Voronoi labels alone, per diagram summed (CPU time across threads).
+    /// Of which the Voronoi labels and their grouping by cell, per diagram summed (CPU time
+    /// across threads).
     pub diagrams: f64,
     /// Exclusive selection.
     pub selection: f64,
@@ -301,7 +302,7 @@ pub fn scatter(recipe: &Recipe, inside: Option<&[bool]>) -> Result<Scatter, Reci
     let start = Instant::now();
     let (width, height) = (recipe.width, recipe.height);
     let pixels = width as usize * height as usize;
-    let made: Vec<(Vec<u32>, Vec<u32>, f64, f64)> = recipe
+    let made: Vec<(Vec<u32>, voronoi::CellPixels, f64, f64)> = recipe
         .layers
         .par_iter()
         .enumerate()
@@ -322,7 +323,10 @@ pub fn scatter(recipe: &Recipe, inside: Option<&[bool]>) -> Result<Scatter, Reci
             let seeds_ms = ms(t);
             let t = Instant::now();
             let labels = voronoi::label(width, height, &seeds, layer.radius);
-            (seeds, labels, seeds_ms, ms(t))
+            // Grouped here, on the diagram's own thread, rather than in the selection, which
+            // runs on one.
+            let cells = voronoi::CellPixels::of(&labels, seeds.len());
+            (seeds, cells, seeds_ms, ms(t))
         })
         .collect();
     let mut timing = Timing {
@@ -343,14 +347,13 @@ pub fn scatter(recipe: &Recipe, inside: Option<&[bool]>) -> Result<Scatter, Reci
     order.sort_by_key(|&i| made[i].0.len());
     let mut diagrams: Vec<Option<Diagram>> = vec![None; recipe.layers.len()];
     for (rank, &i) in order.iter().enumerate() {
-        let (seeds, labels, _, _) = &made[i];
-        let cells = voronoi::CellPixels::of(labels, seeds.len());
+        let (seeds, cells, _, _) = &made[i];
         let goal = match recipe.layers[i].amount {
             Amount::Fraction(f) => Goal::Pixels((f * field_pixels as f64).ceil() as usize),
             Amount::Count(c) => Goal::Cells(c as usize),
         };
         let mut rng = stream(recipe.seed, SELECT, i, 0);
-        let got = select::select(&cells, &mut taken, goal, &mut rng);
+        let got = select::select(cells, &mut taken, goal, &mut rng);
         let reached = match goal {
             Goal::Pixels(p) => got.pixels >= p,
             Goal::Cells(c) => got.cells.len() >= c,
@@ -369,24 +372,36 @@ pub fn scatter(recipe: &Recipe, inside: Option<&[bool]>) -> Result<Scatter, Reci
     timing.selection = ms(t);
 
     let t = Instant::now();
-    let mut polygons: Vec<(usize, u32, Vec<[f64; 2]>)> = Vec::new();
+    // Seeds are more than r apart: a bucket of side r holds a few. One diagram's per thread.
+    let buckets: Vec<voronoi::Buckets> = diagrams
+        .par_iter()
+        .enumerate()
+        .map(|(i, d)| voronoi::Buckets::new(&d.seeds, width, height, recipe.layers[i].radius.max(1.0)))
+        .collect();
+    // Every kept cell of every diagram in one parallel pass, cut in seed order within its
+    // diagram (pixel order: neighbours near in memory) and then put in the order drawn.
+    let mut by_place: Vec<(usize, u32, usize)> = Vec::with_capacity(diagrams.iter().map(|d| d.cells.len()).sum());
     for &i in &order {
-        let d = &diagrams[i];
-        // Seeds are more than r apart: a bucket of side r holds a few.
-        let buckets = voronoi::Buckets::new(&d.seeds, width, height, recipe.layers[i].radius.max(1.0));
-        // Cut in seed order (pixel order: neighbours near in memory), kept in the order drawn.
-        let mut by_place: Vec<(u32, usize)> = d.cells.iter().enumerate().map(|(k, &c)| (c, k)).collect();
-        by_place.sort_unstable();
-        let mut made: Vec<_> = by_place
-            .par_iter()
-            .map(|&(cell, k)| {
-                let polygon = voronoi::cell_polygon(&d.seeds, &buckets, width, height, cell as usize);
-                (k, (i, cell, polygon))
-            })
-            .collect();
-        made.sort_unstable_by_key(|m| m.0);
-        polygons.extend(made.into_iter().map(|m| m.1));
+        let first = by_place.len();
+        let cells = &diagrams[i].cells;
+        by_place.extend(cells.iter().enumerate().map(|(k, &c)| (i, c, first + k)));
+        by_place[first..].sort_unstable_by_key(|m| m.1);
     }
+    let mut cut: Vec<Vec<[f64; 2]>> = by_place
+        .par_iter()
+        .map(|&(i, cell, _)| voronoi::cell_polygon(&diagrams[i].seeds, &buckets[i], width, height, cell as usize))
+        .collect();
+    let mut slot = vec![0u32; by_place.len()];
+    for (j, m) in by_place.iter().enumerate() {
+        slot[m.2] = j as u32;
+    }
+    let polygons: Vec<(usize, u32, Vec<[f64; 2]>)> = slot
+        .iter()
+        .map(|&j| {
+            let (i, cell, _) = by_place[j as usize];
+            (i, cell, std::mem::take(&mut cut[j as usize]))
+        })
+        .collect();
     timing.polygons = ms(t);
     let t = Instant::now();
     let rocks: Vec<Rock> = polygons

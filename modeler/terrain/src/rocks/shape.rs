@@ -106,7 +106,8 @@ fn rock_with(cell: &[[f64; 2]], radius: f64, shape: &Shape, rng: &mut impl Rng, 
     let n = added.len().max(1) as f64;
     let g = added.iter().fold([0.0, 0.0], |g, p| [g[0] + p[0] / n, g[1] + p[1] / n]);
     let j1: f64 = rng.random();
-    let mut vertices: Vec<[f64; 3]> = cell.iter().map(|p| [p[0], p[1], 0.0]).collect();
+    let mut vertices: Vec<[f64; 3]> = Vec::with_capacity(k + added.len());
+    vertices.extend(cell.iter().map(|p| [p[0], p[1], 0.0]));
     for p in &added {
         let j2: f64 = rng.random();
         let [w1, w2, w3] = shape.widths;

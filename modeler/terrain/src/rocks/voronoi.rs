@@ -225,10 +225,41 @@ pub(crate) fn cell_polygon(
     height: u32,
     cell: usize,
 ) -> Vec<[f64; 2]> {
+    POLYGON.with_borrow_mut(|p| cell_polygon_with(points, buckets, width, height, cell, p))
+}
+
+/// Working memory of [`cell_polygon`], one per thread (a field's tens of thousands of cells
+/// would otherwise allocate and free it each time).
+#[derive(Default)]
+struct PolygonScratch {
+    poly: Vec<[f64; 2]>,
+    scratch: Vec<[f64; 2]>,
+    near: Vec<(f64, [f64; 2])>,
+    out: Vec<[f64; 2]>,
+}
+
+thread_local! {
+    static POLYGON: std::cell::RefCell<PolygonScratch> = std::cell::RefCell::default();
+}
+
+fn cell_polygon_with(
+    points: &[[f64; 2]],
+    buckets: &Buckets,
+    width: u32,
+    height: u32,
+    cell: usize,
+    work: &mut PolygonScratch,
+) -> Vec<[f64; 2]> {
     let s = points[cell];
     let (w, h) = (f64::from(width), f64::from(height));
-    let mut poly = vec![[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]];
-    let mut scratch = Vec::with_capacity(16);
+    let PolygonScratch {
+        poly,
+        scratch,
+        near,
+        out,
+    } = work;
+    poly.clear();
+    poly.extend([[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]]);
     let home = buckets.bucket_of(s);
     let last = buckets.last_ring(home);
     let reach = |poly: &[[f64; 2]]| {
@@ -239,9 +270,9 @@ pub(crate) fn cell_polygon(
     // Neighbours nearest first: (squared distance, seed). A seed at distance d cuts the polygon
     // only if the polygon reaches beyond d/2 from `s`, so the cutting stops at the first seed
     // farther than twice the reach; seeds beyond ring k of buckets are farther than k·size.
-    let mut near: Vec<(f64, [f64; 2])> = Vec::with_capacity(32);
+    near.clear();
     let mut next = 0;
-    let mut reach2 = reach(&poly);
+    let mut reach2 = reach(poly);
     'rings: for ring in 0..=last {
         buckets.ring(home, ring, |q, p| {
             if q as usize != cell {
@@ -255,8 +286,8 @@ pub(crate) fn cell_polygon(
             if near[next].0 > 4.0 * reach2 {
                 break 'rings;
             }
-            clip(&mut poly, &mut scratch, s, near[next].1);
-            reach2 = reach(&poly);
+            clip(poly, scratch, s, near[next].1);
+            reach2 = reach(poly);
             next += 1;
         }
         if 4.0 * reach2 <= covered2 {
@@ -264,8 +295,8 @@ pub(crate) fn cell_polygon(
         }
     }
     // Clipping through a vertex shared by several bisectors repeats it; drop the repeats.
-    let mut out: Vec<[f64; 2]> = Vec::with_capacity(poly.len());
-    for p in poly {
+    out.clear();
+    for &mut p in poly {
         let near = |a: &[f64; 2]| (a[0] - p[0]).abs() < 1e-9 && (a[1] - p[1]).abs() < 1e-9;
         if !out.last().is_some_and(near) {
             out.push(p);
@@ -287,5 +318,5 @@ pub(crate) fn cell_polygon(
             i += 1;
         }
     }
-    out
+    out.to_vec()
 }
