@@ -7,6 +7,9 @@ mod config;
 mod descriptor;
 mod error;
 mod frame;
+// The fuzz targets' properties, shared with the stable test that replays their corpora.
+#[doc(hidden)]
+pub mod fuzzing;
 mod info;
 #[cfg(feature = "serde")]
 mod json;

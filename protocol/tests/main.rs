@@ -4,6 +4,7 @@ mod descriptor;
 mod docs;
 mod errors;
 mod frames;
+mod fuzz_corpus;
 mod golden;
 #[cfg(feature = "serde")]
 mod json;
