@@ -23,6 +23,9 @@ pub mod client;
 pub mod daemon;
 pub mod device;
 pub mod events;
+// The fuzz targets' properties, shared with the stable test that replays their corpora.
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod help;
 pub mod hex;
 pub mod pipeline;

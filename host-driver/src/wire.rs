@@ -153,7 +153,7 @@ pub enum WireError {
     /// A button other than SW2 and SW3.
     #[error("button {0} is not 2 or 3")]
     Button(u8),
-    /// `t` is negative, or beyond any time.
+    /// `t` is negative, or not before 2^32 s (the year 2106).
     #[error("t {0} is not a time")]
     Time(f64),
 }
@@ -162,9 +162,15 @@ fn seconds(t_us: u64) -> f64 {
     t_us as f64 * 1e-6
 }
 
+/// The latest time a line carries: 2^32 s after the epoch (the year 2106). Below it a time in
+/// seconds as an `f64` holds every microsecond (its spacing is at most 2^-21 s), so the time pend
+/// writes is the time a client reads; beyond it the spacing passes a microsecond and a time read
+/// and written again drifts (found by fuzzing, docs/reliability.md).
+const LATEST_S: f64 = 4_294_967_296.0;
+
 fn micros(t: f64) -> Result<u64, WireError> {
     let us = (t * 1e6).round();
-    if us.is_finite() && us >= 0.0 && us < u64::MAX as f64 {
+    if us.is_finite() && us >= 0.0 && t < LATEST_S {
         Ok(us as u64)
     } else {
         Err(WireError::Time(t))

@@ -3,6 +3,7 @@ mod calibration;
 mod daemon;
 mod delays;
 mod events;
+mod fuzz_corpus;
 mod install;
 mod penctl;
 mod socket;
