@@ -25,6 +25,9 @@ pub mod edit;
 pub mod editor;
 pub mod engine;
 pub mod export;
+// The fuzz targets' properties, shared with the stable test that replays their corpora.
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod geometry;
 mod heightmap;
 pub mod journal;
