@@ -23,6 +23,9 @@
 
 pub mod debounce;
 pub mod filter;
+// The fuzz target's property, shared with the stable test that replays its corpus.
+#[doc(hidden)]
+pub mod fuzzing;
 pub mod math;
 pub mod ranging;
 pub mod replay;

@@ -2,6 +2,7 @@
 mod common;
 mod debounce;
 mod filter;
+mod fuzz_corpus;
 mod replay;
 mod report;
 mod solve;

@@ -1,0 +1,76 @@
+//! The properties the fuzz target (`firmware/core/fuzz/`) checks, in one place so that the
+//! stable test that replays its corpus (`tests/fuzz_corpus.rs`) checks exactly the same thing.
+//! Not part of the core's API: hidden, and free to change with the target.
+
+use pen_protocol::FirmwareVersion;
+
+use crate::replay::{self, CycleHead};
+use crate::{Cycle, Engine, Vec3};
+
+/// Switch samples a cycle may carry here: pen-qemu's buffer.
+const MAX_SAMPLES: usize = 4096;
+
+/// Any bytes as a replay file (`crate::replay`): never a panic; the header and every cycle that
+/// reads are in canonical form (written again, they are the bytes read); and the cycles' capture
+/// times, whatever they are, through the engine give no fix or report that is not a finite
+/// position (the start of issue 17's "no wild fix": a tighter bound is still to come).
+pub fn replay(bytes: &[u8]) {
+    let mut src = bytes;
+    let Ok(config) = replay::read_header(&mut src) else {
+        return;
+    };
+    let mut written = [0u8; replay::HEADER_LEN];
+    let mut n = 0;
+    replay::write_header(&config, &mut |b: &[u8]| {
+        written[n..n + b.len()].copy_from_slice(b);
+        n += b.len();
+    });
+    assert_eq!(
+        &written[..n],
+        &bytes[..replay::HEADER_LEN],
+        "the header is not canonical"
+    );
+    let mut engine = Engine::new(
+        Some(config),
+        FirmwareVersion {
+            major: 0,
+            minor: 1,
+            patch: 0,
+        },
+        *b"penscape-fuz",
+    );
+    let mut samples = [0u8; MAX_SAMPLES];
+    loop {
+        let before = src;
+        let head = match replay::read_cycle(&mut src, &mut samples) {
+            Ok(Some(head)) => head,
+            Ok(None) | Err(_) => return,
+        };
+        let consumed = &before[..before.len() - src.len()];
+        check_cycle(&head, &samples[..head.samples as usize], consumed);
+        let result = engine.on_cycle(&Cycle {
+            t0_us: head.t0_us,
+            arrival_ns: head.arrival_ns,
+        });
+        if let Ok(fix) = result.fix {
+            assert!(finite(fix.position), "a fix at {:?}", fix.position);
+        }
+        if let Some(p) = result.reported_mm {
+            assert!(finite(p), "a report at {p:?}");
+        }
+    }
+}
+
+fn check_cycle(head: &CycleHead, samples: &[u8], consumed: &[u8]) {
+    let mut written = [0u8; replay::CYCLE_HEAD_LEN + MAX_SAMPLES];
+    let mut n = 0;
+    replay::write_cycle(head.t0_us, &head.arrival_ns, samples, &mut |b: &[u8]| {
+        written[n..n + b.len()].copy_from_slice(b);
+        n += b.len();
+    });
+    assert_eq!(&written[..n], consumed, "a cycle is not canonical: {head:?}");
+}
+
+fn finite(p: Vec3) -> bool {
+    p.x.is_finite() && p.y.is_finite() && p.z.is_finite()
+}
