@@ -23,3 +23,32 @@ fn replay_corpus() {
     // A corpus that vanished would make this pass vacuously.
     assert!(n >= 5);
 }
+
+#[test]
+fn the_corpus_reaches_the_solver() {
+    // The property is only worth its time if the corpus's capture times give fixes: count them.
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/replay");
+    let mut fixes = 0;
+    for entry in fs::read_dir(&dir).expect("corpus") {
+        let bytes = fs::read(entry.expect("entry").path()).expect("file");
+        let mut src = bytes.as_slice();
+        let Ok(config) = pen_core::replay::read_header(&mut src) else {
+            continue;
+        };
+        let version = pen_protocol::FirmwareVersion {
+            major: 0,
+            minor: 1,
+            patch: 0,
+        };
+        let mut engine = pen_core::Engine::new(Some(config), version, *b"penscape-fuz");
+        let mut samples = [0u8; 4096];
+        while let Ok(Some(head)) = pen_core::replay::read_cycle(&mut src, &mut samples) {
+            let cycle = pen_core::Cycle {
+                t0_us: head.t0_us,
+                arrival_ns: head.arrival_ns,
+            };
+            fixes += usize::from(engine.on_cycle(&cycle).reported_mm.is_some());
+        }
+    }
+    assert!(fixes >= 50, "only {fixes} reported positions");
+}
