@@ -51,7 +51,8 @@ pub fn journal_open_line() -> String {
 /// `penmodel open` does after a crash: never a panic; if it opens, the edited document is valid
 /// and saves and loads like any other; and the same files open to the same document again.
 pub fn journal(bytes: &[u8]) {
-    let dir = scratch();
+    let scratch = Scratch::new();
+    let dir = &scratch.0;
     let doc = dir.join("doc.json");
     let mut text = journal_open_line().into_bytes();
     text.extend_from_slice(bytes);
@@ -72,13 +73,24 @@ pub fn journal(bytes: &[u8]) {
     }
 }
 
-/// A directory of this thread's own (tests run in parallel threads), reused by every execution.
-fn scratch() -> PathBuf {
-    let thread = format!("{:?}", std::thread::current().id());
-    let thread: String = thread.chars().filter(char::is_ascii_digit).collect();
-    let dir = std::env::temp_dir().join(format!("penscape-fuzz-journal-{}-{thread}", std::process::id()));
-    if let Err(e) = fs::create_dir_all(&dir) {
-        panic!("cannot create {}: {e}", dir.display());
+/// A directory of this thread's own (tests run in parallel threads), removed when dropped: an
+/// execution leaves nothing behind, whichever way it ends.
+struct Scratch(PathBuf);
+
+impl Scratch {
+    fn new() -> Scratch {
+        let thread = format!("{:?}", std::thread::current().id());
+        let thread: String = thread.chars().filter(char::is_ascii_digit).collect();
+        let dir = std::env::temp_dir().join(format!("penscape-fuzz-journal-{}-{thread}", std::process::id()));
+        if let Err(e) = fs::create_dir_all(&dir) {
+            panic!("cannot create {}: {e}", dir.display());
+        }
+        Scratch(dir)
     }
-    dir
+}
+
+impl Drop for Scratch {
+    fn drop(&mut self) {
+        let _ = fs::remove_dir_all(&self.0);
+    }
 }
