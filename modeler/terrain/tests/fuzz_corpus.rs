@@ -4,24 +4,15 @@
 //! (docs/reliability.md).
 
 use std::fs;
-use std::path::Path;
 
 use penmodel_terrain::fuzzing;
 
+#[path = "../../../protocol/tests/corpus_replay.rs"]
+mod corpus_replay;
+
 /// Runs every file of the target's corpus through `property`; returns how many there were.
 fn replay(target: &str, property: fn(&[u8])) -> usize {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus").join(target);
-    let mut n = 0;
-    for entry in fs::read_dir(&dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
-        let path = entry.expect("corpus entry").path();
-        let bytes = fs::read(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        // A failing file is named, so it can be run alone with `cargo fuzz run <target> <file>`.
-        if let Err(panic) = std::panic::catch_unwind(|| property(&bytes)) {
-            panic!("{}: {panic:?}", path.display());
-        }
-        n += 1;
-    }
-    n
+    corpus_replay::replay(env!("CARGO_MANIFEST_DIR"), target, property)
 }
 
 #[test]
