@@ -85,7 +85,8 @@ pub trait Sink {
     fn pixel(&mut self, x: i32, y: i32, invw: f32, hw: f32, lw: f32);
 }
 
-/// The depth test into a tile of samples whose first row is `y0`.
+/// The depth test into a tile of samples whose first row is `y0`; a winning pixel is marked as
+/// rock or terrain by `rock`.
 pub struct DepthSink<'a> {
     /// The tile's samples, row-major.
     pub samples: &'a mut [Sample],
@@ -93,6 +94,8 @@ pub struct DepthSink<'a> {
     pub width: usize,
     /// The tile's first row.
     pub y0: i32,
+    /// The triangles drawn are a rock's, not the terrain's.
+    pub rock: bool,
 }
 
 impl Sink for DepthSink<'_> {
@@ -105,7 +108,7 @@ impl Sink for DepthSink<'_> {
                 invw,
                 hw,
                 lw,
-                rock: false,
+                rock: self.rock,
             };
         }
     }

@@ -11,7 +11,7 @@
 use penmodel_terrain::export::Mesh;
 
 use super::clip::{self, ClipVertex};
-use super::rasterise::{self, Bounds, Sample, Sink, Vtx};
+use super::rasterise::{self, Bounds, DepthSink, Sample, Vtx};
 use super::scene::Style;
 use super::transform::{self, Affine};
 
@@ -101,10 +101,11 @@ impl Projected {
         let Some(bin) = self.bins.get(bounds.y0.max(0) as usize / self.band_rows.max(1)) else {
             return;
         };
-        let mut sink = RockSink {
+        let mut sink = DepthSink {
             samples,
             width,
             y0: bounds.y0,
+            rock: true,
         };
         for &i in bin {
             let t = self.triangles[i as usize];
@@ -124,29 +125,6 @@ impl Projected {
                     rasterise::triangle(&v[0], &v[k + 1], &v[k], bounds, &mut sink);
                 }
             }
-        }
-    }
-}
-
-/// The depth test for rock pixels: the winner is marked as rock.
-struct RockSink<'a> {
-    samples: &'a mut [Sample],
-    width: usize,
-    y0: i32,
-}
-
-impl Sink for RockSink<'_> {
-    #[inline]
-    fn pixel(&mut self, x: i32, y: i32, invw: f32, hw: f32, lw: f32) {
-        let i = (y - self.y0) as usize * self.width + x as usize;
-        let s = &mut self.samples[i];
-        if invw > s.invw {
-            *s = Sample {
-                invw,
-                hw,
-                lw,
-                rock: true,
-            };
         }
     }
 }

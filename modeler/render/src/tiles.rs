@@ -144,6 +144,7 @@ pub fn render(
                 samples: smp,
                 width,
                 y0: bounds.y0,
+                rock: false,
             };
             pass.terrain(&bounds, &mut sink);
             rocks.draw(&bounds, smp, width, pass.near);
