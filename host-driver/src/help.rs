@@ -19,6 +19,14 @@ pub fn without_examples(command: &clap::Command) -> Vec<String> {
     missing
 }
 
+/// What each tool's tests check of its command line: well formed (clap's own checks) and an
+/// example in every command's `--help`. Panics naming what is wrong.
+pub fn check(command: clap::Command) {
+    command.clone().debug_assert();
+    let missing = without_examples(&command);
+    assert!(missing.is_empty(), "no examples in the --help of {missing:?}");
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

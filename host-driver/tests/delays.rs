@@ -137,36 +137,25 @@ fn penctl_delays_prints_the_delays_and_residuals_and_writes_them() {
 
 #[test]
 fn penctl_delays_refuses_bad_points_before_measuring() {
-    let out = penctl(&["delays", "--source", "sim", "--at", "1,2"]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("is not X,Y,Z"));
-    let out = penctl(&[
-        "delays",
-        "--source",
-        "sim",
-        "--at",
-        "100,60,40",
-        "--at",
-        "500,60,nan",
-        "--at",
-        "1,1,1",
-    ]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("not a finite number"));
-    let out = penctl(&["delays", "--source", "sim", "--at", "100,60,40", "--at", "500,60,120"]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("2 point(s) given, 3 needed"));
-    let out = penctl(&[
-        "delays",
-        "--source",
-        "sim",
-        "--at",
-        "100,60,40",
-        "--at",
-        "500,60,120",
-        "--at",
-        "110,60,40",
-    ]);
-    assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("points 1 and 3 are 10 mm apart"));
+    // (the points given, the exit code, what stderr says): usage errors 2, unusable points 1.
+    let cases: [(&[&str], i32, &str); 4] = [
+        (&["1,2"], 2, "is not X,Y,Z"),
+        (&["100,60,40", "500,60,nan", "1,1,1"], 2, "not a finite number"),
+        (&["100,60,40", "500,60,120"], 1, "2 point(s) given, 3 needed"),
+        (
+            &["100,60,40", "500,60,120", "110,60,40"],
+            1,
+            "points 1 and 3 are 10 mm apart",
+        ),
+    ];
+    for (points, code, says) in cases {
+        let mut args = vec!["delays", "--source", "sim"];
+        for p in points {
+            args.extend(["--at", p]);
+        }
+        let out = penctl(&args);
+        let stderr = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(code), "{points:?}: {stderr}");
+        assert!(stderr.contains(says), "{points:?}: {stderr}");
+    }
 }

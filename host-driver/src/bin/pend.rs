@@ -135,13 +135,7 @@ mod tests {
     use clap::CommandFactory;
 
     #[test]
-    fn every_help_gives_examples() {
-        let missing = pen_host::help::without_examples(&super::Cli::command());
-        assert!(missing.is_empty(), "no examples in the --help of {missing:?}");
-    }
-
-    #[test]
-    fn the_command_line_is_well_formed() {
-        super::Cli::command().debug_assert();
+    fn the_command_line_is_well_formed_with_examples_in_every_help() {
+        pen_host::help::check(super::Cli::command());
     }
 }
