@@ -13,7 +13,7 @@ fn home() -> tempfile::TempDir {
 
 /// penctl with `HOME` at `home` and no `XDG_CONFIG_HOME`: the configuration under
 /// `home/.config`.
-fn penctl_in(home: &Path, args: &[&str]) -> Output {
+pub(crate) fn penctl_in(home: &Path, args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_penctl"))
         .args(args)
         .env("HOME", home)

@@ -2,17 +2,9 @@
 //! and penctl, the simulated pen's scenario per tool, the earlier spellings still read, and
 //! what does not go together refused as a usage error (2).
 
-use std::path::Path;
 use std::process::{Command, Output};
 
-fn penctl_in(home: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_penctl"))
-        .args(args)
-        .env("HOME", home)
-        .env_remove("XDG_CONFIG_HOME")
-        .output()
-        .expect("penctl runs")
-}
+use crate::penctl::penctl_in;
 
 fn penctl(args: &[&str]) -> Output {
     penctl_in(tempfile::tempdir().expect("home").path(), args)

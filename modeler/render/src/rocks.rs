@@ -51,13 +51,7 @@ impl Projected {
         if meshes.is_empty() {
             return;
         }
-        let [lx, ly, lz] = style.light;
-        let len = (lx * lx + ly * ly + lz * lz).sqrt();
-        let light = if len > 0.0 && len.is_finite() {
-            [lx / len, lz / len, ly / len]
-        } else {
-            [0.0, 1.0, 0.0]
-        };
+        let light = super::shade::world_light(style);
         let ambient = style.ambient.clamp(0.0, 1.0);
         let s = cell_size as f32;
         for (_, mesh) in meshes {

@@ -108,14 +108,7 @@ pub fn vertex_light(map: &Heightmap, vertical_scale: f32, style: &Style, out: &m
     }
     let h = map.heights();
     let s = map.cell_size() as f32;
-    // Light in the world frame (X = x, Y = up, Z = y), unit length.
-    let [lx, ly, lz] = style.light;
-    let len = (lx * lx + ly * ly + lz * lz).sqrt();
-    let light = if len > 0.0 && len.is_finite() {
-        [lx / len, lz / len, ly / len]
-    } else {
-        [0.0, 1.0, 0.0]
-    };
+    let light = world_light(style);
     let ambient = style.ambient.clamp(0.0, 1.0);
     out.par_chunks_mut(cols)
         .enumerate()
@@ -191,5 +184,17 @@ pub fn resolve(
                 *p = sky;
             }
         }
+    }
+}
+
+/// The style's light in the world frame (X = x, Y = up, Z = y), unit length; straight down when
+/// the style's light has no direction.
+pub(crate) fn world_light(style: &Style) -> [f32; 3] {
+    let [lx, ly, lz] = style.light;
+    let len = (lx * lx + ly * ly + lz * lz).sqrt();
+    if len > 0.0 && len.is_finite() {
+        [lx / len, lz / len, ly / len]
+    } else {
+        [0.0, 1.0, 0.0]
     }
 }
