@@ -1,6 +1,7 @@
 //! The integration tests of pen-hil, in one binary: a module per area.
 mod architecture;
 mod demo_session;
+mod faults;
 mod flashing;
 mod hil;
 mod pty;
