@@ -8,9 +8,10 @@
 use serde::{Deserialize, Serialize};
 
 /// The format version this build writes (and reads).
-pub const VERSION: u32 = 2;
+pub const VERSION: u32 = 3;
 
-/// The oldest version this build reads: a version 1 document (no rock fields) loads as version 2.
+/// The oldest version this build reads: a version 1 or 2 document (no rock fields, no rivers) loads
+/// as version 3.
 pub const OLDEST_VERSION: u32 = 1;
 
 /// A point in the ground plane, `[x, y]` in metres: x along columns, y along rows.
@@ -32,6 +33,43 @@ pub struct Document {
     /// Rock fields (seed 001) on the terrain; version 2 on.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub rocks: Vec<RockField>,
+    /// Rivers (seed 003) carved into the terrain; version 3 on.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub rivers: Vec<River>,
+}
+
+/// A river (seed 003): a course drawn as a Bézier curve, shaped by `iterations` steps of
+/// morphological erosion and deposition, then carved into the terrain. Its processed shape is
+/// derived (`crate::river`), not stored: it regenerates from these fields in milliseconds, and
+/// an entry that only holds what the user chose stays small and editable.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct River {
+    /// The control points of the course, metres; water flows from the first to the last. Every
+    /// third point (0, 3, 6, …) is on the course, the two between are handles (a chain of cubic
+    /// Bézier segments; a short last segment has a lower degree).
+    pub points: Vec<Point>,
+    /// The radius of the disc swept along the course, metres (the seed's width).
+    pub width: f64,
+    /// The water depth at the centre line, metres.
+    pub depth: f64,
+    /// The water amount (the seed's example: 60).
+    #[serde(default = "default_water")]
+    pub water: f64,
+    /// The ground hardness, ≥ 1 harder (the seed's examples: 1 and 3).
+    #[serde(default = "default_hardness")]
+    pub hardness: f64,
+    /// Years of change: erosion/deposition steps applied before carving.
+    #[serde(default)]
+    pub iterations: u32,
+}
+
+fn default_water() -> f64 {
+    60.0
+}
+
+fn default_hardness() -> f64 {
+    1.0
 }
 
 /// A rock field: rocks of mixed sizes scattered inside an outline (seed 001), standing on the
@@ -201,6 +239,7 @@ impl Document {
             grid,
             regions: Vec::new(),
             rocks: Vec::new(),
+            rivers: Vec::new(),
         }
     }
 }

@@ -80,13 +80,15 @@ impl Document {
             }
         }
         let mut doc: Document = parse(text)?;
-        // Version 1 had no rock fields; it reads as version 2 and is saved as such.
-        if doc.version < 2 {
-            if !doc.rocks.is_empty() {
-                return Err(ValidationError::new("rocks", Defect::NeedsVersion(2)).into());
-            }
-            doc.version = VERSION;
+        // Version 1 had no rock fields, version 2 no rivers; both read as the current version and
+        // are saved as such.
+        if doc.version < 2 && !doc.rocks.is_empty() {
+            return Err(ValidationError::new("rocks", Defect::NeedsVersion(2)).into());
         }
+        if doc.version < 3 && !doc.rivers.is_empty() {
+            return Err(ValidationError::new("rivers", Defect::NeedsVersion(3)).into());
+        }
+        doc.version = VERSION;
         validate::document(&doc)?;
         Ok(doc)
     }

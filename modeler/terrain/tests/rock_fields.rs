@@ -45,21 +45,25 @@ fn doc() -> Document {
 }
 
 #[test]
-fn a_version_1_document_loads_as_version_2() {
+fn a_version_1_document_loads_as_the_current_version() {
     let text = include_str!("../../examples/04-volcano.json");
     assert!(text.contains("\"version\": 1"), "the example is a version 1 file");
     let doc = Document::from_json(text).expect("version 1 loads");
     assert_eq!(doc.version, VERSION);
     assert!(doc.rocks.is_empty());
-    assert!(doc.to_json().contains("\"version\": 2"));
-    // Rock fields need version 2.
+    assert!(doc.to_json().contains(&format!("\"version\": {VERSION}")));
+    // Rock fields need version 2; a version 2 file with them loads.
     let mut v2 = doc.clone();
     v2.rocks.push(field([40.0, 30.0]));
-    let with_rocks = v2.to_json().replace("\"version\": 2", "\"version\": 1");
+    let current = format!("\"version\": {VERSION}");
+    let with_rocks = v2.to_json().replace(&current, "\"version\": 1");
     let e = Document::from_json(&with_rocks).expect_err("rocks in a version 1 file");
     assert_eq!(e.to_string(), "rocks: needs document version 2");
-    let e = Document::from_json(&text.replace("\"version\": 1", "\"version\": 3")).expect_err("version 3");
-    assert!(e.to_string().contains("reads versions 1 to 2"), "{e}");
+    let as_v2 = Document::from_json(&v2.to_json().replace(&current, "\"version\": 2")).expect("version 2 loads");
+    assert_eq!(as_v2, v2);
+    let unknown = format!("\"version\": {}", VERSION + 1);
+    let e = Document::from_json(&text.replace("\"version\": 1", &unknown)).expect_err("a future version");
+    assert!(e.to_string().contains(&format!("reads versions 1 to {VERSION}")), "{e}");
 }
 
 #[test]

@@ -240,10 +240,10 @@ fn json_errors_name_the_element() {
         }
         other => panic!("{other:?}"),
     }
-    let text = base().to_json().replacen("\"version\": 2", "\"version\": 3", 1);
+    let text = base().to_json().replacen("\"version\": 3", "\"version\": 4", 1);
     match Document::from_json(&text) {
         Err(LoadError::Invalid(e)) => {
-            assert_eq!((e.path.as_str(), e.defect), ("version", Defect::Version("3".into())))
+            assert_eq!((e.path.as_str(), e.defect), ("version", Defect::Version("4".into())))
         }
         other => panic!("{other:?}"),
     }
