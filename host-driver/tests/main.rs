@@ -6,6 +6,7 @@ mod events;
 mod fuzz_corpus;
 mod install;
 mod penctl;
+mod pend_faults;
 mod socket;
 mod vocabulary;
 mod waiting;
