@@ -76,7 +76,8 @@ impl Document {
         match version.version.as_u64() {
             Some(v) if (u64::from(OLDEST_VERSION)..=u64::from(VERSION)).contains(&v) => {}
             _ => {
-                return Err(ValidationError::new("version", Defect::Version(version.version.to_string())).into());
+                let shown = clip_quoted(&version.version.to_string());
+                return Err(ValidationError::new("version", Defect::Version(shown)).into());
             }
         }
         let mut doc: Document = parse(text)?;
@@ -167,7 +168,8 @@ pub(crate) struct JsonError {
 pub(crate) fn parse_json<'de, T: Deserialize<'de>>(text: &'de str, what: &str) -> Result<T, JsonError> {
     let mut de = serde_json::Deserializer::from_str(text);
     let value = serde_path_to_error::deserialize(&mut de).map_err(|e| {
-        let path = e.path().to_string();
+        // An unknown key is part of the path, and may be 10 MB long.
+        let path = clip_quoted(&e.path().to_string());
         describe(&path, &e.into_inner())
     })?;
     de.end().map_err(|e| JsonError {
@@ -210,13 +212,60 @@ fn describe(path: &str, e: &serde_json::Error) -> JsonError {
             // is reported while reading `regions`); the line and column say where.
             path.clear();
         }
-        words(&raw)
+        words(&clip_quoted(&raw))
     };
     JsonError {
         path,
         message,
         line: e.line(),
         column: e.column(),
+    }
+}
+
+/// Characters of a quoted value a message shows: a message quotes what it refuses (a string
+/// where a number belongs, an unknown key, a version), and a 10 MB string must not make a 10 MB
+/// message.
+const QUOTED_SHOWN: usize = 40;
+
+/// Characters of a whole message, past which it is cut (a version given as a huge array or
+/// object has no one long quoted run to shorten).
+const MESSAGE_SHOWN: usize = 200;
+
+/// `text` with every quoted run ("…", `…`) longer than [`QUOTED_SHOWN`] characters cut to its
+/// start and an ellipsis, and the whole cut after [`MESSAGE_SHOWN`] characters.
+fn clip_quoted(text: &str) -> String {
+    let mut out = String::with_capacity(text.len().min(1024));
+    let mut open: Option<(char, usize)> = None;
+    let mut escaped = false;
+    for c in text.chars() {
+        match open {
+            None => {
+                if c == '"' || c == '`' {
+                    open = Some((c, 0));
+                }
+                out.push(c);
+            }
+            Some((q, n)) => {
+                let closes = c == q && !escaped;
+                escaped = !escaped && c == '\\';
+                if closes {
+                    if n > QUOTED_SHOWN {
+                        out.push('…');
+                    }
+                    out.push(c);
+                    open = None;
+                } else {
+                    if n < QUOTED_SHOWN {
+                        out.push(c);
+                    }
+                    open = Some((q, n + 1));
+                }
+            }
+        }
+    }
+    match out.char_indices().nth(MESSAGE_SHOWN) {
+        Some((at, _)) => format!("{}…", &out[..at]),
+        None => out,
     }
 }
 

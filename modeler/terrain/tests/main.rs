@@ -6,6 +6,7 @@ mod editing;
 mod equations;
 mod examples;
 mod exports;
+mod faults;
 mod fuzz_corpus;
 mod limits;
 mod properties;
