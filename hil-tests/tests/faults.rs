@@ -190,3 +190,137 @@ fn flipped_bits_never_give_a_wrong_sample() {
 fn a_stream_cut_mid_frame_resyncs_at_the_next_frame() {
     check(Fault::Cut, 1e-3, 6);
 }
+
+/// Kills the simulated pen's process when dropped: the pty's device side closes, as a base
+/// station's serial device does when its cable is pulled.
+struct PenSim(std::process::Child);
+
+impl Drop for PenSim {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+/// `pen-sim serve --pty` playing `draw-figures` in real time, its device linked at `link`
+/// (replaced atomically, as udev's stable names are).
+fn plug_in(link: &std::path::Path) -> PenSim {
+    use std::io::BufRead;
+    let mut child = std::process::Command::new(env!("CARGO_BIN_EXE_pen-sim"))
+        .args(["serve", "--pty", "--scenario", "draw-figures", "--link"])
+        .arg(link)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("pen-sim starts");
+    let mut first = String::new();
+    std::io::BufReader::new(child.stdout.take().expect("stdout"))
+        .read_line(&mut first)
+        .expect("the device path");
+    PenSim(child)
+}
+
+/// The device unplugged mid-stroke and plugged back, through pend's daemon code (the hub, its
+/// socket, the device thread reattaching `serial:LINK`, as `pend` runs them) and a client on the
+/// socket. Expectations: the client is told the device is lost, with the stroke ended (tip up,
+/// then out of range) at once; when the device is back it is told so, and the first motion comes
+/// from the device's first second (the device's clock restarts at 0 when it is plugged in;
+/// pend tries to reattach every 200 ms, so this holds with room on a loaded machine).
+#[test]
+fn a_device_unplugged_mid_stroke_ends_the_stroke_and_resumes_within_a_second() {
+    use std::io::{BufRead, BufReader};
+    use std::os::unix::net::UnixStream;
+    use std::sync::Arc;
+    use std::sync::atomic::AtomicBool;
+
+    use pen_host::calibration::{Calibration, DisplaySize};
+    use pen_host::client::{Line, parse_line};
+    use pen_host::daemon::{self, Hub};
+    use pen_host::events::{EventKind, PenEvent};
+    use pen_host::pipeline::Pipeline;
+    use pen_host::source::Source;
+
+    let dir = tempfile_dir();
+    let link = dir.join("pen-tty");
+    let socket = dir.join("pend.sock");
+    let mut pen = plug_in(&link);
+
+    let listener = daemon::bind(&socket).expect("bind");
+    let stop = Arc::new(AtomicBool::new(false));
+    let hub = Arc::new(Hub::default());
+    let (h, s) = (hub.clone(), stop.clone());
+    std::thread::spawn(move || daemon::accept(listener, h, daemon::DEFAULT_QUEUE, s));
+    let (h, s) = (hub.clone(), stop.clone());
+    let source = Source::Serial(link.to_string_lossy().into_owned());
+    std::thread::spawn(move || {
+        let pipeline = Pipeline::new(source, Calibration::identity(DisplaySize::REFERENCE));
+        daemon::run_device(pipeline, h, s, |_| {})
+    });
+
+    let stream = UnixStream::connect(&socket).expect("connect");
+    stream.set_read_timeout(Some(Duration::from_secs(60))).expect("timeout");
+    let mut reader = BufReader::new(stream);
+    let mut next = || -> PenEvent {
+        loop {
+            let mut line = String::new();
+            let n = reader.read_line(&mut line).expect("a line within the hang guard");
+            assert!(n > 0, "pend closed the socket");
+            if let Line::Event(e) = parse_line(line.trim_end()).expect("a line pend wrote") {
+                return e;
+            }
+        }
+    };
+    // Mid-stroke: the tip down and moving.
+    let cap = Instant::now() + Duration::from_secs(120);
+    while next().kind != EventKind::TipDown {
+        assert!(Instant::now() < cap, "no stroke within the hang guard");
+    }
+    let mut moving = 0;
+    while moving < 5 {
+        let e = next();
+        if e.kind == EventKind::Motion && e.sw == Some([true, false, false]) {
+            moving += 1;
+        }
+    }
+
+    drop(pen); // unplugged
+    // The reports read before the loss still come, then the loss, then the switches released
+    // and the pen out of range, at once.
+    while !matches!(next().kind, EventKind::DeviceLost { .. }) {}
+    let mut released = Vec::new();
+    let out = loop {
+        let e = next();
+        match e.kind {
+            EventKind::TipUp | EventKind::ButtonUp { .. } => released.push(e),
+            _ => break e,
+        }
+    };
+    assert!(
+        released.first().is_some_and(|e| e.kind == EventKind::TipUp),
+        "the stroke ended by the loss: {released:?}"
+    );
+    assert_eq!(out.kind, EventKind::ProximityOut, "{out:?}");
+    assert_eq!(out.sw, Some([false; 3]), "every switch released");
+
+    pen = plug_in(&link); // plugged back
+    let found = next();
+    assert!(matches!(found.kind, EventKind::DeviceFound { .. }), "{found:?}");
+    let first = loop {
+        let e = next();
+        if let Some((_, device_us)) = e.seq {
+            break device_us;
+        }
+    };
+    eprintln!("first report after the replug: {first} µs on the device's clock");
+    assert!(first <= 1_000_000, "resumed {first} µs into the device's run");
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    drop(pen);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A scratch folder of this test process.
+fn tempfile_dir() -> std::path::PathBuf {
+    let dir = std::env::temp_dir().join(format!("pen-hil-faults-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("scratch folder");
+    dir
+}

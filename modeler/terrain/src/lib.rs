@@ -34,11 +34,12 @@ pub mod journal;
 mod json;
 pub mod persist;
 pub mod profile;
+pub mod river;
 pub mod rocks;
 pub mod validate;
 
 pub use address::{CurvePath, FigurePath};
-pub use document::{Document, Figure, FigureKind, Grid, Point, Region};
+pub use document::{Document, Figure, FigureKind, Grid, Point, Region, River};
 pub use edit::{Edit, EditError};
 pub use editor::{Editor, Outcome};
 pub use engine::{Rect, TerrainEngine, generate};
