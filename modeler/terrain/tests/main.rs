@@ -10,6 +10,7 @@ mod faults;
 mod fuzz_corpus;
 mod limits;
 mod properties;
+mod rivers;
 mod rock_fields;
 mod rocks;
 mod validation;

@@ -1,0 +1,485 @@
+//! Rivers shaped by morphology (seed 003, Matsui 2010), carved into the terrain.
+//!
+//! A river's course is a chain of Bézier segments ([`course`]); its water is the sweep of a disc
+//! of radius `width` along it. Each iteration (a "year") works on the current mask and centre
+//! line:
+//!
+//! 1. every cell of the river's window takes the nearest centre-line sample ([`near`]);
+//! 2. each sample has a curvature (the seed's κ), a turn sign (the cross product of successive
+//!    tangents) and a structuring-element level ([`level`]): a diamond of `(2n − 1)²` cells;
+//! 3. on the **outer** bank of each sample the mask is dilated by its diamond (erosion of the bank:
+//!    the cells within `n − 1` city-block steps of the water join it), on the **inner** bank it is
+//!    eroded (deposition: the water cells within `n − 1` of the land leave it) ([`morph`]);
+//! 4. the centre line moves the same `n − 1` cells towards the outer bank (smoothed along the
+//!    course, the ends fixed) and is resampled;
+//! 5. where two parts of the line more than [`NECK_ARC`] widths apart along it come within two
+//!    widths of each other, the bend's neck has closed: the loop's water becomes an oxbow lake
+//!    (standing water, cut off from the river by a sediment plug [`PLUG`] cells wide), and the
+//!    river continues straight through the neck.
+//!
+//! The processed shape is derived from the document's [`River`] entry, not stored: it regenerates
+//! in milliseconds, and it needs no randomness. Carving it into a heightmap is [`carve`].
+
+pub mod carve;
+pub mod course;
+pub mod level;
+pub mod morph;
+pub mod near;
+
+use glam::DVec2;
+
+use crate::document::{Grid, River};
+use course::Sample;
+pub use level::Constants;
+use near::{NONE, Near};
+
+/// The most iterations a river may ask for (validation refuses more).
+pub const MAX_ITERATIONS: u32 = 20;
+
+/// Course samples per cell of length (spacing 1 cell).
+pub const SPACING: f64 = 1.0;
+
+/// Along-course separation, in widths, beyond which two close parts of the line are a neck.
+pub const NECK_ARC: f64 = 6.0;
+
+/// Width in cells of the sediment plug between an oxbow lake and the river.
+pub const PLUG: f64 = 2.0;
+
+/// Cells beyond the water that a sample's field reaches: the largest diamond's reach and one.
+const REACH: f64 = morph::MAX_LEVEL as f64;
+
+/// A rectangle of the grid a river works in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Window {
+    /// First column.
+    pub c0: u32,
+    /// First row.
+    pub r0: u32,
+    /// Columns.
+    pub width: usize,
+    /// Rows.
+    pub height: usize,
+}
+
+impl Window {
+    /// Number of cells.
+    pub fn len(&self) -> usize {
+        self.width * self.height
+    }
+
+    /// Whether it has no cells.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Its first cell in grid cell coordinates.
+    pub fn origin(&self) -> DVec2 {
+        DVec2::new(f64::from(self.c0), f64::from(self.r0))
+    }
+
+    /// The grid index of window index `i`, for a grid of `cols` columns.
+    pub fn grid_index(&self, i: usize, cols: u32) -> usize {
+        (self.r0 as usize + i / self.width) * cols as usize + self.c0 as usize + i % self.width
+    }
+}
+
+/// One course sample as the tools report it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SampleInfo {
+    /// Position in metres.
+    pub at: [f64; 2],
+    /// Curvature in 1/m.
+    pub curvature: f64,
+    /// +1 bending left (x right, y up), −1 right, 0 straight; the outer bank is the other side.
+    pub turn: i8,
+    /// The structuring element's level.
+    pub level: u8,
+}
+
+/// What one iteration did.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Iteration {
+    /// River cells after it.
+    pub area: usize,
+    /// Cells the outer banks lost to the water.
+    pub eroded: usize,
+    /// Cells the inner banks gained from the water.
+    pub deposited: usize,
+    /// The areas (cells) of the oxbow lakes it cut off.
+    pub oxbows: Vec<usize>,
+    /// Oxbow lakes so far, and their cells.
+    pub lakes: usize,
+    /// Cells of all lakes so far.
+    pub lake_area: usize,
+}
+
+/// The erosion (cells that would join the water) and deposition (cells that would leave it) of
+/// the next iteration, over the window: what the seed's interface shows red and light blue.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Preview {
+    /// Cells the outer banks would lose, 0/1.
+    pub erosion: Vec<u8>,
+    /// Cells the inner banks would gain, 0/1.
+    pub deposition: Vec<u8>,
+}
+
+/// A river's processed shape.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Shape {
+    /// Where it is.
+    pub window: Window,
+    /// Cell size in metres.
+    pub cell_size: f64,
+    /// The disc radius in cells.
+    pub radius: f64,
+    /// The centre line, grid cell coordinates (cell centres at integers).
+    pub line: Vec<Sample>,
+    /// Each sample's level.
+    pub levels: Vec<u8>,
+    /// Each sample's turn sign.
+    pub turns: Vec<i8>,
+    /// River water, 0/1 over the window.
+    pub mask: Vec<u8>,
+    /// Lake cells: 0 none, k for lake k − 1.
+    pub lakes: Vec<u16>,
+    /// Each lake's neck, where it was cut off (grid cell coordinates).
+    pub necks: Vec<DVec2>,
+    /// Nearest-sample field of the window.
+    pub near: Near,
+    /// What each iteration did.
+    pub history: Vec<Iteration>,
+    river: River,
+    constants: Constants,
+}
+
+impl Shape {
+    /// The river as drawn: the disc sweep of its course, no iteration yet.
+    pub fn new(river: &River, grid: &Grid, constants: &Constants) -> Shape {
+        let s = grid.cell_size;
+        let ctrl: Vec<DVec2> = river
+            .points
+            .iter()
+            .map(|p| DVec2::new(p[0] / s - 0.5, p[1] / s - 0.5))
+            .collect();
+        let radius = river.width / s;
+        // Room for the water, the largest diamond, and the line's migration.
+        let grow = radius + REACH + 2.0 + (REACH - 1.0) * f64::from(river.iterations.min(MAX_ITERATIONS) + 1);
+        let (lo, hi) = ctrl
+            .iter()
+            .fold((DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)), |(lo, hi), p| {
+                (lo.min(*p), hi.max(*p))
+            });
+        let clip = |v: f64, n: u32| v.clamp(0.0, f64::from(n)) as u32;
+        let (c0, c1) = (
+            clip((lo.x - grow).floor(), grid.cols),
+            clip((hi.x + grow).ceil() + 1.0, grid.cols),
+        );
+        let (r0, r1) = (
+            clip((lo.y - grow).floor(), grid.rows),
+            clip((hi.y + grow).ceil() + 1.0, grid.rows),
+        );
+        let window = Window {
+            c0,
+            r0,
+            width: (c1 - c0) as usize,
+            height: (r1 - r0) as usize,
+        };
+        let line = course::sample(&ctrl, SPACING);
+        let mut shape = Shape {
+            window,
+            cell_size: s,
+            radius,
+            line: Vec::new(),
+            levels: Vec::new(),
+            turns: Vec::new(),
+            mask: vec![0; window.len()],
+            lakes: vec![0; window.len()],
+            necks: Vec::new(),
+            near: Near {
+                owner: Vec::new(),
+                dist: Vec::new(),
+                side: Vec::new(),
+            },
+            history: Vec::new(),
+            river: river.clone(),
+            constants: *constants,
+        };
+        shape.set_line(line);
+        for (m, d) in shape.mask.iter_mut().zip(&shape.near.dist) {
+            *m = u8::from(f64::from(*d) <= radius);
+        }
+        shape
+    }
+
+    /// The river after its `iterations` (at most [`MAX_ITERATIONS`]).
+    pub fn process(river: &River, grid: &Grid, constants: &Constants) -> Shape {
+        let mut shape = Shape::new(river, grid, constants);
+        for _ in 0..river.iterations.min(MAX_ITERATIONS) {
+            shape.step();
+        }
+        shape
+    }
+
+    /// The samples with their curvature, turn and level.
+    pub fn samples(&self) -> Vec<SampleInfo> {
+        let s = self.cell_size;
+        self.line
+            .iter()
+            .zip(self.levels.iter().zip(&self.turns))
+            .map(|(p, (&level, &turn))| SampleInfo {
+                at: [(p.p.x + 0.5) * s, (p.p.y + 0.5) * s],
+                curvature: p.curvature() / s,
+                turn,
+                level,
+            })
+            .collect()
+    }
+
+    /// Takes `line` as the centre line: levels, turns and the nearest-sample field.
+    fn set_line(&mut self, line: Vec<Sample>) {
+        self.levels = line
+            .iter()
+            .map(|p| {
+                level::level(
+                    p.curvature() / self.cell_size,
+                    &self.river,
+                    self.cell_size,
+                    &self.constants,
+                )
+            })
+            .collect();
+        // The turn is the sign of the signed curvature summed over a width of the course, so a
+        // wiggle of a cell does not swap the banks.
+        let m = (self.radius.round() as usize).max(1);
+        let signed: Vec<f64> = line
+            .iter()
+            .map(|p| p.d1.perp_dot(p.d2) / p.d1.length().powi(3).max(1e-12))
+            .collect();
+        self.turns = (0..line.len())
+            .map(|i| {
+                let sum: f64 = signed[i.saturating_sub(m)..(i + m + 1).min(line.len())].iter().sum();
+                if sum.abs() < 1e-9 { 0 } else { sum.signum() as i8 }
+            })
+            .collect();
+        let pts: Vec<DVec2> = line.iter().map(|p| p.p).collect();
+        self.near = near::nearest(&self.window, &pts, self.radius + REACH);
+        self.line = line;
+    }
+
+    /// The cells the next iteration adds to the water (outer banks) and removes from it (inner
+    /// banks), as window indices.
+    fn changes(&self) -> (Vec<usize>, Vec<usize>) {
+        let (w, h) = (self.window.width, self.window.height);
+        let to_water = morph::distance(&self.mask, w, h, true, false);
+        let to_land = morph::distance(&self.mask, w, h, false, false);
+        let (mut add, mut remove) = (Vec::new(), Vec::new());
+        for (i, &o) in self.near.owner.iter().enumerate() {
+            if o == NONE {
+                continue;
+            }
+            let (reach, turn) = (u16::from(self.levels[o as usize]) - 1, self.turns[o as usize]);
+            let side = self.near.side[i];
+            if reach == 0 || turn == 0 || side == 0 {
+                continue;
+            }
+            // Bending left, the centre of the bend is on the left: the outer bank is the right.
+            let outer = side == -turn;
+            if self.mask[i] == 0 {
+                if outer && to_water[i] <= reach {
+                    add.push(i);
+                }
+            } else if !outer && to_land[i] <= reach {
+                remove.push(i);
+            }
+        }
+        (add, remove)
+    }
+
+    /// The next iteration's erosion and deposition.
+    pub fn preview(&self) -> Preview {
+        let (add, remove) = self.changes();
+        let mut erosion = vec![0; self.window.len()];
+        let mut deposition = vec![0; self.window.len()];
+        for i in add {
+            erosion[i] = 1;
+        }
+        for i in remove {
+            deposition[i] = 1;
+        }
+        Preview { erosion, deposition }
+    }
+
+    /// One iteration (module docs, steps 1–5).
+    pub fn step(&mut self) {
+        let (add, remove) = self.changes();
+        for &i in &add {
+            self.mask[i] = 1;
+        }
+        for &i in &remove {
+            self.mask[i] = 0;
+        }
+        let mut record = Iteration {
+            eroded: add.len(),
+            deposited: remove.len(),
+            ..Iteration::default()
+        };
+        let moved = self.migrate();
+        let (pts, cuts) = self.cut_necks(moved);
+        let stencil = (self.radius.round() as usize).max(1);
+        let line = course::resample(&pts, SPACING, stencil);
+        // The loops' water, as owned by the line before it moved, becomes lakes.
+        let old_owner = std::mem::take(&mut self.near.owner);
+        let mut lake_cells: Vec<(usize, u16)> = Vec::new();
+        for (i, &o) in old_owner.iter().enumerate() {
+            if o == NONE || self.mask[i] == 0 {
+                continue;
+            }
+            if let Some(k) = cuts.iter().position(|&(a, b, _)| (a as u32) < o && o < b as u32) {
+                lake_cells.push((i, (self.necks.len() + k + 1) as u16));
+            }
+        }
+        for &(i, id) in &lake_cells {
+            self.mask[i] = 0;
+            self.lakes[i] = id;
+        }
+        self.set_line(line);
+        for &(_, _, neck) in &cuts {
+            near::sweep_segment(&self.window, &mut self.mask, neck.0, neck.1, self.radius);
+            self.necks.push((neck.0 + neck.1) * 0.5);
+        }
+        // The plug: lake cells next to the river's new course silt up.
+        for (i, l) in self.lakes.iter_mut().enumerate() {
+            if *l != 0 && (f64::from(self.near.dist[i]) <= self.radius + PLUG || self.mask[i] != 0) {
+                *l = 0;
+            }
+        }
+        let first_new = self.necks.len() - cuts.len();
+        for k in first_new..self.necks.len() {
+            let area = self.lakes.iter().filter(|&&l| l as usize == k + 1).count();
+            record.oxbows.push(area);
+        }
+        record.area = self.mask.iter().filter(|&&m| m != 0).count();
+        record.lake_area = self.lakes.iter().filter(|&&l| l != 0).count();
+        record.lakes = {
+            let mut seen = vec![false; self.necks.len() + 1];
+            for &l in &self.lakes {
+                seen[l as usize] = true;
+            }
+            seen.iter().skip(1).filter(|&&s| s).count()
+        };
+        self.history.push(record);
+    }
+
+    /// The centre line moved towards the outer banks by each sample's reach, smoothed over a
+    /// width along the course, the ends fixed.
+    fn migrate(&self) -> Vec<DVec2> {
+        let n = self.line.len();
+        let m = (self.radius.round() as usize).max(1);
+        let raw: Vec<DVec2> = (0..n)
+            .map(|i| {
+                let turn = f64::from(self.turns[i]);
+                let reach = f64::from(self.levels[i]) - 1.0;
+                let left = self.line[i].d1.normalize_or_zero().perp();
+                -left * turn * reach
+            })
+            .collect();
+        let moved: Vec<DVec2> = (0..n)
+            .map(|i| {
+                let (a, b) = (i.saturating_sub(m), (i + m).min(n - 1));
+                let mean = raw[a..=b].iter().sum::<DVec2>() / (b - a + 1) as f64;
+                let taper = (i.min(n - 1 - i) as f64 / m as f64).min(1.0);
+                let p = self.line[i].p + mean * taper;
+                if taper < 1.0 {
+                    p
+                } else {
+                    self.recentre(p, self.line[i].d1)
+                }
+            })
+            .collect();
+        // The water's middle moves in whole cells; a light smoothing keeps the line's curvature
+        // from seeing the steps.
+        let mut smooth = moved;
+        for _ in 0..2 {
+            let prev = smooth.clone();
+            for i in 1..n.saturating_sub(1) {
+                smooth[i] = (prev[i - 1] + prev[i] * 2.0 + prev[i + 1]) * 0.25;
+            }
+        }
+        smooth
+    }
+
+    /// The middle of the water across the course at `p` (direction `d1`): the mid-point of the
+    /// run of water cells along the normal through `p`, or `p` if it is dry.
+    fn recentre(&self, p: DVec2, d1: DVec2) -> DVec2 {
+        let normal = d1.normalize_or_zero().perp();
+        let wet = |t: f64| -> bool {
+            let q = (p + normal * t - self.window.origin()).round();
+            q.x >= 0.0
+                && q.y >= 0.0
+                && (q.x as usize) < self.window.width
+                && (q.y as usize) < self.window.height
+                && self.mask[q.y as usize * self.window.width + q.x as usize] != 0
+        };
+        if normal == DVec2::ZERO || !wet(0.0) {
+            return p;
+        }
+        let limit = self.radius + 2.0 * REACH;
+        let (mut lo, mut hi) = (0.0, 0.0);
+        while lo > -limit && wet(lo - 0.5) {
+            lo -= 0.5;
+        }
+        while hi < limit && wet(hi + 0.5) {
+            hi += 0.5;
+        }
+        p + normal * ((lo + hi) * 0.5)
+    }
+
+    /// Closes the necks of `pts`: returns the line with each loop cut out, and per cut the loop's
+    /// first and last sample indices in `pts` (exclusive) and the neck segment.
+    #[allow(clippy::type_complexity)]
+    fn cut_necks(&self, pts: Vec<DVec2>) -> (Vec<DVec2>, Vec<(usize, usize, (DVec2, DVec2))>) {
+        let reach = 2.0 * self.radius;
+        let gap = ((NECK_ARC * self.radius / SPACING).ceil() as usize).max(3);
+        let n = pts.len();
+        // Buckets of `reach` cells: a close pair is in the same or neighbouring buckets.
+        let b = reach.max(1.0);
+        let key = |p: DVec2| ((p.x / b).floor() as i64, (p.y / b).floor() as i64);
+        let mut buckets: std::collections::HashMap<(i64, i64), Vec<usize>> = std::collections::HashMap::new();
+        for (i, p) in pts.iter().enumerate() {
+            buckets.entry(key(*p)).or_default().push(i);
+        }
+        let mut cuts = Vec::new();
+        let mut i = 0;
+        while i < n {
+            let (kx, ky) = key(pts[i]);
+            let mut far = None;
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    for &j in buckets.get(&(kx + dx, ky + dy)).map(Vec::as_slice).unwrap_or(&[]) {
+                        if j > i + gap && pts[i].distance(pts[j]) < reach && far.is_none_or(|f| j > f) {
+                            far = Some(j);
+                        }
+                    }
+                }
+            }
+            match far {
+                Some(j) => {
+                    cuts.push((i, j, (pts[i], pts[j])));
+                    i = j;
+                }
+                None => i += 1,
+            }
+        }
+        if cuts.is_empty() {
+            return (pts, cuts);
+        }
+        let mut out = Vec::with_capacity(n);
+        let mut from = 0;
+        for &(a, b, _) in &cuts {
+            out.extend_from_slice(&pts[from..=a]);
+            from = b;
+        }
+        out.extend_from_slice(&pts[from..]);
+        (out, cuts)
+    }
+}

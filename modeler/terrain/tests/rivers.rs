@@ -1,0 +1,371 @@
+//! Rivers (issue 13, seed 003): the diamonds against the iterated cross, the curvature formula,
+//! bank sides on a bend, oxbow lakes, the carved bed, determinism. Each property is checked by a
+//! computation of its own here.
+
+use glam::DVec2;
+use penmodel_terrain::river::course::{self, Sample};
+use penmodel_terrain::river::{self, Constants, Shape, carve, level, morph};
+use penmodel_terrain::{Grid, Heightmap, River};
+
+/// A deterministic pseudo-random 0/1 image with about `fill` of its cells set.
+fn noise(w: usize, h: usize, seed: u64, fill: f64) -> Vec<u8> {
+    let mut x = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    (0..w * h)
+        .map(|_| {
+            x = x.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            u8::from(((x >> 33) as f64 / (1u64 << 31) as f64) < fill)
+        })
+        .collect()
+}
+
+/// One step of the 4-neighbour cross: dilation (any of the five set) or erosion (all five set,
+/// outside the image unset).
+fn cross(img: &[u8], w: usize, h: usize, dilate: bool) -> Vec<u8> {
+    let at = |c: i64, r: i64| -> u8 {
+        if c < 0 || r < 0 || c >= w as i64 || r >= h as i64 {
+            0
+        } else {
+            img[r as usize * w + c as usize]
+        }
+    };
+    let mut out = vec![0; w * h];
+    for r in 0..h as i64 {
+        for c in 0..w as i64 {
+            let five = [at(c, r), at(c - 1, r), at(c + 1, r), at(c, r - 1), at(c, r + 1)];
+            out[r as usize * w + c as usize] = if dilate {
+                u8::from(five.iter().any(|&v| v != 0))
+            } else {
+                u8::from(five.iter().all(|&v| v != 0))
+            };
+        }
+    }
+    out
+}
+
+#[test]
+fn diamonds_equal_the_iterated_cross() {
+    for level in 1..=morph::MAX_LEVEL {
+        // The element itself: a single cell dilated n − 1 times.
+        let side = 2 * level as usize - 1;
+        let mut one = vec![0; side * side];
+        one[side * side / 2] = 1;
+        let mut grown = one.clone();
+        for _ in 1..level {
+            grown = cross(&grown, side, side, true);
+        }
+        assert_eq!(morph::diamond(level), grown, "level {level}");
+        assert_eq!(morph::dilate(&one, side, side, level), grown, "level {level}");
+        for (w, h, fill, seed) in [(37, 23, 0.1, 1), (40, 40, 0.6, 2), (64, 17, 0.85, 3), (1, 9, 0.5, 4)] {
+            let img = noise(w, h, seed, fill);
+            let (mut d, mut e) = (img.clone(), img.clone());
+            for _ in 1..level {
+                d = cross(&d, w, h, true);
+                e = cross(&e, w, h, false);
+            }
+            assert_eq!(morph::dilate(&img, w, h, level), d, "dilation, level {level}, {w}x{h}");
+            assert_eq!(morph::erode(&img, w, h, level), e, "erosion, level {level}, {w}x{h}");
+        }
+    }
+}
+
+#[test]
+fn curvature_of_a_circle_is_one_over_r_and_of_a_line_zero() {
+    for r in [0.5, 3.0, 40.0] {
+        for k in 0..16 {
+            let a = k as f64 * 0.4;
+            // x = r cos a, y = r sin a.
+            let d1 = DVec2::new(-r * a.sin(), r * a.cos());
+            let d2 = DVec2::new(-r * a.cos(), -r * a.sin());
+            assert!((course::curvature(d1, d2) - 1.0 / r).abs() < 1e-12);
+        }
+    }
+    assert_eq!(course::curvature(DVec2::new(3.0, -1.0), DVec2::ZERO), 0.0);
+    assert_eq!(course::curvature(DVec2::new(3.0, -1.0), DVec2::new(6.0, -2.0)), 0.0);
+    // Sampled: a straight course, and a circle of radius 50 by four cubic quarters (handle
+    // 0.5523 r: within 0.03 % of the circle), through the course sampler.
+    let line = course::sample(&[DVec2::new(5.0, 5.0), DVec2::new(60.0, 30.0)], 1.0);
+    assert!(line.iter().all(|s| s.curvature() == 0.0));
+    let r = 50.0;
+    let k = 0.552_284_75 * r;
+    let c = DVec2::new(100.0, 100.0);
+    let pts = [
+        c + DVec2::new(r, 0.0),
+        c + DVec2::new(r, k),
+        c + DVec2::new(k, r),
+        c + DVec2::new(0.0, r),
+        c + DVec2::new(-k, r),
+        c + DVec2::new(-r, k),
+        c + DVec2::new(-r, 0.0),
+    ];
+    let samples = course::sample(&pts, 1.0);
+    assert!(samples.len() > 150);
+    for s in &samples {
+        assert!((s.p.distance(c) - r).abs() < 0.02 * r);
+        // The cubic quarter's curvature strays more than its radius does (by up to 2.5 %).
+        assert!((s.curvature() * r - 1.0).abs() < 0.03, "{}", s.curvature() * r);
+    }
+    // By differences over a polyline on the circle (the later iterations' centre lines).
+    let ring: Vec<DVec2> = (0..200).map(|i| c + DVec2::from_angle(i as f64 * 0.01) * r).collect();
+    for s in &course::differentiate(&ring, 3)[3..197] {
+        assert!((s.curvature() * r - 1.0).abs() < 0.01);
+    }
+}
+
+fn grid(n: u32) -> Grid {
+    Grid {
+        cols: n,
+        rows: n,
+        cell_size: 1.0,
+    }
+}
+
+fn river(points: Vec<[f64; 2]>, width: f64, iterations: u32) -> River {
+    River {
+        points,
+        width,
+        depth: 1.5,
+        water: 60.0,
+        hardness: 1.0,
+        iterations,
+    }
+}
+
+/// A half circle of radius `r` around `c` by two cubic quarters, from the left to the right over the top.
+fn bend(c: [f64; 2], r: f64) -> Vec<[f64; 2]> {
+    let k = 0.552_284_75 * r;
+    vec![
+        [c[0] - r, c[1]],
+        [c[0] - r, c[1] - k],
+        [c[0] - k, c[1] - r],
+        [c[0], c[1] - r],
+        [c[0] + k, c[1] - r],
+        [c[0] + r, c[1] - k],
+        [c[0] + r, c[1]],
+    ]
+}
+
+#[test]
+fn on_a_bend_the_outer_bank_moves_out_and_the_inner_bank_in() {
+    let (c, r) = ([64.0, 70.0], 20.0);
+    for iterations in 0..3 {
+        let rv = river(bend(c, r), 4.0, iterations);
+        let shape = Shape::process(&rv, &grid(128), &Constants::default());
+        let before = shape.mask.clone();
+        let mut next = shape.clone();
+        next.step();
+        let win = shape.window;
+        let centre = DVec2::new(c[0] - 0.5, c[1] - 0.5) - win.origin();
+        let line: Vec<DVec2> = shape.line.iter().map(|s| s.p - win.origin()).collect();
+        let (mut out, mut inn) = (0, 0);
+        for i in 0..win.len() {
+            let p = DVec2::new((i % win.width) as f64, (i / win.width) as f64);
+            // Only the arc: above the centre, away from the fixed ends.
+            if p.y > centre.y - 0.5 * r {
+                continue;
+            }
+            // The bank's side: farther from the bend's centre than the nearest point of the
+            // course (outer) or nearer (inner).
+            let nearest = line
+                .iter()
+                .min_by(|a, b| a.distance(p).total_cmp(&b.distance(p)))
+                .copied()
+                .unwrap_or(p);
+            let (radial, course) = (p.distance(centre), nearest.distance(centre));
+            match (before[i], next.mask[i]) {
+                (0, 1) => {
+                    assert!(
+                        radial > course,
+                        "bank cut on the inside at {p} ({radial} against {course})"
+                    );
+                    out += 1;
+                }
+                (1, 0) => {
+                    assert!(
+                        radial < course,
+                        "sediment on the outside at {p} ({radial} against {course})"
+                    );
+                    inn += 1;
+                }
+                _ => {}
+            }
+        }
+        assert!(out > 0 && inn > 0, "the bend moved: {out} cells cut, {inn} filled");
+        // The preview shows exactly the next step's changes.
+        let preview = shape.preview();
+        for i in 0..win.len() {
+            assert_eq!(preview.erosion[i], u8::from(before[i] == 0 && next.mask[i] == 1));
+            assert_eq!(preview.deposition[i], u8::from(before[i] == 1 && next.mask[i] == 0));
+        }
+    }
+}
+
+/// An Ω: up from the bottom, a loop of radius 28 round (100, 70), back down; its neck (the two
+/// legs at the loop's foot) `neck` cells wide.
+pub fn omega(neck: f64) -> Vec<[f64; 2]> {
+    let (c, r) = (DVec2::new(100.0, 70.0), 28.0);
+    let a0 = (neck / 2.0 / r).asin();
+    let foot = c.y + r * a0.cos();
+    let mut stroke = vec![
+        DVec2::new(c.x - neck / 2.0, 190.0),
+        DVec2::new(c.x - neck / 2.0, foot + 10.0),
+    ];
+    // From the foot's left side (angle π/2 + a0, y down) round the left, the top and the right.
+    for k in 0..=64 {
+        let a = std::f64::consts::FRAC_PI_2 + a0 + k as f64 * (2.0 * std::f64::consts::PI - 2.0 * a0) / 64.0;
+        stroke.push(c + DVec2::new(a.cos(), a.sin()) * r);
+    }
+    stroke.extend([
+        DVec2::new(c.x + neck / 2.0, foot + 10.0),
+        DVec2::new(c.x + neck / 2.0, 190.0),
+    ]);
+    course::fit(&stroke, 16).iter().map(|p| [p.x, p.y]).collect()
+}
+
+#[test]
+fn a_sharp_bend_forms_an_oxbow_lake() {
+    let rv = river(omega(18.0), 3.0, 12);
+    let shape = Shape::process(&rv, &grid(200), &Constants::default());
+    let cut = shape.history.iter().position(|it| !it.oxbows.is_empty());
+    let Some(k) = cut else {
+        panic!("no oxbow in {:?}", shape.history);
+    };
+    // Standing water away from the river: lake cells, none of them river cells, none next to the
+    // river's course, and the river's course no longer goes round the loop.
+    let lake: Vec<usize> = (0..shape.window.len()).filter(|&i| shape.lakes[i] != 0).collect();
+    assert!(!lake.is_empty() && shape.history[k].oxbows.iter().all(|&a| a > 0));
+    assert!(lake.iter().all(|&i| shape.mask[i] == 0));
+    let win = shape.window;
+    for &i in &lake {
+        let p = DVec2::new((i % win.width) as f64, (i / win.width) as f64) + win.origin();
+        let d = shape.line.iter().map(|s| s.p.distance(p)).fold(f64::INFINITY, f64::min);
+        assert!(
+            d > shape.radius + river::PLUG - 1.0,
+            "lake cell {p} is {d} from the river"
+        );
+    }
+    let top = shape.line.iter().map(|s| s.p.y).fold(f64::INFINITY, f64::min);
+    assert!(top > 60.0, "the course still reaches y = {top}: the loop was not cut");
+}
+
+/// Rolling ground sloping down to the right with a ridge across the course.
+fn ground(n: u32) -> Heightmap {
+    let heights = (0..n * n)
+        .map(|i| {
+            let (x, y) = (f64::from(i % n), f64::from(i / n));
+            (40.0 - 0.1 * x + 3.0 * (x / 9.0).sin() * (y / 13.0).cos() + 6.0 * (-(x - 120.0).powi(2) / 60.0).exp())
+                as f32
+        })
+        .collect();
+    Heightmap::from_heights(n, n, 1.0, heights).expect("n² heights")
+}
+
+#[test]
+fn the_carved_bed_never_rises_along_the_course() {
+    let g = ground(200);
+    for (points, iterations) in [(omega(18.0), 12), (omega(40.0), 3), (bend([100.0, 120.0], 50.0), 2)] {
+        let rv = river(points, 3.0, iterations);
+        let shape = Shape::process(&rv, &grid(200), &Constants::default());
+        let carve = carve::carve(&shape, rv.width, rv.depth, &g);
+        let mut map = g.clone();
+        carve.apply(&mut map);
+        let mut last = f32::INFINITY;
+        for s in &shape.line {
+            let (c, r) = (s.p.x.round() as u32, s.p.y.round() as u32);
+            let h = map.get(c, r);
+            assert!(
+                h <= last,
+                "the bed rises to {h} at ({c}, {r}) after {last} (ground {})",
+                g.get(c, r)
+            );
+            last = h;
+        }
+        // Carving only lowers, and every river cell is under water.
+        for i in 0..g.heights().len() {
+            assert!(map.heights()[i] <= g.heights()[i]);
+        }
+        let win = carve.window;
+        for i in 0..win.len() {
+            if shape.mask[i] != 0 {
+                let (c, r) = (win.c0 + (i % win.width) as u32, win.r0 + (i / win.width) as u32);
+                assert!(carve.water[i] > map.get(c, r), "dry river cell ({c}, {r})");
+            }
+        }
+    }
+}
+
+#[test]
+fn rivers_are_deterministic() {
+    let rv = river(omega(18.0), 3.0, 8);
+    let a = Shape::process(&rv, &grid(200), &Constants::default());
+    let b = Shape::process(&rv, &grid(200), &Constants::default());
+    assert_eq!(a, b);
+    let g = ground(200);
+    let (ca, cb) = (carve::carve(&a, 3.0, 1.5, &g), carve::carve(&b, 3.0, 1.5, &g));
+    assert_eq!(
+        ca.target.iter().map(|t| t.to_bits()).collect::<Vec<_>>(),
+        cb.target.iter().map(|t| t.to_bits()).collect::<Vec<_>>()
+    );
+    // Iterating one step at a time is processing with more iterations.
+    let mut stepwise = Shape::process(&river(omega(18.0), 3.0, 0), &grid(200), &Constants::default());
+    let full = Shape::process(&rv, &grid(200), &Constants::default());
+    for _ in 0..8 {
+        stepwise.step();
+    }
+    assert_eq!(
+        stepwise.mask.iter().filter(|&&m| m != 0).count(),
+        full.history.last().map_or(0, |h| h.area)
+    );
+}
+
+#[test]
+fn the_level_grows_with_curvature_flow_and_softer_ground() {
+    let c = Constants::default();
+    let base = river(vec![[0.0, 0.0], [1.0, 0.0]], 3.0, 0);
+    let mut seen = std::collections::BTreeSet::new();
+    for (i, kappa) in [0.0, 0.01, 0.05, 0.1, 0.2, 0.5, 1.0, 5.0]
+        .windows(2)
+        .map(|w| (w[0], w[1]))
+        .enumerate()
+    {
+        let _ = i;
+        for water in [10.0, 60.0, 200.0] {
+            for hardness in [0.5, 1.0, 3.0] {
+                let mut r = base.clone();
+                r.water = water;
+                r.hardness = hardness;
+                let (a, b) = (level::level(kappa.0, &r, 1.0, &c), level::level(kappa.1, &r, 1.0, &c));
+                assert!(a <= b && (1..=morph::MAX_LEVEL).contains(&a) && b <= level::max_level(&r, 1.0, &c));
+                seen.insert(b);
+                let mut more = r.clone();
+                more.water *= 2.0;
+                assert!(level::level(kappa.1, &more, 1.0, &c) >= b);
+                let mut harder = r.clone();
+                harder.hardness *= 2.0;
+                assert!(level::level(kappa.1, &harder, 1.0, &c) <= b);
+                let mut deeper = r.clone();
+                deeper.depth *= 2.0;
+                assert!(level::level(kappa.1, &deeper, 1.0, &c) >= b);
+            }
+        }
+    }
+    assert!(seen.len() >= 3, "levels used: {seen:?}");
+    assert_eq!(
+        level::level(0.0, &base, 1.0, &c),
+        1,
+        "a straight course does not change"
+    );
+}
+
+#[test]
+fn a_fitted_course_passes_through_the_stroke() {
+    let stroke: Vec<DVec2> = (0..100)
+        .map(|i| DVec2::new(i as f64, 20.0 * (i as f64 / 15.0).sin()))
+        .collect();
+    let pts = course::fit(&stroke, 8);
+    assert_eq!(pts.len(), 3 * 7 + 1);
+    let samples: Vec<Sample> = course::sample(&pts, 0.5);
+    for p in &stroke {
+        let d = samples.iter().map(|s| s.p.distance(*p)).fold(f64::INFINITY, f64::min);
+        assert!(d < 1.5, "the course is {d} from the stroke at {p}");
+    }
+}
