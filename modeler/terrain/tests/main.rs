@@ -10,6 +10,7 @@ mod faults;
 mod fuzz_corpus;
 mod limits;
 mod properties;
+mod ridges;
 mod rivers;
 mod rock_fields;
 mod rocks;

@@ -1,0 +1,131 @@
+//! Ridge and valley areas by rain (seed 002 §3.1): one drop on every cell, each traced downhill,
+//! and per cell the number of drops that pass through it. Often passed = valley, rarely =
+//! ridge.
+//!
+//! A drop in cell c moves to the neighbour (of 8) nearest the direction of steepest descent, the
+//! negative Sobel gradient ([`super::gradient::sobel`]), if that neighbour is strictly lower;
+//! otherwise it stops there (a flat, a pit, or a step that would climb). It also stops at the
+//! grid's edge when the descent points off the grid. Since every step goes strictly down, no
+//! drop loops, and each cell's move is the same whichever drop arrives, so the count of a cell
+//! is 1 + the counts of the cells that move into it: counted in one pass over the cells in
+//! upstream-first order ([`counts`]) instead of tracing a million drops one by one (the tests
+//! trace them one by one and compare).
+
+use std::f64::consts::FRAC_PI_4;
+
+use rayon::prelude::*;
+
+use super::gradient::sobel;
+
+/// No move: the drop stops in this cell.
+pub const STOP: u32 = u32::MAX;
+
+/// Column and row steps of the 8 directions, counterclockwise from +x (towards +y).
+const STEPS: [(i32, i32); 8] = [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)];
+
+/// Per cell, the cell a drop moves to ([`STOP`] if it stays).
+pub fn directions(z: &[f32], cols: u32, rows: u32, cell: f64) -> Vec<u32> {
+    let mut next = vec![STOP; z.len()];
+    next.par_chunks_mut(cols as usize).enumerate().for_each(|(r, line)| {
+        let r = r as u32;
+        for (c, n) in line.iter_mut().enumerate() {
+            *n = step(z, cols, rows, cell, c as u32, r);
+        }
+    });
+    next
+}
+
+/// Where a drop in cell `(c, r)` moves ([`STOP`] if it stays).
+pub fn step(z: &[f32], cols: u32, rows: u32, cell: f64, c: u32, r: u32) -> u32 {
+    let [gx, gy] = sobel(z, cols, rows, cell, c, r);
+    if gx == 0.0 && gy == 0.0 {
+        return STOP;
+    }
+    let octant = ((-gy).atan2(-gx) / FRAC_PI_4).round() as i32;
+    let (dc, dr) = STEPS[octant.rem_euclid(8) as usize];
+    let (nc, nr) = (c as i32 + dc, r as i32 + dr);
+    if nc < 0 || nr < 0 || nc >= cols as i32 || nr >= rows as i32 {
+        return STOP;
+    }
+    let (i, j) = (
+        r as usize * cols as usize + c as usize,
+        nr as usize * cols as usize + nc as usize,
+    );
+    if z[j] < z[i] { j as u32 } else { STOP }
+}
+
+/// The rain pass counts: per cell, how many drops (one started on every cell) pass through it,
+/// its own included.
+pub fn counts(z: &[f32], cols: u32, rows: u32, cell: f64) -> Vec<u32> {
+    accumulate(&directions(z, cols, rows, cell))
+}
+
+/// The pass counts of the moves `next` ([`directions`]).
+pub fn accumulate(next: &[u32]) -> Vec<u32> {
+    let mut inflow = vec![0u32; next.len()];
+    for &n in next {
+        if n != STOP {
+            inflow[n as usize] += 1;
+        }
+    }
+    let mut count = vec![1u32; next.len()];
+    // Upstream-first (Kahn's order): a cell is passed on once every cell moving into it was.
+    let mut ready: Vec<u32> = (0..next.len() as u32).filter(|&i| inflow[i as usize] == 0).collect();
+    while let Some(i) = ready.pop() {
+        let n = next[i as usize];
+        if n != STOP {
+            count[n as usize] += count[i as usize];
+            inflow[n as usize] -= 1;
+            if inflow[n as usize] == 0 {
+                ready.push(n);
+            }
+        }
+    }
+    count
+}
+
+/// The cells a drop starting in cell `start` passes through, `start` first.
+pub fn trace(next: &[u32], start: u32) -> Vec<u32> {
+    let mut path = vec![start];
+    let mut i = start;
+    while next[i as usize] != STOP {
+        i = next[i as usize];
+        path.push(i);
+    }
+    path
+}
+
+/// Thresholds of the classification.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Classes {
+    /// A cell passed by at most this many drops is ridge.
+    pub ridge_max: u32,
+    /// A cell passed by at least this many drops is valley.
+    pub valley_min: u32,
+}
+
+impl Classes {
+    /// Ridge: no drop but its own passes (1) and its own moves on; valley: 32 drops or more.
+    pub const DEFAULT: Classes = Classes {
+        ridge_max: 1,
+        valley_min: 32,
+    };
+
+    /// 1.0 where the count is ridge, else 0.0. A cell whose drop stays put (a flat or a pit,
+    /// `next` [`STOP`]) is never ridge: nothing passes a flat plain either, but it sheds no water.
+    pub fn ridges(&self, counts: &[u32], next: &[u32]) -> Vec<f32> {
+        counts
+            .iter()
+            .zip(next)
+            .map(|(&n, &m)| f32::from(u8::from(n <= self.ridge_max && m != STOP)))
+            .collect()
+    }
+
+    /// 1.0 where the count is valley, else 0.0.
+    pub fn valleys(&self, counts: &[u32]) -> Vec<f32> {
+        counts
+            .iter()
+            .map(|&n| f32::from(u8::from(n >= self.valley_min)))
+            .collect()
+    }
+}
