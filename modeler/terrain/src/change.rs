@@ -59,4 +59,7 @@ pub enum Scope {
     /// Rock field N was added, removed, moved or replaced: the terrain is unchanged (rocks stand
     /// on it; [`crate::rocks::cache::Rocks`] follows the document).
     Rocks(usize),
+    /// River N was added, removed or changed: the engine reprocesses it and recarves only its
+    /// window ([`crate::river::layer::Layer`]).
+    Rivers(usize),
 }

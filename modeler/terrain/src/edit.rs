@@ -11,7 +11,7 @@ use thiserror::Error;
 use crate::address::{CurvePath, FigurePath};
 use crate::cells::{self, Mask};
 use crate::change::{FigureList, ListChange, Scope};
-use crate::document::{Document, Figure, FigureKind, Point, Region, RockField};
+use crate::document::{Document, Figure, FigureKind, Point, Region, River, RockField};
 use crate::validate::{self, ValidationError};
 
 /// One change to a document. Serialised (in the journal) as an object tagged by `"op"`.
@@ -76,6 +76,12 @@ pub enum Edit {
     },
     /// Replaces rock field `index` (its density, sizes, shapes, outline or seed).
     ReplaceRocks { index: usize, field: RockField },
+    /// Inserts a river at `index`.
+    AddRiver { index: usize, river: River },
+    /// Removes river `index`.
+    DeleteRiver { index: usize },
+    /// Replaces river `index` (its course, width, depth, water, hardness or iterations).
+    ReplaceRiver { index: usize, river: River },
 }
 
 /// Why an edit was refused. The document is unchanged.
@@ -97,6 +103,9 @@ pub enum EditError {
     /// No rock field at that index.
     #[error("there is no rocks[{0}]")]
     NoRocks(usize),
+    /// No river at that index.
+    #[error("there is no rivers[{0}]")]
+    NoRiver(usize),
     /// [`Edit::apply_to`] was given a group, whose edits are applied one at a time.
     #[error("a group of edits is applied edit by edit")]
     Group,
@@ -355,7 +364,46 @@ fn apply(doc: &mut Document, edit: &Edit) -> Result<Applied, EditError> {
             doc.rocks.get(*index).ok_or(EditError::NoRocks(*index))?;
             replace_rocks(doc, *index, field.clone())
         }
+        Edit::AddRiver { index, river } => add_river(doc, *index, river.clone()),
+        Edit::DeleteRiver { index } => {
+            if *index >= doc.rivers.len() {
+                return Err(EditError::NoRiver(*index));
+            }
+            let river = doc.rivers.remove(*index);
+            Ok(Applied {
+                inverse: Edit::AddRiver { index: *index, river },
+                scope: Scope::Rivers(*index),
+            })
+        }
+        Edit::ReplaceRiver { index, river } => replace_river(doc, *index, river.clone()),
     }
+}
+
+fn add_river(doc: &mut Document, index: usize, river: River) -> Result<Applied, EditError> {
+    if index > doc.rivers.len() {
+        return Err(EditError::NoRiver(index));
+    }
+    doc.rivers.insert(index, river);
+    if let Err(e) = validate::rivers(doc) {
+        doc.rivers.remove(index);
+        return Err(e.into());
+    }
+    Ok(Applied {
+        inverse: Edit::DeleteRiver { index },
+        scope: Scope::Rivers(index),
+    })
+}
+
+fn replace_river(doc: &mut Document, index: usize, new: River) -> Result<Applied, EditError> {
+    let old = std::mem::replace(doc.rivers.get_mut(index).ok_or(EditError::NoRiver(index))?, new);
+    if let Err(e) = validate::rivers(doc) {
+        doc.rivers[index] = old;
+        return Err(e.into());
+    }
+    Ok(Applied {
+        inverse: Edit::ReplaceRiver { index, river: old },
+        scope: Scope::Rivers(index),
+    })
 }
 
 fn replace_rocks(doc: &mut Document, index: usize, new: RockField) -> Result<Applied, EditError> {

@@ -60,6 +60,7 @@ use crate::distance;
 use crate::document::{Document, Figure, FigureKind, Grid, Point, Region};
 use crate::heightmap::Heightmap;
 use crate::profile;
+use crate::river::layer::{Layer, Water};
 use crate::validate::{self, ValidationError};
 
 /// Generates the terrain of a document (validating it first).
@@ -427,7 +428,9 @@ impl RegionNode {
 /// touches.
 pub struct TerrainEngine {
     regions: Vec<RegionNode>,
+    /// The ground: the regions' terrain before the rivers carve it.
     map: Heightmap,
+    rivers: Layer,
 }
 
 /// The node that owns figure list `list`, with that list's figures, base and outer slope.
@@ -468,17 +471,30 @@ impl TerrainEngine {
         for (node, r) in regions.iter().zip(&doc.regions) {
             node.paint_all(&r.figures, 0.0, &mut map);
         }
-        TerrainEngine { regions, map }
+        let mut rivers = Layer::default();
+        rivers.sync(doc, &map, Rect::EMPTY);
+        TerrainEngine { regions, map, rivers }
     }
 
     /// The terrain as of the last update.
     pub fn heightmap(&self) -> &Heightmap {
-        &self.map
+        self.rivers.carved().map_or(&self.map, |(carved, _)| carved)
+    }
+
+    /// The rivers' water (surface level per cell, lakes), if the document has rivers.
+    pub fn water(&self) -> Option<&Water> {
+        self.rivers.carved().map(|(_, water)| water)
+    }
+
+    /// The rivers' processed shapes and carvings.
+    pub fn rivers(&self) -> &Layer {
+        &self.rivers
     }
 
     /// The terrain, without the caches.
     pub fn into_heightmap(self) -> Heightmap {
-        self.map
+        let TerrainEngine { map, rivers, .. } = self;
+        rivers.carved().map_or(map, |(carved, _)| carved.clone())
     }
 
     /// Brings the terrain up to date with `doc` after the change `scope` describes, regenerating
@@ -490,7 +506,11 @@ impl TerrainEngine {
     /// other mismatch leaves a terrain that does not match the document.
     pub fn update(&mut self, doc: &Document, scope: &Scope) -> Rect {
         match self.regenerate(doc, scope) {
-            Some(rect) => rect,
+            // The rivers follow their entries and the ground that changed under them.
+            Some(rect) => match self.rivers.sync(doc, &self.map, rect) {
+                Some(more) => rect.union(more),
+                None => rect,
+            },
             None => {
                 *self = TerrainEngine::build(doc);
                 Rect {
@@ -506,7 +526,7 @@ impl TerrainEngine {
     /// The part of [`TerrainEngine::update`] that regenerates by scope; `None` when the scope
     /// does not fit.
     fn regenerate(&mut self, doc: &Document, scope: &Scope) -> Option<Rect> {
-        let TerrainEngine { regions, map } = self;
+        let TerrainEngine { regions, map, .. } = self;
         let grid = doc.grid;
         let before = match scope {
             Scope::RegionAdded(_) => doc.regions.len().checked_sub(1)?,
@@ -517,7 +537,7 @@ impl TerrainEngine {
             return None;
         }
         let rect = match scope {
-            Scope::Rocks(_) => Rect {
+            Scope::Rocks(_) | Scope::Rivers(_) => Rect {
                 c0: 0,
                 r0: 0,
                 width: 0,

@@ -253,6 +253,15 @@ pub enum Defect {
     /// A shape coefficient out of range.
     #[error("{} must be from {} to {}", Num(*value), Num(*min), Num(*max))]
     Coefficient { value: f64, min: f64, max: f64 },
+    /// A river course with fewer than two control points.
+    #[error("a river's course needs at least two control points, found {0}")]
+    CourseTooShort(usize),
+    /// A river width, depth, water amount or hardness that is not above 0.
+    #[error("{} must be above 0", Num(*_0))]
+    NotPositive(f64),
+    /// More river iterations than [`crate::river::MAX_ITERATIONS`].
+    #[error("{0} iterations is more than the {max} a river may have", max = crate::river::MAX_ITERATIONS)]
+    TooManyIterations(u32),
 }
 
 /// Checks the whole document.
@@ -276,6 +285,7 @@ pub fn document(doc: &Document) -> Result<(), ValidationError> {
         region_overlap(i, m, masks.iter().enumerate().take(i))?;
     }
     rock_fields(doc)?;
+    rivers(doc)?;
     memory(doc)
 }
 
@@ -509,6 +519,40 @@ pub fn region_overlap<'a>(
                     other: format!("regions[{j}]"),
                     cell,
                 },
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Checks every river: at least two control points, all on the grid (a Bézier course stays
+/// within its control points' hull, so the course cannot leave the grid), a width, depth, water
+/// amount and hardness above 0, and at most [`crate::river::MAX_ITERATIONS`] iterations.
+pub fn rivers(doc: &Document) -> Result<(), ValidationError> {
+    for (i, r) in doc.rivers.iter().enumerate() {
+        let path = format!("rivers[{i}]");
+        if r.points.len() < 2 {
+            return Err(ValidationError::new(
+                format!("{path}.points"),
+                Defect::CourseTooShort(r.points.len()),
+            ));
+        }
+        points(&doc.grid, &r.points, &|k| format!("{path}.points[{k}]"))?;
+        for (name, v) in [
+            ("width", r.width),
+            ("depth", r.depth),
+            ("water", r.water),
+            ("hardness", r.hardness),
+        ] {
+            finite(v, || format!("{path}.{name}"))?;
+            if v <= 0.0 {
+                return Err(ValidationError::new(format!("{path}.{name}"), Defect::NotPositive(v)));
+            }
+        }
+        if r.iterations > crate::river::MAX_ITERATIONS {
+            return Err(ValidationError::new(
+                format!("{path}.iterations"),
+                Defect::TooManyIterations(r.iterations),
             ));
         }
     }

@@ -1,6 +1,8 @@
 //! Rivers (issue 13, seed 003): the diamonds against the iterated cross, the curvature formula,
 //! bank sides on a bend, oxbow lakes, the carved bed, determinism. Each property is checked by a
 //! computation of its own here.
+// Cells are addressed by window index in several parallel arrays.
+#![allow(clippy::needless_range_loop)]
 
 use glam::DVec2;
 use penmodel_terrain::river::course::{self, Sample};
@@ -368,4 +370,122 @@ fn a_fitted_course_passes_through_the_stroke() {
         let d = samples.iter().map(|s| s.p.distance(*p)).fold(f64::INFINITY, f64::min);
         assert!(d < 1.5, "the course is {d} from the stroke at {p}");
     }
+}
+
+/// A document with one region (a hill) and the Ω river across it.
+fn river_doc() -> penmodel_terrain::Document {
+    use penmodel_terrain::{Document, Figure, FigureKind, Region};
+    let mut d = Document::new(grid(200));
+    d.regions.push(Region {
+        boundary: vec![[2.0, 2.0], [198.0, 2.0], [198.0, 198.0], [2.0, 198.0], [2.0, 2.0]],
+        figures: vec![Figure {
+            kind: FigureKind::Point,
+            points: vec![[100.0, 20.0]],
+            height: 30.0,
+            slope: 0.0,
+            figures: Vec::new(),
+        }],
+    });
+    d.rivers.push(river(omega(18.0), 3.0, 4));
+    d
+}
+
+#[test]
+fn river_entries_load_validate_and_name_the_element() {
+    use penmodel_terrain::Document;
+    let d = river_doc();
+    let back = Document::from_json(&d.to_json()).expect("valid");
+    assert_eq!(back, d);
+    // Rivers need version 3.
+    let v2 = d.to_json().replace("\"version\": 3", "\"version\": 2");
+    let e = Document::from_json(&v2).expect_err("a v2 file with rivers");
+    assert_eq!(e.to_string(), "rivers: needs document version 3");
+    // Defaults: water 60, hardness 1, no iterations.
+    let text = d.to_json();
+    let start = text.find("\"rivers\"").expect("rivers in the file");
+    let bare = format!(
+        "{}\"rivers\": [{{\"points\": [[10.0, 10.0], [50.0, 60.0]], \"width\": 2.0, \"depth\": 1.0}}]\n}}\n",
+        &text[..start]
+    );
+    let doc = Document::from_json(&bare).expect("defaults");
+    assert_eq!(
+        (doc.rivers[0].water, doc.rivers[0].hardness, doc.rivers[0].iterations),
+        (60.0, 1.0, 0)
+    );
+    let bad = |f: &dyn Fn(&mut River), want: &str| {
+        let mut d = river_doc();
+        f(&mut d.rivers[0]);
+        let e = Document::from_json(&d.to_json()).expect_err(want);
+        assert_eq!(e.to_string(), want);
+    };
+    bad(
+        &|r| r.points.truncate(1),
+        "rivers[0].points: a river's course needs at least two control points, found 1",
+    );
+    bad(&|r| r.width = 0.0, "rivers[0].width: 0 must be above 0");
+    bad(&|r| r.depth = -1.0, "rivers[0].depth: -1 must be above 0");
+    bad(&|r| r.hardness = 0.0, "rivers[0].hardness: 0 must be above 0");
+    bad(
+        &|r| r.points[2] = [250.0, 10.0],
+        "rivers[0].points[2]: (250, 10) lies outside the grid [0, 200) × [0, 200) m",
+    );
+    bad(
+        &|r| r.iterations = river::MAX_ITERATIONS + 1,
+        "rivers[0].iterations: 21 iterations is more than the 20 a river may have",
+    );
+}
+
+#[test]
+fn river_edits_undo_and_recarve_incrementally() {
+    use penmodel_terrain::{Edit, Editor, generate};
+    let d = river_doc();
+    let mut ed = Editor::new(d.clone()).expect("valid");
+    let fresh = |doc: &penmodel_terrain::Document| generate(doc).expect("valid");
+    assert_eq!(ed.heightmap(), &fresh(&d));
+    // A carved river lowers the ground.
+    let mut dry = d.clone();
+    dry.rivers.clear();
+    let ground = fresh(&dry);
+    assert!(
+        ed.heightmap()
+            .heights()
+            .iter()
+            .zip(ground.heights())
+            .any(|(c, g)| c < g)
+    );
+    let mut more = d.rivers[0].clone();
+    more.iterations += 1;
+    more.width = 4.0;
+    ed.apply(Edit::ReplaceRiver {
+        index: 0,
+        river: more.clone(),
+    })
+    .expect("replaced");
+    assert_eq!(ed.heightmap(), &fresh(ed.document()));
+    ed.apply(Edit::AddRiver {
+        index: 1,
+        river: river(bend([100.0, 150.0], 30.0), 2.0, 1),
+    })
+    .expect("added");
+    assert_eq!(ed.heightmap(), &fresh(ed.document()));
+    ed.apply(Edit::DeleteRiver { index: 0 }).expect("deleted");
+    assert_eq!(ed.heightmap(), &fresh(ed.document()));
+    for _ in 0..3 {
+        ed.undo().expect("undo");
+    }
+    assert_eq!(ed.document(), &d);
+    assert_eq!(ed.heightmap(), &fresh(&d));
+    // A bad river is refused and the document kept.
+    let mut bad = more;
+    bad.depth = 0.0;
+    let e = ed
+        .apply(Edit::ReplaceRiver { index: 0, river: bad })
+        .expect_err("refused");
+    assert!(e.to_string().contains("rivers[0].depth"), "{e}");
+    assert_eq!(ed.document(), &d);
+    // The journal's form.
+    let e = Edit::DeleteRiver { index: 2 };
+    let line = serde_json::to_string(&e).expect("json");
+    assert_eq!(line, r#"{"op":"delete_river","index":2}"#);
+    assert_eq!(serde_json::from_str::<Edit>(&line).expect("parses"), e);
 }
