@@ -54,7 +54,8 @@ pub struct LiveArgs {
     /// The folder for frames and results (always a folder: the document, the terrain, renders).
     #[arg(long, value_name = "DIR", default_value = "out")]
     out: PathBuf,
-    /// Frame size in pixels [default: 1280x720 in a window, 960x540 for files].
+    /// Frame size in pixels [default: 1280x720 in a window; for files, 640x360 for the
+    /// animation's frames and 960x540 for the final renders].
     #[arg(long, value_name = "WxH", value_parser = size)]
     size: Option<(u32, u32)>,
     /// Leave out the overview: the terrain from an orbit camera, where heights read at a glance,
@@ -323,9 +324,13 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
     } else {
         None
     };
+    // Headless, the animation's frames are small enough to mail (640 × 360 views, 960 × 360
+    // with the overview beside them: the demo's animation is a few MB) and the final renders
+    // are 960 × 540; `--size` sets both. In a window, the window's size.
+    let windowed = viewer.is_some();
     let (w, h) = args
         .size
-        .unwrap_or(if viewer.is_some() { (1280, 720) } else { (960, 540) });
+        .unwrap_or(if windowed { (1280, 720) } else { (640, 360) });
     let layout = match (args.no_overview, viewer.is_some()) {
         (true, _) | (false, true) => Overview::Off,
         (false, false) => Overview::Beside,
@@ -356,7 +361,13 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
         .editor
         .save()
         .with_context(|| format!("cannot save {}", doc_path.display()))?;
-    let results = write_results(&args.out, args.meshes, &session, &look, &mut painter)?;
+    let results_size = match (args.size, windowed) {
+        (Some(size), _) => size,
+        (None, true) => (painter.view.width(), painter.view.height()),
+        (None, false) => (960, 540),
+    };
+    let mut results_painter = Painter::new(results_size.0, results_size.1, Overview::Off)?;
+    let results = write_results(&args.out, args.meshes, &session, &look, &mut results_painter)?;
     let stats = session.interaction.stats().clone();
     let state = match session.state() {
         State::Running => "stopped".to_string(),
