@@ -328,9 +328,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
     // with the overview beside them: the demo's animation is a few MB) and the final renders
     // are 960 × 540; `--size` sets both. In a window, the window's size.
     let windowed = viewer.is_some();
-    let (w, h) = args
-        .size
-        .unwrap_or(if windowed { (1280, 720) } else { (640, 360) });
+    let (w, h) = args.size.unwrap_or(if windowed { (1280, 720) } else { (640, 360) });
     let layout = match (args.no_overview, viewer.is_some()) {
         (true, _) | (false, true) => Overview::Off,
         (false, false) => Overview::Beside,
