@@ -211,7 +211,7 @@ fn check_seated(rocks: &Rocks, map: &Heightmap) -> usize {
         let mut seen = f.flat.order.clone();
         seen.sort_unstable();
         assert!(seen.iter().copied().eq(0..f.scatter.rocks.len() as u32));
-        for rock in f.flat.order.iter().map(|&i| &f.scatter.rocks[i as usize]) {
+        for rock in f.flat.order.iter().filter_map(|&i| f.scatter.rocks.get(i as usize)) {
             for (k, v) in rock.mesh.vertices.iter().enumerate() {
                 let p = mesh.positions[at + k];
                 let ground = on_terrain(map, f64::from(p[0]), f64::from(p[2]));
@@ -271,7 +271,7 @@ fn rocks_stand_on_the_terrain_and_follow_it() {
     // Every kept cell lies inside the outline: its pixels' centres are.
     let f = &rocks.fields()[0];
     for rock in &f.scatter.rocks {
-        for v in &rock.polygon {
+        for v in rock.polygon {
             let p = [v[0] * 0.5 + f.image.origin[0], v[1] * 0.5 + f.image.origin[1]];
             assert!(
                 (-0.6..=50.6).contains(&p[0]) && (-0.6..=40.6).contains(&p[1]),

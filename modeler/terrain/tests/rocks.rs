@@ -199,9 +199,9 @@ fn each_rock_has_as_many_added_points_as_cell_vertices_and_a_delaunay_triangulat
         assert!(k >= 3, "rock {n}: a cell of {k} vertices");
         assert_eq!(rock.mesh.added.len(), k, "rock {n}: added points");
         assert_eq!(rock.mesh.vertices.len(), 2 * k);
-        let pts: Vec<[f64; 2]> = rock.polygon.iter().chain(&rock.mesh.added).copied().collect();
+        let pts: Vec<[f64; 2]> = rock.polygon.iter().chain(rock.mesh.added).copied().collect();
         // Each added point lies inside the (convex, positive) cell.
-        for p in &rock.mesh.added {
+        for p in rock.mesh.added {
             for i in 0..k {
                 let (a, b) = (rock.polygon[i], rock.polygon[(i + 1) % k]);
                 assert!(
@@ -214,7 +214,7 @@ fn each_rock_has_as_many_added_points_as_cell_vertices_and_a_delaunay_triangulat
         assert_eq!(rock.mesh.triangles.len(), 2 * pts.len() - k - 2, "rock {n}");
         let mut covered = 0.0;
         let scale = area(&rock.polygon);
-        for t in &rock.mesh.triangles {
+        for t in rock.mesh.triangles {
             let [a, b, c] = t.map(|i| pts[i as usize]);
             let doubled = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
             assert!(doubled <= 0.0, "rock {n}: triangle {t:?} is not clockwise in (x, y)");
@@ -245,7 +245,7 @@ fn cells_are_their_pixels_and_rim_vertices_stay_on_the_ground() {
         let seed = d.seeds[rock.cell as usize];
         let k = rock.polygon.len();
         // Every polygon vertex is at least as near its own seed as any other (a Voronoi cell).
-        for v in &rock.polygon {
+        for v in rock.polygon {
             let own = (v[0] - seed[0]).powi(2) + (v[1] - seed[1]).powi(2);
             for o in &d.seeds {
                 let other = (v[0] - o[0]).powi(2) + (v[1] - o[1]).powi(2);

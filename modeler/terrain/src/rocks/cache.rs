@@ -72,7 +72,7 @@ impl Rocks {
                         height: image.height,
                         field_pixels: 0,
                         diagrams: Vec::new(),
-                        rocks: Vec::new(),
+                        rocks: Default::default(),
                         timing: Default::default(),
                     });
                     Field {

@@ -4,20 +4,24 @@
 //! Why not a general triangulator: a rock has about ten points and a field tens of thousands of
 //! rocks, so the cost is per call, not per point. `delaunator` (fast, robust orientation) spent
 //! about 1.8 µs a rock here, most of it setting up its hull structures and a dozen allocations;
-//! this starts from the cell's fan, which is already a triangulation of the hull, inserts the
-//! points by splitting the triangle holding each, and flips edges (Lawson) until every edge is
-//! locally Delaunay, with two allocations — about 4 times faster on fig. 1
-//! (`cargo bench -p penmodel-terrain --bench rocks -- delaunay`). The predicates are the
-//! `robust` crate's exact `orient2d` and `incircle` (Shewchuk's adaptive arithmetic), so the
-//! flips end, and the result is Delaunay, even for cocircular cell vertices; `incircle` goes
-//! through [`super::predicates`], which skips `robust`'s costly set-up on the cocircular cells
-//! that are common here and returns the same values.
+//! this starts from the cell's fan, which is already a triangulation of the hull, makes it
+//! Delaunay by flipping edges (Lawson), then inserts the points one by one — walking from the
+//! last new triangle to the one holding the point, splitting it in three, and flipping the edges
+//! facing the point while they are not locally Delaunay — in memory reused from rock to rock
+//! (`cargo bench -p penmodel-terrain --bench rocks -- delaunay`). Orientation is `robust`'s
+//! exact `orient2d`; the incircle test is its filter ([`super::predicates`]): an edge is flipped
+//! only when that is certain, so the flips end and the result is Delaunay to within rounding,
+//! cocircular cells included.
 
 use robust::{Coord, orient2d};
 
 use super::predicates::incircle;
 
 const NONE: u32 = u32::MAX;
+/// Edge indices one and two on from an edge (tables, not `% 3`: flips run a few dozen times a
+/// rock).
+const NEXT: [usize; 3] = [1, 2, 0];
+const AFTER: [usize; 3] = [2, 0, 1];
 
 fn c(p: [f64; 2]) -> Coord<f64> {
     Coord { x: p[0], y: p[1] }
@@ -53,17 +57,14 @@ impl Mesh<'_> {
         }
     }
 
-    /// Flips edge `e` of `t` if the vertex across it lies inside `t`'s circumcircle; returns the
-    /// two edges that became outer edges of the flipped pair, to be checked in turn.
-    fn legalize(&mut self, t: u32, e: usize, stack: &mut Vec<(u32, usize)>) {
+    /// Flips edge `e` of `t` if the vertex across it lies inside `t`'s circumcircle. The flipped
+    /// pair is `t = (a, q, p)`, `u = (q, b, p)` (`p` was `t`'s vertex facing the edge `(a, b)`,
+    /// `q` the other's); returns `u`.
+    fn legalize(&mut self, t: u32, e: usize) -> Option<u32> {
         let u = self.adj[t as usize][e];
         if u == NONE {
-            return;
+            return None;
         }
-        // Edge indices one and two on from `e` (a table, not `% 3`: this runs a few dozen
-        // times per rock).
-        const NEXT: [usize; 3] = [1, 2, 0];
-        const AFTER: [usize; 3] = [2, 0, 1];
         let tt = self.tri[t as usize];
         let [a, b, p] = [tt[e], tt[NEXT[e]], tt[AFTER[e]]];
         let au = self.adj[u as usize];
@@ -74,12 +75,12 @@ impl Mesh<'_> {
         } else if au[2] == t {
             2
         } else {
-            return;
+            return None;
         };
         let q = self.tri[u as usize][AFTER[f]];
         let pt = |i: u32| self.points[i as usize];
         if incircle(pt(a), pt(b), pt(p), pt(q)) <= 0.0 {
-            return;
+            return None;
         }
         let at = self.adj[t as usize];
         let (ta, tb) = (at[AFTER[e]], at[NEXT[e]]);
@@ -90,14 +91,51 @@ impl Mesh<'_> {
         self.adj[u as usize] = [ub, tb, t];
         self.repoint(ua, u, t);
         self.repoint(tb, t, u);
-        stack.push((t, 0));
-        stack.push((u, 0));
+        Some(u)
     }
 
-    fn settle(&mut self, stack: &mut Vec<(u32, usize)>) {
+    /// Flips until the edges on `stack` and those a flip exposes are locally Delaunay. After
+    /// inserting a point `p` only the edges facing it need checking (Lawson); otherwise all
+    /// four outer edges of a flipped pair.
+    fn settle(&mut self, stack: &mut Vec<(u32, usize)>, inserting: bool) {
         while let Some((t, e)) = stack.pop() {
-            self.legalize(t, e, stack);
+            if let Some(u) = self.legalize(t, e) {
+                stack.push((t, 0));
+                stack.push((u, 0));
+                if !inserting {
+                    stack.push((t, 2));
+                    stack.push((u, 1));
+                }
+            }
         }
+    }
+
+    /// The triangle holding point `p` (inside the hull), walking from triangle `from` towards it
+    /// across the edge it lies beyond; a full search if the walk goes on too long (it cannot
+    /// loop in a Delaunay triangulation, but this one is Delaunay only to within rounding).
+    fn locate(&self, from: u32, p: Coord<f64>) -> Option<u32> {
+        let mut t = from;
+        'walk: for _ in 0..self.tri.len() + 4 {
+            let v = self.tri[t as usize];
+            for e in 0..3 {
+                let (a, b) = (v[e], v[NEXT[e]]);
+                if orient2d(self.p(a), self.p(b), p) < 0.0 {
+                    let n = self.adj[t as usize][e];
+                    if n == NONE {
+                        break 'walk;
+                    }
+                    t = n;
+                    continue 'walk;
+                }
+            }
+            return Some(t);
+        }
+        (0..self.tri.len() as u32).find(|&t| {
+            let [a, b, c] = self.tri[t as usize];
+            orient2d(self.p(a), self.p(b), p) >= 0.0
+                && orient2d(self.p(b), self.p(c), p) >= 0.0
+                && orient2d(self.p(c), self.p(a), p) >= 0.0
+        })
     }
 }
 
@@ -127,24 +165,15 @@ pub fn triangulate_with<'a>(points: &[[f64; 2]], hull: usize, scratch: &'a mut S
         let after = if i + 1 == fan { NONE } else { i as u32 + 1 };
         m.adj.push([before, NONE, after]);
     }
-    for t in 0..fan as u32 {
-        stack.push((t, 0));
-        stack.push((t, 2));
-    }
-    m.settle(stack);
+    // Its diagonals: edge 2 of each triangle but the last.
+    stack.extend((0..fan as u32 - 1).map(|t| (t, 2)));
+    m.settle(stack, false);
     for v in hull..n {
         let v = v as u32;
-        let pv = m.p(v);
-        let found = (0..m.tri.len()).find(|&t| {
-            let [a, b, c] = m.tri[t];
-            orient2d(m.p(a), m.p(b), pv) >= 0.0
-                && orient2d(m.p(b), m.p(c), pv) >= 0.0
-                && orient2d(m.p(c), m.p(a), pv) >= 0.0
-        });
-        let Some(t) = found else {
+        let last = m.tri.len() as u32 - 1;
+        let Some(t) = m.locate(last, m.p(v)) else {
             continue;
         };
-        let t = t as u32;
         let [a, b, cc] = m.tri[t as usize];
         let [na, nb, nc] = m.adj[t as usize];
         let (t1, t2) = (m.tri.len() as u32, m.tri.len() as u32 + 1);
@@ -157,7 +186,7 @@ pub fn triangulate_with<'a>(points: &[[f64; 2]], hull: usize, scratch: &'a mut S
         m.repoint(nb, t, t1);
         m.repoint(nc, t, t2);
         stack.extend([(t, 0), (t1, 0), (t2, 0)]);
-        m.settle(stack);
+        m.settle(stack, true);
     }
     &scratch.tri
 }

@@ -19,6 +19,7 @@
 pub mod cache;
 pub mod delaunay;
 pub mod field;
+pub mod list;
 pub mod place;
 pub mod poisson;
 mod predicates;
@@ -34,6 +35,7 @@ use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
 use thiserror::Error;
 
+pub use list::{Rock, RockList};
 pub use select::Goal;
 pub use shape::{RockMesh, Shape};
 
@@ -223,19 +225,6 @@ pub struct Diagram {
     pub reached: bool,
 }
 
-/// A rock: a kept cell and its mesh.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Rock {
-    /// The diagram (layer index) it came from.
-    pub diagram: usize,
-    /// The cell (seed index in its diagram).
-    pub cell: u32,
-    /// The cell's polygon, counter-clockwise in (x, y) (positive area), no repeated vertex.
-    pub polygon: Vec<[f64; 2]>,
-    /// The mesh.
-    pub mesh: RockMesh,
-}
-
 /// Milliseconds per stage (summed over diagrams where they run one after another).
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub struct Timing {
@@ -268,7 +257,7 @@ pub struct Scatter {
     /// One per layer, in the recipe's order.
     pub diagrams: Vec<Diagram>,
     /// The rocks, diagram by diagram in selection order, each in the order drawn.
-    pub rocks: Vec<Rock>,
+    pub rocks: RockList,
     /// Stage times.
     pub timing: Timing,
 }
@@ -387,37 +376,68 @@ pub fn scatter(recipe: &Recipe, inside: Option<&[bool]>) -> Result<Scatter, Reci
         by_place.extend(cells.iter().enumerate().map(|(k, &c)| (i, c, first + k)));
         by_place[first..].sort_unstable_by_key(|m| m.1);
     }
-    let mut cut: Vec<Vec<[f64; 2]>> = by_place
-        .par_iter()
-        .map(|&(i, cell, _)| voronoi::cell_polygon(&diagrams[i].seeds, &buckets[i], width, height, cell as usize))
-        .collect();
-    let mut slot = vec![0u32; by_place.len()];
-    for (j, m) in by_place.iter().enumerate() {
-        slot[m.2] = j as u32;
-    }
-    let polygons: Vec<(usize, u32, Vec<[f64; 2]>)> = slot
-        .iter()
-        .map(|&j| {
-            let (i, cell, _) = by_place[j as usize];
-            (i, cell, std::mem::take(&mut cut[j as usize]))
+    // Cut into blocks of whole rocks in that order, one block per task: the same blocks on any
+    // number of threads.
+    let mut blocks: Vec<list::Block> = by_place
+        .par_chunks(list::BLOCK)
+        .map(|part| {
+            let mut block = list::Block::with_rocks(part.len());
+            for &(i, cell, _) in part {
+                let d = &diagrams[i];
+                voronoi::cell_polygon(&d.seeds, &buckets[i], width, height, cell as usize, &mut block.polygons);
+                block.end_polygon();
+            }
+            block
         })
         .collect();
     timing.polygons = ms(t);
     let t = Instant::now();
-    let rocks: Vec<Rock> = polygons
-        .into_par_iter()
-        .map(|(i, cell, polygon)| {
+    blocks.par_iter_mut().enumerate().for_each(|(b, block)| {
+        let part = &by_place[b * list::BLOCK..];
+        let corners = block.polygons.len();
+        block.added.reserve(corners);
+        block.vertices.reserve(2 * corners);
+        block.triangles.reserve(3 * corners);
+        for (k, &(i, cell, _)) in part.iter().take(block.len()).enumerate() {
             let layer = &recipe.layers[i];
             let mut rng = stream(recipe.seed, SHAPE, i, u64::from(cell));
-            let mesh = shape::rock(&polygon, layer.radius, &layer.shape, &mut rng);
-            Rock {
-                diagram: i,
-                cell,
-                polygon,
-                mesh,
-            }
-        })
-        .collect();
+            let list::Block {
+                polygons,
+                polygon_starts,
+                added,
+                vertices,
+                triangles,
+                ..
+            } = block;
+            let polygon = &polygons[polygon_starts[k] as usize..polygon_starts[k + 1] as usize];
+            let out = shape::Out {
+                added,
+                vertices,
+                triangles,
+            };
+            shape::rock_into(polygon, layer.radius, &layer.shape, &mut rng, out);
+            block.end_mesh();
+        }
+    });
+    // Listed in the order drawn.
+    let mut at = vec![
+        list::At {
+            diagram: 0,
+            cell: 0,
+            block: 0,
+            index: 0
+        };
+        by_place.len()
+    ];
+    for (j, &(i, cell, drawn)) in by_place.iter().enumerate() {
+        at[drawn] = list::At {
+            diagram: i as u32,
+            cell,
+            block: (j / list::BLOCK) as u32,
+            index: (j % list::BLOCK) as u32,
+        };
+    }
+    let rocks = RockList { at, blocks };
     timing.meshes = ms(t);
     timing.total = ms(start);
     Ok(Scatter {

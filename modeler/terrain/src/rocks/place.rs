@@ -66,8 +66,8 @@ impl Flat {
         let t: usize = scatter.rocks.iter().map(|r| r.mesh.triangles.len()).sum();
         let mut order: Vec<u32> = (0..scatter.rocks.len() as u32).collect();
         let seed = |i: u32| {
-            let r = &scatter.rocks[i as usize];
-            scatter.diagrams[r.diagram].seeds[r.cell as usize]
+            let at = &scatter.rocks.at[i as usize];
+            scatter.diagrams[at.diagram as usize].seeds[at.cell as usize]
         };
         order.sort_by(|&a, &b| {
             let (p, q) = (seed(a), seed(b));
@@ -84,7 +84,9 @@ impl Flat {
             local: Vec::with_capacity(t),
         };
         for (k, &i) in f.order.iter().enumerate() {
-            let rock = &scatter.rocks[i as usize];
+            let Some(rock) = scatter.rocks.get(i as usize) else {
+                continue;
+            };
             let start = f.blocks.last().map_or(0, |b| b.0);
             if f.vertices.len() - start >= BLOCK {
                 f.blocks.push((f.vertices.len(), k));

@@ -28,16 +28,16 @@ impl Shape {
     };
 }
 
-/// One rock's mesh in field coordinates (cells; z up, in cells).
-#[derive(Debug, Clone, PartialEq)]
-pub struct RockMesh {
+/// One rock's mesh in field coordinates (cells; z up, in cells), borrowed from its scatter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RockMesh<'a> {
     /// The added points where they were drawn, before eq. 2 and 3.
-    pub added: Vec<[f64; 2]>,
+    pub added: &'a [[f64; 2]],
     /// The cell's vertices (z = 0), then the added points moved and raised.
-    pub vertices: Vec<[f64; 3]>,
+    pub vertices: &'a [[f64; 3]],
     /// Triangles as vertex indices, clockwise in (x, y) — counter-clockwise seen from above when
     /// y is drawn downwards or mapped to the exports' Z with Y up.
-    pub triangles: Vec<[u32; 3]>,
+    pub triangles: &'a [[u32; 3]],
 }
 
 fn cross(o: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
@@ -60,12 +60,20 @@ fn inside(cell: &[[f64; 2]], fan: &[f64], rng: &mut impl Rng) -> [f64; 2] {
     ]
 }
 
-/// The rock of convex cell `cell` (at least 3 vertices) of a diagram of radius `radius`.
-pub fn rock(cell: &[[f64; 2]], radius: f64, shape: &Shape, rng: &mut impl Rng) -> RockMesh {
-    SCRATCH.with_borrow_mut(|scratch| rock_with(cell, radius, shape, rng, scratch))
+/// The rock of convex cell `cell` (at least 3 vertices) of a diagram of radius `radius`,
+/// appended to `block`'s added points, vertices and triangles (the caller closes it).
+pub(crate) fn rock_into(cell: &[[f64; 2]], radius: f64, shape: &Shape, rng: &mut impl Rng, block: Out<'_>) {
+    SCRATCH.with_borrow_mut(|scratch| rock_with(cell, radius, shape, rng, scratch, block))
 }
 
-/// Working memory of [`rock`], one per thread.
+/// Where [`rock_into`] writes.
+pub(crate) struct Out<'a> {
+    pub(crate) added: &'a mut Vec<[f64; 2]>,
+    pub(crate) vertices: &'a mut Vec<[f64; 3]>,
+    pub(crate) triangles: &'a mut Vec<[u32; 3]>,
+}
+
+/// Working memory of [`rock_into`], one per thread.
 #[derive(Debug, Default)]
 struct Scratch {
     fan: Vec<f64>,
@@ -77,7 +85,7 @@ thread_local! {
     static SCRATCH: std::cell::RefCell<Scratch> = std::cell::RefCell::default();
 }
 
-fn rock_with(cell: &[[f64; 2]], radius: f64, shape: &Shape, rng: &mut impl Rng, scratch: &mut Scratch) -> RockMesh {
+fn rock_with(cell: &[[f64; 2]], radius: f64, shape: &Shape, rng: &mut impl Rng, scratch: &mut Scratch, out: Out<'_>) {
     let k = cell.len();
     let fan = &mut scratch.fan;
     fan.clear();
@@ -86,29 +94,27 @@ fn rock_with(cell: &[[f64; 2]], radius: f64, shape: &Shape, rng: &mut impl Rng, 
         sum += cross(cell[0], cell[t + 1], cell[t + 2]).abs() * 0.5;
         fan.push(sum);
     }
-    let added: Vec<[f64; 2]> = if sum > 0.0 {
-        (0..k).map(|_| inside(cell, fan, rng)).collect()
-    } else {
-        Vec::new()
-    };
-    let points = &mut scratch.points;
-    points.clear();
-    points.extend(cell.iter().chain(&added));
-    // Counter-clockwise in (x, y) from the triangulation; turned clockwise (see `triangles`).
-    let triangles: Vec<[u32; 3]> = if added.is_empty() {
-        Vec::new()
-    } else {
-        super::delaunay::triangulate_with(points, k, &mut scratch.delaunay)
-            .iter()
-            .map(|&[a, b, c]| [a, c, b])
-            .collect()
-    };
+    let first = out.added.len();
+    if sum > 0.0 {
+        out.added.extend((0..k).map(|_| inside(cell, fan, rng)));
+    }
+    let added = &out.added[first..];
+    if !added.is_empty() {
+        let points = &mut scratch.points;
+        points.clear();
+        points.extend(cell.iter().chain(added));
+        // Counter-clockwise in (x, y) from the triangulation; turned clockwise (see `triangles`).
+        out.triangles.extend(
+            super::delaunay::triangulate_with(points, k, &mut scratch.delaunay)
+                .iter()
+                .map(|&[a, b, c]| [a, c, b]),
+        );
+    }
     let n = added.len().max(1) as f64;
     let g = added.iter().fold([0.0, 0.0], |g, p| [g[0] + p[0] / n, g[1] + p[1] / n]);
     let j1: f64 = rng.random();
-    let mut vertices: Vec<[f64; 3]> = Vec::with_capacity(k + added.len());
-    vertices.extend(cell.iter().map(|p| [p[0], p[1], 0.0]));
-    for p in &added {
+    out.vertices.extend(cell.iter().map(|p| [p[0], p[1], 0.0]));
+    for p in added {
         let j2: f64 = rng.random();
         let [w1, w2, w3] = shape.widths;
         let [h1, h2, h3] = shape.heights;
@@ -122,11 +128,6 @@ fn rock_with(cell: &[[f64; 2]], radius: f64, shape: &Shape, rng: &mut impl Rng, 
         } else {
             *p
         };
-        vertices.push([q[0], q[1], t_z]);
-    }
-    RockMesh {
-        added,
-        vertices,
-        triangles,
+        out.vertices.push([q[0], q[1], t_z]);
     }
 }

@@ -24,7 +24,7 @@ pub fn top_view(scatter: &Scatter, scale: u32) -> (u32, u32, Vec<u8>) {
         .collect();
     let s = f64::from(scale);
     for rock in &scatter.rocks {
-        let poly = &rock.polygon;
+        let poly = rock.polygon;
         let order = scatter.diagrams[rock.diagram].order;
         // A cell's shade from its index, spread by a multiplicative hash.
         let shade = 0.8 + 0.4 * f64::from(rock.cell.wrapping_mul(2_654_435_761) >> 24) / 255.0;

@@ -86,6 +86,22 @@ impl Buckets {
         }
     }
 
+    /// Calls `f` with each seed (index and position) in the buckets that meet the square of
+    /// half-side `half` about `p`: every seed within `half` of `p`, and some farther. A row of
+    /// buckets is one run of `seeds`.
+    fn square(&self, p: [f64; 2], half: f64, mut f: impl FnMut(u32, [f64; 2])) {
+        let at = |v: f64, n: i32| ((v / self.size).floor().max(0.0) as i32).min(n - 1);
+        let (c0, c1) = (at(p[0] - half, self.cols), at(p[0] + half, self.cols));
+        let (r0, r1) = (at(p[1] - half, self.rows), at(p[1] + half, self.rows));
+        for r in r0..=r1 {
+            let row = (r * self.cols) as usize;
+            let run = self.start[row + c0 as usize] as usize..self.start[row + c1 as usize + 1] as usize;
+            for &(s, q) in &self.seeds[run] {
+                f(s, q);
+            }
+        }
+    }
+
     /// The largest ring index that still meets the grid from `(c, r)`.
     fn last_ring(&self, (c, r): (i32, i32)) -> i32 {
         c.max(self.cols - 1 - c).max(r).max(self.rows - 1 - r)
@@ -202,9 +218,12 @@ fn clip(poly: &mut Vec<[f64; 2]>, scratch: &mut Vec<[f64; 2]>, s: [f64; 2], q: [
         return;
     }
     scratch.clear();
-    for i in 0..poly.len() {
-        let (a, b) = (poly[i], poly[(i + 1) % poly.len()]);
-        let (sa, sb) = (side(a), side(b));
+    let len = poly.len();
+    let mut sa = side(poly[0]);
+    for i in 0..len {
+        // The next vertex without `% len` (a division per edge).
+        let (a, b) = (poly[i], poly[if i + 1 == len { 0 } else { i + 1 }]);
+        let sb = side(b);
         if sa <= 0.0 {
             scratch.push(a);
         }
@@ -212,20 +231,23 @@ fn clip(poly: &mut Vec<[f64; 2]>, scratch: &mut Vec<[f64; 2]>, s: [f64; 2], q: [
             let t = sa / (sa - sb);
             scratch.push([a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t]);
         }
+        sa = sb;
     }
     std::mem::swap(poly, scratch);
 }
 
 /// The polygon of the cell of `points[cell]` within the `width × height` rectangle, its
-/// vertices counter-clockwise in (x, y) with y down (clockwise on screen), without repeats.
+/// vertices counter-clockwise in (x, y) with y down (clockwise on screen), without repeats,
+/// appended to `dst`.
 pub(crate) fn cell_polygon(
     points: &[[f64; 2]],
     buckets: &Buckets,
     width: u32,
     height: u32,
     cell: usize,
-) -> Vec<[f64; 2]> {
-    POLYGON.with_borrow_mut(|p| cell_polygon_with(points, buckets, width, height, cell, p))
+    dst: &mut Vec<[f64; 2]>,
+) {
+    POLYGON.with_borrow_mut(|p| cell_polygon_with(points, buckets, width, height, cell, p, dst))
 }
 
 /// Working memory of [`cell_polygon`], one per thread (a field's tens of thousands of cells
@@ -249,7 +271,8 @@ fn cell_polygon_with(
     height: u32,
     cell: usize,
     work: &mut PolygonScratch,
-) -> Vec<[f64; 2]> {
+    dst: &mut Vec<[f64; 2]>,
+) {
     let s = points[cell];
     let (w, h) = (f64::from(width), f64::from(height));
     let PolygonScratch {
@@ -260,39 +283,40 @@ fn cell_polygon_with(
     } = work;
     poly.clear();
     poly.extend([[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]]);
-    let home = buckets.bucket_of(s);
-    let last = buckets.last_ring(home);
     let reach = |poly: &[[f64; 2]]| {
         poly.iter()
             .map(|p| (p[0] - s[0]).powi(2) + (p[1] - s[1]).powi(2))
             .fold(0.0, f64::max)
     };
-    // Neighbours nearest first: (squared distance, seed). A seed at distance d cuts the polygon
-    // only if the polygon reaches beyond d/2 from `s`, so the cutting stops at the first seed
-    // farther than twice the reach; seeds beyond ring k of buckets are farther than k·size.
-    near.clear();
-    let mut next = 0;
+    // Neighbours: (squared distance, seed). A seed at distance d cuts the polygon only if the
+    // polygon reaches beyond d/2 from `s`, so seeds farther than twice the reach are skipped. Seeds are gathered from a square about `s` of half-side
+    // `want`, first a guess from the bucket size (about the radius: cells of a saturated
+    // diagram reach about r from their seed), widened while the polygon may reach beyond half
+    // of what was gathered; `done`: every seed within it has cut.
     let mut reach2 = reach(poly);
-    'rings: for ring in 0..=last {
-        buckets.ring(home, ring, |q, p| {
-            if q as usize != cell {
-                near.push(((p[0] - s[0]).powi(2) + (p[1] - s[1]).powi(2), p));
+    let (mut done, mut want) = (0.0f64, 1.5 * buckets.size + 1.0);
+    let far = w.hypot(h);
+    loop {
+        near.clear();
+        let (done2, want2) = (done * done, want * want);
+        buckets.square(s, want, |q, p| {
+            let d2 = (p[0] - s[0]).powi(2) + (p[1] - s[1]).powi(2);
+            if q as usize != cell && d2 > done2 && d2 <= want2 {
+                near.push((d2, p));
             }
         });
-        near[next..].sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
-        let covered = f64::from(ring) * buckets.size;
-        let covered2 = covered * covered;
-        while next < near.len() && near[next].0 <= covered2 {
-            if near[next].0 > 4.0 * reach2 {
-                break 'rings;
+        // In bucket order, not sorted: sorting cost more than the clips it saves.
+        for &(d2, p) in near.iter() {
+            if d2 <= 4.0 * reach2 {
+                clip(poly, scratch, s, p);
+                reach2 = reach(poly);
             }
-            clip(poly, scratch, s, near[next].1);
-            reach2 = reach(poly);
-            next += 1;
         }
-        if 4.0 * reach2 <= covered2 {
+        done = want;
+        if 4.0 * reach2 <= done * done || done >= far {
             break;
         }
+        want = (2.0 * reach2.sqrt()).max(1.5 * done).min(far);
     }
     // Clipping through a vertex shared by several bisectors repeats it; drop the repeats.
     out.clear();
@@ -318,5 +342,5 @@ fn cell_polygon_with(
             i += 1;
         }
     }
-    out.to_vec()
+    dst.extend_from_slice(out);
 }
