@@ -17,8 +17,8 @@
 //! * Vendor 0xFF00 / 0x01: the project's own pen report 0x01 (3D, tracker or display frame,
 //!   with its quality), described field by field as before but where no OS pen stack binds
 //!   (Windows and Linux take input only from Generic Desktop, Digitizer and Consumer
-//!   application collections); the diagnostics input report 0x02 and the feature reports
-//!   0x03–0x06, opaque byte arrays whose layout the report codecs define.
+//!   application collections); the diagnostics input report 0x02, the head report 0x08 and the
+//!   feature reports 0x03–0x06, opaque byte arrays whose layout the report codecs define.
 
 use usbd_hid::descriptor::{AsInputReport, BufferOverflow, SerializedDescriptor};
 use usbd_hid_descriptors::{GlobalItemKind as G, ItemType, LocalItemKind as L, MainItemKind as M};
@@ -26,6 +26,7 @@ use usbd_hid_descriptors::{GlobalItemKind as G, ItemType, LocalItemKind as L, Ma
 use crate::ReportId;
 use crate::codec::Report;
 use crate::config::Config;
+use crate::head::HeadReport;
 use crate::info::DeviceInfo;
 
 use crate::pen::{POSITION_LOGICAL_MAX, PenReport};
@@ -355,6 +356,7 @@ impl Builder {
             .end_collection()
             // Diagnostics and feature reports as byte arrays.
             .vendor_bytes(ReportId::Tof, TofReport::LEN, false)
+            .vendor_bytes(ReportId::Head, HeadReport::LEN, false)
             .vendor_bytes(ReportId::DeviceInfo, DeviceInfo::LEN, true)
             .vendor_bytes(ReportId::Config, Config::LEN, true)
             .vendor_bytes(ReportId::Status, Status::LEN, true)
@@ -438,6 +440,12 @@ impl SerializedDescriptor for PenReport {
 }
 
 impl AsInputReport for PenReport {
+    fn serialize(&self, buffer: &mut [u8]) -> Result<usize, BufferOverflow> {
+        self.encode(buffer).map_err(|_| BufferOverflow)
+    }
+}
+
+impl AsInputReport for HeadReport {
     fn serialize(&self, buffer: &mut [u8]) -> Result<usize, BufferOverflow> {
         self.encode(buffer).map_err(|_| BufferOverflow)
     }

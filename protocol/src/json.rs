@@ -317,6 +317,25 @@ struct OsPenJson {
     y_mm: u16,
 }
 
+/// The head report: its fields, positions in mm.
+#[derive(Serialize)]
+struct HeadJson<'a> {
+    report_id: u8,
+    report: &'static str,
+    no_fix: bool,
+    display_frame: bool,
+    #[serde(serialize_with = "tenths")]
+    x_mm: i16,
+    #[serde(serialize_with = "tenths")]
+    y_mm: i16,
+    #[serde(serialize_with = "tenths")]
+    z_mm: i16,
+    prediction_ms: u8,
+    seq: u16,
+    timestamp_us: u32,
+    quality: &'a Quality,
+}
+
 #[derive(Serialize)]
 struct CommandJson {
     report_id: u8,
@@ -377,6 +396,20 @@ impl Serialize for Message {
                 in_range: r.in_range,
                 x_mm: r.x,
                 y_mm: r.y,
+            }
+            .serialize(s),
+            Message::Head(r) => HeadJson {
+                report_id: ReportId::Head as u8,
+                report: ReportId::Head.name(),
+                no_fix: r.no_fix,
+                display_frame: r.display_frame,
+                x_mm: r.position.x,
+                y_mm: r.position.y,
+                z_mm: r.position.z,
+                prediction_ms: r.prediction_ms,
+                seq: r.seq,
+                timestamp_us: r.timestamp_us,
+                quality: &r.quality,
             }
             .serialize(s),
             Message::GetFeature(r) => r.json(tag).serialize(s),

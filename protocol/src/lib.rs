@@ -7,6 +7,7 @@ mod config;
 mod descriptor;
 mod error;
 mod frame;
+mod head;
 // The fuzz targets' properties, shared with the stable test that replays their corpora.
 #[doc(hidden)]
 pub mod fuzzing;
@@ -27,6 +28,7 @@ pub use config::{Config, ConfigError, ConfigField, DisplayPose, Filter, Problem,
 pub use descriptor::{Descriptor, REPORT_DESCRIPTOR, REPORT_DESCRIPTOR_LEN, os_extent, report_descriptor, usage};
 pub use error::{DecodeError, EncodeError};
 pub use frame::{CRC, CRC_LEN, FrameDecoder, FrameError, MAX_FRAME, MAX_PAYLOAD, encode_frame, encode_report_frame};
+pub use head::{HeadReport, MAX_PREDICTION_MS};
 pub use info::SUPPORTED_MAJOR_VERSIONS;
 pub use info::{DeviceInfo, FirmwareVersion, PROTOCOL_VERSION, UnsupportedVersion, Version, check_version};
 #[cfg(feature = "serde")]
@@ -61,13 +63,15 @@ pub enum ReportId {
     Command = 0x06,
     /// Input, USB HID only: [`OsPenReport`], the operating system's pen.
     OsPen = 0x07,
+    /// Input (protocol 2.1): [`HeadReport`], the tracked head.
+    Head = 0x08,
     /// Serial only, host to device: [`GetFeature`].
     GetFeature = 0x80,
 }
 
 impl ReportId {
     /// All IDs, in order.
-    pub const ALL: [ReportId; 8] = [
+    pub const ALL: [ReportId; 9] = [
         ReportId::Pen,
         ReportId::Tof,
         ReportId::DeviceInfo,
@@ -75,6 +79,7 @@ impl ReportId {
         ReportId::Status,
         ReportId::Command,
         ReportId::OsPen,
+        ReportId::Head,
         ReportId::GetFeature,
     ];
 
@@ -101,6 +106,7 @@ impl ReportId {
             ReportId::Status => "status",
             ReportId::Command => "command",
             ReportId::OsPen => "OS pen",
+            ReportId::Head => "head",
             ReportId::GetFeature => "get-feature request",
         }
     }
@@ -124,6 +130,7 @@ pub enum Message {
     Status(Status),
     Command(Command),
     OsPen(OsPenReport),
+    Head(HeadReport),
     GetFeature(GetFeature),
 }
 
@@ -140,6 +147,7 @@ impl Message {
             ReportId::Status => Message::Status(Status::decode(bytes)?),
             ReportId::Command => Message::Command(Command::decode(bytes)?),
             ReportId::OsPen => Message::OsPen(OsPenReport::decode(bytes)?),
+            ReportId::Head => Message::Head(HeadReport::decode(bytes)?),
             ReportId::GetFeature => Message::GetFeature(GetFeature::decode(bytes)?),
         })
     }
@@ -154,6 +162,7 @@ impl Message {
             Message::Status(r) => r.encode(out),
             Message::Command(r) => r.encode(out),
             Message::OsPen(r) => r.encode(out),
+            Message::Head(r) => r.encode(out),
             Message::GetFeature(r) => r.encode(out),
         }
     }
@@ -168,6 +177,7 @@ impl Message {
             Message::Status(_) => ReportId::Status,
             Message::Command(_) => ReportId::Command,
             Message::OsPen(_) => ReportId::OsPen,
+            Message::Head(_) => ReportId::Head,
             Message::GetFeature(_) => ReportId::GetFeature,
         }
     }

@@ -58,12 +58,13 @@ fn every_report_has_the_codec_length() {
     };
     let inputs: Vec<&dyn HidReport> = rd.input_reports().iter().map(|r| r as &dyn HidReport).collect();
     let features: Vec<&dyn HidReport> = rd.feature_reports().iter().map(|r| r as &dyn HidReport).collect();
-    assert_eq!(inputs.len(), 3);
+    assert_eq!(inputs.len(), 4);
     assert_eq!(features.len(), 4);
     assert!(rd.output_reports().is_empty());
     assert_eq!(len(&inputs, ReportId::Pen), PenReport::LEN);
     assert_eq!(len(&inputs, ReportId::Tof), TofReport::LEN);
     assert_eq!(len(&inputs, ReportId::OsPen), OsPenReport::LEN);
+    assert_eq!(len(&inputs, ReportId::Head), HeadReport::LEN);
     assert_eq!(len(&features, ReportId::DeviceInfo), DeviceInfo::LEN);
     assert_eq!(len(&features, ReportId::Config), Config::LEN);
     assert_eq!(len(&features, ReportId::Status), Status::LEN);

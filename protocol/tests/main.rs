@@ -6,6 +6,7 @@ mod errors;
 mod frames;
 mod fuzz_corpus;
 mod golden;
+mod head;
 #[cfg(feature = "serde")]
 mod json;
 mod roundtrip;

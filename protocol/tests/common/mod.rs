@@ -245,9 +245,41 @@ pub fn status() -> impl Strategy<Value = Status> {
     })
 }
 
+/// Any head report in canonical form: receivers used 0 exactly when there is no fix.
+pub fn head() -> impl Strategy<Value = HeadReport> {
+    (
+        any::<[bool; 2]>(),
+        [-i16::MAX..=i16::MAX, -i16::MAX..=i16::MAX, -i16::MAX..=i16::MAX],
+        0..=MAX_PREDICTION_MS,
+        any::<u16>(),
+        any::<u32>(),
+        (1..=MAX_RECEIVERS as u8, any::<u8>(), any::<u8>()),
+    )
+        .prop_map(
+            |([no_fix, display_frame], [x, y, z], prediction_ms, seq, timestamp_us, q)| HeadReport {
+                no_fix,
+                display_frame,
+                position: Position { x, y, z },
+                prediction_ms,
+                seq,
+                timestamp_us,
+                quality: if no_fix {
+                    Quality::NONE
+                } else {
+                    Quality {
+                        receivers_used: q.0,
+                        residual: q.1,
+                        dop: q.2,
+                    }
+                },
+            },
+        )
+}
+
 pub fn message() -> impl Strategy<Value = Message> {
     prop_oneof![
         pen().prop_map(Message::Pen),
+        head().prop_map(Message::Head),
         tof().prop_map(Message::Tof),
         info().prop_map(Message::DeviceInfo),
         config().prop_map(Message::Config),
