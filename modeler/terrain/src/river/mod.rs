@@ -49,6 +49,31 @@ pub const PLUG: f64 = 2.0;
 /// Cells beyond the water that a sample's field reaches: the largest diamond's reach and one.
 const REACH: f64 = morph::MAX_LEVEL as f64;
 
+/// A meandering river across a `size × size` grid of 1 m cells, for benches, the command line's
+/// examples and the demo: a sine course of `anchors` anchors (`3·(anchors − 1) + 1` control
+/// points) from the left edge to the right, amplitude a sixth of the grid, `width` m wide (the
+/// disc radius) and half as deep.
+pub fn meander(size: u32, anchors: usize, width: f64, iterations: u32) -> River {
+    let n = f64::from(size);
+    let stroke: Vec<DVec2> = (0..=400)
+        .map(|k| {
+            let t = f64::from(k) / 400.0;
+            DVec2::new(
+                n * (0.04 + 0.92 * t),
+                n * (0.5 + (t * std::f64::consts::TAU * 3.0).sin() / 6.0),
+            )
+        })
+        .collect();
+    River {
+        points: course::fit(&stroke, anchors).iter().map(|p| [p.x, p.y]).collect(),
+        width,
+        depth: width / 2.0,
+        water: 60.0,
+        hardness: 1.0,
+        iterations,
+    }
+}
+
 /// A rectangle of the grid a river works in.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Window {

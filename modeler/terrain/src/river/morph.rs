@@ -33,30 +33,42 @@ pub fn distance(image: &[u8], width: usize, height: usize, target: bool, outside
         .iter()
         .map(|&v| if (v != 0) == target { 0 } else { FAR })
         .collect();
-    // Forward pass: from the left and from above.
+    if width == 0 {
+        return d;
+    }
+    // Forward pass: from above, then from the left along the row.
     for r in 0..height {
-        let row = r * width;
-        for c in 0..width {
-            let i = row + c;
-            let left = if c > 0 { d[i - 1] } else { outside };
-            let up = if r > 0 { d[i - width] } else { outside };
-            let best = left.min(up).saturating_add(1);
-            if best < d[i] {
-                d[i] = best;
+        let (done, rest) = d.split_at_mut(r * width);
+        let row = &mut rest[..width];
+        match done.len().checked_sub(width) {
+            Some(up) => {
+                for (v, &u) in row.iter_mut().zip(&done[up..]) {
+                    *v = (*v).min(u.saturating_add(1));
+                }
             }
+            None => row.iter_mut().for_each(|v| *v = (*v).min(outside.saturating_add(1))),
+        }
+        let mut left = outside;
+        for v in row.iter_mut() {
+            left = (*v).min(left.saturating_add(1));
+            *v = left;
         }
     }
-    // Backward pass: from the right and from below.
+    // Backward pass: from below, then from the right.
     for r in (0..height).rev() {
-        let row = r * width;
-        for c in (0..width).rev() {
-            let i = row + c;
-            let right = if c + 1 < width { d[i + 1] } else { outside };
-            let down = if r + 1 < height { d[i + width] } else { outside };
-            let best = right.min(down).saturating_add(1);
-            if best < d[i] {
-                d[i] = best;
+        let (head, below) = d.split_at_mut((r + 1) * width);
+        let row = &mut head[r * width..];
+        if below.is_empty() {
+            row.iter_mut().for_each(|v| *v = (*v).min(outside.saturating_add(1)));
+        } else {
+            for (v, &u) in row.iter_mut().zip(&below[..width]) {
+                *v = (*v).min(u.saturating_add(1));
             }
+        }
+        let mut right = outside;
+        for v in row.iter_mut().rev() {
+            right = (*v).min(right.saturating_add(1));
+            *v = right;
         }
     }
     d

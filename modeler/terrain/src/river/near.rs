@@ -42,11 +42,25 @@ pub fn nearest(win: &Window, line: &[DVec2], reach: f64) -> Near {
         });
         return near;
     }
-    for k in 0..pts.len().saturating_sub(1) {
+    let segs = pts.len() - 1;
+    let dir = |k: usize| (pts[k + 1] - pts[k]).normalize_or_zero();
+    for k in 0..segs {
         let (a, b) = (pts[k], pts[k + 1]);
         let ab = b - a;
-        let len2 = ab.length_squared();
-        visit(win, a, b, reach, |i, p| {
+        let len = ab.length();
+        // Each segment visits its slab (the cells whose projection falls on it) widened over
+        // the wedge its joints leave on the outer side of a bend: `reach × angle` past each end,
+        // at least one segment; the course's ends get a cap of `reach`.
+        let widen = |other: Option<usize>| -> f64 {
+            match other {
+                None => reach,
+                Some(j) => (reach * dir(k).angle_to(dir(j)).abs()).max(len) + 1.0,
+            }
+        };
+        let before = widen(k.checked_sub(1));
+        let after = widen((k + 1 < segs).then_some(k + 1));
+        slab(win, a, b, before, after, reach, |i, p| {
+            let len2 = ab.length_squared();
             let t = if len2 > 0.0 {
                 ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
             } else {
@@ -82,6 +96,51 @@ fn visit(win: &Window, a: DVec2, b: DVec2, reach: f64, mut f: impl FnMut(usize, 
     let (r0, r1) = (lo.y.ceil().max(0.0) as usize, (hi.y.floor().min(h - 1.0)) as usize);
     for r in r0..=r1 {
         for c in c0..=c1 {
+            f(r * win.width + c, DVec2::new(c as f64, r as f64));
+        }
+    }
+}
+
+/// Calls `f(index, local position)` for the window's cells within `reach` of the line through
+/// `a`, `b` whose projection on it lies from `before` before `a` to `after` past `b` (distances
+/// along the line), row by row: each row's cells form one interval.
+fn slab(win: &Window, a: DVec2, b: DVec2, before: f64, after: f64, reach: f64, mut f: impl FnMut(usize, DVec2)) {
+    let ab = b - a;
+    let len = ab.length();
+    if len == 0.0 {
+        return visit(win, a, b, reach, f);
+    }
+    let u = ab / len;
+    let (lo_t, hi_t) = (-before, len + after);
+    let corners = [a + u * lo_t, a + u * hi_t];
+    let lo = corners[0].min(corners[1]) - DVec2::splat(reach);
+    let hi = corners[0].max(corners[1]) + DVec2::splat(reach);
+    let (w, h) = (win.width as f64, win.height as f64);
+    if hi.x < 0.0 || hi.y < 0.0 || lo.x > w - 1.0 || lo.y > h - 1.0 {
+        return;
+    }
+    let (r0, r1) = (lo.y.ceil().max(0.0) as usize, hi.y.floor().min(h - 1.0) as usize);
+    let (cmin, cmax) = (lo.x.ceil().max(0.0), hi.x.floor().min(w - 1.0));
+    for r in r0..=r1 {
+        let dy = r as f64 - a.y;
+        // Along: s(c) = (c − a.x)·u.x + dy·u.y in [lo_t, hi_t]; across: n(c) = (c − a.x)·u.y − dy·u.x
+        // (up to sign) in [−reach, reach]. Both are linear in c.
+        let (mut c0, mut c1) = (cmin, cmax);
+        for (k, off, range) in [(u.x, dy * u.y, (lo_t, hi_t)), (u.y, -dy * u.x, (-reach, reach))] {
+            if k.abs() < 1e-12 {
+                if off < range.0 || off > range.1 {
+                    c1 = c0 - 1.0;
+                }
+            } else {
+                let (x0, x1) = ((range.0 - off) / k + a.x, (range.1 - off) / k + a.x);
+                c0 = c0.max(x0.min(x1).ceil());
+                c1 = c1.min(x0.max(x1).floor());
+            }
+        }
+        if c1 < c0 {
+            continue;
+        }
+        for c in c0 as usize..=c1 as usize {
             f(r * win.width + c, DVec2::new(c as f64, r as f64));
         }
     }
