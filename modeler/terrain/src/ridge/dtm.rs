@@ -39,6 +39,7 @@ pub const NONE: u32 = u32::MAX;
 struct Slot {
     poly: Polygon,
     prepared: Prepared,
+    outlines: Vec<Vec<[f64; 2]>>,
     rect: Rect,
 }
 
@@ -113,7 +114,7 @@ impl Dtm {
                     for r in rr0..rr1 {
                         let base = (r - r0) as usize * cols;
                         raster_row(
-                            &slot.prepared,
+                            slot,
                             slot.rect,
                             r,
                             cell,
@@ -204,7 +205,7 @@ impl Dtm {
                 for r in meet.r0..meet.r0 + meet.height {
                     let row = r as usize * w;
                     raster_row(
-                        &slot.prepared,
+                        slot,
                         meet,
                         r,
                         self.cell,
@@ -231,7 +232,7 @@ impl Dtm {
             for r in slot.rect.r0..slot.rect.r0 + slot.rect.height {
                 let row = r as usize * w;
                 raster_row(
-                    &slot.prepared,
+                    slot,
                     slot.rect,
                     r,
                     self.cell,
@@ -251,6 +252,7 @@ impl Dtm {
     fn insert(&mut self, id: u32, part: Part, poly: Polygon) -> u32 {
         let slot = Slot {
             prepared: poly.prepare(),
+            outlines: poly.outlines(),
             rect: poly.cells(self.cols, self.rows, self.cell),
             poly,
         };
@@ -317,7 +319,7 @@ fn intersect(a: Rect, b: Rect) -> Option<Rect> {
 #[allow(clippy::too_many_arguments)] // one row of the raster loop, called from three places.
 #[inline]
 fn raster_row(
-    poly: &Prepared,
+    slot: &Slot,
     rect: Rect,
     r: u32,
     cell: f64,
@@ -327,7 +329,15 @@ fn raster_row(
     win: &mut [u32],
 ) {
     let y = (f64::from(r) + 0.5) * cell;
-    for c in rect.c0..rect.c0 + rect.width {
+    let Some((x0, x1)) = polygon::span(&slot.outlines, y) else {
+        return;
+    };
+    // The cells whose centres fall in [x0, x1], a cell wider on each side for rounding; the
+    // polygon's own test decides.
+    let c0 = ((x0 / cell - 1.5).ceil().max(f64::from(rect.c0))) as u32;
+    let c1 = ((x1 / cell + 0.5).floor().min(f64::from(rect.c0 + rect.width) - 1.0)).max(-1.0) as i64;
+    let poly = &slot.prepared;
+    for c in c0..(c1 + 1).max(i64::from(c0)) as u32 {
         let i = c as usize;
         if let Some(m) = hole
             && !m[i]

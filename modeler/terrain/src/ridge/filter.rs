@@ -91,26 +91,38 @@ pub fn apply(input: &[f32], cols: u32, filter: Filter, rect: Rect, out: &mut [f3
             .clamp(i64::from(e.r0), i64::from(e.r0) + eh as i64 - 1)
             - i64::from(e.r0)) as usize
     };
+    // Columns whose whole window is inside the buffer (and the grid) read it directly; the rest
+    // through the clamps. Either way the taps are summed from -k to k, so the bits agree.
+    let (lo, hi) = (k as usize, ew.saturating_sub(k as usize));
     for _ in 0..filter.passes {
         tmp.par_chunks_mut(ew).enumerate().for_each(|(y, line)| {
             let src = &buf[y * ew..(y + 1) * ew];
             for (x, o) in line.iter_mut().enumerate() {
-                let gc = i64::from(e.c0) + x as i64;
                 let mut s = 0.0f32;
-                for dx in -k..=k {
-                    s += src[col(gc + dx)];
+                if x >= lo && x < hi {
+                    for v in &src[x - lo..=x + lo] {
+                        s += v;
+                    }
+                } else {
+                    let gc = i64::from(e.c0) + x as i64;
+                    for dx in -k..=k {
+                        s += src[col(gc + dx)];
+                    }
                 }
                 *o = s * norm;
             }
         });
         buf.par_chunks_mut(ew).enumerate().for_each(|(y, line)| {
             let gr = i64::from(e.r0) + y as i64;
-            for (x, o) in line.iter_mut().enumerate() {
-                let mut s = 0.0f32;
-                for dy in -k..=k {
-                    s += tmp[row(gr + dy) * ew + x];
+            let taps: Vec<usize> = (-k..=k).map(|dy| row(gr + dy) * ew).collect();
+            line.fill(0.0);
+            for &t in &taps {
+                for (o, v) in line.iter_mut().zip(&tmp[t..t + ew]) {
+                    *o += v;
                 }
-                *o = s * norm;
+            }
+            for o in line.iter_mut() {
+                *o *= norm;
             }
         });
     }

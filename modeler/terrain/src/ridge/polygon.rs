@@ -101,6 +101,25 @@ impl Polygon {
         }
     }
 
+    /// Convex outlines whose union holds the polygon (the flanks' trapezoid, each fan
+    /// triangle): they bound the cells a row visits ([`span`]).
+    pub fn outlines(&self) -> Vec<Vec<[f64; 2]>> {
+        match self {
+            Polygon::Flanks { p0, p1, z0, z1, tan } => {
+                let d = [p1[0] - p0[0], p1[1] - p0[1]];
+                let len = d[0].hypot(d[1]);
+                if len == 0.0 {
+                    return Vec::new();
+                }
+                let n = [-d[1] / len, d[0] / len];
+                let (r0, r1) = (z0.max(0.0) / tan, z1.max(0.0) / tan);
+                let at = |p: &[f64; 2], r: f64| [p[0] + n[0] * r, p[1] + n[1] * r];
+                vec![vec![at(p0, r0), at(p1, r1), at(p1, -r1), at(p0, -r0)]]
+            }
+            Polygon::Fan { apex, triangles, .. } => triangles.iter().map(|[a, b]| vec![*apex, *a, *b]).collect(),
+        }
+    }
+
     /// A form of the polygon that evaluates cells quickly.
     pub fn prepare(&self) -> Prepared {
         match self {
@@ -293,6 +312,32 @@ pub fn polygons(s: &Skeleton) -> Vec<(Part, Polygon)> {
                     triangles,
                 },
             ));
+        }
+    }
+    out
+}
+
+/// The x-interval the convex `outlines` cover on the horizontal line at `y` (the hull of each
+/// outline's interval), or `None` if the line misses them all.
+pub fn span(outlines: &[Vec<[f64; 2]>], y: f64) -> Option<(f64, f64)> {
+    let mut out: Option<(f64, f64)> = None;
+    for o in outlines {
+        for k in 0..o.len() {
+            let (a, b) = (o[k], o[(k + 1) % o.len()]);
+            let (lo, hi) = if a[1] <= b[1] { (a, b) } else { (b, a) };
+            if y < lo[1] || y > hi[1] {
+                continue;
+            }
+            let x = if hi[1] == lo[1] {
+                // A horizontal edge on the line: both ends count.
+                out = Some(out.map_or((lo[0].min(hi[0]), lo[0].max(hi[0])), |(x0, x1)| {
+                    (x0.min(lo[0]).min(hi[0]), x1.max(lo[0]).max(hi[0]))
+                }));
+                continue;
+            } else {
+                lo[0] + (y - lo[1]) / (hi[1] - lo[1]) * (hi[0] - lo[0])
+            };
+            out = Some(out.map_or((x, x), |(x0, x1)| (x0.min(x), x1.max(x))));
         }
     }
     out

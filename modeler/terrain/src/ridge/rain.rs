@@ -11,8 +11,6 @@
 //! upstream-first order ([`counts`]) instead of tracing a million drops one by one (the tests
 //! trace them one by one and compare).
 
-use std::f64::consts::FRAC_PI_4;
-
 use rayon::prelude::*;
 
 use super::gradient::sobel;
@@ -20,8 +18,8 @@ use super::gradient::sobel;
 /// No move: the drop stops in this cell.
 pub const STOP: u32 = u32::MAX;
 
-/// Column and row steps of the 8 directions, counterclockwise from +x (towards +y).
-const STEPS: [(i32, i32); 8] = [(1, 0), (1, 1), (0, 1), (-1, 1), (-1, 0), (-1, -1), (0, -1), (1, -1)];
+/// tan 22.5°: the descent's octant boundary.
+const TAN_22_5: f64 = 0.414_213_562_373_095_03;
 
 /// Per cell, the cell a drop moves to ([`STOP`] if it stays).
 pub fn directions(z: &[f32], cols: u32, rows: u32, cell: f64) -> Vec<u32> {
@@ -41,8 +39,17 @@ pub fn step(z: &[f32], cols: u32, rows: u32, cell: f64, c: u32, r: u32) -> u32 {
     if gx == 0.0 && gy == 0.0 {
         return STOP;
     }
-    let octant = ((-gy).atan2(-gx) / FRAC_PI_4).round() as i32;
-    let (dc, dr) = STEPS[octant.rem_euclid(8) as usize];
+    // The octant nearest the descent's angle, by comparing the components with tan 22.5°.
+    let (ax, ay) = (-gx, -gy);
+    let sx = if ax > 0.0 { 1 } else { -1 };
+    let sy = if ay > 0.0 { 1 } else { -1 };
+    let (dc, dr) = if ay.abs() <= ax.abs() * TAN_22_5 {
+        (sx, 0)
+    } else if ax.abs() <= ay.abs() * TAN_22_5 {
+        (0, sy)
+    } else {
+        (sx, sy)
+    };
     let (nc, nr) = (c as i32 + dc, r as i32 + dr);
     if nc < 0 || nr < 0 || nc >= cols as i32 || nr >= rows as i32 {
         return STOP;

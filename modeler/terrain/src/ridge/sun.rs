@@ -80,14 +80,123 @@ pub struct Field<'a> {
 /// tangent is `-∞` where nothing lies ahead.
 pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
     let Field { z, cols, rows, cell } = field;
+    let n = z.len();
+    let (mut sum, mut weight) = (vec![0.0f32; n], vec![0.0f32; n]);
     let (dx, dy) = (azimuth.cos(), azimuth.sin());
-    // Swap axes so that the sweep's dominant axis is "u" (cells along it: nu), the other "v".
     let x_major = dx.abs() >= dy.abs();
-    let (nu, nv, du, dv) = if x_major {
-        (cols, rows, dx, dy)
-    } else {
-        (rows, cols, dy, dx)
+    let mut sink = |line: &Line, k: usize, t: Option<f32>| {
+        if let Some(t) = t {
+            line.spread(k, t, &mut sum, &mut weight);
+        }
     };
+    if x_major {
+        sweep(z, cols, rows, cell, (dx, dy), &mut sink, None::<&mut Sink>);
+    } else {
+        let zt = transpose(z, cols, rows);
+        sweep(&zt, rows, cols, cell, (dy, dx), &mut sink, None::<&mut Sink>);
+    }
+    for i in 0..n {
+        // Transposed, cell (c, r) is at c·rows + r.
+        let j = if x_major {
+            i
+        } else {
+            (i % cols as usize) * rows as usize + i / cols as usize
+        };
+        f(
+            i,
+            if weight[j] > 0.0 {
+                f64::from(sum[j] / weight[j])
+            } else {
+                f64::NEG_INFINITY
+            },
+        );
+    }
+}
+
+type Sink<'a> = dyn FnMut(&Line, usize, Option<f32>) + 'a;
+
+/// One section's samples, in increasing u: the lower cell's index, the interpolation weight of
+/// the cell one row further, the interpolated height and the position along the line.
+#[derive(Default)]
+struct Line {
+    i0: Vec<u32>,
+    frac: Vec<f32>,
+    h: Vec<f32>,
+    s: Vec<f32>,
+    /// Grid columns (the row stride of `i0`).
+    stride: usize,
+}
+
+impl Line {
+    /// Adds `value` to sample k's two cells, weighted by nearness, and the weights.
+    #[inline]
+    fn spread(&self, k: usize, value: f32, sum: &mut [f32], weight: &mut [f32]) {
+        let (i0, frac) = (self.i0[k] as usize, self.frac[k]);
+        let w0 = 1.0 - frac;
+        sum[i0] += w0 * value;
+        weight[i0] += w0;
+        if frac > 0.0 {
+            sum[i0 + self.stride] += frac * value;
+            weight[i0 + self.stride] += frac;
+        }
+    }
+}
+
+/// The upper-hull pass over a line's samples in the order `order`, the first ones the farthest
+/// ahead: calls `sink(line, k, tangent)` for each sample (`None` when nothing is ahead).
+/// `sign` is 1 when ahead is increasing u, −1 when decreasing, so that positions grow ahead.
+#[inline]
+fn hull_pass(
+    line: &Line,
+    hull: &mut Vec<(f32, f32)>,
+    sign: f32,
+    order: impl Iterator<Item = usize>,
+    sink: &mut impl FnMut(&Line, usize, Option<f32>),
+) {
+    hull.clear();
+    for k in order {
+        let (s, h) = (sign * line.s[k], line.h[k]);
+        // Pop the nearest hull point while it lies on or under the line to the next one.
+        while hull.len() >= 2 {
+            let (s1, h1) = hull[hull.len() - 1];
+            let (s2, h2) = hull[hull.len() - 2];
+            if (h1 - h) * (s2 - s) <= (h2 - h) * (s1 - s) {
+                hull.pop();
+            } else {
+                break;
+            }
+        }
+        let t = hull.last().map(|&(s1, h1)| (h1 - h) / (s1 - s));
+        sink(line, k, t);
+        hull.push((s, h));
+    }
+}
+
+/// `z` (`cols × rows`, row-major) transposed: `rows × cols`.
+fn transpose(z: &[f32], cols: u32, rows: u32) -> Vec<f32> {
+    let (w, h) = (cols as usize, rows as usize);
+    let mut t = vec![0.0f32; z.len()];
+    t.par_chunks_mut(h).enumerate().for_each(|(c, line)| {
+        for (r, o) in line.iter_mut().enumerate() {
+            *o = z[r * w + c];
+        }
+    });
+    t
+}
+
+/// The horizon sweep for a direction `(du, dv)` with `|du| ≥ |dv|`, u along the columns of the
+/// `cols × rows` grid `z`: every line's samples through `ahead`, and, when given, through
+/// `behind` for the opposite direction (the same lines swept the other way).
+fn sweep(
+    z: &[f32],
+    cols: u32,
+    rows: u32,
+    cell: f64,
+    (du, dv): (f64, f64),
+    ahead: &mut impl FnMut(&Line, usize, Option<f32>),
+    mut behind: Option<&mut Sink<'_>>,
+) {
+    let (nu, nv) = (cols, rows);
     // A step ahead (u += sign du) moves v by dv/|du|: line b is v = b + u·dv/du.
     let mut slope = dv / du;
     // cos 45° and sin 45° differ in the last bit: snap the diagonals and axes so that their
@@ -97,62 +206,65 @@ pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
             slope = exact;
         }
     }
-    let spacing = (1.0 + slope * slope).sqrt() * cell * du.signum();
-    let index = |u: u32, v: u32| {
-        if x_major {
-            v as usize * cols as usize + u as usize
-        } else {
-            u as usize * cols as usize + v as usize
-        }
-    };
+    let spacing = ((1.0 + slope * slope).sqrt() * cell) as f32;
+    let w = cols as usize;
     let (lo, hi) = (f64::from(nu - 1) * slope.min(0.0), f64::from(nu - 1) * slope.max(0.0));
     let ahead_up = du > 0.0;
-    // Per cell, the weighted sum of its two neighbouring lines' horizons, and the weights.
-    let mut sum = vec![0.0f32; z.len()];
-    let mut weight = vec![0.0f32; z.len()];
-    let mut hull: Vec<(f64, f64)> = Vec::with_capacity(nu as usize);
+    let mut hull: Vec<(f32, f32)> = Vec::with_capacity(nu as usize);
+    let mut line = Line {
+        stride: w,
+        ..Line::default()
+    };
     let nvf = f64::from(nv);
-    for b in (-hi.ceil() as i64 - 1)..(nv as i64 - lo.floor() as i64 + 1) {
-        hull.clear();
-        // From the far end back: the sweep's first samples are the farthest ahead.
-        for k in 0..nu {
-            let u = if ahead_up { nu - 1 - k } else { k };
-            let v = b as f64 + f64::from(u) * slope;
+    let last_u = i64::from(nu) - 1;
+    for b in (-hi.ceil() as i64 - 1)..(i64::from(nv) - lo.floor() as i64 + 1) {
+        // The columns where the line is on the grid (a column wider each way; checked below).
+        let (ua, ub) = if slope == 0.0 {
+            (0, last_u)
+        } else {
+            let (a, c) = ((-(b as f64)) / slope, (nvf - 1.0 - b as f64) / slope);
+            let (a, c) = (a.min(c), a.max(c));
+            ((a.floor() as i64 - 1).max(0), (c.ceil() as i64 + 1).min(last_u))
+        };
+        line.i0.clear();
+        line.frac.clear();
+        line.h.clear();
+        line.s.clear();
+        for u in ua..=ub {
+            let v = b as f64 + u as f64 * slope;
             if v < 0.0 || v > nvf - 1.0 {
                 continue;
             }
-            let v0 = v.floor();
-            let frac = v - v0;
-            let v0 = v0 as u32;
-            let v1 = (v0 + 1).min(nv - 1);
-            let (i0, i1) = (index(u, v0), index(u, v1));
-            let h = f64::from(z[i0]) * (1.0 - frac) + f64::from(z[i1]) * frac;
-            let s = f64::from(u) * spacing;
-            // Pop the nearest hull point while it lies on or under the line to the next one.
-            while hull.len() >= 2 {
-                let (s1, h1) = hull[hull.len() - 1];
-                let (s2, h2) = hull[hull.len() - 2];
-                if (h1 - h) * (s2 - s) <= (h2 - h) * (s1 - s) {
-                    hull.pop();
-                } else {
-                    break;
-                }
-            }
-            if let Some(&(s1, h1)) = hull.last() {
-                let t = ((h1 - h) / (s1 - s)) as f32;
-                let w0 = (1.0 - frac) as f32;
-                sum[i0] += w0 * t;
-                weight[i0] += w0;
-                if frac > 0.0 {
-                    sum[i1] += frac as f32 * t;
-                    weight[i1] += frac as f32;
-                }
-            }
-            hull.push((s, h));
+            // v ≥ 0: truncation is the floor.
+            let v0 = v as usize;
+            let frac = (v - v0 as f64) as f32;
+            let i0 = v0 * w + u as usize;
+            let h = if frac > 0.0 {
+                z[i0] * (1.0 - frac) + z[i0 + w] * frac
+            } else {
+                z[i0]
+            };
+            line.i0.push(i0 as u32);
+            line.frac.push(frac);
+            line.h.push(h);
+            line.s.push(u as f32 * spacing);
         }
-    }
-    for (i, (&s, &w)) in sum.iter().zip(&weight).enumerate() {
-        f(i, if w > 0.0 { f64::from(s / w) } else { f64::NEG_INFINITY });
+        let n = line.h.len();
+        if n == 0 {
+            continue;
+        }
+        // From the far end back: the first samples swept are the farthest ahead.
+        if ahead_up {
+            hull_pass(&line, &mut hull, 1.0, (0..n).rev(), ahead);
+            if let Some(b) = behind.as_deref_mut() {
+                hull_pass(&line, &mut hull, -1.0, 0..n, &mut |l: &Line, k, t| b(l, k, t));
+            }
+        } else {
+            hull_pass(&line, &mut hull, -1.0, 0..n, ahead);
+            if let Some(b) = behind.as_deref_mut() {
+                hull_pass(&line, &mut hull, 1.0, (0..n).rev(), &mut |l: &Line, k, t| b(l, k, t));
+            }
+        }
     }
 }
 
@@ -211,37 +323,90 @@ pub fn direct(field: Field<'_>, sun: Sun) -> Vec<f32> {
     out
 }
 
-/// Azimuths summed together on one thread; fixed so that the sum's order, and so its bits, do
-/// not depend on the number of threads.
-const GROUP: usize = 8;
+/// Azimuth pairs summed together on one thread; fixed so that the sum's order, and so its bits,
+/// do not depend on the number of threads.
+const GROUP: usize = 4;
 
 /// The sky-view fraction per cell from `k` azimuths (`2πi/k`): `1 − (1/k)·Σ sin² H_i`.
+///
+/// Each line sample's `sin² H` is spread over its two cells like a horizon (see [`horizons`]),
+/// with the weights summed alongside: the mean over all directions is the weighted mean (every
+/// cell gets weight 1 per azimuth but at the grid's edge). Opposite azimuths share their lines
+/// and are swept together.
 pub fn sky_view(field: Field<'_>, k: u32) -> Vec<f32> {
-    let n = field.z.len();
+    let Field { z, cols, rows, cell } = field;
+    let n = z.len();
     let k = k.max(1) as usize;
-    let groups: Vec<Vec<f32>> = (0..k.div_ceil(GROUP))
-        .into_par_iter()
-        .map(|g| {
-            let mut acc = vec![0.0f32; n];
-            for d in g * GROUP..((g + 1) * GROUP).min(k) {
+    let zt = transpose(z, cols, rows);
+    // Azimuth d with its opposite d + k/2 when k is even.
+    let pairs: Vec<(usize, Option<usize>)> = if k.is_multiple_of(2) {
+        (0..k / 2).map(|d| (d, Some(d + k / 2))).collect()
+    } else {
+        (0..k).map(|d| (d, None)).collect()
+    };
+    // Per group: sums and weights in the grid's layout and in the transposed one.
+    let groups: Vec<[Vec<f32>; 4]> = pairs
+        .par_chunks(GROUP)
+        .map(|chunk| {
+            let [mut acc, mut wt, mut acc_t, mut wt_t] = [(); 4].map(|_| vec![0.0f32; n]);
+            for &(d, opposite) in chunk {
                 let az = TAU * d as f64 / k as f64;
-                horizons(field, az, |i, t| {
-                    let m = t.max(0.0);
-                    acc[i] += (m * m / (1.0 + m * m)) as f32;
-                });
+                let (dx, dy) = (az.cos(), az.sin());
+                let (grid, sum, weight) = if dx.abs() >= dy.abs() {
+                    (z, &mut acc, &mut wt)
+                } else {
+                    (&zt[..], &mut acc_t, &mut wt_t)
+                };
+                let (c, r, dir) = if dx.abs() >= dy.abs() {
+                    (cols, rows, (dx, dy))
+                } else {
+                    (rows, cols, (dy, dx))
+                };
+                let (sum2, weight2) = (
+                    std::cell::RefCell::new(&mut *sum),
+                    std::cell::RefCell::new(&mut *weight),
+                );
+                let mut add = |line: &Line, j: usize, t: Option<f32>| {
+                    let m = t.unwrap_or(0.0).max(0.0);
+                    line.spread(
+                        j,
+                        m * m / (1.0 + m * m),
+                        &mut sum2.borrow_mut(),
+                        &mut weight2.borrow_mut(),
+                    );
+                };
+                let mut add_behind = |line: &Line, j: usize, t: Option<f32>| {
+                    let m = t.unwrap_or(0.0).max(0.0);
+                    line.spread(
+                        j,
+                        m * m / (1.0 + m * m),
+                        &mut sum2.borrow_mut(),
+                        &mut weight2.borrow_mut(),
+                    );
+                };
+                sweep(
+                    grid,
+                    c,
+                    r,
+                    cell,
+                    dir,
+                    &mut add,
+                    opposite.map(|_| &mut add_behind as &mut Sink),
+                );
             }
-            acc
+            [acc, wt, acc_t, wt_t]
         })
         .collect();
-    let inv = 1.0 / k as f32;
+    let (w, h) = (cols as usize, rows as usize);
     let mut out = vec![0.0f32; n];
-    out.par_chunks_mut(4096).enumerate().for_each(|(j, chunk)| {
-        for (o, i) in chunk.iter_mut().zip(j * 4096..) {
-            let mut s = 0.0f32;
-            for g in &groups {
-                s += g[i];
+    out.par_chunks_mut(w).enumerate().for_each(|(r, line)| {
+        for (c, o) in line.iter_mut().enumerate() {
+            let (mut s, mut wsum) = (0.0f32, 0.0f32);
+            for [a, wt, at, wtt] in &groups {
+                s += a[r * w + c] + at[c * h + r];
+                wsum += wt[r * w + c] + wtt[c * h + r];
             }
-            *o = 1.0 - s * inv;
+            *o = if wsum > 0.0 { 1.0 - s / wsum } else { 1.0 };
         }
     });
     out

@@ -1,0 +1,160 @@
+//! Ridgeline terrain figures (issue 12, seed 002):
+//!
+//! - `move_segment/512`, `add_delete_segment/512`: one segment moved (a pen drag), or added and
+//!   deleted again, on a 512² grid holding 60 other segments — the terrain update alone, target
+//!   ≤ 2 ms per update.
+//! - `full_dtm/200seg/1024`: the DTM of 200 segments on 1024², target ≤ 50 ms on 2 cores.
+//! - `sky32/1024`, `direct/1024`, `insolation32/1024`: horizons in 32 azimuths (sky view), one
+//!   sun direction (direct), both combined; target ≤ 100 ms for 32 directions. Beside it, printed
+//!   before the runs: the brute-force ray march (`sun::ray_march`) over a sample of cells in the
+//!   same 32 azimuths, its time per cell scaled to the whole grid, the ratio, and the largest and
+//!   mean difference in horizon angle over the sample.
+//! - `rain/1024`: rain pass counts on the 1024² DTM (the valley map's peer, a D8 flow
+//!   accumulation, is timed by `scripts/ridge_peer.py` in the same run as `penmodel analyze`).
+//!
+//! Run: `cargo bench -p penmodel-terrain --bench ridge` (filter with e.g. `-- sky32`).
+
+use std::f64::consts::TAU;
+use std::hint::black_box;
+use std::time::{Duration, Instant};
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use penmodel_terrain::ridge::sun::{self, Field, Sun};
+use penmodel_terrain::ridge::{Dtm, Filter, Skeleton, rain};
+use rand::{RngExt, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+
+/// `lines` random-walk ridgelines of `segs` segments each over a `side`² grid of 1 m cells,
+/// elevations between `lo` and `hi` metres.
+fn scene(side: u32, lines: usize, segs: usize, lo: f64, hi: f64, seed: u64) -> Vec<Skeleton> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let s = f64::from(side);
+    (0..lines)
+        .map(|_| {
+            let mut p = [rng.random_range(0.1 * s..0.9 * s), rng.random_range(0.1 * s..0.9 * s)];
+            let mut heading: f64 = rng.random_range(0.0..TAU);
+            let pts: Vec<[f64; 3]> = (0..=segs)
+                .map(|_| {
+                    let q = [p[0], p[1], rng.random_range(lo..hi)];
+                    heading += rng.random_range(-0.6..0.6);
+                    let step = rng.random_range(0.02 * s..0.04 * s);
+                    p = [
+                        (p[0] + step * heading.cos()).clamp(0.0, s),
+                        (p[1] + step * heading.sin()).clamp(0.0, s),
+                    ];
+                    q
+                })
+                .collect();
+            Skeleton::polyline(&pts, 30f64.to_radians())
+        })
+        .collect()
+}
+
+fn ids(s: &[Skeleton]) -> Vec<(u32, &Skeleton)> {
+    s.iter().enumerate().map(|(i, s)| (i as u32, s)).collect()
+}
+
+fn bench(c: &mut Criterion) {
+    let mut g = c.benchmark_group("ridge");
+    g.sample_size(20)
+        .warm_up_time(Duration::from_secs(1))
+        .measurement_time(Duration::from_secs(4));
+
+    // A pen drag on 512²: 12 lines of 5 segments, one more 1-segment line moved back and forth.
+    let small = scene(512, 12, 5, 20.0, 60.0, 1);
+    let mut dtm = Dtm::build(512, 512, 1.0, Filter::DEFAULT, &ids(&small));
+    let seg = |dx: f64| {
+        Skeleton::polyline(
+            &[[200.0 + dx, 250.0, 45.0], [230.0 + dx, 262.0, 50.0]],
+            30f64.to_radians(),
+        )
+    };
+    let (a, b) = (seg(0.0), seg(3.0));
+    let extra = small.len() as u32;
+    dtm.set(extra, Some(&a));
+    let mut flip = false;
+    g.bench_function("move_segment/512", |bch| {
+        bch.iter(|| {
+            flip = !flip;
+            black_box(dtm.set(extra, Some(if flip { &b } else { &a })))
+        })
+    });
+    g.bench_function("add_delete_segment/512", |bch| {
+        bch.iter(|| {
+            dtm.set(extra + 1, Some(&a));
+            black_box(dtm.set(extra + 1, None))
+        })
+    });
+
+    // 200 segments on 1024²: 20 lines of 10.
+    let big = scene(1024, 20, 10, 40.0, 150.0, 2);
+    let full = Dtm::build(1024, 1024, 1.0, Filter::DEFAULT, &ids(&big));
+    eprintln!("full_dtm/200seg/1024: {} polygons", full.polygon_count());
+    g.bench_function("full_dtm/200seg/1024", |bch| {
+        bch.iter(|| Dtm::build(1024, 1024, 1.0, Filter::DEFAULT, black_box(&ids(&big))))
+    });
+
+    let z = full.heights().to_vec();
+    let field = Field {
+        z: &z,
+        cols: 1024,
+        rows: 1024,
+        cell: 1.0,
+    };
+    peer_ray_march(field, 32);
+    let sun = Sun::degrees(135.0, 25.0, "sun").expect("a sun above the horizon");
+    g.bench_function("sky32/1024", |bch| bch.iter(|| sun::sky_view(black_box(field), 32)));
+    g.bench_function("direct/1024", |bch| bch.iter(|| sun::direct(black_box(field), sun)));
+    g.bench_function("insolation32/1024", |bch| {
+        bch.iter(|| {
+            let d = sun::direct(black_box(field), sun);
+            let s = sun::sky_view(field, 32);
+            sun::insolation(&d, &s)
+        })
+    });
+    g.bench_function("rain/1024", |bch| {
+        bch.iter(|| rain::counts(black_box(&z), 1024, 1024, 1.0))
+    });
+    g.finish();
+}
+
+/// The brute force beside the sweep, on every 16th cell of every 16th row in `k` azimuths.
+fn peer_ray_march(field: Field<'_>, k: u32) {
+    let t = Instant::now();
+    let mut sweep = Vec::with_capacity(k as usize);
+    for d in 0..k {
+        let mut h = vec![0.0; field.z.len()];
+        sun::horizons(field, TAU * f64::from(d) / f64::from(k), |i, t| h[i] = t);
+        sweep.push(h);
+    }
+    let sweep_ms = t.elapsed().as_secs_f64() * 1e3;
+    let (mut worst, mut sum, mut n) = (0.0f64, 0.0f64, 0usize);
+    let t = Instant::now();
+    let mut cells = 0usize;
+    for r in (0..field.rows).step_by(16) {
+        for c in (0..field.cols).step_by(16) {
+            cells += 1;
+            for (d, h) in sweep.iter().enumerate() {
+                let a = sun::ray_march(field, TAU * d as f64 / f64::from(k), c, r);
+                let b = h[(r * field.cols + c) as usize];
+                if a.is_finite() && b.is_finite() {
+                    let diff = (a.atan() - b.atan()).abs().to_degrees();
+                    worst = worst.max(diff);
+                    sum += diff;
+                    n += 1;
+                }
+            }
+        }
+    }
+    let brute_ms = t.elapsed().as_secs_f64() * 1e3 * field.z.len() as f64 / cells as f64;
+    eprintln!(
+        "horizons {k} azimuths on {}x{}: sweep {sweep_ms:.1} ms (one thread, all cells); ray march {brute_ms:.0} ms (one thread, scaled from {cells} cells); ratio {:.0}; horizon angle difference largest {worst:.2} deg, mean {:.3} deg over {n} cell-azimuths",
+        field.cols,
+        field.rows,
+        brute_ms / sweep_ms,
+        sum / n.max(1) as f64
+    );
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
