@@ -10,7 +10,8 @@
 //! 5. [`debounce`]: the switches;
 //! 6. [`report`]: report assembly, and configuration requests answered;
 //!
-//! around them the measurement loop over the hardware seams ([`station`]), the settings a
+//! around them the measurement loop and its emitter schedule with the tracked head's filter
+//! ([`head`]), over the hardware seams ([`station`]), the settings a
 //! configuration report turns into ([`settings`]), configuration storage ([`store`]), the replay
 //! format of recorded cycles ([`replay`]) and the correctly rounded arithmetic ([`math`]).
 //! `no_std`, no allocation; the board runs it, the host tests it, the simulated pen drives it.
@@ -26,6 +27,7 @@ pub mod filter;
 // The fuzz target's property, shared with the stable test that replays its corpus.
 #[doc(hidden)]
 pub mod fuzzing;
+pub mod head;
 pub mod math;
 pub mod ranging;
 pub mod replay;
@@ -36,8 +38,9 @@ pub mod station;
 pub mod store;
 pub mod track;
 
+pub use head::{Emitter, HeadSettings, Schedule};
 pub use math::Vec3;
-pub use report::{Action, Counters, Cycle, CycleResult, Engine, LISTEN_US, MIN_CYCLE_US, TICK_US};
+pub use report::{Action, Counters, Cycle, CycleResult, Engine, HeadCounters, LISTEN_US, MIN_CYCLE_US, Slot, TICK_US};
 pub use settings::{DisplayFrame, Settings, default_config};
 pub use solve::{Fix, NoFix};
 pub use station::{Clock, Ranging, ReportSink, SharedEngine, Station, Switches, WakeOnPress};

@@ -5,12 +5,16 @@
 //! it reports.
 
 use pen_protocol::{
-    Command, Config, DeviceInfo, Filter, FirmwareVersion, GetFeature, MAX_RECEIVERS, Message, NO_ARRIVAL, OsPenReport,
-    PROTOCOL_VERSION, PenReport, Position, Quality, Report, ReportId, Status, StatusCode, TofReport, os_extent,
+    Command, Config, DeviceInfo, Filter, FirmwareVersion, GetFeature, HeadReport, MAX_PREDICTION_MS, MAX_RECEIVERS,
+    Message, NO_ARRIVAL, OsPenReport, PROTOCOL_VERSION, PenReport, Position, Quality, Report, ReportId, Status,
+    StatusCode, TofReport, os_extent,
 };
 
 use crate::debounce::Debouncer;
 use crate::filter::{OneEuroParams, Smoother};
+use crate::head::{
+    Emitter, HEAD_MAX_SPEED_MM_PER_US, HEAD_TRACK_TIMEOUT_US, HeadFilter, HeadSettings, MUX_GUARD_US, mux_listen_us,
+};
 use crate::math::Vec3;
 use crate::ranging::{range_mm, time_of_flight_ns};
 use crate::settings::{Settings, default_config};
@@ -95,6 +99,63 @@ pub struct Counters {
     pub reports: u32,
 }
 
+/// One slot of the measurement loop: which emitter fires, how long the slot lasts and how long
+/// after the burst the receivers are listened to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Slot {
+    /// The emitter fired.
+    pub emitter: Emitter,
+    /// From this burst to the next, µs.
+    pub period_us: u64,
+    /// From the burst to the collection of the arrivals, µs (less than the period).
+    pub listen_us: u64,
+}
+
+/// Head counters since head tracking started.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct HeadCounters {
+    /// Head slots.
+    pub slots: u32,
+    /// Head slots with a fix through the head's tracking gate.
+    pub fixes: u32,
+    /// Head reports produced.
+    pub reports: u32,
+}
+
+/// The tracked head's state.
+struct HeadState {
+    settings: HeadSettings,
+    track: Track,
+    filter: HeadFilter,
+    /// The last reported position (held while no fix comes).
+    position: Position,
+    pending: Option<HeadReport>,
+    seq: u16,
+    /// The slot within the schedule's pattern.
+    slot: u32,
+    counters: HeadCounters,
+}
+
+impl HeadState {
+    fn new(settings: HeadSettings) -> HeadState {
+        HeadState {
+            settings: HeadSettings {
+                prediction_ms: settings.prediction_ms.min(MAX_PREDICTION_MS),
+                ..settings
+            },
+            track: Track::with_limits(HEAD_TRACK_TIMEOUT_US, HEAD_MAX_SPEED_MM_PER_US),
+            filter: HeadFilter::new(),
+            position: Position::default(),
+            pending: None,
+            seq: 0,
+            slot: 0,
+            counters: HeadCounters::default(),
+        }
+    }
+}
+
 /// The switch transitions not yet reported, so that a click between two reports is never lost.
 #[derive(Debug, Clone, Copy, Default)]
 struct SwitchLatch {
@@ -153,6 +214,8 @@ pub struct Engine {
     seq: u16,
     last_report_us: Option<u64>,
     counters: Counters,
+    /// Head tracking, when the glasses' emitter is fitted.
+    head: Option<HeadState>,
 }
 
 /// The OS pen's extent for a configuration's display, if its size is known.
@@ -212,6 +275,7 @@ impl Engine {
             seq: 0,
             last_report_us: None,
             counters: Counters::default(),
+            head: None,
         }
     }
 
@@ -241,9 +305,67 @@ impl Engine {
     }
 
     /// The measurement cycle's period, µs: the report interval, but never shorter than
-    /// [`MIN_CYCLE_US`]; faster report rates repeat the latest fix between cycles.
+    /// [`MIN_CYCLE_US`]; faster report rates repeat the latest fix between cycles. With the head
+    /// tracked, every slot's: 1.5 m of flight at the running speed of sound and a guard
+    /// ([`crate::head`]), whatever the report rate.
     pub fn cycle_period_us(&self) -> u64 {
-        self.settings.report_interval_us.unwrap_or(0).max(MIN_CYCLE_US)
+        match self.head {
+            Some(_) => self.mux_listen_us() + MUX_GUARD_US,
+            None => self.settings.report_interval_us.unwrap_or(0).max(MIN_CYCLE_US),
+        }
+    }
+
+    fn mux_listen_us(&self) -> u64 {
+        let s = &self.settings;
+        let max_delay = s.delays_ns[..s.count].iter().copied().max().unwrap_or(0);
+        mux_listen_us(s.speed_m_s, max_delay)
+    }
+
+    /// Starts tracking the head (the glasses' emitter is fitted) with `settings`, or stops it
+    /// (`None`): the pen then has every cycle again.
+    pub fn set_head(&mut self, settings: Option<HeadSettings>) {
+        self.head = settings.map(HeadState::new);
+    }
+
+    /// The head's settings, while it is tracked.
+    pub fn head_settings(&self) -> Option<HeadSettings> {
+        self.head.as_ref().map(|h| h.settings)
+    }
+
+    /// Head counters, while the head is tracked.
+    pub fn head_counters(&self) -> Option<HeadCounters> {
+        self.head.as_ref().map(|h| h.counters)
+    }
+
+    /// The next slot of the measurement loop (and the schedule moves on): every one the pen's
+    /// without the head, else the schedule's pattern.
+    pub fn next_slot(&mut self) -> Slot {
+        let period_us = self.cycle_period_us();
+        let Some(head) = self.head.as_mut() else {
+            return Slot {
+                emitter: Emitter::Pen,
+                period_us,
+                listen_us: LISTEN_US,
+            };
+        };
+        let schedule = head.settings.schedule;
+        let emitter = schedule.emitter(head.slot);
+        head.slot = (head.slot + 1) % schedule.slots().max(1);
+        Slot {
+            emitter,
+            period_us,
+            listen_us: period_us - MUX_GUARD_US,
+        }
+    }
+
+    /// Pen fixes per second the schedule allows.
+    fn pen_rate_hz(&self) -> u16 {
+        let period = self.cycle_period_us();
+        let (pen, slots) = self.head.as_ref().map_or((1, 1), |h| {
+            (h.settings.schedule.pen as u64, h.settings.schedule.slots() as u64)
+        });
+        let per_frame = period * slots.max(1);
+        ((1_000_000 * pen + per_frame / 2) / per_frame) as u16
     }
 
     /// The device information report.
@@ -253,7 +375,7 @@ impl Engine {
             firmware: self.firmware,
             receiver_count: self.settings.config.receiver_count,
             max_receivers: MAX_RECEIVERS as u8,
-            fix_rate_hz: ((1_000_000 + self.cycle_period_us() / 2) / self.cycle_period_us()) as u16,
+            fix_rate_hz: self.pen_rate_hz(),
             unique_id: self.unique_id,
         }
     }
@@ -268,28 +390,10 @@ impl Engine {
 
     /// Solves a measurement cycle and updates the position the next report carries.
     pub fn on_cycle(&mut self, cycle: &Cycle) -> CycleResult {
-        let s = &self.settings;
-        let mut ranges = [None; MAX_RECEIVERS];
-        let mut tof_ns = [NO_ARRIVAL; MAX_RECEIVERS];
-        for i in 0..s.count {
-            if let Some(t) = cycle.arrival_ns[i].and_then(|a| time_of_flight_ns(a, s.delays_ns[i])) {
-                tof_ns[i] = t;
-                ranges[i] = Some(range_mm(t, s.speed_m_s));
-            }
-        }
-        let geometry = Geometry {
-            receivers: &s.receivers[..s.count],
-            front: s.front(),
-        };
+        let (ranges, tof_ns) = self.ranges(cycle);
         let hint = self.track.hint(cycle.t0_us);
-        let raw = solve::solve(&geometry, &ranges, &|p| s.height(p), hint)
-            .and_then(|fix| {
-                if fix.dop > MAX_REPORTED_DOP {
-                    Err(NoFix::PoorGeometry)
-                } else {
-                    Ok(fix)
-                }
-            })
+        let raw = self
+            .solve(&ranges, hint)
             .and_then(|fix| self.track.gate(cycle.t0_us, fix.position).map(|()| fix));
         self.counters.cycles += 1;
         let reported = match raw {
@@ -334,6 +438,95 @@ impl Engine {
         };
         self.last_result = Some(result);
         result
+    }
+
+    /// Each configured receiver's range (mm) and time of flight (ns) in `cycle`.
+    fn ranges(&self, cycle: &Cycle) -> ([Option<f32>; MAX_RECEIVERS], [u32; MAX_RECEIVERS]) {
+        let s = &self.settings;
+        let mut ranges = [None; MAX_RECEIVERS];
+        let mut tof_ns = [NO_ARRIVAL; MAX_RECEIVERS];
+        for i in 0..s.count {
+            if let Some(t) = cycle.arrival_ns[i].and_then(|a| time_of_flight_ns(a, s.delays_ns[i])) {
+                tof_ns[i] = t;
+                ranges[i] = Some(range_mm(t, s.speed_m_s));
+            }
+        }
+        (ranges, tof_ns)
+    }
+
+    /// Multilateration of one burst, with fixes placed too poorly refused.
+    fn solve(&self, ranges: &[Option<f32>; MAX_RECEIVERS], hint: Option<Vec3>) -> Result<Fix, NoFix> {
+        let s = &self.settings;
+        let geometry = Geometry {
+            receivers: &s.receivers[..s.count],
+            front: s.front(),
+        };
+        solve::solve(&geometry, ranges, &|p| s.height(p), hint).and_then(|fix| {
+            if fix.dop > MAX_REPORTED_DOP {
+                Err(NoFix::PoorGeometry)
+            } else {
+                Ok(fix)
+            }
+        })
+    }
+
+    /// Solves a head slot (the glasses' burst): through the head's own tracking gate and
+    /// alpha-beta filter, predicted ahead, into the head report [`poll_head`](Self::poll_head)
+    /// returns. A slot without a fix holds the last position with `no_fix` set. Without head
+    /// tracking the slot is ignored.
+    pub fn on_head_cycle(&mut self, cycle: &Cycle) -> CycleResult {
+        let (ranges, _) = self.ranges(cycle);
+        let hint = self.head.as_ref().and_then(|h| h.track.hint(cycle.t0_us));
+        let solved = self.solve(&ranges, hint);
+        let display = self
+            .settings
+            .display
+            .filter(|_| self.settings.config.report_display_frame);
+        let Some(head) = self.head.as_mut() else {
+            return CycleResult {
+                fix: Err(NoFix::TooFewRanges),
+                reported_mm: None,
+            };
+        };
+        head.counters.slots += 1;
+        let raw = solved.and_then(|fix| head.track.gate(cycle.t0_us, fix.position).map(|()| fix));
+        let mut reported = None;
+        let mut quality = Quality::NONE;
+        if let Ok(fix) = raw {
+            head.counters.fixes += 1;
+            head.filter.update(cycle.t0_us, fix.position);
+            let ahead_us = head.settings.prediction_ms as u64 * 1000;
+            if let Some(predicted) = head.filter.predict(ahead_us) {
+                let p = display.map_or(predicted, |d| d.to_display(predicted));
+                if let Some(position) = Position::from_mm(p.to_array()) {
+                    head.position = position;
+                    reported = Some(p);
+                    quality = Quality::new(fix.used, fix.residual_rms_mm, fix.dop);
+                }
+            }
+        }
+        head.pending = Some(HeadReport {
+            no_fix: reported.is_none(),
+            display_frame: display.is_some(),
+            position: head.position,
+            prediction_ms: head.settings.prediction_ms,
+            seq: head.seq,
+            timestamp_us: cycle.t0_us as u32,
+            quality,
+        });
+        head.seq = head.seq.wrapping_add(1);
+        CycleResult {
+            fix: raw,
+            reported_mm: reported,
+        }
+    }
+
+    /// The head report of the latest head slot, once.
+    pub fn poll_head(&mut self) -> Option<HeadReport> {
+        let head = self.head.as_mut()?;
+        let report = head.pending.take()?;
+        head.counters.reports += 1;
+        Some(report)
     }
 
     /// Smooths, constrains and transforms a fix; `None` if it cannot be reported.
@@ -501,6 +694,12 @@ impl Engine {
                 // next fix.
                 self.last_fix_us = None;
                 self.fixed = false;
+                if let Some(head) = self.head.as_mut() {
+                    // The head's history belongs to the old geometry too; its count goes on.
+                    let seq = head.seq;
+                    *head = HeadState::new(head.settings);
+                    head.seq = seq;
+                }
                 let filter_changed = settings.config.filter != self.settings.config.filter;
                 self.settings = settings;
                 if filter_changed {

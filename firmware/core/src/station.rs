@@ -10,9 +10,10 @@ use core::ops::Deref;
 
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::RawMutex;
-use pen_protocol::{MAX_RECEIVERS, OsPenReport, PenReport, TofReport};
+use pen_protocol::{HeadReport, MAX_RECEIVERS, OsPenReport, PenReport, TofReport};
 
-use crate::report::{Cycle, CycleResult, Engine, LISTEN_US, TICK_US};
+use crate::head::Emitter;
+use crate::report::{Cycle, CycleResult, Engine, TICK_US};
 
 /// The ultrasonic front end: a burst from the pen and the receivers' first arrivals.
 pub trait Ranging {
@@ -20,6 +21,10 @@ pub trait Ranging {
     /// every burst, so a configuration change takes effect at the next cycle. Front ends that
     /// listen to every receiver anyway need not care.
     fn set_receivers(&mut self, _count: usize) {}
+    /// The emitter the next [`fire`](Self::fire) drives (the station says so before every
+    /// burst). A front end with only the pen's emitter never hears of the head: the engine
+    /// schedules it only while head tracking is on.
+    fn set_emitter(&mut self, _emitter: Emitter) {}
     /// Fires a burst; the capture time base starts with it.
     fn fire(&mut self);
     /// The first arrival at each receiver since the last burst, ns after it; `None` for a
@@ -50,6 +55,12 @@ pub trait ReportSink {
     /// Sends the operating system's pen report that goes with the pen report just sent (USB
     /// HID only; other sinks have no OS to tell).
     fn os_pen(&mut self, report: &OsPenReport) -> impl Future<Output = ()> {
+        let _ = report;
+        async {}
+    }
+    /// Sends a head report (head tracking only; a sink of a base station without the head's
+    /// emitter never gets one).
+    fn head(&mut self, report: &HeadReport) -> impl Future<Output = ()> {
         let _ = report;
         async {}
     }
@@ -124,30 +135,44 @@ where
         self.engine.lock(|e| f(&mut e.borrow_mut()))
     }
 
-    /// One measurement cycle: fire the burst, sample the switches every tick, collect the
-    /// arrivals when the listening window closes, send every report that falls due, and return
-    /// when the next cycle may start.
+    /// One measurement cycle (one slot of the schedule): fire the slot's emitter, sample the
+    /// switches every tick, collect the arrivals when the listening window closes, send every
+    /// report that falls due, and return when the next slot may start.
     pub async fn cycle(&mut self) -> CycleResult {
         let t0 = self.clock.now_us();
-        let (period, receivers) = self.with(|e| (e.cycle_period_us(), e.settings().count));
+        let (slot, receivers) = self.with(|e| (e.next_slot(), e.settings().count));
+        let period = slot.period_us;
+        let listen = t0 + slot.listen_us;
         self.ranging.set_receivers(receivers);
+        self.ranging.set_emitter(slot.emitter);
         self.ranging.fire();
         let mut result = None;
-        // Ticks at t0, t0 + TICK_US, … up to the end of the period.
+        // Ticks at t0, t0 + TICK_US, … up to the end of the period, and one when the listening
+        // window closes if that falls between ticks (head tracking's slots).
         let mut t = t0;
         while t < t0 + period {
             self.clock.wait_until(t).await;
             let raw = self.switches.read();
             self.with(|e| e.on_switches(t, raw));
             let mut tof = None;
-            if result.is_none() && t >= t0 + LISTEN_US {
+            let mut head = None;
+            if result.is_none() && t >= listen {
                 let cycle = Cycle {
                     t0_us: t0,
                     arrival_ns: self.ranging.collect(),
                 };
-                let (r, streamed) = self.with(|e| (e.on_cycle(&cycle), e.tof_report()));
-                result = Some(r);
-                tof = streamed;
+                match slot.emitter {
+                    Emitter::Pen => {
+                        let (r, streamed) = self.with(|e| (e.on_cycle(&cycle), e.tof_report()));
+                        result = Some(r);
+                        tof = streamed;
+                    }
+                    Emitter::Head => {
+                        let (r, report) = self.with(|e| (e.on_head_cycle(&cycle), e.poll_head()));
+                        result = Some(r);
+                        head = report;
+                    }
+                }
             }
             while let Some(report) = self.with(|e| e.poll_report(t)) {
                 self.sink.pen(&report).await;
@@ -157,7 +182,11 @@ where
             if let Some(tof) = tof {
                 self.sink.tof(&tof).await;
             }
-            t += TICK_US;
+            if let Some(head) = head {
+                self.sink.head(&head).await;
+            }
+            let next = t + TICK_US;
+            t = if t < listen && listen < next { listen } else { next };
         }
         self.clock.wait_until(t0 + period).await;
         match result {

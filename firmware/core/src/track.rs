@@ -19,41 +19,59 @@ pub const GATE_MARGIN_MM: f32 = 10.0;
 pub const TRACK_TIMEOUT_US: u64 = 30_000;
 
 /// The last accepted fix and the candidate that may start a new track.
-#[derive(Debug, Clone, Copy, Default)]
+#[derive(Debug, Clone, Copy)]
 pub struct Track {
     last: Option<(u64, Vec3)>,
     candidate: Option<(u64, Vec3)>,
+    /// How long a fix gates and hints, µs.
+    timeout_us: u64,
+    /// The fastest the emitter moves, mm/µs.
+    max_speed: f32,
 }
 
-fn reachable(from: Option<(u64, Vec3)>, t_us: u64, p: Vec3) -> bool {
-    match from {
-        Some((t0, q)) if t_us >= t0 && t_us - t0 <= TRACK_TIMEOUT_US => {
-            (p - q).length() <= MAX_SPEED_MM_PER_US * (t_us - t0) as f32 + GATE_MARGIN_MM
-        }
-        _ => false,
+impl Default for Track {
+    fn default() -> Self {
+        Track::new()
     }
 }
 
 impl Track {
-    /// No history.
+    /// No history, with the pen's limits.
     pub const fn new() -> Track {
+        Track::with_limits(TRACK_TIMEOUT_US, MAX_SPEED_MM_PER_US)
+    }
+
+    /// No history, for an emitter fixed at most every `timeout_us` µs and moving at most
+    /// `max_speed` mm/µs (the head's slots are further apart than the pen's cycles).
+    pub const fn with_limits(timeout_us: u64, max_speed: f32) -> Track {
         Track {
             last: None,
             candidate: None,
+            timeout_us,
+            max_speed,
         }
     }
 
-    /// The last accepted fix if it is recent: where the pen probably is at `t_us`.
+    fn reachable(&self, from: Option<(u64, Vec3)>, t_us: u64, p: Vec3) -> bool {
+        match from {
+            Some((t0, q)) if t_us >= t0 && t_us - t0 <= self.timeout_us => {
+                (p - q).length() <= self.max_speed * (t_us - t0) as f32 + GATE_MARGIN_MM
+            }
+            _ => false,
+        }
+    }
+
+    /// The last accepted fix if it is recent: where the emitter probably is at `t_us`.
     pub fn hint(&self, t_us: u64) -> Option<Vec3> {
         match self.last {
-            Some((t0, p)) if t_us >= t0 && t_us - t0 <= TRACK_TIMEOUT_US => Some(p),
+            Some((t0, p)) if t_us >= t0 && t_us - t0 <= self.timeout_us => Some(p),
             _ => None,
         }
     }
 
     /// Accepts the fix `p` at `t_us` or says why it is held back.
     pub fn gate(&mut self, t_us: u64, p: Vec3) -> Result<(), NoFix> {
-        if reachable(self.last, t_us, p) || reachable(self.candidate, t_us, p) {
+        if self.reachable(self.last, t_us, p) || self.reachable(self.candidate, t_us, p) {
             self.last = Some((t_us, p));
             self.candidate = None;
             return Ok(());

@@ -3,6 +3,7 @@ mod common;
 mod debounce;
 mod filter;
 mod fuzz_corpus;
+mod head;
 mod replay;
 mod report;
 mod solve;
