@@ -62,4 +62,7 @@ pub enum Scope {
     /// River N was added, removed or changed: the engine reprocesses it and recarves only its
     /// window ([`crate::river::layer::Layer`]).
     Rivers(usize),
+    /// The `ridges` entry changed: the ridge layer ([`crate::ridge::layer::Layer`]) compares
+    /// each ridgeline and tree with the last it saw and re-rasterises only those that differ.
+    Ridges,
 }

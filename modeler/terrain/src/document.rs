@@ -36,6 +36,86 @@ pub struct Document {
     /// Rivers (seed 003) carved into the terrain; version 3 on.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub rivers: Vec<River>,
+    /// Ridgelines (seed 002), a height layer combined with the regions' terrain; version 3 on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub ridges: Option<Ridges>,
+}
+
+/// Ridgeline terrain (seed 002, `crate::ridge`): 3D ridgelines and 2D ridgeline trees whose
+/// flanks, sloping down at `slope`, make a height layer. Where the layer is above the ground
+/// (z > 0) a cell's height is the larger of it and the regions' terrain; elsewhere the regions'
+/// terrain alone (`docs/ridgelines.md`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Ridges {
+    /// The flank slope α in degrees, strictly between 0 and 90.
+    #[serde(default = "default_ridge_slope")]
+    pub slope: f64,
+    /// The low-pass filter: box half-width in cells.
+    #[serde(default = "default_filter_radius")]
+    pub filter_radius: u32,
+    /// The low-pass filter: how many times the box is applied (0: the unfiltered maximum).
+    #[serde(default = "default_filter_passes")]
+    pub filter_passes: u32,
+    /// 3D ridgelines, each a polyline of `[x, y, z]` points (metres), at least two.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub lines: Vec<Ridgeline>,
+    /// 2D ridgeline trees with automatic elevations.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub trees: Vec<RidgeTree>,
+}
+
+fn default_ridge_slope() -> f64 {
+    30.0
+}
+
+fn default_filter_radius() -> u32 {
+    1
+}
+
+fn default_filter_passes() -> u32 {
+    2
+}
+
+impl Default for Ridges {
+    fn default() -> Ridges {
+        Ridges {
+            slope: default_ridge_slope(),
+            filter_radius: default_filter_radius(),
+            filter_passes: default_filter_passes(),
+            lines: Vec::new(),
+            trees: Vec::new(),
+        }
+    }
+}
+
+/// A 3D ridgeline: drawn in the air, its points carry their elevations.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Ridgeline {
+    /// `[x, y, z]` in metres, at least two.
+    pub points: Vec<[f64; 3]>,
+}
+
+/// A 2D ridgeline tree: nodes joined by segments, no cycle; each node's elevation is
+/// `h_end + d·tan θ`, d its distance along the tree to the nearest end node (Alg. 2.4).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RidgeTree {
+    /// The nodes `[x, y]`, metres.
+    pub nodes: Vec<Point>,
+    /// The segments, pairs of node indices.
+    pub edges: Vec<[u32; 2]>,
+    /// The characteristic slope θ in degrees, strictly between 0 and 90.
+    #[serde(default = "default_theta")]
+    pub theta: f64,
+    /// The end nodes' elevation, metres.
+    #[serde(default)]
+    pub h_end: f64,
+}
+
+fn default_theta() -> f64 {
+    20.0
 }
 
 /// A river (seed 003): a course drawn as a Bézier curve, shaped by `iterations` steps of
@@ -240,6 +320,7 @@ impl Document {
             regions: Vec::new(),
             rocks: Vec::new(),
             rivers: Vec::new(),
+            ridges: None,
         }
     }
 }

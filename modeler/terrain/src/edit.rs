@@ -11,7 +11,7 @@ use thiserror::Error;
 use crate::address::{CurvePath, FigurePath};
 use crate::cells::{self, Mask};
 use crate::change::{FigureList, ListChange, Scope};
-use crate::document::{Document, Figure, FigureKind, Point, Region, River, RockField};
+use crate::document::{Document, Figure, FigureKind, Point, Region, Ridges, River, RockField};
 use crate::validate::{self, ValidationError};
 
 /// One change to a document. Serialised (in the journal) as an object tagged by `"op"`.
@@ -82,6 +82,9 @@ pub enum Edit {
     DeleteRiver { index: usize },
     /// Replaces river `index` (its course, width, depth, water, hardness or iterations).
     ReplaceRiver { index: usize, river: River },
+    /// Replaces the `ridges` entry (`null` removes it): a ridgeline drawn, a node dragged, a
+    /// tree grown. Only the ridgelines and trees that differ are re-rasterised.
+    SetRidges { ridges: Option<Ridges> },
 }
 
 /// Why an edit was refused. The document is unchanged.
@@ -376,6 +379,17 @@ fn apply(doc: &mut Document, edit: &Edit) -> Result<Applied, EditError> {
             })
         }
         Edit::ReplaceRiver { index, river } => replace_river(doc, *index, river.clone()),
+        Edit::SetRidges { ridges } => {
+            let old = std::mem::replace(&mut doc.ridges, ridges.clone());
+            if let Err(e) = validate::ridges(doc) {
+                doc.ridges = old;
+                return Err(e.into());
+            }
+            Ok(Applied {
+                inverse: Edit::SetRidges { ridges: old },
+                scope: Scope::Ridges,
+            })
+        }
     }
 }
 

@@ -428,8 +428,10 @@ impl RegionNode {
 /// touches.
 pub struct TerrainEngine {
     regions: Vec<RegionNode>,
-    /// The ground: the regions' terrain before the rivers carve it.
+    /// The regions' terrain, before the ridges join it and the rivers carve it.
     map: Heightmap,
+    /// The ridgelines (seed 002) and the ground they make with `map`.
+    ridges: crate::ridge::layer::Layer,
     rivers: Layer,
 }
 
@@ -471,14 +473,27 @@ impl TerrainEngine {
         for (node, r) in regions.iter().zip(&doc.regions) {
             node.paint_all(&r.figures, 0.0, &mut map);
         }
+        let ridges = crate::ridge::layer::Layer::new(doc, &map);
         let mut rivers = Layer::default();
-        rivers.sync(doc, &map, Rect::EMPTY);
-        TerrainEngine { regions, map, rivers }
+        rivers.sync(doc, ridges.ground(&map), Rect::EMPTY);
+        TerrainEngine {
+            regions,
+            map,
+            ridges,
+            rivers,
+        }
     }
 
     /// The terrain as of the last update.
     pub fn heightmap(&self) -> &Heightmap {
-        self.rivers.carved().map_or(&self.map, |(carved, _)| carved)
+        self.rivers
+            .carved()
+            .map_or(self.ridges.ground(&self.map), |(carved, _)| carved)
+    }
+
+    /// The ridgelines' layer (its DTM, and the terrain before the rivers).
+    pub fn ridges(&self) -> &crate::ridge::layer::Layer {
+        &self.ridges
     }
 
     /// The rivers' water (surface level per cell, lakes), if the document has rivers.
@@ -493,8 +508,13 @@ impl TerrainEngine {
 
     /// The terrain, without the caches.
     pub fn into_heightmap(self) -> Heightmap {
-        let TerrainEngine { map, rivers, .. } = self;
-        rivers.carved().map_or(map, |(carved, _)| carved.clone())
+        let TerrainEngine {
+            map, ridges, rivers, ..
+        } = self;
+        match rivers.carved() {
+            Some((carved, _)) => carved.clone(),
+            None => ridges.ground(&map).clone(),
+        }
     }
 
     /// Brings the terrain up to date with `doc` after the change `scope` describes, regenerating
@@ -506,11 +526,15 @@ impl TerrainEngine {
     /// other mismatch leaves a terrain that does not match the document.
     pub fn update(&mut self, doc: &Document, scope: &Scope) -> Rect {
         match self.regenerate(doc, scope) {
-            // The rivers follow their entries and the ground that changed under them.
-            Some(rect) => match self.rivers.sync(doc, &self.map, rect) {
-                Some(more) => rect.union(more),
-                None => rect,
-            },
+            Some(rect) => {
+                // The ridges follow their entry and join the regions' terrain that changed; the
+                // rivers follow their entries and the ground that changed under them.
+                let rect = rect.union(self.ridges.sync(doc, &self.map, rect));
+                match self.rivers.sync(doc, self.ridges.ground(&self.map), rect) {
+                    Some(more) => rect.union(more),
+                    None => rect,
+                }
+            }
             None => {
                 *self = TerrainEngine::build(doc);
                 Rect {
@@ -537,7 +561,7 @@ impl TerrainEngine {
             return None;
         }
         let rect = match scope {
-            Scope::Rocks(_) | Scope::Rivers(_) => Rect {
+            Scope::Rocks(_) | Scope::Rivers(_) | Scope::Ridges => Rect {
                 c0: 0,
                 r0: 0,
                 width: 0,

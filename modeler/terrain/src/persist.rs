@@ -89,6 +89,9 @@ impl Document {
         if doc.version < 3 && !doc.rivers.is_empty() {
             return Err(ValidationError::new("rivers", Defect::NeedsVersion(3)).into());
         }
+        if doc.version < 3 && doc.ridges.is_some() {
+            return Err(ValidationError::new("ridges", Defect::NeedsVersion(3)).into());
+        }
         doc.version = VERSION;
         validate::document(&doc)?;
         Ok(doc)

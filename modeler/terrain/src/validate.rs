@@ -253,6 +253,10 @@ pub enum Defect {
     /// A shape coefficient out of range.
     #[error("{} must be from {} to {}", Num(*value), Num(*min), Num(*max))]
     Coefficient { value: f64, min: f64, max: f64 },
+    /// A ridgeline, ridgeline tree or ridge parameter that cannot be used; the message names
+    /// the element (`ridges.lines[2].points[1]`).
+    #[error("{0}")]
+    Ridge(String),
     /// A river course with fewer than two control points.
     #[error("a river's course needs at least two control points, found {0}")]
     CourseTooShort(usize),
@@ -286,6 +290,7 @@ pub fn document(doc: &Document) -> Result<(), ValidationError> {
     }
     rock_fields(doc)?;
     rivers(doc)?;
+    ridges(doc)?;
     memory(doc)
 }
 
@@ -523,6 +528,18 @@ pub fn region_overlap<'a>(
         }
     }
     Ok(())
+}
+
+/// Checks the ridgelines and trees (`crate::ridge::layer::skeletons`): at least two points
+/// each, finite numbers, trees without cycles and connected, slopes strictly between 0° and
+/// 90°, filter parameters up to 64.
+pub fn ridges(doc: &Document) -> Result<(), ValidationError> {
+    match &doc.ridges {
+        Some(r) => crate::ridge::layer::skeletons(r)
+            .map(|_| ())
+            .map_err(|e| ValidationError::new("ridges", Defect::Ridge(e.to_string()))),
+        None => Ok(()),
+    }
 }
 
 /// Checks every river: at least two control points, all on the grid (a Bézier course stays

@@ -551,3 +551,158 @@ fn growth_is_seeded_and_its_lines_run_downhill_from_the_ridge() {
         Err(RidgeError::Slope { .. })
     ));
 }
+
+fn ridge_doc() -> penmodel_terrain::Document {
+    use penmodel_terrain::document::{RidgeTree, Ridgeline, Ridges};
+    use penmodel_terrain::{Document, Figure, FigureKind, Grid, Region};
+    let mut d = Document::new(Grid {
+        cols: 96,
+        rows: 80,
+        cell_size: 1.0,
+    });
+    // A seed-000 hill under part of the ridge, and a depression away from it.
+    d.regions.push(Region {
+        boundary: vec![[5.0, 5.0], [45.0, 5.0], [45.0, 40.0], [5.0, 40.0], [5.0, 5.0]],
+        figures: vec![Figure {
+            kind: FigureKind::Point,
+            points: vec![[25.0, 22.0]],
+            height: 18.0,
+            slope: 0.0,
+            figures: vec![],
+        }],
+    });
+    d.regions.push(Region {
+        boundary: vec![[60.0, 50.0], [90.0, 50.0], [90.0, 75.0], [60.0, 75.0], [60.0, 50.0]],
+        figures: vec![Figure {
+            kind: FigureKind::Point,
+            points: vec![[75.0, 62.0]],
+            height: -6.0,
+            slope: 0.0,
+            figures: vec![],
+        }],
+    });
+    d.ridges = Some(Ridges {
+        lines: vec![Ridgeline {
+            points: vec![[10.0, 30.0, 12.0], [30.0, 26.0, 24.0], [50.0, 40.0, 16.0]],
+        }],
+        trees: vec![RidgeTree {
+            nodes: vec![[20.0, 60.0], [35.0, 62.0], [45.0, 72.0], [40.0, 50.0]],
+            edges: vec![[0, 1], [1, 2], [1, 3]],
+            theta: 35.0,
+            h_end: 2.0,
+        }],
+        ..Ridges::default()
+    });
+    d
+}
+
+#[test]
+fn ridges_join_the_terrain_by_max_where_they_stand_above_the_ground() {
+    use penmodel_terrain::generate;
+    let d = ridge_doc();
+    let with = generate(&d).expect("valid");
+    let mut plain = d.clone();
+    plain.ridges = None;
+    let base = generate(&plain).expect("valid");
+    // The layer alone, from the module.
+    let r = d.ridges.as_ref().expect("ridges");
+    let sk = penmodel_terrain::ridge::layer::skeletons(r).expect("valid ridges");
+    let ids: Vec<(u32, &Skeleton)> = sk.iter().map(|(i, s)| (*i, s)).collect();
+    let layer = Dtm::build(96, 80, 1.0, Filter::DEFAULT, &ids);
+    let mut raised = 0;
+    for (i, ((&w, &b), &l)) in with
+        .heights()
+        .iter()
+        .zip(base.heights())
+        .zip(layer.heights())
+        .enumerate()
+    {
+        let want = if l > 0.0 { b.max(l) } else { b };
+        assert_eq!(w, want, "cell {i}");
+        raised += usize::from(w > b);
+    }
+    assert!(raised > 500, "{raised} cells raised");
+    // The depression away from the ridges stays below 0.
+    assert!(with.heights().iter().any(|&h| h < -1.0));
+}
+
+#[test]
+fn ridge_edits_update_the_terrain_like_a_fresh_generation_and_undo() {
+    use penmodel_terrain::{Edit, Editor, generate};
+    let d = ridge_doc();
+    let mut ed = Editor::new(d.clone()).expect("valid");
+    let fresh = |doc: &penmodel_terrain::Document| generate(doc).expect("valid");
+    assert_eq!(ed.heightmap(), &fresh(&d));
+    let mut r = d.ridges.clone().expect("ridges");
+    // Drag a node of the line, then of the tree, add a line, delete the first.
+    r.lines[0].points[1] = [33.0, 28.0, 30.0];
+    ed.apply(Edit::SetRidges {
+        ridges: Some(r.clone()),
+    })
+    .expect("moved");
+    assert_eq!(ed.heightmap(), &fresh(ed.document()));
+    r.trees[0].nodes[2] = [50.0, 75.0];
+    ed.apply(Edit::SetRidges {
+        ridges: Some(r.clone()),
+    })
+    .expect("moved");
+    assert_eq!(ed.heightmap(), &fresh(ed.document()));
+    r.lines.push(penmodel_terrain::document::Ridgeline {
+        points: vec![[70.0, 10.0, 8.0], [80.0, 20.0, 14.0]],
+    });
+    ed.apply(Edit::SetRidges {
+        ridges: Some(r.clone()),
+    })
+    .expect("added");
+    assert_eq!(ed.heightmap(), &fresh(ed.document()));
+    r.lines.remove(0);
+    ed.apply(Edit::SetRidges {
+        ridges: Some(r.clone()),
+    })
+    .expect("deleted");
+    assert_eq!(ed.heightmap(), &fresh(ed.document()));
+    ed.apply(Edit::SetRidges { ridges: None }).expect("removed");
+    assert_eq!(ed.heightmap(), &fresh(ed.document()));
+    for _ in 0..5 {
+        ed.undo().expect("undo");
+        assert_eq!(ed.heightmap(), &fresh(ed.document()));
+    }
+    assert_eq!(ed.document(), &d);
+    // Bad input is refused by name and the document kept.
+    let mut bad = d.ridges.clone().expect("ridges");
+    bad.trees[0].edges.push([2, 3]);
+    let e = ed.apply(Edit::SetRidges { ridges: Some(bad) }).expect_err("a cycle");
+    assert!(
+        e.to_string().contains("ridges.trees[0].edges[3]") && e.to_string().contains("cycle"),
+        "{e}"
+    );
+    let mut bad = d.ridges.clone().expect("ridges");
+    bad.slope = 90.0;
+    let e = ed.apply(Edit::SetRidges { ridges: Some(bad) }).expect_err("α = 90°");
+    assert!(e.to_string().contains("ridges.slope"), "{e}");
+    let mut bad = d.ridges.clone().expect("ridges");
+    bad.lines[0].points.truncate(1);
+    let e = ed.apply(Edit::SetRidges { ridges: Some(bad) }).expect_err("one point");
+    assert!(e.to_string().contains("ridges.lines[0]"), "{e}");
+    assert_eq!(ed.document(), &d);
+}
+
+#[test]
+fn ridges_round_trip_and_need_version_3() {
+    use penmodel_terrain::Document;
+    let d = ridge_doc();
+    let text = d.to_json();
+    assert_eq!(Document::from_json(&text).expect("loads"), d);
+    let old = text.replacen("\"version\": 3", "\"version\": 2", 1);
+    assert_ne!(old, text);
+    let e = Document::from_json(&old).expect_err("ridges need version 3");
+    assert!(e.to_string().contains("ridges"), "{e}");
+    // NaN cannot be written in JSON; an infinite elevation overflows and is refused by name.
+    let bad = text.replacen("24.0", "1e999", 1);
+    assert!(Document::from_json(&bad).is_err());
+    // A version 2 document without ridges still loads.
+    let mut plain = d.clone();
+    plain.ridges = None;
+    let v2 = plain.to_json().replacen("\"version\": 3", "\"version\": 2", 1);
+    assert_eq!(Document::from_json(&v2).expect("a v2 document loads"), plain);
+}

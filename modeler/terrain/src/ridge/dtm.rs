@@ -290,6 +290,11 @@ impl Dtm {
         self.filter
     }
 
+    /// The cell size, metres.
+    pub fn cell_size(&self) -> f64 {
+        self.cell
+    }
+
     /// Columns and rows.
     pub fn size(&self) -> (u32, u32) {
         (self.cols, self.rows)

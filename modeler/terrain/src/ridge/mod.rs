@@ -22,6 +22,7 @@ pub mod dtm;
 pub mod filter;
 pub mod gradient;
 pub mod grow;
+pub mod layer;
 pub mod polygon;
 pub mod rain;
 pub mod sun;
