@@ -10,6 +10,7 @@ mod bench;
 mod generate;
 mod live;
 mod render;
+mod river;
 mod rocks;
 
 use std::process::ExitCode;
@@ -64,6 +65,8 @@ enum Command {
     Bench(bench::Args),
     /// Scatter rocks of mixed sizes on a field (seed 001) and write them out.
     Rocks(rocks::Args),
+    /// Shape one river of a document by erosion and deposition (seed 003) and write its masks.
+    River(river::Args),
 }
 
 fn main() -> ExitCode {
@@ -75,6 +78,7 @@ fn main() -> ExitCode {
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::Rocks(args)) => rocks::run(&args),
+        Some(Command::River(args)) => river::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

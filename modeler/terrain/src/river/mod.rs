@@ -41,7 +41,7 @@ pub const MAX_ITERATIONS: u32 = 20;
 pub const SPACING: f64 = 1.0;
 
 /// Along-course separation, in widths, beyond which two close parts of the line are a neck.
-pub const NECK_ARC: f64 = 6.0;
+pub const NECK_ARC: f64 = 10.0;
 
 /// Width in cells of the sediment plug between an oxbow lake and the river.
 pub const PLUG: f64 = 2.0;
@@ -263,33 +263,35 @@ impl Shape {
 
     /// Takes `line` as the centre line: levels, turns and the nearest-sample field.
     fn set_line(&mut self, line: Vec<Sample>) {
-        self.levels = line
-            .iter()
-            .map(|p| {
-                level::level(
-                    p.curvature() / self.cell_size,
-                    &self.river,
-                    self.cell_size,
-                    &self.constants,
-                )
-            })
-            .collect();
-        // The turn is the sign of the signed curvature summed over a width of the course, so a
-        // wiggle of a cell does not swap the banks.
-        let m = (self.radius.round() as usize).max(1);
+        // A bend is read over a width of the course each way: the seed's κ with its sign, averaged,
+        // so a wiggle of a cell neither swaps the banks nor makes a level of its own.
+        let m = self.stencil();
         let signed: Vec<f64> = line
             .iter()
             .map(|p| p.d1.perp_dot(p.d2) / p.d1.length().powi(3).max(1e-12))
             .collect();
-        self.turns = (0..line.len())
+        let bend: Vec<f64> = (0..line.len())
             .map(|i| {
-                let sum: f64 = signed[i.saturating_sub(m)..(i + m + 1).min(line.len())].iter().sum();
-                if sum.abs() < 1e-9 { 0 } else { sum.signum() as i8 }
+                let span = &signed[i.saturating_sub(m)..(i + m + 1).min(line.len())];
+                span.iter().sum::<f64>() / span.len() as f64
             })
+            .collect();
+        self.turns = bend
+            .iter()
+            .map(|&b| if b.abs() < 1e-9 { 0 } else { b.signum() as i8 })
+            .collect();
+        self.levels = bend
+            .iter()
+            .map(|b| level::level(b.abs() / self.cell_size, &self.river, self.cell_size, &self.constants))
             .collect();
         let pts: Vec<DVec2> = line.iter().map(|p| p.p).collect();
         self.near = near::nearest(&self.window, &pts, self.radius + REACH);
         self.line = line;
+    }
+
+    /// Samples each way over which a bend is read: a width, at least 2.
+    fn stencil(&self) -> usize {
+        (self.radius.round() as usize).max(2)
     }
 
     /// The cells the next iteration adds to the water (outer banks) and removes from it (inner
@@ -351,8 +353,7 @@ impl Shape {
         };
         let moved = self.migrate();
         let (pts, cuts) = self.cut_necks(moved);
-        let stencil = (self.radius.round() as usize).max(1);
-        let line = course::resample(&pts, SPACING, stencil);
+        let line = course::resample(&pts, SPACING, self.stencil());
         // The loops' water, as owned by the line before it moved, becomes lakes.
         let old_owner = std::mem::take(&mut self.near.owner);
         let mut lake_cells: Vec<(usize, u16)> = Vec::new();
