@@ -3,5 +3,6 @@ mod cli;
 mod demo_cli;
 mod help_examples;
 mod interaction;
+mod kill_loop;
 mod rocks_cli;
 mod waiting_cli;
