@@ -4,5 +4,6 @@ mod demo_cli;
 mod help_examples;
 mod interaction;
 mod kill_loop;
+mod river_cli;
 mod rocks_cli;
 mod waiting_cli;

@@ -286,6 +286,16 @@ impl Editor {
         self.terrain.heightmap()
     }
 
+    /// The rivers' water over [`Editor::heightmap`] (level per cell, lakes), if there are rivers.
+    pub fn water(&self) -> Option<&crate::river::layer::Water> {
+        self.terrain.water()
+    }
+
+    /// The terrain engine (the rivers' processed shapes: [`TerrainEngine::rivers`]).
+    pub fn terrain(&self) -> &TerrainEngine {
+        &self.terrain
+    }
+
     /// The document's rock fields standing on [`Editor::heightmap`], one mesh each.
     pub fn rocks(&self) -> &Seated {
         &self.rocks

@@ -73,14 +73,21 @@ pub fn run(args: &Args) -> Result<()> {
     let map = editor.heightmap();
     export(map, &args.raw, |m, out| export::write_raw(m, out))?;
     export(map, &args.png, |m, out| export::write_png(m, out).map(|_| ()))?;
-    // The document's rock fields stand on the terrain in the meshes (an object or node each).
-    let rocks = if args.obj.is_some() || args.glb.is_some() {
+    // The document's rock fields stand on the terrain in the meshes (an object or node each),
+    // and the rivers' water is one more.
+    let mut placed = if args.obj.is_some() || args.glb.is_some() {
         Rocks::of(editor.document()).seated(map)
     } else {
         Vec::new()
     };
-    export(map, &args.obj, |m, out| export::write_obj_with(m, &rocks, out))?;
-    export(map, &args.glb, |m, out| export::write_glb_with(m, &rocks, out))?;
+    // The rivers' and lakes' water surface: a separate mesh (object or node) "water".
+    if let Some(water) = editor.water().filter(|w| w.any())
+        && (args.obj.is_some() || args.glb.is_some())
+    {
+        placed.push(("water".to_string(), water.mesh(map.cell_size())));
+    }
+    export(map, &args.obj, |m, out| export::write_obj_with(m, &placed, out))?;
+    export(map, &args.glb, |m, out| export::write_glb_with(m, &placed, out))?;
     let (lo, hi) = map.range();
     let journal = if report.replayed > 0 {
         format!(", {} journal entries replayed", report.replayed)

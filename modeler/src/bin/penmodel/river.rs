@@ -14,9 +14,9 @@ use serde_json::json;
 /// Arguments of `penmodel river`.
 #[derive(clap::Args)]
 #[command(after_help = "Examples (from the repository's folder):\n  \
-    penmodel river modeler/examples/06-river.json --masks river-out --json river.json\n  \
-    penmodel river doc.json --index 1 --iterations 8 --json -\n  \
-    penmodel river doc.json --masks out --morph 4 --json -      # the diamond step alone, for the peer script")]
+    penmodel river modeler/examples/rivers/omega.json --masks river-out --json river.json\n  \
+    penmodel river modeler/examples/rivers/omega.json --iterations 3 --json -\n  \
+    penmodel river modeler/examples/rivers/omega.json --masks out --morph 4 --json -   # the diamond step alone, for the peer")]
 pub struct Args {
     /// The document (JSON).
     #[arg(value_name = "DOC.json")]

@@ -10,6 +10,7 @@ use super::carve::{self, Carve};
 use super::{Constants, Shape, Window};
 use crate::document::{Document, River};
 use crate::engine::Rect;
+use crate::export::Mesh;
 use crate::heightmap::Heightmap;
 
 /// Water over the grid: its surface level per cell (NaN where dry) and whether it stands (lakes).
@@ -29,6 +30,27 @@ impl Water {
     /// Whether any cell is wet.
     pub fn any(&self) -> bool {
         self.level.iter().any(|l| !l.is_nan())
+    }
+
+    /// The water surface as a mesh in the terrain mesh's frame (`[x, level, y]`, Y up): a flat
+    /// square at its level over each wet cell, normals up.
+    pub fn mesh(&self, cell_size: f64) -> Mesh {
+        let mut m = Mesh::default();
+        for (i, &l) in self.level.iter().enumerate() {
+            if l.is_nan() {
+                continue;
+            }
+            let (c, r) = ((i % self.cols as usize) as f64, (i / self.cols as usize) as f64);
+            let a = m.positions.len() as u32;
+            for (dc, dr) in [(0.0, 0.0), (1.0, 0.0), (0.0, 1.0), (1.0, 1.0)] {
+                m.positions
+                    .push([((c + dc) * cell_size) as f32, l, ((r + dr) * cell_size) as f32]);
+                m.normals.push([0.0, 1.0, 0.0]);
+            }
+            // Counter-clockwise seen from +Y, as the terrain's triangles.
+            m.indices.extend_from_slice(&[a, a + 2, a + 1, a + 1, a + 2, a + 3]);
+        }
+        m
     }
 }
 
