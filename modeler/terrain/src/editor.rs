@@ -143,6 +143,25 @@ pub struct Editor {
     rocks: Seated,
 }
 
+/// Moves a stale journal to `JOURNAL.stale`, or `.stale.2`, `.stale.3`, … when one set aside
+/// earlier is there: a rename would replace it, and the edits it holds with it.
+fn set_aside(jpath: &Path) -> io::Result<PathBuf> {
+    let mut n = 1u32;
+    loop {
+        let mut aside = jpath.as_os_str().to_owned();
+        match n {
+            1 => aside.push(".stale"),
+            _ => aside.push(format!(".stale.{n}")),
+        }
+        let aside = PathBuf::from(aside);
+        if fs::symlink_metadata(&aside).is_err() {
+            fs::rename(jpath, &aside)?;
+            return Ok(aside);
+        }
+        n += 1;
+    }
+}
+
 fn journal_io(path: &Path) -> impl FnOnce(io::Error) -> EditorError + '_ {
     move |cause| {
         EditorError::Journal(JournalError::Io {
@@ -204,10 +223,7 @@ impl Editor {
             Replay::Missing => {}
             Replay::Stale(_) => {
                 if write {
-                    let mut aside = jpath.clone().into_os_string();
-                    aside.push(".stale");
-                    let aside = PathBuf::from(aside);
-                    fs::rename(&jpath, &aside).map_err(journal_io(&jpath))?;
+                    let aside = set_aside(&jpath).map_err(journal_io(&jpath))?;
                     report.stale_journal = Some(aside);
                 } else {
                     report.ignored_stale_journal = Some(jpath.clone());

@@ -258,3 +258,41 @@ fn a_journal_for_another_document_is_set_aside_not_replayed_nor_lost() {
     let aside = report.stale_journal.expect("the journal is set aside");
     assert_eq!(fs::read(aside).expect("kept"), journal_bytes, "and kept whole");
 }
+
+#[test]
+fn a_second_stale_journal_does_not_overwrite_the_first() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (path, _) = edited(dir.path());
+    let jpath = journal::path_for(&path);
+    let first = fs::read(&jpath).expect("journal");
+    fs::write(
+        &path,
+        volcano_with(r#""note": ""#, r#""note": "saved elsewhere once. "#),
+    )
+    .expect("write");
+    let (mut editor, report) = Editor::open(&path).expect("opens");
+    let first_aside = report.stale_journal.expect("set aside");
+    // Edits journaled against this version, then the document replaced again.
+    editor
+        .apply(Edit::SetHeight {
+            at: FigurePath::new(0, 0),
+            height: 123.0,
+        })
+        .expect("edit");
+    drop(editor);
+    let second = fs::read(&jpath).expect("journal");
+    fs::write(
+        &path,
+        volcano_with(r#""note": ""#, r#""note": "saved elsewhere twice. "#),
+    )
+    .expect("write");
+    let (_, report) = Editor::open(&path).expect("opens");
+    let second_aside = report.stale_journal.expect("set aside");
+    assert_ne!(first_aside, second_aside);
+    assert_eq!(
+        fs::read(&first_aside).expect("kept"),
+        first,
+        "the first journal set aside is kept"
+    );
+    assert_eq!(fs::read(&second_aside).expect("kept"), second);
+}
