@@ -6,10 +6,12 @@
 //! Exit status: 0 on success, 1 when the input is not valid, a file cannot be read or written, or
 //! the pen fails (the reason on stderr), 2 on a usage error.
 
+mod analyze;
 mod bench;
 mod generate;
 mod live;
 mod render;
+mod ridges;
 mod river;
 mod rocks;
 
@@ -65,6 +67,10 @@ enum Command {
     Bench(bench::Args),
     /// Scatter rocks of mixed sizes on a field (seed 001) and write them out.
     Rocks(rocks::Args),
+    /// Maps of a document's terrain: rain pass counts, ridge and valley areas, sunlight, sky view (seed 002).
+    Analyze(analyze::Args),
+    /// A document's ridgeline trees' elevations, or ridgelines grown from them (seed 002).
+    Ridges(ridges::Args),
     /// Shape one river of a document by erosion and deposition (seed 003) and write its masks.
     River(river::Args),
 }
@@ -78,6 +84,8 @@ fn main() -> ExitCode {
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::Rocks(args)) => rocks::run(&args),
+        Some(Command::Analyze(args)) => analyze::run(&args),
+        Some(Command::Ridges(args)) => ridges::run(&args),
         Some(Command::River(args)) => river::run(&args),
     };
     match result {

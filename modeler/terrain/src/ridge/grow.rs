@@ -1,8 +1,11 @@
 //! Recursive ridgeline generation (Alg. 2.5): from the main ridgelines, rounds of
 //!
 //! 1. the DTM with flank slope α (every line, old and new, at this round's α);
-//! 2. on a randomly chosen side of every segment, water drops at spacing d along it, each
-//!    started 1.5 cells off the segment and traced downhill as the rain is ([`super::rain`]);
+//! 2. on a randomly chosen side of every segment of the lines added last (the main lines in the
+//!    first round), water drops every d along the line, each started 1.5 cells off the segment
+//!    and traced downhill as the rain is ([`super::rain`]); a drop that reaches a cell an earlier
+//!    drop of the round passed joins that path there and stops, so the paths branch like a
+//!    drainage network instead of running down the same valley twice;
 //! 3. each drop's path, joined to the segment where it was dropped and sampled at the DTM's
 //!    heights, becomes a new ridgeline;
 //!
@@ -34,13 +37,13 @@ pub struct Growth {
 }
 
 impl Growth {
-    /// `rounds` rounds: d from 8 cells, × 0.6 a round; α + 5° a round.
+    /// `rounds` rounds: d from 12 cells, × 0.7 a round; α + 5° a round.
     pub fn new(rounds: u32, seed: u64, cell: f64) -> Growth {
         Growth {
             rounds,
             seed,
-            spacing: 8.0 * cell,
-            spacing_factor: 0.6,
+            spacing: 12.0 * cell,
+            spacing_factor: 0.7,
             slope_step: 5f64.to_radians(),
         }
     }
@@ -84,6 +87,8 @@ pub fn grow(
     }
     let mut rng = ChaCha8Rng::seed_from_u64(g.seed);
     let mut lines: Vec<Vec<[f64; 3]>> = Vec::new();
+    // The lines drops fall from: the base, then each round's new lines.
+    let mut sources: Vec<Skeleton> = base.to_vec();
     let (mut alpha, mut d) = (slope, g.spacing);
     for _ in 0..g.rounds {
         let mut all: Vec<Skeleton> = base
@@ -98,8 +103,13 @@ pub fn grow(
         let dtm = Dtm::build(cols, rows, cell, filter, &ids);
         let z = dtm.heights();
         let next = rain::directions(z, cols, rows, cell);
+        // Cells a path of this round already follows: a later drop joins it there and stops,
+        // so the new lines branch like a drainage network instead of doubling each other.
+        let mut taken = vec![false; z.len()];
         let mut fresh = Vec::new();
-        for s in &all {
+        for s in &sources {
+            // Drops every d along each segment, counted on from the previous segment.
+            let mut at = d / 2.0;
             for &[a, b] in &s.edges {
                 let (p, q) = (s.nodes[a as usize], s.nodes[b as usize]);
                 let len = (q[0] - p[0]).hypot(q[1] - p[1]);
@@ -108,7 +118,6 @@ pub fn grow(
                     continue;
                 }
                 let n = [-(q[1] - p[1]) / len * side, (q[0] - p[0]) / len * side];
-                let mut at = d / 2.0;
                 while at < len {
                     let t = at / len;
                     let on = [
@@ -122,9 +131,15 @@ pub fn grow(
                     if c < 0.0 || r < 0.0 || c >= f64::from(cols) || r >= f64::from(rows) {
                         continue;
                     }
-                    let path = rain::trace(&next, r as u32 * cols + c as u32);
+                    let mut path = rain::trace(&next, r as u32 * cols + c as u32);
+                    if let Some(k) = path.iter().position(|&i| taken[i as usize]) {
+                        path.truncate(k + 1);
+                    }
                     if path.len() < 3 {
                         continue;
+                    }
+                    for &i in &path {
+                        taken[i as usize] = true;
                     }
                     // Every few cells, and the last: enough for the line's shape.
                     let stride = ((d / cell / 2.0).round() as usize).clamp(1, 4);
@@ -141,8 +156,10 @@ pub fn grow(
                     }
                     fresh.push(line);
                 }
+                at -= len;
             }
         }
+        sources = fresh.iter().map(|l| Skeleton::polyline(l, alpha)).collect();
         lines.extend(fresh);
         alpha += g.slope_step;
         d *= g.spacing_factor;
