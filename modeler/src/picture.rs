@@ -91,6 +91,8 @@ pub struct Picture {
     look: Look,
     /// The rock fields standing on the terrain.
     rocks: Arc<Vec<(String, Mesh)>>,
+    /// The rivers' and lakes' water surface.
+    water: Arc<Vec<(String, Mesh)>>,
 }
 
 fn dot(at: Point, height: Option<f64>, colour: Rgba, width: f32) -> Overlay {
@@ -119,7 +121,18 @@ impl Picture {
             }
             crate::session::State::Running => ui.status(doc),
         };
-        Picture::from_parts(ui, doc, mode, look).with_rocks(session.editor.rocks().shared())
+        let water = session.editor.water().filter(|w| w.any()).map_or_else(Vec::new, |w| {
+            vec![("water".to_string(), w.mesh(doc.grid.cell_size))]
+        });
+        Picture::from_parts(ui, doc, mode, look)
+            .with_rocks(session.editor.rocks().shared())
+            .with_water(Arc::new(water))
+    }
+
+    /// The picture with the water surface `water` (from [`penmodel_terrain::Editor::water`]).
+    pub fn with_water(mut self, water: Arc<Vec<(String, Mesh)>>) -> Picture {
+        self.water = water;
+        self
     }
 
     /// The picture with the rock fields `rocks` (an editor's, [`penmodel_terrain::Editor::rocks`]).
@@ -189,6 +202,7 @@ impl Picture {
             vertical_scale: view.exaggeration as f32,
             look: look.clone(),
             rocks: Arc::default(),
+            water: Arc::default(),
         }
     }
 
@@ -267,6 +281,7 @@ impl Picture {
             vertical_scale: view.exaggeration as f32,
             look: look.clone(),
             rocks: Arc::default(),
+            water: Arc::default(),
         }
     }
 
@@ -318,6 +333,7 @@ impl Picture {
             vertical_scale: self.vertical_scale,
             overlays: &self.overlays,
             rocks: &self.rocks,
+            water: &self.water,
             selection: self.selection,
             slope_bar: self.slope_bar.clone(),
             mode: &self.mode,

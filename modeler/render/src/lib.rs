@@ -73,6 +73,8 @@ struct EyeBuffers {
     projected: Projected,
     capsules: Vec<Capsule>,
     rocks: rocks::Projected,
+    /// The water meshes, drawn as the rocks are, in the water colour.
+    water: rocks::Projected,
 }
 
 /// Renders scenes into frames, keeping its buffers from one frame to the next.
@@ -221,6 +223,14 @@ impl Renderer {
             &scene.style,
             (height as usize, self.tile_rows),
         );
+        self.eye.water.project(
+            scene.water,
+            &affine,
+            scene.terrain.cell_size(),
+            near,
+            &scene.style,
+            (height as usize, self.tile_rows),
+        );
         (affine, near)
     }
 
@@ -240,6 +250,7 @@ impl Renderer {
         tiles::render(
             &pass,
             &self.eye.rocks,
+            &self.eye.water,
             &self.eye.capsules,
             &ramp,
             &scene.style,

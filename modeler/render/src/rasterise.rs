@@ -75,8 +75,20 @@ pub struct Sample {
     pub hw: f32,
     /// Light / w.
     pub lw: f32,
-    /// A rock's surface (drawn in the rock colour), not the terrain's.
-    pub rock: bool,
+    /// Whose surface: the terrain's (the height ramp), a rock's or the water's (their colours).
+    pub surface: Surface,
+}
+
+/// What a sample shows, which decides its colour.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Surface {
+    /// The terrain: the height ramp.
+    #[default]
+    Terrain,
+    /// A rock: [`crate::Style::rock_colour`].
+    Rock,
+    /// River or lake water: [`crate::Style::water_colour`].
+    Water,
 }
 
 /// Where covered pixels go.
@@ -86,7 +98,7 @@ pub trait Sink {
 }
 
 /// The depth test into a tile of samples whose first row is `y0`; a winning pixel is marked as
-/// rock or terrain by `rock`.
+/// the `surface` drawn.
 pub struct DepthSink<'a> {
     /// The tile's samples, row-major.
     pub samples: &'a mut [Sample],
@@ -94,8 +106,8 @@ pub struct DepthSink<'a> {
     pub width: usize,
     /// The tile's first row.
     pub y0: i32,
-    /// The triangles drawn are a rock's, not the terrain's.
-    pub rock: bool,
+    /// Whose triangles are drawn.
+    pub surface: Surface,
 }
 
 impl Sink for DepthSink<'_> {
@@ -108,7 +120,7 @@ impl Sink for DepthSink<'_> {
                 invw,
                 hw,
                 lw,
-                rock: self.rock,
+                surface: self.surface,
             };
         }
     }

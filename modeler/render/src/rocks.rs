@@ -11,7 +11,7 @@
 use penmodel_terrain::export::Mesh;
 
 use super::clip::{self, ClipVertex};
-use super::rasterise::{self, Bounds, DepthSink, Sample, Vtx};
+use super::rasterise::{self, Bounds, DepthSink, Sample, Surface, Vtx};
 use super::scene::Style;
 use super::transform::{self, Affine};
 
@@ -91,7 +91,7 @@ impl Projected {
 
     /// Draws the triangles that reach the tile `bounds` (its first row starts a band) into its
     /// samples.
-    pub fn draw(&self, bounds: &Bounds, samples: &mut [Sample], width: usize, near: f32) {
+    pub fn draw(&self, bounds: &Bounds, samples: &mut [Sample], width: usize, near: f32, surface: Surface) {
         let Some(bin) = self.bins.get(bounds.y0.max(0) as usize / self.band_rows.max(1)) else {
             return;
         };
@@ -99,7 +99,7 @@ impl Projected {
             samples,
             width,
             y0: bounds.y0,
-            rock: true,
+            surface,
         };
         for &i in bin {
             let t = self.triangles[i as usize];

@@ -90,6 +90,8 @@ pub struct Style {
     pub text_scale: u32,
     /// Colour of rocks, before light.
     pub rock_colour: Rgba,
+    /// Colour of river and lake water, before light.
+    pub water_colour: Rgba,
 }
 
 impl Default for Style {
@@ -110,6 +112,7 @@ impl Default for Style {
             text_scale: 2,
             // Weathered granite, a little warmer than the terrain's grey.
             rock_colour: [158, 148, 136, 255],
+            water_colour: [52, 104, 168, 255],
         }
     }
 }
@@ -126,6 +129,9 @@ pub struct Scene<'a> {
     /// Meshes standing on the terrain (rock fields), in the exports' frame (X, Y up, Z; metres),
     /// drawn in [`Style::rock_colour`].
     pub rocks: &'a [(String, Mesh)],
+    /// Water surfaces (rivers and lakes: flat meshes at their level, the same frame), drawn in
+    /// [`Style::water_colour`].
+    pub water: &'a [(String, Mesh)],
     /// The index in `overlays` of the selected one, drawn in the selection colour and width.
     pub selection: Option<usize>,
     /// The slope bar, when shown.
@@ -148,6 +154,7 @@ impl<'a> Scene<'a> {
             vertical_scale: 1.0,
             overlays: &[],
             rocks: &[],
+            water: &[],
             selection: None,
             slope_bar: None,
             mode: "",

@@ -15,7 +15,7 @@
 use rayon::prelude::*;
 
 use super::frame::Rgba;
-use super::rasterise::Sample;
+use super::rasterise::{Sample, Surface};
 use super::scene::Style;
 use penmodel_terrain::Heightmap;
 
@@ -172,11 +172,11 @@ pub fn resolve(
         for (s, p) in srow[x0..x1].iter().zip(&mut prow[x0..x1]) {
             if s.invw > 0.0 {
                 let w = 1.0 / s.invw;
-                let c = if s.rock {
-                    let r = style.rock_colour;
-                    [f32::from(r[0]), f32::from(r[1]), f32::from(r[2])]
-                } else {
-                    ramp.get(s.hw * w)
+                let flat = |r: Rgba| [f32::from(r[0]), f32::from(r[1]), f32::from(r[2])];
+                let c = match s.surface {
+                    Surface::Rock => flat(style.rock_colour),
+                    Surface::Water => flat(style.water_colour),
+                    Surface::Terrain => ramp.get(s.hw * w),
                 };
                 let l = (s.lw * w).clamp(0.0, 1.0);
                 *p = [(c[0] * l) as u8, (c[1] * l) as u8, (c[2] * l) as u8, 255];

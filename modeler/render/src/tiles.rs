@@ -112,6 +112,7 @@ impl EyePass<'_> {
 pub fn render(
     pass: &EyePass,
     rocks: &super::rocks::Projected,
+    water: &super::rocks::Projected,
     capsules: &[Capsule],
     ramp: &Ramp,
     style: &Style,
@@ -144,10 +145,11 @@ pub fn render(
                 samples: smp,
                 width,
                 y0: bounds.y0,
-                rock: false,
+                surface: rasterise::Surface::Terrain,
             };
             pass.terrain(&bounds, &mut sink);
-            rocks.draw(&bounds, smp, width, pass.near);
+            rocks.draw(&bounds, smp, width, pass.near, rasterise::Surface::Rock);
+            water.draw(&bounds, smp, width, pass.near, rasterise::Surface::Water);
             shade::resolve(smp, pix, width, (x0, x1), y0, frame_height, ramp, style);
             let (top, bottom) = (bounds.y0 as f32, bounds.y1 as f32);
             for cap in capsules {

@@ -2,3 +2,4 @@
 mod outputs;
 mod render;
 mod rocks;
+mod water;

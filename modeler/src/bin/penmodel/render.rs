@@ -181,6 +181,12 @@ pub fn run(args: &Args) -> Result<()> {
         penmodel::picture::document_overlays(editor.document())
     };
     let (_, hi) = map.range();
+    // The rivers' and lakes' water, drawn flat at its level.
+    let water: Vec<(String, penmodel_terrain::export::Mesh)> = editor
+        .water()
+        .filter(|w| w.any())
+        .map(|w| vec![("water".to_string(), w.mesh(map.cell_size()))])
+        .unwrap_or_default();
     let mut scene = Scene::new(
         map,
         Camera {
@@ -190,6 +196,7 @@ pub fn run(args: &Args) -> Result<()> {
     );
     scene.overlays = &overlays;
     scene.rocks = editor.rocks().meshes();
+    scene.water = &water;
     scene.mode = &args.mode;
     scene.vertical_scale = args.vertical_scale as f32;
     scene.style.ramp_top = ramp_top(hi);
