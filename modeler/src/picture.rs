@@ -121,9 +121,11 @@ impl Picture {
             }
             crate::session::State::Running => ui.status(doc),
         };
-        let water = session.editor.water().filter(|w| w.any()).map_or_else(Vec::new, |w| {
-            vec![("water".to_string(), w.mesh(doc.grid.cell_size))]
-        });
+        let water = session
+            .editor
+            .water()
+            .filter(|w| w.any())
+            .map_or_else(Vec::new, |w| vec![("water".to_string(), w.mesh(doc.grid.cell_size))]);
         Picture::from_parts(ui, doc, mode, look)
             .with_rocks(session.editor.rocks().shared())
             .with_water(Arc::new(water))
