@@ -16,7 +16,7 @@
 use std::collections::VecDeque;
 use std::io::{BufWriter, Read, Write};
 use std::net::Shutdown;
-use std::os::unix::net::{UnixListener, UnixStream};
+use std::os::unix::net::UnixStream;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
@@ -352,12 +352,13 @@ fn client_left(stream: &UnixStream) -> bool {
 /// Binds the socket at `path`, owner-only from the start, replacing only a dead socket
 /// (`socket` says what is checked). At the default path the directory is pend's own and must be
 /// private to this user.
-pub fn bind(path: &Path) -> Result<UnixListener, SocketError> {
+pub fn bind(path: &Path) -> Result<socket::Bound, SocketError> {
     socket::bind(path, path == default_socket())
 }
 
-/// Accepts clients until `stop` is set.
-pub fn accept(listener: UnixListener, hub: Arc<Hub>, queue_len: usize, stop: Arc<AtomicBool>) {
+/// Accepts clients until `stop` is set; the socket's lock is held until then.
+pub fn accept(bound: socket::Bound, hub: Arc<Hub>, queue_len: usize, stop: Arc<AtomicBool>) {
+    let listener = &bound.listener;
     if listener.set_nonblocking(true).is_err() {
         return;
     }

@@ -15,14 +15,21 @@
 //! - Only a *socket* nobody answers on is removed as stale (a crashed pend left it); a regular
 //!   file, a folder or a symlink at the path is an error naming it, and a socket that answers is
 //!   another pend.
+//! - The pend at a path holds `PATH.lock` (an owner-only file beside the socket, `flock`ed for as
+//!   long as it listens) from before it looks at the socket: pends started together on a stale
+//!   socket would otherwise each find it dead, and one could remove the socket another had just
+//!   bound, leaving a pend nobody can reach. The kernel drops the lock when pend dies, however it
+//!   dies; the file stays (removing it would reopen the race).
 
 use std::ffi::OsString;
-use std::fs::{DirBuilder, Metadata};
+use std::fs::{DirBuilder, File, Metadata, OpenOptions};
 use std::io;
-use std::os::unix::fs::{DirBuilderExt, FileTypeExt, MetadataExt, PermissionsExt};
+use std::os::unix::fs::{DirBuilderExt, FileTypeExt, MetadataExt, OpenOptionsExt, PermissionsExt};
 use std::os::unix::net::{UnixListener, UnixStream};
 use std::path::{Path, PathBuf};
 
+use nix::errno::Errno;
+use nix::fcntl::{Flock, FlockArg, OFlag};
 use nix::sys::stat::{Mode, umask};
 
 /// Why pend cannot listen where it was asked to.
@@ -90,24 +97,64 @@ fn default_path_from(runtime_dir: Option<OsString>, uid: u32) -> PathBuf {
     }
 }
 
+/// pend's socket, bound, and the lock that makes the path this pend's while it listens.
+#[derive(Debug)]
+pub struct Bound {
+    /// The listening socket.
+    pub listener: UnixListener,
+    /// Released when this is dropped (or the process ends).
+    _lock: Flock<File>,
+}
+
 /// Binds pend's socket at `path`. `private_dir`: the directory is pend's own (the default
 /// location) and is held to the strict rule — owned by this user, mode 0700 or tighter.
-pub fn bind(path: &Path, private_dir: bool) -> Result<UnixListener, SocketError> {
+pub fn bind(path: &Path, private_dir: bool) -> Result<Bound, SocketError> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
         _ => PathBuf::from("."),
     };
     prepare_dir(&dir, private_dir)?;
+    let lock = take_lock(path)?;
     clear_stale(path)?;
     // Owner-only from creation: the umask is the process's, so restore it at once.
     let old = umask(Mode::from_bits_truncate(0o177));
     let bound = UnixListener::bind(path);
     umask(old);
-    bound.map_err(|cause| SocketError::Io {
+    let listener = bound.map_err(|cause| SocketError::Io {
         what: "listen on",
         path: path.to_path_buf(),
         cause,
-    })
+    })?;
+    Ok(Bound { listener, _lock: lock })
+}
+
+/// Takes `PATH.lock`, owner-only and not through a symlink; another pend holding it is
+/// [`SocketError::InUse`].
+fn take_lock(path: &Path) -> Result<Flock<File>, SocketError> {
+    let mut name = path.as_os_str().to_owned();
+    name.push(".lock");
+    let lock_path = PathBuf::from(name);
+    let file = OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .mode(0o600)
+        .custom_flags(OFlag::O_NOFOLLOW.bits() | OFlag::O_CLOEXEC.bits())
+        .open(&lock_path)
+        .map_err(|cause| SocketError::Io {
+            what: "open the lock",
+            path: lock_path.clone(),
+            cause,
+        })?;
+    match Flock::lock(file, FlockArg::LockExclusiveNonblock) {
+        Ok(lock) => Ok(lock),
+        Err((_, Errno::EWOULDBLOCK)) => Err(SocketError::InUse(path.to_path_buf())),
+        Err((_, errno)) => Err(SocketError::Io {
+            what: "lock",
+            path: lock_path,
+            cause: io::Error::from(errno),
+        }),
+    }
 }
 
 /// Makes `dir` (0700) if it is missing, and checks an existing one.
@@ -345,6 +392,36 @@ mod tests {
         // The listener is gone, its file remains and refuses connections: stale.
         assert!(path.exists());
         bind(&path, false).expect("a stale socket is replaced");
+    }
+
+    /// Pends started together on a stale socket: each sees it dead, and without a lock one could
+    /// remove the socket another had just bound in its place, leaving two pends, one of them
+    /// listening on a file nobody can reach. Exactly one bind may win each round.
+    #[test]
+    fn pends_racing_for_a_stale_socket_leave_exactly_one_listening() {
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let path = tmp.path().join("pend.sock");
+        for round in 0..200 {
+            drop(bind(&path, false).expect("binds"));
+            assert!(path.exists(), "stale");
+            let barrier = std::sync::Barrier::new(4);
+            let won: Vec<_> = std::thread::scope(|s| {
+                let racers: Vec<_> = (0..4)
+                    .map(|_| {
+                        s.spawn(|| {
+                            barrier.wait();
+                            bind(&path, false)
+                        })
+                    })
+                    .collect();
+                racers
+                    .into_iter()
+                    .filter_map(|r| r.join().expect("racer").ok())
+                    .collect()
+            });
+            assert_eq!(won.len(), 1, "round {round}: {} binds won", won.len());
+            drop(won);
+        }
     }
 
     #[test]
