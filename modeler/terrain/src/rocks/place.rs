@@ -198,7 +198,9 @@ fn seat_rock(
     for s in norms.iter_mut() {
         let len = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
         *s = if len > 0.0 {
-            [s[0] / len, s[1] / len, s[2] / len]
+            // One division, not three (a re-seat waits on them).
+            let inv = 1.0 / len;
+            [s[0] * inv, s[1] * inv, s[2] * inv]
         } else {
             [0.0, 1.0, 0.0]
         };
@@ -218,9 +220,11 @@ pub fn ground(map: &Heightmap) -> impl Fn(f64, f64) -> f64 + Sync + '_ {
     // (`c ≤ cols − 2`); only a grid one cell wide needs its indices held in.
     let wide = cols >= 2 && rows >= 2;
     let stride = cols as usize;
+    // Multiplied, not divided: two divisions per rock vertex were a tenth of a re-seat.
+    let per_metre = 1.0 / s;
     move |x: f64, y: f64| {
-        let fx = (x / s - 0.5).clamp(0.0, last_c);
-        let fy = (y / s - 0.5).clamp(0.0, last_r);
+        let fx = (x * per_metre - 0.5).clamp(0.0, last_c);
+        let fy = (y * per_metre - 0.5).clamp(0.0, last_r);
         let (c, r) = ((fx as u32).min(max_c), (fy as u32).min(max_r));
         let (u, v) = (fx - f64::from(c), fy - f64::from(r));
         let (a, b, d, e) = if wide {
@@ -232,11 +236,15 @@ pub fn ground(map: &Heightmap) -> impl Fn(f64, f64) -> f64 + Sync + '_ {
             (at(c, r), at(c + 1, r), at(c, r + 1), at(c + 1, r + 1))
         };
         let (a, b, d, e) = (f64::from(a), f64::from(b), f64::from(d), f64::from(e));
-        if u + v <= 1.0 {
-            a + u * (b - a) + v * (d - a)
-        } else {
-            e + (1.0 - u) * (d - e) + (1.0 - v) * (b - e)
-        }
+        // The lower triangle `a + u·(b − a) + v·(d − a)` or the upper one, `e + (1 − u)·(d − e)
+        // + (1 − v)·(b − e)` = `(b + d − e) + u·(e − d) + v·(e − b)`, blended by a 0 or 1
+        // rather than branched on: which half a rock vertex falls in is random, and the
+        // mispredicted branch was a tenth of a re-seat.
+        let upper = f64::from(u8::from(u + v > 1.0));
+        let base = a + upper * (b + d - e - a);
+        let along_u = (b - a) + upper * (e - d - (b - a));
+        let along_v = (d - a) + upper * (e - b - (d - a));
+        base + u * along_u + v * along_v
     }
 }
 
