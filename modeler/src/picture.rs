@@ -12,12 +12,19 @@ use penmodel_terrain::document::{Document, Figure, FigureKind, Point};
 use penmodel_terrain::export::Mesh;
 
 use crate::feed::Calibrating;
+use crate::interaction::river;
 use crate::interaction::rocks::{self, Tool};
 use crate::interaction::{Interaction, View};
 use crate::session::Session;
 
 /// Colour of a rock field's outline.
 pub const ROCK_FIELD_COLOUR: Rgba = [200, 170, 130, 255];
+/// Colour of a river's control polygon and points.
+pub const RIVER_COLOUR: Rgba = [90, 160, 255, 255];
+/// Colour of the cells the next iteration erodes (the seed's red).
+pub const EROSION_COLOUR: Rgba = [230, 40, 30, 255];
+/// Colour of the cells the next iteration deposits (the seed's light blue).
+pub const DEPOSITION_COLOUR: Rgba = [160, 215, 255, 255];
 /// Colour of the palette button while the rock tool is on.
 pub const PALETTE_ON_COLOUR: Rgba = [255, 200, 90, 255];
 /// Colour of the palette button while figures are drawn.
@@ -250,6 +257,45 @@ impl Picture {
                 PALETTE_OFF_COLOUR
             },
             width: if ui.tool() == Tool::Rocks { 5.0 } else { 2.0 },
+            height: None,
+        });
+        // Rivers: each control polygon and its points (the held river as the pen makes it), the
+        // next iteration's erosion and deposition while one is edited, the river button.
+        let moving_river = ui.river_moving(doc);
+        for (i, r) in doc.rivers.iter().enumerate() {
+            let points = match &moving_river {
+                Some((m, moved)) if *m == i => moved.points.clone(),
+                _ => r.points.clone(),
+            };
+            let held = moving_river.as_ref().is_some_and(|(m, _)| *m == i);
+            if ui.tool() == Tool::Rivers && ui.river_hover() == Some(i) && !held {
+                selection = Some(overlays.len());
+            }
+            let colour = if held { MOVING_COLOUR } else { RIVER_COLOUR };
+            overlays.push(Overlay {
+                points: points.clone(),
+                closed: false,
+                colour,
+                width: 1.0,
+                height: None,
+            });
+            if ui.tool() == Tool::Rivers {
+                overlays.extend(points.iter().map(|p| dot(*p, None, colour, 4.0)));
+            }
+        }
+        if let Some((erosion, deposition)) = ui.river_preview() {
+            overlays.extend(erosion.iter().map(|p| dot(*p, None, EROSION_COLOUR, 2.0)));
+            overlays.extend(deposition.iter().map(|p| dot(*p, None, DEPOSITION_COLOUR, 2.0)));
+        }
+        overlays.push(Overlay {
+            points: river::palette_outline(view),
+            closed: true,
+            colour: if ui.tool() == Tool::Rivers {
+                PALETTE_ON_COLOUR
+            } else {
+                PALETTE_OFF_COLOUR
+            },
+            width: if ui.tool() == Tool::Rivers { 5.0 } else { 2.0 },
             height: None,
         });
         if let Some(drawn) = ui.drawing() {

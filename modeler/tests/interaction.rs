@@ -462,3 +462,75 @@ fn a_rock_field_dropped_outside_every_region_goes() {
     pen.editor.undo().expect("undo");
     assert_eq!(pen.doc().rocks.len(), 1);
 }
+
+/// The river tool (issue 13): the river button picks it; a stroke becomes a river fitted to
+/// Bézier segments; an SW3 click over it adds a year; SW2 on a control point reshapes it, with
+/// the next year's erosion and deposition previewed; SW2 + SW3 sideways widens it.
+#[test]
+fn the_river_tool_draws_ages_reshapes_and_widens_a_river() {
+    use penmodel::interaction::rocks::Tool;
+    let mut pen = Pen::new(blank());
+    pen.closed(&REGION);
+    // The river button: 8 to 28 mm across, 32 to 52 mm down.
+    pen.hover(18.0, 42.0).touch().lift(HOVER);
+    assert_eq!(pen.ui.tool(), Tool::Rivers);
+    let course = [
+        (100.0, 250.0),
+        (180.0, 170.0),
+        (260.0, 230.0),
+        (340.0, 150.0),
+        (420.0, 210.0),
+        (500.0, 120.0),
+    ];
+    pen.stroke(&course);
+    assert_eq!(pen.doc().rivers.len(), 1, "{:?}", pen.ui.take_messages());
+    assert_eq!(pen.doc().regions[0].figures.len(), 0, "the course is no figure");
+    let river = pen.doc().rivers[0].clone();
+    assert_eq!(river.points.len() % 3, 1, "whole cubic segments");
+    assert!(near(river.points[0], pen.ground(100.0, 250.0), 15.0));
+    assert!(near(
+        *river.points.last().expect("points"),
+        pen.ground(500.0, 120.0),
+        15.0
+    ));
+    // A year: SW3 click over the course.
+    pen.hover(180.0, 170.0).click(2);
+    let years = pen.doc().rivers[0].iterations;
+    assert_eq!(years, 1, "{:?}", pen.ui.take_messages());
+    // SW2 on control point 3 and a slide: the point moves by the slide, the preview shows.
+    let p3 = pen.view().to_display(pen.doc().rivers[0].points[3]);
+    pen.grab(p3[0], p3[1]).drag_to(p3[0] + 20.0, p3[1] + 10.0);
+    let (erosion, deposition) = pen.ui.river_preview().cloned().expect("a preview while reshaping");
+    assert!(!erosion.is_empty() && !deposition.is_empty());
+    pen.lift(HOVER).let_go();
+    let moved = pen.doc().rivers[0].clone();
+    let by = [
+        moved.points[3][0] - river.points[3][0],
+        moved.points[3][1] - river.points[3][1],
+    ];
+    let slide = {
+        let (a, b) = (pen.ground(p3[0], p3[1]), pen.ground(p3[0] + 20.0, p3[1] + 10.0));
+        [b[0] - a[0], b[1] - a[1]]
+    };
+    assert!(near(by, slide, 15.0), "moved by {by:?}, slid {slide:?}");
+    assert_eq!(moved.points[0], river.points[0], "only the held point moves");
+    // Held on its course, SW3 and a move right and up: wider and deeper, one edit.
+    let on = pen.view().to_display(moved.points[0]);
+    pen.grab(on[0], on[1]);
+    pen.set(2, true).set(0, false);
+    let to = pen.at + DVec3::new(35.0, 0.0, 20.0);
+    pen.move_to(to).set(2, false).let_go();
+    let wide = &pen.doc().rivers[0];
+    assert!(
+        wide.width > moved.width * 1.5 && wide.depth > moved.depth * 1.2,
+        "{wide:?}"
+    );
+    // Undo: the width, the point, the year, the river.
+    for _ in 0..4 {
+        pen.editor.undo().expect("undo");
+    }
+    assert!(pen.doc().rivers.is_empty());
+    // Back to figures with the button again.
+    pen.hover(18.0, 42.0).touch().lift(HOVER);
+    assert_eq!(pen.ui.tool(), Tool::Figures);
+}

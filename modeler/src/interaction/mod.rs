@@ -24,6 +24,7 @@
 //! A refused edit is a message and a count, never a lost document: the editor keeps it valid.
 
 pub mod pick;
+pub mod river;
 pub mod rocks;
 pub mod stroke;
 pub mod view;
@@ -184,6 +185,8 @@ enum State {
     Palette,
     /// A rock field held with SW2.
     Field(rocks::FieldGrab),
+    /// A river (or one of its control points) held with SW2.
+    River(river::RiverGrab),
     /// SW3 held with nothing drawn or grabbed: a click (undo) or a pan.
     Sw3 {
         t0: u64,
@@ -223,6 +226,10 @@ pub struct Interaction {
     tool: rocks::Tool,
     /// The rock field under the pen, with the rock tool.
     field_hover: Option<usize>,
+    /// The river under the pen, with the river tool.
+    river_hover: Option<usize>,
+    /// The held river's next erosion and deposition cells (ground metres), while it is edited.
+    river_preview: Option<(Vec<Point>, Vec<Point>)>,
 }
 
 /// The event's time on the device's clock, µs; `None` for events not from a report (device
@@ -264,6 +271,30 @@ impl Interaction {
             last_message: None,
             tool: rocks::Tool::Figures,
             field_hover: None,
+            river_hover: None,
+            river_preview: None,
+        }
+    }
+
+    /// The river under the pen (river tool), or held.
+    pub fn river_hover(&self) -> Option<usize> {
+        match &self.state {
+            State::River(g) => Some(g.index),
+            _ => self.river_hover,
+        }
+    }
+
+    /// The held river as the pen is making it: `(index, river)`.
+    pub fn river_moving(&self, doc: &Document) -> Option<(usize, penmodel_terrain::River)> {
+        let State::River(g) = &self.state else { return None };
+        Some((g.index, g.river(doc)?))
+    }
+
+    /// The held river's next erosion and deposition cells (ground metres), while it is edited.
+    pub fn river_preview(&self) -> Option<&(Vec<Point>, Vec<Point>)> {
+        match &self.state {
+            State::River(_) => self.river_preview.as_ref(),
+            _ => None,
         }
     }
 
@@ -393,8 +424,25 @@ impl Interaction {
             State::Armed if self.tool == rocks::Tool::Rocks => {
                 "rocks: SW2: touch a rock field to grab it | SW3: redo".to_string()
             }
+            State::Idle if self.tool == rocks::Tool::Rivers => match self.river_hover {
+                Some(i) => format!("rivers: river {i}: SW3 click: one more year | SW2 + touch grabs it"),
+                None => "rivers: draw a course from source to mouth | SW3 ends it | tap the river button for figures"
+                    .to_string(),
+            },
+            State::Armed if self.tool == rocks::Tool::Rivers => {
+                "rivers: SW2: touch a control point to move it, the course to hold it | SW3: redo".to_string()
+            }
+            State::River(g) => match (g.tuning, g.control) {
+                (Some((_, w, d)), _) => format!(
+                    "river {}: width ×{w:.2}, depth ×{d:.2} | sideways: width, up/down: depth",
+                    g.index
+                ),
+                (None, Some(k)) if g.moving => format!("river {}: moving point {k} | lift to set", g.index),
+                (None, _) => format!("river {}: slide a point to reshape | SW3 + move: width, depth", g.index),
+            },
             State::Palette => match self.tool {
                 rocks::Tool::Rocks => "rock tool".to_string(),
+                rocks::Tool::Rivers => "river tool".to_string(),
                 rocks::Tool::Figures => "figures".to_string(),
             },
             State::Field(g) => match g.tuning {
@@ -507,6 +555,16 @@ impl Interaction {
         match command {
             KeyCommand::Undo => self.undo(editor),
             KeyCommand::Redo => self.redo(editor),
+            KeyCommand::Delete if self.tool == rocks::Tool::Rivers => {
+                let Some(index) = self.river_hover() else {
+                    self.say("no river highlighted to delete".into());
+                    return;
+                };
+                if self.commit(editor, Edit::DeleteRiver { index }, "delete") {
+                    self.stats.deletes += 1;
+                    self.river_hover = None;
+                }
+            }
             KeyCommand::Delete if self.tool == rocks::Tool::Rocks => {
                 let Some(index) = self.field_hover() else {
                     self.say("no rock field highlighted to delete".into());
@@ -561,6 +619,23 @@ impl Interaction {
         let Some((g, p)) = self.ground() else { return };
         let s = self.tuning;
         match &mut self.state {
+            State::Idle | State::Armed if self.tool == rocks::Tool::Rivers => {
+                self.hover = None;
+                self.river_hover = river::river_at(editor.document(), g, self.view.metres(s.pick_mm));
+            }
+            State::River(grab) => {
+                let slid = (p.u_mm - grab.at_mm[0]).hypot(p.v_mm - grab.at_mm[1]);
+                if let Some((start, _, _)) = grab.tuning {
+                    let width = ((p.u_mm - start[0]) * river::GAIN_PER_MM).exp();
+                    let depth = ((p.h_mm - start[1]) * river::GAIN_PER_MM).exp();
+                    grab.tuning = Some((start, width, depth));
+                } else if self.sw[0] && grab.control.is_some() && (grab.moving || slid > s.move_mm) {
+                    grab.moving = true;
+                    grab.by = minus(g, self.view.to_ground(grab.at_mm[0], grab.at_mm[1]));
+                }
+                let doc = editor.document();
+                self.river_preview = grab.river(doc).map(|r| river::preview(&r, &doc.grid));
+            }
             State::Idle | State::Armed if self.tool == rocks::Tool::Rocks => {
                 self.hover = None;
                 self.field_hover = rocks::field_at(editor.document(), g);
@@ -672,23 +747,60 @@ impl Interaction {
     fn on_tip_down(&mut self, editor: &mut Editor) {
         let Some((g, p)) = self.ground() else { return };
         match &mut self.state {
+            State::Idle if river::on_palette(p.u_mm, p.v_mm) => {
+                self.tool = match self.tool {
+                    rocks::Tool::Rivers => rocks::Tool::Figures,
+                    _ => rocks::Tool::Rivers,
+                };
+                self.hover = None;
+                self.field_hover = None;
+                self.river_hover = None;
+                self.state = State::Palette;
+                self.say(match self.tool {
+                    rocks::Tool::Rivers => "river tool: draw a course from source to mouth, SW3 ends it".into(),
+                    _ => "figures: draw with the tip".into(),
+                });
+            }
             State::Idle if rocks::on_palette(p.u_mm, p.v_mm) => {
                 self.tool = match self.tool {
-                    rocks::Tool::Figures => rocks::Tool::Rocks,
                     rocks::Tool::Rocks => rocks::Tool::Figures,
+                    _ => rocks::Tool::Rocks,
                 };
+                self.river_hover = None;
                 self.hover = None;
                 self.field_hover = None;
                 self.state = State::Palette;
                 self.say(match self.tool {
                     rocks::Tool::Rocks => "rock tool: draw a field's outline, SW3 ends it".into(),
-                    rocks::Tool::Figures => "figures: draw with the tip".into(),
+                    _ => "figures: draw with the tip".into(),
                 });
             }
             State::Idle => {
                 self.state = State::Drawing {
                     positions: vec![g],
                     touching: true,
+                }
+            }
+            State::Armed if self.tool == rocks::Tool::Rivers => {
+                let doc = editor.document();
+                let tol = self.view.metres(self.tuning.pick_mm);
+                let grab = match river::control_at(doc, g, tol) {
+                    Some((index, k)) => Some((index, Some(k))),
+                    None => river::river_at(doc, g, tol).map(|i| (i, None)),
+                };
+                match grab {
+                    Some((index, control)) => {
+                        self.river_preview = doc.rivers.get(index).map(|r| river::preview(r, &doc.grid));
+                        self.state = State::River(river::RiverGrab {
+                            index,
+                            control,
+                            at_mm: [p.u_mm, p.v_mm],
+                            by: [0.0, 0.0],
+                            moving: false,
+                            tuning: None,
+                        });
+                    }
+                    None => self.say("no river here to grab".into()),
                 }
             }
             State::Armed if self.tool == rocks::Tool::Rocks => match rocks::field_at(editor.document(), g) {
@@ -725,7 +837,7 @@ impl Interaction {
                     None => self.say("nothing here to grab".into()),
                 }
             }
-            State::Grabbed(_) | State::Sw3 { .. } | State::Palette | State::Field(_) => {}
+            State::Grabbed(_) | State::Sw3 { .. } | State::Palette | State::Field(_) | State::River(_) => {}
         }
     }
 
@@ -757,6 +869,10 @@ impl Interaction {
             State::Palette => self.state = State::Idle,
             State::Field(grab) if grab.moving => {
                 self.drop_field(editor);
+                self.state = State::Armed;
+            }
+            State::River(grab) if grab.moving => {
+                self.drop_river(editor);
                 self.state = State::Armed;
             }
             _ => {}
@@ -793,7 +909,28 @@ impl Interaction {
         }
     }
 
+    /// Sets the held river's point where the pen has taken it.
+    fn drop_river(&mut self, editor: &mut Editor) {
+        let State::River(grab) = &self.state else { return };
+        if !grab.moving || grab.by == [0.0, 0.0] {
+            return;
+        }
+        let (index, k) = (grab.index, grab.control);
+        let Some(river) = grab.river(editor.document()) else {
+            return;
+        };
+        if self.commit(editor, Edit::ReplaceRiver { index, river }, "moving the river's point") {
+            self.stats.moves += 1;
+            self.say(format!("river {index}: point {} moved", k.unwrap_or(0)));
+        }
+    }
+
     fn on_sw2_up(&mut self, editor: &mut Editor) {
+        if let State::River(_) = &self.state {
+            self.drop_river(editor);
+            self.state = State::Idle;
+            return;
+        }
         if let State::Field(_) = &self.state {
             self.drop_field(editor);
             self.state = State::Idle;
@@ -851,6 +988,13 @@ impl Interaction {
                     grab.tuned = true;
                 }
             }
+            State::River(grab) => {
+                if let Some(p) = self.pen
+                    && !grab.moving
+                {
+                    grab.tuning = Some(([p.u_mm, p.h_mm], 1.0, 1.0));
+                }
+            }
             State::Sw3 { .. } | State::Palette => {}
         }
     }
@@ -879,10 +1023,38 @@ impl Interaction {
                     self.say(format!("rock field {index}: density ×{density:.2}, size ×{size:.2}"));
                 }
             }
+            State::River(grab) => {
+                let Some((_, width, depth)) = grab.tuning else {
+                    return;
+                };
+                let index = grab.index;
+                let Some(river) = grab.river(editor.document()) else {
+                    return;
+                };
+                grab.tuning = None;
+                if self.commit(
+                    editor,
+                    Edit::ReplaceRiver { index, river },
+                    "the river's width and depth",
+                ) {
+                    self.say(format!("river {index}: width ×{width:.2}, depth ×{depth:.2}"));
+                }
+            }
             State::Sw3 { t0, moved, .. } => {
                 let click = !*moved && t.saturating_sub(*t0) < self.tuning.click_us;
                 self.state = State::Idle;
-                if click {
+                // With the river tool, a click over a river is one more year of its change.
+                let over = self.river_hover.filter(|_| self.tool == rocks::Tool::Rivers);
+                if click && let Some(index) = over {
+                    let Some(river) = editor.document().rivers.get(index).and_then(river::aged) else {
+                        self.say(format!("river {index} has had the most years a river may have"));
+                        return;
+                    };
+                    let years = river.iterations;
+                    if self.commit(editor, Edit::ReplaceRiver { index, river }, "the river's year") {
+                        self.say(format!("river {index}: {years} years of erosion and deposition"));
+                    }
+                } else if click {
                     self.undo(editor);
                 }
             }
@@ -894,6 +1066,10 @@ impl Interaction {
         match &mut self.state {
             State::Field(_) => {
                 self.say(format!("pen lost ({reason}): the rock field stays where it was"));
+                self.state = State::Idle;
+            }
+            State::River(_) => {
+                self.say(format!("pen lost ({reason}): the river stays as it was"));
                 self.state = State::Idle;
             }
             State::Grabbed(_) => {
@@ -1028,8 +1204,26 @@ impl Interaction {
         }
     }
 
+    /// Ends the river being drawn: its course fitted to Bézier segments, a new river.
+    fn finish_river(&mut self, editor: &mut Editor, positions: &[Point]) {
+        let Some(river) = river::new_river(positions, &self.view) else {
+            self.say("a river's course needs a longer stroke".into());
+            return;
+        };
+        let index = editor.document().rivers.len();
+        let points = river.points.len();
+        if self.commit(editor, Edit::AddRiver { index, river }, &format!("river {index}")) {
+            self.say(format!(
+                "river {index}: {points} control points | SW3 click over it: one year"
+            ));
+        }
+    }
+
     /// Ends the figure being drawn: classifies it and adds it where it belongs.
     fn finish(&mut self, editor: &mut Editor, positions: &[Point]) {
+        if self.tool == rocks::Tool::Rivers {
+            return self.finish_river(editor, positions);
+        }
         let v = self.view;
         let tol = Tolerances {
             point: v.metres(self.tuning.point_mm),

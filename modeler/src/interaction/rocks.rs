@@ -36,6 +36,8 @@ pub enum Tool {
     Figures,
     /// Rock fields.
     Rocks,
+    /// Rivers (seed 003; [`super::river`]).
+    Rivers,
 }
 
 /// Whether display point `(u, v)` mm is on the palette button.
