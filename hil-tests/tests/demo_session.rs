@@ -178,6 +178,36 @@ fn demo(seed: u64) {
     assert!(rocks > 100, "{rocks} rocks");
     assert_eq!(seated.meshes().len(), 1);
     println!("rock field within {field_mm:.2} mm, {rocks} rocks");
+
+    // The river (issue 13): drawn with the river tool along the session's course, two years old,
+    // carved into the flat ground left of the region with water over it.
+    let river = pen_sim::session::river_step();
+    assert_eq!(got.rivers.len(), 1, "one river");
+    let r = &got.rivers[0];
+    assert_eq!(r.iterations, river.years);
+    let course: Vec<Point> = river.course.iter().map(|p| to_ground(&view, *p)).collect();
+    let ctrl: Vec<glam::DVec2> = r.points.iter().map(|p| glam::DVec2::from(*p)).collect();
+    let fitted: Vec<Point> = penmodel_terrain::river::course::sample(&ctrl, view.metres(0.5))
+        .iter()
+        .map(|s| [s.p.x, s.p.y])
+        .collect();
+    let course_mm = shape_error(&fitted, &course) * view.scale;
+    // The fit rounds the stroke's corners: within 4 mm of the polyline through its corners.
+    assert!(course_mm <= 5.0, "the river's course is off by {course_mm:.2} mm");
+    let shape = session.editor.terrain().rivers().shape(0).expect("processed");
+    let moved: usize = shape.history.iter().map(|h| h.eroded + h.deposited).sum();
+    assert!(moved > 0, "the bends migrate");
+    let water = session.editor.water().expect("water");
+    let wet: Vec<usize> = (0..water.level.len()).filter(|&i| !water.level[i].is_nan()).collect();
+    assert!(!wet.is_empty());
+    assert!(
+        wet.iter().all(|&i| water.level[i] > a.heights()[i]),
+        "every wet cell holds water"
+    );
+    println!(
+        "river within {course_mm:.2} mm, {} wet cells, {moved} cells moved in two years",
+        wet.len()
+    );
 }
 
 fn to_ground(view: &View, p: glam::DVec2) -> Point {

@@ -118,6 +118,40 @@ pub fn rock_step() -> RockStep {
     }
 }
 
+/// The session's river (issue 13): the river button tapped (the river tool), a meandering course
+/// drawn down the flat strip left of the region, two SW3 clicks over it (two years: its bends
+/// migrate), and the button tapped again (back to figures).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RiverStep {
+    /// The river button's centre, display mm (the modeler's button is the square from 8 to 28
+    /// mm across and 32 to 52 mm down).
+    pub button: DVec2,
+    /// The course as drawn, display mm, source first.
+    pub course: Vec<DVec2>,
+    /// Where the hand clicks SW3 for each year: on the course.
+    pub over: DVec2,
+    /// Years committed.
+    pub years: u32,
+}
+
+/// The river of the demo's session, after the rock field.
+pub fn river_step() -> RiverStep {
+    let course = vec![
+        v(30.0, 70.0),
+        v(44.0, 110.0),
+        v(14.0, 160.0),
+        v(44.0, 210.0),
+        v(14.0, 260.0),
+        v(30.0, 330.0),
+    ];
+    RiverStep {
+        button: v(18.0, 42.0),
+        over: course[2],
+        course,
+        years: 2,
+    }
+}
+
 /// The hand's timeline for `steps`, from and back to `home`.
 pub fn timeline(steps: &[ModelingStep], home: glam::DVec3) -> Timeline {
     let mut s = Script::new(home);
@@ -150,6 +184,14 @@ pub fn timeline(steps: &[ModelingStep], home: glam::DVec3) -> Timeline {
         .lift(8.0)
         .let_go();
     s.hover(rock.palette).touch().lift(8.0);
+    let river = river_step();
+    // The river tool: tap its button, draw the course, two years, tap the button again.
+    s.hover(river.button).touch().lift(8.0);
+    s.draw_polyline(&river.course);
+    for _ in 0..river.years {
+        s.hover(river.over).click(SW3).hold(0.3);
+    }
+    s.hover(river.button).touch().lift(8.0);
     s.move_to(home);
     s.build()
 }

@@ -5,8 +5,8 @@
 //! - The **drive** of a sample grows with the bend's sharpness (curvature × width), the flow
 //!   (width × depth × water, against `flow_reference`) and softer ground (÷ hardness):
 //!   `drive = curvature_gain · κ · width · (width · depth · water / flow_reference) / hardness`.
-//! - The **level** is `1 + ⌊(n_max − 1) · (1 − e^(−drive))⌋`, at most `n_max`: 1 (no change) on a
-//!   straight course, `n_max` only on the sharpest bends.
+//! - The **level** is `1 + round((n_max − 1) · (1 − e^(−drive)))`: 1 (no change) on a straight
+//!   course, `n_max` on the sharpest bends.
 //!
 //! Each factor enters through a non-decreasing function, so the level never falls when the
 //! curvature, the water, the width or the depth grows, or when the hardness falls.
@@ -47,6 +47,6 @@ pub fn level(kappa: f64, river: &River, cell_size: f64, c: &Constants) -> u8 {
     let flow = river.width * river.depth * river.water / c.flow_reference;
     let drive = c.curvature_gain * kappa * river.width * flow / river.hardness;
     let grow = 1.0 - (-drive.max(0.0)).exp();
-    let n = 1.0 + (f64::from(n_max - 1) * grow).floor();
+    let n = 1.0 + (f64::from(n_max - 1) * grow).round();
     n.clamp(1.0, f64::from(n_max)) as u8
 }
