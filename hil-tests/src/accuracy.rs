@@ -119,7 +119,9 @@ pub fn evaluate(scenario: &Scenario, records: &[CycleRecord]) -> Metrics {
     let rig = &scenario.rig;
     let sigma_t = scenario.acoustics.sigma_t_us;
     let (mut errors, mut crlb_sum) = (Vec::new(), 0.0);
-    for r in records {
+    // The pen's cycles only: with the head tracked, the head's slots are not the pen's fixes.
+    let pen_cycles: Vec<&CycleRecord> = records.iter().filter(|r| r.emitter == pen_core::Emitter::Pen).collect();
+    for r in &pen_cycles {
         let Ok(fix) = r.result.fix else { continue };
         let p = DVec3::new(fix.position.x as f64, fix.position.y as f64, fix.position.z as f64);
         errors.push((p - r.truth_mm).length());
@@ -147,7 +149,7 @@ pub fn evaluate(scenario: &Scenario, records: &[CycleRecord]) -> Metrics {
     Metrics {
         name: scenario.name.clone(),
         seconds,
-        cycles: records.len(),
+        cycles: pen_cycles.len(),
         fixes,
         rmse_mm: rmse,
         crlb_mm: crlb,

@@ -3,6 +3,7 @@ mod architecture;
 mod demo_session;
 mod faults;
 mod flashing;
+mod head;
 mod hil;
 mod pty;
 mod qemu;

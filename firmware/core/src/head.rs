@@ -5,9 +5,11 @@
 //! slot is one burst and its listening window. With the head fitted every slot is as long as
 //! 1.5 m of flight at the running speed of sound plus the slowest receiver's delay (4.40 ms at
 //! 21 °C) and a short guard, instead of the pen-only cycle's fixed 6.5 ms, and the slots follow
-//! a pattern of `pen` pen slots to `head` head slots spread evenly. 2:1 is what the simulator
-//! chose (docs/firmware.md, *Head tracking*): 1:1 leaves the pen at 113 fixes/s and 3:1 the head
-//! at 57; 2:1 gives 150.8 and 75.4.
+//! a pattern of `pen` pen slots to `head` head slots spread evenly. 5:2 is what the simulator
+//! chose (`pen-sim head`, docs/firmware.md, *Head tracking*): 1:1 leaves the pen at 113 fixes/s
+//! and 3:1 the head at 57; 2:1 gives 150.6 and 75.3 at 21 °C but the pen drops below 150 in
+//! colder air (longer slots) or with echoes (149.0); 5:2 gives 161.4 and 64.5, and keeps both
+//! targets down to −10 °C (153 and 61).
 //!
 //! **Filter.** A seated viewer's head moves slowly and smoothly (sway, leaning in), so an
 //! alpha-beta (constant-velocity) filter suits it: it smooths the fix noise and estimates the
@@ -51,8 +53,8 @@ pub struct Schedule {
 }
 
 impl Schedule {
-    /// The chosen schedule, 2:1.
-    pub const CHOSEN: Schedule = Schedule { pen: 2, head: 1 };
+    /// The chosen schedule, 5:2 (P P P H P P H).
+    pub const CHOSEN: Schedule = Schedule { pen: 5, head: 2 };
 
     /// The emitter of slot `n` (counting from 0): head slots where `n · head / (pen + head)`
     /// steps up, so they are spread as evenly as the ratio allows (2:1 is P P H).
@@ -103,10 +105,12 @@ impl Default for HeadSettings {
 }
 
 /// Alpha-beta gains: how much of a new fix's innovation goes into the position and into the
-/// velocity (per slot). Chosen by the simulator's `head` figures (docs/firmware.md).
-pub const HEAD_ALPHA: f32 = 0.35;
+/// velocity (per slot). Chosen by `pen-sim head` (docs/firmware.md): a head's motion, not the
+/// fix noise, dominates the prediction's error, so the gains are fairly high; 0.45–0.5 with
+/// β 0.12–0.15 is a flat optimum (0.35/0.05 lags: 1.58 mm against 1.14 at 20 ms).
+pub const HEAD_ALPHA: f32 = 0.5;
 /// See [`HEAD_ALPHA`].
-pub const HEAD_BETA: f32 = 0.05;
+pub const HEAD_BETA: f32 = 0.15;
 
 /// An alpha-beta (constant-velocity) filter with prediction.
 #[derive(Debug, Clone, Copy, Default)]
@@ -161,12 +165,12 @@ mod tests {
 
     #[test]
     fn two_to_one_is_pen_pen_head() {
-        let s = Schedule::CHOSEN;
+        let s = Schedule { pen: 2, head: 1 };
         let got: [Emitter; 6] = core::array::from_fn(|n| s.emitter(n as u32));
         use Emitter::*;
         assert_eq!(got, [Pen, Pen, Head, Pen, Pen, Head]);
         // 5:2 spreads its two head slots apart.
-        let s = Schedule { pen: 5, head: 2 };
+        let s = Schedule::CHOSEN;
         let heads: [bool; 7] = core::array::from_fn(|n| s.emitter(n as u32) == Head);
         assert_eq!(heads.iter().filter(|h| **h).count(), 2);
         assert!(!(0..6).any(|i| heads[i] && heads[i + 1]));

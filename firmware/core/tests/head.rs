@@ -25,7 +25,7 @@ fn cycle_at(e: &Engine, t0_us: u64, p: Vec3) -> Cycle {
 fn head_engine(prediction_ms: u8) -> Engine {
     let mut e = Engine::new(None, FIRMWARE, [7; 12]);
     e.set_head(Some(HeadSettings {
-        schedule: Schedule::CHOSEN,
+        schedule: Schedule { pen: 2, head: 1 },
         prediction_ms,
     }));
     e
@@ -55,6 +55,14 @@ fn slots_follow_the_schedule_and_cover_the_workspace() {
     let expected = (2.0e6 / (3.0 * period)).round() as u16;
     assert_eq!(e.device_info().fix_rate_hz, expected);
     assert!(expected >= 150, "{expected}");
+    // The chosen 5:2: five of every seven slots the pen's, the head at least 60 a second.
+    e.set_head(Some(HeadSettings::default()));
+    assert_eq!(HeadSettings::default().schedule, Schedule::CHOSEN);
+    let pen_slots = (0..7).filter(|_| e.next_slot().emitter == Pen).count();
+    assert_eq!(pen_slots, 5);
+    let rate = e.device_info().fix_rate_hz as f64;
+    assert!((rate - 5.0e6 / (7.0 * period)).abs() <= 0.5, "{rate}");
+    assert!(2.0e6 / (7.0 * period) >= 60.0);
     // Without the head every cycle is the pen's, at the pen-only period.
     e.set_head(None);
     let slot = e.next_slot();

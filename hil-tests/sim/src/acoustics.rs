@@ -112,8 +112,23 @@ pub struct Heard {
 }
 
 impl Acoustics {
-    /// The arrivals of a burst from `emitter` at `t_s`.
+    /// The arrivals of a burst from `emitter` at `t_s`, within the pen-only cycle's listening
+    /// window.
     pub fn hear(&self, rig: &Rig, emitter: DVec3, t_s: f64, rng: &mut ChaCha8Rng) -> Heard {
+        self.hear_slot(rig, emitter, t_s, LISTEN_US, 0, rng)
+    }
+
+    /// The arrivals of a burst from `emitter` at `t_s` that come within `listen_us` of it,
+    /// with the receivers in `blocked` (bit i: receiver i) shadowed (the viewer's own head).
+    pub fn hear_slot(
+        &self,
+        rig: &Rig,
+        emitter: DVec3,
+        t_s: f64,
+        listen_us: u64,
+        blocked: u8,
+        rng: &mut ChaCha8Rng,
+    ) -> Heard {
         let mut heard = Heard {
             arrival_ns: [None; MAX_RECEIVERS],
             tof_us: [None; MAX_RECEIVERS],
@@ -131,7 +146,7 @@ impl Acoustics {
             // random sequence of the others.
             let dropped = rng.random_bool(self.dropout_rate.clamp(0.0, 1.0));
             let echo = rng.random_bool(echo_rate.clamp(0.0, 1.0));
-            if dropped || self.dead_mask & (1 << i) != 0 {
+            if dropped || (self.dead_mask | blocked) & (1 << i) != 0 {
                 continue;
             }
             let mut path = (emitter - *receiver).length();
@@ -141,7 +156,7 @@ impl Acoustics {
             }
             let tof_us = path / c_mm_per_us + jitter.sample(rng);
             let arrival_us = tof_us + rig.delays_us[i];
-            if arrival_us <= 0.0 || arrival_us >= LISTEN_US as f64 {
+            if arrival_us <= 0.0 || arrival_us >= listen_us as f64 {
                 continue;
             }
             // The capture timer counts whole ticks; the board converts them to ns.

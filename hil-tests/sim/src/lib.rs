@@ -2,7 +2,8 @@
 //!
 //! It models what makes ultrasonic tracking hard — receiver geometry ([`rig`]), the speed of
 //! sound and its drift, timing jitter, timer quantisation, late echoes and dropouts
-//! ([`acoustics`]), a human hand with tremor and bouncing switch contacts ([`hand`]) — plays
+//! ([`acoustics`]), a human hand with tremor and bouncing switch contacts ([`hand`]), a seated
+//! viewer wearing the tracked shutter glasses ([`viewer`]) — plays
 //! scripted sessions of the seed's operations ([`script`], [`scenarios`], [`session`]), and
 //! drives the real firmware core through its hardware traits ([`sim`]), so what comes out are
 //! the exact report bytes the device sends, in process ([`sim::Simulation`]).
@@ -20,5 +21,6 @@ pub mod scenarios;
 pub mod script;
 pub mod session;
 pub mod sim;
+pub mod viewer;
 
 pub use sim::{CycleRecord, Scenario, Sent, Simulation};

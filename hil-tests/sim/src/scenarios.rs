@@ -43,6 +43,10 @@ pub const NAMES: &[(&str, &str)] = &[
         "the hand sweep with half of all arrivals late echoes for one second",
     ),
     (
+        "viewer",
+        "the hand sweep with a seated viewer's tracked glasses (sway, leaning in) multiplexed 5:2",
+    ),
+    (
         "temperature-step",
         "the hand sweep while the air warms by 5 °C at 3 s and the device is not told",
     ),
@@ -53,6 +57,8 @@ pub fn by_name(name: &str) -> Option<Scenario> {
     let scenario = match name {
         "static-grid" => Scenario::new(name, Rig::reference(), Acoustics::clean(), static_grid()),
         "hand-sweep" => Scenario::new(name, Rig::reference(), Acoustics::clean(), hand_sweep()),
+        "viewer" => Scenario::new(name, Rig::reference(), Acoustics::clean(), hand_sweep())
+            .with_head(pen_core::HeadSettings::default()),
         "echoes" => Scenario::new(
             name,
             Rig::reference_six(),

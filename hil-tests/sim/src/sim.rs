@@ -14,9 +14,10 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use glam::DVec3;
 use pen_core::{
-    Clock, ConfigStore, CycleResult, Engine, Ranging, ReportSink, SharedEngine, Station, StoreError, Switches,
+    Clock, ConfigStore, CycleResult, Emitter, Engine, HeadSettings, Ranging, ReportSink, SharedEngine, Station,
+    StoreError, Switches,
 };
-use pen_protocol::{Config, FirmwareVersion, MAX_RECEIVERS, PenReport, Report, TofReport};
+use pen_protocol::{Config, FirmwareVersion, HeadReport, MAX_RECEIVERS, PenReport, Report, TofReport};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -24,6 +25,7 @@ use crate::acoustics::{Acoustics, Heard};
 use crate::hand::Hand;
 use crate::rig::Rig;
 use crate::script::Timeline;
+use crate::viewer::Viewer;
 
 /// The firmware version the simulated device reports.
 pub const SIM_FIRMWARE: FirmwareVersion = FirmwareVersion {
@@ -50,6 +52,9 @@ pub struct Scenario {
     /// The unique ID the device reports ([`SIM_UNIQUE_ID`] unless set otherwise): another
     /// one stands for another base station, whose calibration is not this one's.
     pub unique_id: [u8; 12],
+    /// A viewer wears the tracked glasses and the device schedules their emitter with these
+    /// settings; `None`: the pen alone.
+    pub head: Option<HeadSettings>,
 }
 
 impl Scenario {
@@ -63,6 +68,16 @@ impl Scenario {
             timeline,
             config,
             unique_id: SIM_UNIQUE_ID,
+            head: None,
+        }
+    }
+
+    /// The same session with a seated viewer wearing the tracked glasses, the device
+    /// multiplexing their emitter with the pen's by `head`.
+    pub fn with_head(self, head: HeadSettings) -> Scenario {
+        Scenario {
+            head: Some(head),
+            ..self
         }
     }
 
@@ -86,6 +101,8 @@ pub struct Sent {
 pub struct CycleRecord {
     /// Device time of the burst, µs.
     pub t0_us: u64,
+    /// The emitter the burst came from (the pen's unless the head is tracked).
+    pub emitter: Emitter,
     /// Where the emitter really was, tracker frame, mm.
     pub truth_mm: DVec3,
     /// What the receivers heard.
@@ -94,6 +111,8 @@ pub struct CycleRecord {
     pub result: CycleResult,
     /// The pen report of this cycle (sent when the listening window closed).
     pub report: Option<PenReport>,
+    /// The head report of this cycle (head slots only).
+    pub head_report: Option<HeadReport>,
     /// The switches as the hand meant them at the end of the cycle.
     pub intended_switches: [bool; 3],
     /// Every report the device sent during the cycle, in order.
@@ -112,11 +131,17 @@ struct World {
     rig: Rig,
     acoustics: Acoustics,
     hand: Hand,
+    viewer: Option<Viewer>,
+    emitter: Emitter,
+    /// Device time the station collected the arrivals: the slot's listening window closed.
+    collected_at: Option<u64>,
     rng: ChaCha8Rng,
     heard: Option<(DVec3, Heard)>,
     sent: Vec<Sent>,
     samples: Vec<u8>,
     pacer: Option<Pacer>,
+    /// The listening window of the slot being fired, µs.
+    listen_us: u64,
 }
 
 type Shared = Rc<RefCell<World>>;
@@ -127,20 +152,47 @@ struct SimClock(Shared);
 struct SimSink(Shared);
 
 impl Ranging for SimRanging {
+    fn set_emitter(&mut self, emitter: Emitter) {
+        self.0.borrow_mut().emitter = emitter;
+    }
+
     fn fire(&mut self) {
         let mut w = self.0.borrow_mut();
         let w = &mut *w;
         let t_s = w.now_us as f64 * 1e-6;
-        let emitter = w.hand.emitter(&w.rig, t_s);
-        let heard = w.acoustics.hear(&w.rig, emitter, t_s, &mut w.rng);
-        w.heard = Some((emitter, heard));
+        w.collected_at = None;
+        let heard = match (w.emitter, &w.viewer) {
+            (Emitter::Head, Some(viewer)) => {
+                let emitter = viewer.emitter(&w.rig, t_s);
+                let blocked = viewer.shadowed(&w.rig, t_s);
+                let listen = w.listen_us;
+                (
+                    emitter,
+                    w.acoustics.hear_slot(&w.rig, emitter, t_s, listen, blocked, &mut w.rng),
+                )
+            }
+            (Emitter::Head, None) => {
+                // Glasses scheduled but nobody wears them: the burst drives no emitter.
+                let emitter = w.hand.emitter(&w.rig, t_s);
+                let silent = w.acoustics.hear_slot(&w.rig, emitter, t_s, 0, u8::MAX, &mut w.rng);
+                (emitter, silent)
+            }
+            (Emitter::Pen, _) => {
+                let emitter = w.hand.emitter(&w.rig, t_s);
+                let listen = w.listen_us;
+                (
+                    emitter,
+                    w.acoustics.hear_slot(&w.rig, emitter, t_s, listen, 0, &mut w.rng),
+                )
+            }
+        };
+        w.heard = Some(heard);
     }
 
     fn collect(&mut self) -> [Option<u32>; MAX_RECEIVERS] {
-        self.0
-            .borrow()
-            .heard
-            .map_or([None; MAX_RECEIVERS], |(_, h)| h.arrival_ns)
+        let mut w = self.0.borrow_mut();
+        w.collected_at = Some(w.now_us);
+        w.heard.map_or([None; MAX_RECEIVERS], |(_, h)| h.arrival_ns)
     }
 }
 
@@ -187,6 +239,10 @@ impl ReportSink for SimSink {
     async fn tof(&mut self, report: &TofReport) {
         self.push(report);
     }
+
+    async fn head(&mut self, report: &HeadReport) {
+        self.push(report);
+    }
 }
 
 /// The simulated device's configuration storage: memory that lasts as long as the simulation.
@@ -226,6 +282,11 @@ impl Simulation {
         Simulation::with_hand(scenario, hand, rng)
     }
 
+    /// The viewer wearing the glasses, when the scenario has one.
+    pub fn viewer(&self) -> Option<Viewer> {
+        self.world.borrow().viewer.clone()
+    }
+
     /// As [`new`](Self::new), with the scenario repeating for as long as the simulation runs.
     pub fn looping(scenario: &Scenario, seed: u64) -> Simulation {
         let mut rng = ChaCha8Rng::seed_from_u64(seed);
@@ -233,23 +294,35 @@ impl Simulation {
         Simulation::with_hand(scenario, hand, rng)
     }
 
-    fn with_hand(scenario: &Scenario, hand: Hand, rng: ChaCha8Rng) -> Simulation {
+    fn with_hand(scenario: &Scenario, hand: Hand, mut rng: ChaCha8Rng) -> Simulation {
+        // The viewer sits in front of the display; the reference display is 600 × 340 mm.
+        let size = scenario
+            .config
+            .display
+            .map(|d| d.size_mm)
+            .filter(|s| s[0] > 0.0)
+            .unwrap_or([600.0, 340.0]);
+        let viewer = scenario
+            .head
+            .map(|_| Viewer::seated(size[0] as f64, size[1] as f64, &mut rng));
         let world = Rc::new(RefCell::new(World {
             now_us: 0,
             rig: scenario.rig.clone(),
             acoustics: scenario.acoustics,
             hand,
+            viewer,
+            emitter: Emitter::Pen,
+            collected_at: None,
+            listen_us: pen_core::LISTEN_US,
             rng,
             heard: None,
             sent: Vec::new(),
             samples: Vec::new(),
             pacer: None,
         }));
-        let engine: SimEngine = Rc::new(Mutex::new(RefCell::new(Engine::new(
-            Some(scenario.config),
-            SIM_FIRMWARE,
-            scenario.unique_id,
-        ))));
+        let mut device = Engine::new(Some(scenario.config), SIM_FIRMWARE, scenario.unique_id);
+        device.set_head(scenario.head);
+        let engine: SimEngine = Rc::new(Mutex::new(RefCell::new(device)));
         let station = Station::new(
             engine.clone(),
             SimRanging(world.clone()),
@@ -289,23 +362,37 @@ impl Simulation {
     /// Runs one measurement cycle.
     pub fn step(&mut self) -> CycleRecord {
         let t0_us = self.now_us();
+        // The world hears within the slot's listening window, which the engine knows (it is
+        // the pen-only cycle's unless the head is tracked).
+        let listen = self.engine.lock(|e| {
+            let e = e.borrow();
+            match e.head_settings() {
+                Some(_) => e.cycle_period_us() - pen_core::head::MUX_GUARD_US,
+                None => pen_core::LISTEN_US,
+            }
+        });
+        self.world.borrow_mut().listen_us = listen;
         let result = block_on(self.station.cycle());
         let mut w = self.world.borrow_mut();
         let (truth_mm, heard) = w.heard.unwrap_or_else(|| unreachable!("every cycle fires"));
         let sent = std::mem::take(&mut w.sent);
         let switch_samples = std::mem::take(&mut w.samples);
+        let collected = w.collected_at.unwrap_or(t0_us + pen_core::LISTEN_US);
         // The cycle's own report is the first one sent at or after the listening window closed.
         let report = sent
             .iter()
-            .filter(|s| s.t_us >= t0_us + pen_core::LISTEN_US)
+            .filter(|s| s.t_us >= collected)
             .find_map(|s| PenReport::decode(&s.bytes).ok());
+        let head_report = sent.iter().find_map(|s| HeadReport::decode(&s.bytes).ok());
         let intended_switches = w.hand.intended_switches(w.now_us as f64 * 1e-6);
         CycleRecord {
             t0_us,
+            emitter: w.emitter,
             truth_mm,
             heard,
             result,
             report,
+            head_report,
             intended_switches,
             sent,
             switch_samples,

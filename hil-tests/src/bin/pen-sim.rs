@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use anyhow::{Context, Result, bail};
 use clap::{Parser, Subcommand};
 use indicatif::{ProgressBar, ProgressStyle};
-use pen_hil::{accuracy, pty, qemu, trace};
+use pen_hil::{accuracy, head, pty, qemu, trace};
 use pen_sim::{Simulation, scenarios};
 
 #[derive(Parser)]
@@ -80,6 +80,31 @@ enum Command {
         /// Scenarios to run (default: static-grid, hand-sweep, echoes).
         #[arg(long = "scenario", value_name = "NAME")]
         scenarios: Vec<String>,
+    },
+    /// Measure the tracked head: the pen alone, then with a seated viewer's glasses multiplexed
+    /// at each ratio; print the pen's and the head's fix rates and errors.
+    #[command(
+        after_help = "Examples:\n  pen-sim head\n  pen-sim head --ratio 2:1 --prediction-ms 30 --seconds 30 --json"
+    )]
+    Head {
+        /// The pen's session (it loops for --seconds).
+        #[arg(long, default_value = "hand-sweep")]
+        scenario: String,
+        /// Device seconds per run.
+        #[arg(long, default_value_t = 20.0)]
+        seconds: f64,
+        /// Seed of the randomness.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Pen:head slot ratios to compare (default 1:1, 2:1, 5:2, 3:1).
+        #[arg(long = "ratio", value_name = "PEN:HEAD")]
+        ratios: Vec<String>,
+        /// How far ahead the head's pose is predicted, ms (0…50).
+        #[arg(long, default_value_t = 20)]
+        prediction_ms: u8,
+        /// Print the runs as one JSON object.
+        #[arg(long)]
+        json: bool,
     },
     /// Replay a scenario's cycles through the core on QEMU's Cortex-M4F (mps2-an386), compare
     /// its reports with this host build's, and print the instructions a fix costs there.
@@ -222,6 +247,92 @@ fn run(cli: Cli) -> Result<()> {
                         m.missed_switch_events
                     );
                 }
+            }
+            Ok(())
+        }
+        Command::Head {
+            scenario: name,
+            seconds,
+            seed,
+            ratios,
+            prediction_ms,
+            json,
+        } => {
+            if !(seconds > 0.0 && seconds.is_finite()) {
+                bail!("--seconds must be a positive number");
+            }
+            if prediction_ms > pen_protocol::MAX_PREDICTION_MS {
+                bail!("--prediction-ms must be 0…{}", pen_protocol::MAX_PREDICTION_MS);
+            }
+            let ratios = if ratios.is_empty() {
+                vec!["1:1".to_string(), "2:1".into(), "5:2".into(), "3:1".into()]
+            } else {
+                ratios
+            };
+            let schedules = ratios
+                .iter()
+                .map(|r| head::parse_ratio(r).map_err(|e| anyhow::anyhow!("--ratio: {e}")))
+                .collect::<Result<Vec<_>>>()?;
+            let pen_only = scenario(&name)?;
+            let mut runs = vec![("pen alone".to_string(), head::run(&pen_only, seed, seconds))];
+            for (label, schedule) in ratios.iter().zip(schedules) {
+                let s = pen_only.clone().with_head(pen_core::HeadSettings {
+                    schedule,
+                    prediction_ms,
+                });
+                runs.push((label.clone(), head::run(&s, seed, seconds)));
+            }
+            if json {
+                let runs: Vec<_> = runs
+                    .iter()
+                    .map(|(ratio, r)| serde_json::json!({ "ratio": ratio, "pen": r.pen, "head": r.head }))
+                    .collect();
+                println!(
+                    "{}",
+                    serde_json::json!({ "scenario": name, "seconds": seconds, "runs": runs })
+                );
+            } else {
+                println!(
+                    "{:<10} {:>9} {:>8} {:>8} {:>9} {:>8} {:>9} {:>8} {:>8}",
+                    "ratio",
+                    "pen fix/s",
+                    "pen rmse",
+                    "pen p99",
+                    "head fix/s",
+                    "head raw",
+                    "head pred",
+                    "held",
+                    "shadowed"
+                );
+                let base = &runs[0].1.pen;
+                for (ratio, r) in &runs {
+                    let (rate, raw, pred, held, shadow) = r.head.as_ref().map_or(
+                        (
+                            "-".to_string(),
+                            "-".to_string(),
+                            "-".to_string(),
+                            "-".to_string(),
+                            "-".to_string(),
+                        ),
+                        |h| {
+                            (
+                                format!("{:.1}", h.fix_rate_hz),
+                                format!("{:.2}", h.raw_rmse_mm),
+                                format!("{:.2}", h.predicted_rmse_mm),
+                                format!("{:.2}", h.held_rmse_mm),
+                                format!("{:.0} %", h.shadowed_fraction * 100.0),
+                            )
+                        },
+                    );
+                    println!(
+                        "{:<10} {:>9.1} {:>8.3} {:>8.3} {:>9} {:>8} {:>9} {:>8} {:>8}",
+                        ratio, r.pen.fix_rate_hz, r.pen.rmse_mm, r.pen.p99_mm, rate, raw, pred, held, shadow
+                    );
+                    let _ = base;
+                }
+                println!(
+                    "errors in mm; head pred: the reported pose (predicted {prediction_ms} ms ahead) against the head then; held: the raw fix held as long"
+                );
             }
             Ok(())
         }

@@ -1,0 +1,102 @@
+//! The tracked head through the whole firmware core: a seated viewer's glasses multiplexed with
+//! the pen on one base station, judged from the report bytes against the simulated truth.
+
+use glam::DVec3;
+use pen_core::Emitter;
+use pen_protocol::{HeadReport, Message};
+use pen_sim::{CycleRecord, Simulation, scenarios};
+
+const SECONDS: f64 = 20.0;
+
+fn run(name: &str) -> (pen_sim::Scenario, Simulation, Vec<CycleRecord>) {
+    let s = scenarios::by_name(name).unwrap_or_else(|| panic!("scenario {name}"));
+    let mut sim = Simulation::looping(&s, 7);
+    let records = sim.run_for(SECONDS);
+    (s, sim, records)
+}
+
+/// Pen fixes per second and their RMS error, from the pen's cycles.
+fn pen_figures(records: &[CycleRecord]) -> (f64, f64) {
+    let errors: Vec<f64> = records
+        .iter()
+        .filter(|r| r.emitter == Emitter::Pen)
+        .filter_map(|r| {
+            let f = r.result.fix.ok()?;
+            Some((DVec3::new(f.position.x as f64, f.position.y as f64, f.position.z as f64) - r.truth_mm).length())
+        })
+        .collect();
+    let rms = (errors.iter().map(|e| e * e).sum::<f64>() / errors.len() as f64).sqrt();
+    (errors.len() as f64 / SECONDS, rms)
+}
+
+#[test]
+fn the_head_is_tracked_and_the_pen_keeps_its_rate_and_accuracy() {
+    let (_, _, alone) = run("hand-sweep");
+    let (s, sim, with_head) = run("viewer");
+    let viewer = sim.viewer().expect("the viewer scenario has a viewer");
+    let (rate_alone, rms_alone) = pen_figures(&alone);
+    let (rate, rms) = pen_figures(&with_head);
+    assert!(rate >= 150.0, "pen {rate:.1} fixes/s with the head");
+    assert!(
+        (rms / rms_alone - 1.0).abs() <= 0.05,
+        "pen RMS {rms:.3} mm against {rms_alone:.3} alone"
+    );
+    assert!(rate >= 0.95 * rate_alone, "{rate:.1} against {rate_alone:.1}");
+
+    // The head reports, decoded from the bytes the device sent.
+    let reports: Vec<(u64, HeadReport)> = with_head
+        .iter()
+        .flat_map(|r| &r.sent)
+        .filter_map(|sent| match Message::decode(&sent.bytes) {
+            Ok(Message::Head(h)) => Some((sent.t_us, h)),
+            _ => None,
+        })
+        .collect();
+    let fixed: Vec<&(u64, HeadReport)> = reports.iter().filter(|(_, h)| !h.no_fix).collect();
+    assert!(
+        fixed.len() as f64 / SECONDS >= 60.0,
+        "{} head fixes in {SECONDS} s",
+        fixed.len()
+    );
+    // Against where the head is when the prediction says, computed from the viewer.
+    let mut sq = 0.0;
+    for (_, h) in &fixed {
+        let t_s = (h.timestamp_us as f64 + h.prediction_ms as f64 * 1000.0) * 1e-6;
+        let truth = viewer.emitter(&s.rig, t_s);
+        let [x, y, z] = h.position.to_mm();
+        sq += (DVec3::new(x as f64, y as f64, z as f64) - truth).length_squared();
+    }
+    let head_rms = (sq / fixed.len() as f64).sqrt();
+    assert!(head_rms <= 3.0, "head RMS {head_rms:.2} mm");
+    // One report per head slot, counted without gaps; a no-fix report holds the pose before it.
+    assert_eq!(
+        reports.len(),
+        with_head.iter().filter(|r| r.emitter == Emitter::Head).count()
+    );
+    for pair in reports.windows(2) {
+        let (a, b) = (pair[0].1, pair[1].1);
+        assert_eq!(b.seq, a.seq.wrapping_add(1));
+        if b.no_fix {
+            assert_eq!(b.position, a.position);
+            assert_eq!(b.quality.receivers_used, 0);
+        }
+    }
+}
+
+#[test]
+fn the_head_shadows_receivers_when_leaning_in() {
+    let (s, sim, records) = run("viewer");
+    let viewer = sim.viewer().expect("viewer");
+    // The receivers the head shadows hear nothing in the head's slots.
+    let mut shadowed_slots = 0;
+    for r in records.iter().filter(|r| r.emitter == Emitter::Head) {
+        let mask = viewer.shadowed(&s.rig, r.t0_us as f64 * 1e-6);
+        for i in 0..s.rig.receivers_mm.len() {
+            if mask & (1 << i) != 0 {
+                shadowed_slots += 1;
+                assert_eq!(r.heard.arrival_ns[i], None, "receiver {i} heard through the head");
+            }
+        }
+    }
+    assert!(shadowed_slots > 0, "the viewer never shadowed a receiver");
+}
