@@ -95,21 +95,13 @@ pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
         let zt = transpose(z, cols, rows);
         sweep(&zt, rows, cols, cell, (dy, dx), &mut sink, None::<&mut Sink>);
     }
-    for i in 0..n {
-        // Transposed, cell (c, r) is at c·rows + r.
-        let j = if x_major {
-            i
-        } else {
-            (i % cols as usize) * rows as usize + i / cols as usize
-        };
-        f(
-            i,
-            if weight[j] > 0.0 {
-                f64::from(sum[j] / weight[j])
-            } else {
-                f64::NEG_INFINITY
-            },
-        );
+    if !x_major {
+        // Back to the grid's layout: the transposed grid is rows wide.
+        sum = transpose(&sum, rows, cols);
+        weight = transpose(&weight, rows, cols);
+    }
+    for (i, (&s, &w)) in sum.iter().zip(&weight).enumerate() {
+        f(i, if w > 0.0 { f64::from(s / w) } else { f64::NEG_INFINITY });
     }
 }
 
@@ -172,13 +164,24 @@ fn hull_pass(
     }
 }
 
-/// `z` (`cols × rows`, row-major) transposed: `rows × cols`.
+/// `z` (`cols × rows`, row-major) transposed: `rows × cols`. In tiles, so that both the reads
+/// and the writes stay within a few cache lines and pages (a plain column walk misses the cache
+/// on every cell of a large grid).
 fn transpose(z: &[f32], cols: u32, rows: u32) -> Vec<f32> {
+    const TILE: usize = 64;
     let (w, h) = (cols as usize, rows as usize);
     let mut t = vec![0.0f32; z.len()];
-    t.par_chunks_mut(h).enumerate().for_each(|(c, line)| {
-        for (r, o) in line.iter_mut().enumerate() {
-            *o = z[r * w + c];
+    // Each task writes TILE rows of the result (TILE columns of `z`).
+    t.par_chunks_mut(h * TILE).enumerate().for_each(|(tc, out)| {
+        let c0 = tc * TILE;
+        let nc = out.len() / h;
+        for r0 in (0..h).step_by(TILE) {
+            for c in c0..c0 + nc {
+                let dst = &mut out[(c - c0) * h..(c - c0 + 1) * h];
+                for r in r0..(r0 + TILE).min(h) {
+                    dst[r] = z[r * w + c];
+                }
+            }
         }
     });
     t
@@ -397,19 +400,23 @@ pub fn sky_view(field: Field<'_>, k: u32) -> Vec<f32> {
             [acc, wt, acc_t, wt_t]
         })
         .collect();
-    let (w, h) = (cols as usize, rows as usize);
-    let mut out = vec![0.0f32; n];
-    out.par_chunks_mut(w).enumerate().for_each(|(r, line)| {
-        for (c, o) in line.iter_mut().enumerate() {
-            let (mut s, mut wsum) = (0.0f32, 0.0f32);
-            for [a, wt, at, wtt] in &groups {
-                s += a[r * w + c] + at[c * h + r];
-                wsum += wt[r * w + c] + wtt[c * h + r];
-            }
-            *o = if wsum > 0.0 { 1.0 - s / wsum } else { 1.0 };
+    // The groups' sums in a fixed order, the transposed ones brought back to the grid's layout.
+    let mut total = [(); 4].map(|_| vec![0.0f32; n]);
+    for g in &groups {
+        for (t, a) in total.iter_mut().zip(g) {
+            t.par_iter_mut().zip(a.par_iter()).for_each(|(t, a)| *t += a);
         }
-    });
-    out
+    }
+    let [acc, wt, acc_t, wt_t] = total;
+    let (acc_t, wt_t) = (transpose(&acc_t, rows, cols), transpose(&wt_t, rows, cols));
+    acc.par_iter()
+        .zip(wt.par_iter())
+        .zip(acc_t.par_iter().zip(wt_t.par_iter()))
+        .map(|((&a, &w), (&at, &wt))| {
+            let (s, ws) = (a + at, w + wt);
+            if ws > 0.0 { 1.0 - s / ws } else { 1.0 }
+        })
+        .collect()
 }
 
 /// `(1 − f)·direct + f·sky` with `f` = [`DIFFUSE`].
