@@ -72,6 +72,22 @@ fn bench(c: &mut Criterion) {
         least(|t| t.total),
         median,
     );
+    // One thread's CPU time per scatter (see `thread_cpu_ns`): the fastest of five.
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .expect("a pool of one thread");
+    let cpu = one.install(|| {
+        (0..5)
+            .filter_map(|_| {
+                let before = thread_cpu_ns()?;
+                let s = scatter(&fig1, None).expect("fig. 1 is a valid recipe");
+                drop(s);
+                Some((thread_cpu_ns()? - before) as f64 / 1e6)
+            })
+            .fold(f64::INFINITY, f64::min)
+    });
+    eprintln!("fig1/512: one thread, CPU time {cpu:.1} ms a scatter (the fastest of 5, the drop included)");
     g.bench_function("fig1/512", |b| b.iter(|| scatter(black_box(&fig1), None)));
     for r in [9.0, 3.0, 1.0] {
         g.bench_with_input(BenchmarkId::new("single/512", r), &single(r), |b, recipe| {
@@ -112,10 +128,6 @@ fn bench(c: &mut Criterion) {
     );
     // CPU time of one thread per re-seat, which other processes on a loaded machine do not
     // inflate as they do wall time (Linux: the scheduler's count for the thread).
-    let one = rayon::ThreadPoolBuilder::new()
-        .num_threads(1)
-        .build()
-        .expect("a pool of one thread");
     let per_reseat = one.install(|| {
         let before = thread_cpu_ns()?;
         for _ in 0..50 {

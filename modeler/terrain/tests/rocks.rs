@@ -213,7 +213,7 @@ fn each_rock_has_as_many_added_points_as_cell_vertices_and_a_delaunay_triangulat
         // A triangulation of n points with h on the hull has 2n − h − 2 triangles covering the cell.
         assert_eq!(rock.mesh.triangles.len(), 2 * pts.len() - k - 2, "rock {n}");
         let mut covered = 0.0;
-        let scale = area(&rock.polygon);
+        let scale = area(rock.polygon);
         for t in rock.mesh.triangles {
             let [a, b, c] = t.map(|i| pts[i as usize]);
             let doubled = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);

@@ -285,7 +285,7 @@ fn to_json(recipe: &Recipe, s: &Scatter) -> Value {
                 .rocks
                 .iter()
                 .filter(|r| r.diagram == i)
-                .map(|r| json!({"seed": r.cell, "polygon": points2(&r.polygon)}))
+                .map(|r| json!({"seed": r.cell, "polygon": points2(r.polygon)}))
                 .collect();
             json!({
                 "radius": d.radius,
@@ -310,10 +310,10 @@ fn to_json(recipe: &Recipe, s: &Scatter) -> Value {
             json!({
                 "diagram": r.diagram,
                 "seed": r.cell,
-                "polygon": points2(&r.polygon),
-                "added": points2(&r.mesh.added),
+                "polygon": points2(r.polygon),
+                "added": points2(r.mesh.added),
                 "moved": points3(&r.mesh.vertices[k..]),
-                "vertices": points3(&r.mesh.vertices),
+                "vertices": points3(r.mesh.vertices),
                 "triangles": r.mesh.triangles,
             })
         })

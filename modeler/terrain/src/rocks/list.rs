@@ -24,7 +24,7 @@ pub struct Rock<'a> {
 }
 
 /// Where a rock is: its diagram and cell, its block and its index there.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 pub(crate) struct At {
     pub(crate) diagram: u32,
     pub(crate) cell: u32,
@@ -73,11 +73,6 @@ impl Block {
             self.vertices.len() as u32,
             self.triangles.len() as u32,
         ]);
-    }
-
-    /// Rocks whose polygons are in.
-    pub(crate) fn len(&self) -> usize {
-        self.polygon_starts.len() - 1
     }
 
     /// Rock `i`'s polygon.

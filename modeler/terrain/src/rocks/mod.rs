@@ -28,6 +28,7 @@ pub mod shape;
 pub mod top_view;
 pub mod voronoi;
 
+use std::sync::{Arc, Mutex};
 use std::time::Instant;
 
 use rand::SeedableRng;
@@ -269,6 +270,75 @@ impl Scatter {
     }
 }
 
+/// One diagram's seeds, pixels by cell and seed buckets, and what they took (ms).
+struct Made {
+    centres: Vec<[f64; 2]>,
+    cells: voronoi::CellPixels,
+    buckets: voronoi::Buckets,
+    seeds_ms: f64,
+    diagram_ms: f64,
+}
+
+/// A diagram's selection: what it took, whether it reached its goal, and its kept cells with
+/// their places in the order drawn, sorted by cell.
+type Selected = (select::Taken, bool, Arc<Vec<(u32, usize)>>);
+
+/// A block of rocks and the time its polygons and meshes took (ms).
+struct MadeBlock {
+    block: list::Block,
+    polygons_ms: f64,
+    meshes_ms: f64,
+}
+
+/// The rocks of cells `part` (cell, order drawn) of diagram `i`: their polygons, then meshes.
+fn make_block(recipe: &Recipe, made: &Made, i: usize, part: &[(u32, usize)]) -> MadeBlock {
+    let (width, height) = (recipe.width, recipe.height);
+    let t = Instant::now();
+    let mut block = list::Block::with_rocks(part.len());
+    for &(cell, _) in part {
+        voronoi::cell_polygon(
+            &made.centres,
+            &made.buckets,
+            width,
+            height,
+            cell as usize,
+            &mut block.polygons,
+        );
+        block.end_polygon();
+    }
+    let polygons_ms = ms(t);
+    let t = Instant::now();
+    let corners = block.polygons.len();
+    block.added.reserve(corners);
+    block.vertices.reserve(2 * corners);
+    block.triangles.reserve(3 * corners);
+    let layer = &recipe.layers[i];
+    for (k, &(cell, _)) in part.iter().enumerate() {
+        let mut rng = stream(recipe.seed, SHAPE, i, u64::from(cell));
+        let list::Block {
+            polygons,
+            polygon_starts,
+            added,
+            vertices,
+            triangles,
+            ..
+        } = &mut block;
+        let polygon = &polygons[polygon_starts[k] as usize..polygon_starts[k + 1] as usize];
+        let out = shape::Out {
+            added,
+            vertices,
+            triangles,
+        };
+        shape::rock_into(polygon, layer.radius, &layer.shape, &mut rng, out);
+        block.end_mesh();
+    }
+    MadeBlock {
+        block,
+        polygons_ms,
+        meshes_ms: ms(t),
+    }
+}
+
 fn ms(since: Instant) -> f64 {
     since.elapsed().as_secs_f64() * 1e3
 }
@@ -291,7 +361,7 @@ pub fn scatter(recipe: &Recipe, inside: Option<&[bool]>) -> Result<Scatter, Reci
     let start = Instant::now();
     let (width, height) = (recipe.width, recipe.height);
     let pixels = width as usize * height as usize;
-    let made: Vec<(Vec<u32>, voronoi::CellPixels, f64, f64)> = recipe
+    let made: Vec<Made> = recipe
         .layers
         .par_iter()
         .enumerate()
@@ -312,20 +382,28 @@ pub fn scatter(recipe: &Recipe, inside: Option<&[bool]>) -> Result<Scatter, Reci
             let seeds_ms = ms(t);
             let t = Instant::now();
             let labels = voronoi::label(width, height, &seeds, layer.radius);
-            // Grouped here, on the diagram's own thread, rather than in the selection, which
-            // runs on one.
+            // Grouped, and the seeds' buckets built, here on the diagram's own thread rather
+            // than in the selection, which runs on one.
             let cells = voronoi::CellPixels::of(&labels, seeds.len());
-            (seeds, cells, seeds_ms, ms(t))
+            let centres: Vec<[f64; 2]> = seeds.iter().map(|&p| voronoi::centre(p, width)).collect();
+            // Seeds are more than r apart: a bucket of side r holds a few.
+            let buckets = voronoi::Buckets::new(&centres, width, height, layer.radius.max(1.0));
+            Made {
+                centres,
+                cells,
+                buckets,
+                seeds_ms,
+                diagram_ms: ms(t),
+            }
         })
         .collect();
     let mut timing = Timing {
         seeds_and_diagrams: ms(start),
-        seeds: made.iter().map(|m| m.2).sum(),
-        diagrams: made.iter().map(|m| m.3).sum(),
+        seeds: made.iter().map(|m| m.seeds_ms).sum(),
+        diagrams: made.iter().map(|m| m.diagram_ms).sum(),
         ..Timing::default()
     };
 
-    let t = Instant::now();
     let mut taken: Vec<bool> = match inside {
         Some(mask) if mask.len() == pixels => mask.iter().map(|&i| !i).collect(),
         _ => vec![false; pixels],
@@ -333,112 +411,106 @@ pub fn scatter(recipe: &Recipe, inside: Option<&[bool]>) -> Result<Scatter, Reci
     let field_pixels = taken.iter().filter(|&&t| !t).count();
     // Largest mean cell first: the fewest seeds; ties keep the recipe's order.
     let mut order: Vec<usize> = (0..recipe.layers.len()).collect();
-    order.sort_by_key(|&i| made[i].0.len());
-    let mut diagrams: Vec<Option<Diagram>> = vec![None; recipe.layers.len()];
-    for (rank, &i) in order.iter().enumerate() {
-        let (seeds, cells, _, _) = &made[i];
-        let goal = match recipe.layers[i].amount {
-            Amount::Fraction(f) => Goal::Pixels((f * field_pixels as f64).ceil() as usize),
-            Amount::Count(c) => Goal::Cells(c as usize),
-        };
-        let mut rng = stream(recipe.seed, SELECT, i, 0);
-        let got = select::select(cells, &mut taken, goal, &mut rng);
-        let reached = match goal {
-            Goal::Pixels(p) => got.pixels >= p,
-            Goal::Cells(c) => got.cells.len() >= c,
-        };
-        diagrams[i] = Some(Diagram {
-            radius: recipe.layers[i].radius,
-            seeds: seeds.iter().map(|&p| voronoi::centre(p, width)).collect(),
-            order: rank,
-            cells: got.cells,
-            pixels: got.pixels,
-            tried: got.tried,
-            reached,
+    order.sort_by_key(|&i| made[i].centres.len());
+    // The selection runs on this thread, diagram after diagram; each diagram's kept cells are
+    // handed to the other threads as soon as it is done, in blocks of whole rocks (a fixed
+    // split: the same blocks on any number of threads), each block's polygons cut and then its
+    // meshes made — so the rocks of the larger diagrams are made while the smaller ones are
+    // still being selected. Within a diagram the cells are cut in seed order (pixel order:
+    // neighbours near in memory), and listed in the order drawn at the end.
+    let made_blocks: Vec<Mutex<Vec<(usize, MadeBlock)>>> = order.iter().map(|_| Mutex::default()).collect();
+    let mut selected: Vec<Option<Selected>> = vec![None; recipe.layers.len()];
+    let mut selection_ms = 0.0;
+    {
+        let (made, made_blocks) = (&made, &made_blocks);
+        rayon::scope(|scope| {
+            for (rank, &i) in order.iter().enumerate() {
+                let t = Instant::now();
+                let goal = match recipe.layers[i].amount {
+                    Amount::Fraction(f) => Goal::Pixels((f * field_pixels as f64).ceil() as usize),
+                    Amount::Count(c) => Goal::Cells(c as usize),
+                };
+                let mut rng = stream(recipe.seed, SELECT, i, 0);
+                let got = select::select(&made[i].cells, &mut taken, goal, &mut rng);
+                let reached = match goal {
+                    Goal::Pixels(p) => got.pixels >= p,
+                    Goal::Cells(c) => got.cells.len() >= c,
+                };
+                let mut by_place: Vec<(u32, usize)> = got.cells.iter().enumerate().map(|(k, &c)| (c, k)).collect();
+                by_place.sort_unstable_by_key(|m| m.0);
+                let by_place = Arc::new(by_place);
+                selection_ms += ms(t);
+                for b in 0..by_place.len().div_ceil(list::BLOCK) {
+                    let by_place = Arc::clone(&by_place);
+                    scope.spawn(move |_| {
+                        let part = &by_place[b * list::BLOCK..((b + 1) * list::BLOCK).min(by_place.len())];
+                        let block = make_block(recipe, &made[i], i, part);
+                        if let Ok(mut done) = made_blocks[rank].lock() {
+                            done.push((b, block));
+                        }
+                    });
+                }
+                selected[i] = Some((got, reached, by_place));
+            }
         });
     }
-    let diagrams: Vec<Diagram> = diagrams.into_iter().flatten().collect();
-    timing.selection = ms(t);
-
-    let t = Instant::now();
-    // Seeds are more than r apart: a bucket of side r holds a few. One diagram's per thread.
-    let buckets: Vec<voronoi::Buckets> = diagrams
-        .par_iter()
-        .enumerate()
-        .map(|(i, d)| voronoi::Buckets::new(&d.seeds, width, height, recipe.layers[i].radius.max(1.0)))
-        .collect();
-    // Every kept cell of every diagram in one parallel pass, cut in seed order within its
-    // diagram (pixel order: neighbours near in memory) and then put in the order drawn.
-    let mut by_place: Vec<(usize, u32, usize)> = Vec::with_capacity(diagrams.iter().map(|d| d.cells.len()).sum());
-    for &i in &order {
-        let first = by_place.len();
-        let cells = &diagrams[i].cells;
-        by_place.extend(cells.iter().enumerate().map(|(k, &c)| (i, c, first + k)));
-        by_place[first..].sort_unstable_by_key(|m| m.1);
-    }
-    // Cut into blocks of whole rocks in that order, one block per task: the same blocks on any
-    // number of threads.
-    let mut blocks: Vec<list::Block> = by_place
-        .par_chunks(list::BLOCK)
-        .map(|part| {
-            let mut block = list::Block::with_rocks(part.len());
-            for &(i, cell, _) in part {
-                let d = &diagrams[i];
-                voronoi::cell_polygon(&d.seeds, &buckets[i], width, height, cell as usize, &mut block.polygons);
-                block.end_polygon();
-            }
-            block
-        })
-        .collect();
-    timing.polygons = ms(t);
-    let t = Instant::now();
-    blocks.par_iter_mut().enumerate().for_each(|(b, block)| {
-        let part = &by_place[b * list::BLOCK..];
-        let corners = block.polygons.len();
-        block.added.reserve(corners);
-        block.vertices.reserve(2 * corners);
-        block.triangles.reserve(3 * corners);
-        for (k, &(i, cell, _)) in part.iter().take(block.len()).enumerate() {
-            let layer = &recipe.layers[i];
-            let mut rng = stream(recipe.seed, SHAPE, i, u64::from(cell));
-            let list::Block {
-                polygons,
-                polygon_starts,
-                added,
-                vertices,
-                triangles,
-                ..
-            } = block;
-            let polygon = &polygons[polygon_starts[k] as usize..polygon_starts[k + 1] as usize];
-            let out = shape::Out {
-                added,
-                vertices,
-                triangles,
+    timing.selection = selection_ms;
+    // The blocks in order, and the rocks listed in the order drawn.
+    let mut blocks: Vec<list::Block> = Vec::new();
+    let mut at: Vec<list::At> = Vec::new();
+    for (rank, &i) in order.iter().enumerate() {
+        let mut done = made_blocks[rank]
+            .lock()
+            .map(|mut d| std::mem::take(&mut *d))
+            .unwrap_or_default();
+        done.sort_unstable_by_key(|d| d.0);
+        let Some((_, _, by_place)) = &selected[i] else {
+            continue;
+        };
+        let (first_block, first_rock) = (blocks.len(), at.len());
+        at.resize(first_rock + by_place.len(), list::At::default());
+        for (j, &(cell, drawn)) in by_place.iter().enumerate() {
+            at[first_rock + drawn] = list::At {
+                diagram: i as u32,
+                cell,
+                block: (first_block + j / list::BLOCK) as u32,
+                index: (j % list::BLOCK) as u32,
             };
-            shape::rock_into(polygon, layer.radius, &layer.shape, &mut rng, out);
-            block.end_mesh();
         }
-    });
-    // Listed in the order drawn.
-    let mut at = vec![
-        list::At {
-            diagram: 0,
-            cell: 0,
-            block: 0,
-            index: 0
-        };
-        by_place.len()
-    ];
-    for (j, &(i, cell, drawn)) in by_place.iter().enumerate() {
-        at[drawn] = list::At {
-            diagram: i as u32,
-            cell,
-            block: (j / list::BLOCK) as u32,
-            index: (j % list::BLOCK) as u32,
-        };
+        for (_, d) in done {
+            timing.polygons += d.polygons_ms;
+            timing.meshes += d.meshes_ms;
+            blocks.push(d.block);
+        }
     }
     let rocks = RockList { at, blocks };
-    timing.meshes = ms(t);
+    let diagrams: Vec<Diagram> = made
+        .into_iter()
+        .zip(selected)
+        .enumerate()
+        .map(|(i, (m, sel))| {
+            let (got, reached, _) = sel.unwrap_or_else(|| {
+                (
+                    select::Taken {
+                        cells: Vec::new(),
+                        pixels: 0,
+                        tried: 0,
+                    },
+                    false,
+                    Arc::default(),
+                )
+            });
+            Diagram {
+                radius: recipe.layers[i].radius,
+                seeds: m.centres,
+                order: order.iter().position(|&o| o == i).unwrap_or(i),
+                cells: got.cells,
+                pixels: got.pixels,
+                tried: got.tried,
+                reached,
+            }
+        })
+        .collect();
     timing.total = ms(start);
     Ok(Scatter {
         width,
