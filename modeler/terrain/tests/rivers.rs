@@ -489,3 +489,45 @@ fn river_edits_undo_and_recarve_incrementally() {
     assert_eq!(line, r#"{"op":"delete_river","index":2}"#);
     assert_eq!(serde_json::from_str::<Edit>(&line).expect("parses"), e);
 }
+
+#[test]
+fn the_nearest_sample_field_is_the_distance_to_the_course() {
+    use penmodel_terrain::river::near::{self, NONE};
+    // The Ω's sampled course (sharp bends and a neck) and a zigzag with 90° corners.
+    let omega: Vec<DVec2> = course::sample(&omega(18.0).iter().map(|p| DVec2::from(*p)).collect::<Vec<_>>(), 1.0)
+        .iter()
+        .map(|s| s.p)
+        .collect();
+    let zigzag: Vec<DVec2> = (0..40)
+        .map(|i| DVec2::new(10.0 + 3.0 * i as f64, 60.0 + 6.0 * (i % 2) as f64))
+        .collect();
+    let win = river::Window {
+        c0: 0,
+        r0: 0,
+        width: 200,
+        height: 200,
+    };
+    for (line, reach) in [(omega, 9.0), (zigzag, 7.0)] {
+        let field = near::nearest(&win, &line, reach);
+        for i in 0..win.len() {
+            let p = DVec2::new((i % 200) as f64, (i / 200) as f64);
+            // Brute force over every segment.
+            let d = line
+                .windows(2)
+                .map(|w| {
+                    let ab = w[1] - w[0];
+                    let t = ((p - w[0]).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
+                    p.distance(w[0] + ab * t)
+                })
+                .fold(f64::INFINITY, f64::min);
+            if d <= reach - 1e-9 {
+                assert_ne!(field.owner[i], NONE, "{p} at {d} has no sample");
+                assert!(
+                    (f64::from(field.dist[i]) - d).abs() < 1e-4,
+                    "{p}: {} against {d}",
+                    field.dist[i]
+                );
+            }
+        }
+    }
+}

@@ -50,11 +50,12 @@ pub fn nearest(win: &Window, line: &[DVec2], reach: f64) -> Near {
         let len = ab.length();
         // Each segment visits its slab (the cells whose projection falls on it) widened over
         // the wedge its joints leave on the outer side of a bend: `reach × angle` past each end,
-        // at least one segment; the course's ends get a cap of `reach`.
+        // and 0.6 cell more so that neighbouring slabs overlap whatever the rounding; the
+        // course's ends get a cap of `reach`.
         let widen = |other: Option<usize>| -> f64 {
             match other {
                 None => reach,
-                Some(j) => (reach * dir(k).angle_to(dir(j)).abs()).max(len) + 1.0,
+                Some(j) => reach * dir(k).angle_to(dir(j)).abs() + 0.6,
             }
         };
         let before = widen(k.checked_sub(1));
