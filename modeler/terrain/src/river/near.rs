@@ -47,7 +47,6 @@ pub fn nearest(win: &Window, line: &[DVec2], reach: f64) -> Near {
     for k in 0..segs {
         let (a, b) = (pts[k], pts[k + 1]);
         let ab = b - a;
-        let len = ab.length();
         // Each segment visits its slab (the cells whose projection falls on it) widened over
         // the wedge its joints leave on the outer side of a bend: `reach × angle` past each end,
         // and 0.6 cell more so that neighbouring slabs overlap whatever the rounding; the
