@@ -108,19 +108,51 @@ impl Buckets {
     }
 }
 
-/// Pixel → cell (seed index) for the whole `width × height` image; seeds at pixel indices.
+/// Pixel → cell (seed index) for the whole `width × height` image; seeds at pixel indices, in
+/// ascending order.
 pub fn label(width: u32, height: u32, seeds: &[u32], radius: f64) -> Vec<u32> {
+    use rayon::prelude::*;
     let n = width as usize * height as usize;
     let mut best = vec![u32::MAX; n];
     let mut owner = vec![u32::MAX; n];
     let offsets = super::poisson::disk(radius);
-    let (w, h) = (width as i32, height as i32);
-    for (i, &p) in seeds.iter().enumerate() {
+    // Bands of rows painted in parallel, each by the seeds whose disks reach it, in index order
+    // as a whole image would be (so a tie still keeps the lower index): the same labels on any
+    // number of threads.
+    let rows = (height as usize).div_ceil(LABEL_BANDS).max(1);
+    let band = rows * width as usize;
+    best.par_chunks_mut(band)
+        .zip(owner.par_chunks_mut(band))
+        .enumerate()
+        .for_each(|(b, (best, owner))| {
+            let first = (b * rows) as i32;
+            paint(width, first, best, owner, seeds, &offsets);
+        });
+    if owner.contains(&u32::MAX) && !seeds.is_empty() {
+        fill_holes(width, height, seeds, radius, &mut owner);
+    }
+    owner
+}
+
+/// Bands of rows [`label`] paints in parallel.
+const LABEL_BANDS: usize = 4;
+
+/// Paints the rows from `first` that `best` and `owner` hold (whole rows of `width`): each pixel
+/// takes the seed nearest its centre, of the seeds (pixel indices, ascending) whose disk of
+/// `offsets` reaches it.
+fn paint(width: u32, first: i32, best: &mut [u32], owner: &mut [u32], seeds: &[u32], offsets: &[(i32, i32)]) {
+    let w = width as i32;
+    let last = first + (best.len() / width as usize) as i32;
+    let reach = offsets.iter().map(|o| o.1.abs()).max().unwrap_or(0);
+    // Seeds are in pixel order, so those within `reach` rows of the band are one run.
+    let lo = seeds.partition_point(|&p| (p / width) as i32 + reach < first);
+    let hi = seeds.partition_point(|&p| ((p / width) as i32) - reach < last);
+    for (i, &p) in seeds.iter().enumerate().take(hi).skip(lo) {
         let (x, y) = ((p % width) as i32, (p / width) as i32);
-        for &(dx, dy) in &offsets {
+        for &(dx, dy) in offsets {
             let (px, py) = (x + dx, y + dy);
-            if px >= 0 && py >= 0 && px < w && py < h {
-                let at = (py * w + px) as usize;
+            if px >= 0 && py >= first && px < w && py < last {
+                let at = ((py - first) * w + px) as usize;
                 let d = (dx * dx + dy * dy) as u32;
                 // Seeds are painted in index order, so a tie keeps the lower index.
                 if d < best[at] {
@@ -130,10 +162,6 @@ pub fn label(width: u32, height: u32, seeds: &[u32], radius: f64) -> Vec<u32> {
             }
         }
     }
-    if owner.contains(&u32::MAX) && !seeds.is_empty() {
-        fill_holes(width, height, seeds, radius, &mut owner);
-    }
-    owner
 }
 
 /// Labels the pixels no disk reached by searching the seed buckets outwards.
