@@ -10,6 +10,7 @@ use std::time::{Duration, Instant};
 
 use pen_protocol::{DeviceInfo, Message, ReportId, TofReport, USB_PID, USB_VID};
 
+use crate::head::{HeadSample, HeadSampler};
 use crate::sample::{Sample, Sampler, now_us};
 use crate::source::Source;
 use crate::transport::{Transport, TransportError};
@@ -48,6 +49,8 @@ pub enum DeviceEvent {
     Sample(Sample, u64),
     /// A time-of-flight diagnostics report.
     Tof(TofReport),
+    /// A head report (protocol 2.1, the tracked glasses).
+    Head(HeadSample),
     /// The device cannot be attached yet: what is awaited, why the last try failed, and what
     /// to do. Said at the first failed try (after a [`Lost`](Self::Lost), which says it waits,
     /// only after [`notice_every`]) and then every [`notice_every`] while it lasts.
@@ -59,6 +62,7 @@ pub struct Device {
     source: Source,
     transport: Option<Box<dyn Transport>>,
     sampler: Sampler,
+    head_sampler: HeadSampler,
     next_try: Instant,
     last_error: Option<String>,
     info: Result<DeviceInfo, String>,
@@ -77,6 +81,7 @@ impl Device {
             source,
             transport: None,
             sampler: Sampler::new(),
+            head_sampler: HeadSampler::new(),
             next_try: Instant::now(),
             last_error: None,
             info: Err("not attached".into()),
@@ -167,6 +172,7 @@ impl Device {
                     };
                     self.transport = Some(t);
                     self.sampler = Sampler::new();
+                    self.head_sampler = HeadSampler::new();
                     self.last_error = None;
                     Some(DeviceEvent::Found(name))
                 }
@@ -194,6 +200,7 @@ impl Device {
                 Some(DeviceEvent::Sample(sample, lost))
             }
             Ok(Some(Message::Tof(t))) => Some(DeviceEvent::Tof(t)),
+            Ok(Some(Message::Head(h))) => Some(DeviceEvent::Head(self.head_sampler.sample(&h, now_us()))),
             Ok(_) => None,
             Err(TransportError::Disconnected(why)) => {
                 self.transport = None;

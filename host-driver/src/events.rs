@@ -61,6 +61,8 @@ pub enum EventKind {
     DeviceFound { device: String },
     /// This client lost `count` events because it did not read them fast enough.
     Missed { count: u64 },
+    /// The tracked head's pose (a head report): fresh, held or refused.
+    Head(crate::head::HeadPose),
 }
 
 impl EventKind {
@@ -77,6 +79,7 @@ impl EventKind {
             EventKind::DeviceLost { .. } => "device_lost",
             EventKind::DeviceFound { .. } => "device_found",
             EventKind::Missed { .. } => "missed",
+            EventKind::Head(_) => "head",
         }
     }
 }
@@ -264,7 +267,8 @@ impl PenState {
             EventKind::TipUp => self.sw[0] = false,
             EventKind::ButtonDown { button } => self.set_button(*button, true),
             EventKind::ButtonUp { button } => self.set_button(*button, false),
-            EventKind::Motion | EventKind::Missed { .. } => {}
+            // The head is not the pen's state: a late client has the next one in 16 ms.
+            EventKind::Motion | EventKind::Missed { .. } | EventKind::Head(_) => {}
             EventKind::DeviceLost { .. } => self.device = None,
             EventKind::DeviceFound { device } => {
                 // The detector starts a new device from nothing pressed and out of range.

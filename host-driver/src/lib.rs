@@ -9,7 +9,8 @@
 //! * [`calibration`]: the tracker → display transform fitted to touched targets, its file, the
 //!   procedure that collects the touches, display coordinates (u, v, h in mm and pixels), and
 //!   the residual plot.
-//! * [`events`]: pen events from samples; [`pipeline`] turns a device into events.
+//! * [`events`]: pen events from samples; [`head`]: the tracked head's samples and `head`
+//!   events; [`pipeline`] turns a device into events.
 //! * [`daemon`]: `pend`, serving events to any number of clients on a Unix socket; [`client`]
 //!   reads them; [`wire`] is the socket's line format, shared by both.
 //!
@@ -26,6 +27,7 @@ pub mod events;
 // The fuzz targets' properties, shared with the stable test that replays their corpora.
 #[doc(hidden)]
 pub mod fuzzing;
+pub mod head;
 pub mod help;
 pub mod hex;
 pub mod pipeline;

@@ -10,6 +10,7 @@ use std::time::Duration;
 use crate::calibration::Calibration;
 use crate::device::{Device, DeviceEvent};
 use crate::events::{DisplayPoint, EventDetector, PenEvent};
+use crate::head::HeadTracker;
 use crate::sample::{Sample, now_us};
 use crate::source::Source;
 
@@ -22,6 +23,7 @@ pub struct Pipeline {
     device: Device,
     calibration: Calibration,
     detector: EventDetector,
+    head: HeadTracker,
     lost: u64,
     refused: Option<String>,
     notice: Option<String>,
@@ -44,6 +46,7 @@ impl Pipeline {
             device,
             calibration,
             detector: EventDetector::new(),
+            head: HeadTracker::new(),
             lost: 0,
             refused: None,
             notice: None,
@@ -79,11 +82,20 @@ impl Pipeline {
     /// Where a sample is on the display: calibrated here, or as the device reported it when the
     /// device applies a calibration itself.
     pub fn point(&self, s: &Sample) -> DisplayPoint {
-        if s.display_frame {
-            self.calibration.point(s.position_mm)
+        self.display_point(s.position_mm, s.display_frame)
+    }
+
+    fn display_point(&self, position_mm: glam::DVec3, display_frame: bool) -> DisplayPoint {
+        if display_frame {
+            self.calibration.point(position_mm)
         } else {
-            self.calibration.to_display(s.position_mm)
+            self.calibration.to_display(position_mm)
         }
+    }
+
+    /// The tracked head: its last good pose and the reports refused.
+    pub fn head(&self) -> &HeadTracker {
+        &self.head
     }
 
     /// Waits at most `timeout` for the device; appends the resulting events to `out` and returns
@@ -117,6 +129,12 @@ impl Pipeline {
             }
             DeviceEvent::Waiting(notice) => {
                 self.notice = Some(notice);
+                None
+            }
+            DeviceEvent::Head(h) => {
+                // Only a device the calibration belongs to gets here (a refused one is detached).
+                let point = self.display_point(h.position_mm, h.display_frame);
+                out.push(self.head.on_sample(&h, point, now_us()));
                 None
             }
             DeviceEvent::Tof(_) => None,

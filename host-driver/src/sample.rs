@@ -76,6 +76,22 @@ pub fn now_us() -> u64 {
         .map_or(0, |d| d.as_micros() as u64)
 }
 
+/// The device clock, which wraps every 2³² µs, extended to 64 bits with the previous value's
+/// high bits (`prev`, the last unwrapped time of the same stream).
+pub fn unwrap_device_us(prev: Option<u64>, timestamp_us: u32) -> u64 {
+    match prev {
+        Some(prev) => {
+            let candidate = (prev & !0xFFFF_FFFF) | timestamp_us as u64;
+            if candidate + 0x8000_0000 < prev {
+                candidate + 0x1_0000_0000
+            } else {
+                candidate
+            }
+        }
+        None => timestamp_us as u64,
+    }
+}
+
 /// Turns reports into samples: unwraps the device's 32-bit microsecond clock and counts the
 /// reports lost between consecutive sequence numbers.
 #[derive(Debug, Default, Clone)]
@@ -115,18 +131,7 @@ impl Sampler {
         self.lost += gap;
         self.received += 1;
         self.last_seq = Some(report.seq);
-        let device_us = match self.last_device_us {
-            // The device clock wraps every 2³² µs; extend it with the previous value's high bits.
-            Some(prev) => {
-                let candidate = (prev & !0xFFFF_FFFF) | report.timestamp_us as u64;
-                if candidate + 0x8000_0000 < prev {
-                    candidate + 0x1_0000_0000
-                } else {
-                    candidate
-                }
-            }
-            None => report.timestamp_us as u64,
-        };
+        let device_us = unwrap_device_us(self.last_device_us, report.timestamp_us);
         self.last_device_us = Some(device_us);
         // From the logical units in f64: 0.1 mm steps stay exact decimals.
         let units = pen_protocol::UNITS_PER_MM as f64;

@@ -10,11 +10,12 @@
 use serde::{Deserialize, Serialize};
 
 use crate::events::{DisplayPoint, EventKind, PenEvent};
+use crate::head::{HeadPose, HeadStatus};
 
 /// The events schema's version, the greeting's `events`. Version 2 added the `refused` line and
-/// the events that bring a client up to date when it joins and after a `missed` notice
-/// (docs/events.md).
-pub const EVENTS_VERSION: u32 = 2;
+/// the events that bring a client up to date when it joins and after a `missed` notice; version
+/// 3 the `head` line (docs/events.md).
+pub const EVENTS_VERSION: u32 = 3;
 
 /// One line on the socket, by its `type`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -35,6 +36,7 @@ pub enum SocketLine {
     DeviceLost(DeviceLost),
     DeviceFound(DeviceFound),
     Missed(Missed),
+    Head(Head),
 }
 
 /// The greeting: the schema's version, and whether a base station is attached.
@@ -141,6 +143,28 @@ pub struct Missed {
     pub count: u64,
 }
 
+/// The tracked head's pose (docs/events.md, *Head*).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Head {
+    /// Host time, seconds since the Unix epoch.
+    pub t: f64,
+    /// The pose to use (fresh, or the last good one); absent before the first good one.
+    #[serde(flatten)]
+    pub point: Point,
+    /// `tracked`, `held` (no fix: the last pose) or `refused` (behind the display: the last pose).
+    pub status: String,
+    /// How far ahead of `device_us` the pose is predicted, ms.
+    pub prediction_ms: u8,
+    /// Head reports refused since pend started.
+    pub refused: u64,
+    /// Why the pose is not fresh, for a person (`held` and `refused`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub reason: Option<String>,
+    /// The head report's own sequence number and device time.
+    #[serde(flatten)]
+    pub report: Report,
+}
+
 /// Why a well-formed JSON line is not an event.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum WireError {
@@ -153,6 +177,9 @@ pub enum WireError {
     /// A button other than SW2 and SW3.
     #[error("button {0} is not 2 or 3")]
     Button(u8),
+    /// A head status other than `tracked`, `held` and `refused`.
+    #[error("head status {0:?} is not tracked, held or refused")]
+    HeadStatus(String),
     /// `t` is negative, or not before 2^32 s (the year 2106).
     #[error("t {0} is not a time")]
     Time(f64),
@@ -282,6 +309,15 @@ impl From<&PenEvent> for SocketLine {
                 device: device.clone(),
             }),
             EventKind::Missed { count } => SocketLine::Missed(Missed { t, count: *count }),
+            EventKind::Head(h) => SocketLine::Head(Head {
+                t,
+                point: Point::of(h.at),
+                status: h.status.name().to_string(),
+                prediction_ms: h.prediction_ms,
+                refused: h.refused,
+                reason: h.reason.clone(),
+                report: Report::of(e.seq),
+            }),
         }
     }
 }
@@ -339,6 +375,19 @@ impl SocketLine {
             SocketLine::DeviceLost(d) => bare(EventKind::DeviceLost { reason: d.reason }, d.t)?,
             SocketLine::DeviceFound(d) => bare(EventKind::DeviceFound { device: d.device }, d.t)?,
             SocketLine::Missed(m) => bare(EventKind::Missed { count: m.count }, m.t)?,
+            SocketLine::Head(h) => PenEvent {
+                t_us: micros(h.t)?,
+                seq: h.report.read()?,
+                kind: EventKind::Head(HeadPose {
+                    at: h.point.read()?,
+                    status: HeadStatus::from_name(&h.status).ok_or(WireError::HeadStatus(h.status))?,
+                    prediction_ms: h.prediction_ms,
+                    refused: h.refused,
+                    reason: h.reason,
+                }),
+                point: None,
+                sw: None,
+            },
         }))
     }
 

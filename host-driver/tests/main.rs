@@ -4,6 +4,7 @@ mod daemon;
 mod delays;
 mod events;
 mod fuzz_corpus;
+mod head;
 mod install;
 mod penctl;
 mod pend_faults;

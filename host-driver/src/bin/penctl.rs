@@ -413,6 +413,30 @@ fn monitor(args: &DeviceArgs, as_json: bool, count: Option<u64>) -> Result<()> {
                 }
                 printed += 1;
             }
+            Some(DeviceEvent::Head(h)) => {
+                if as_json {
+                    writeln!(out, "{}", serde_json::to_string(&h.json())?)?;
+                } else {
+                    // The head's row: its own sequence, "head" for the range column, the pose
+                    // predicted ahead, then "+N ms" and whether the report had a fix.
+                    writeln!(
+                        out,
+                        "{:5}  {:11.6}  {:5}  {:8.1}  {:8.1}  {:8.1}  {:11}  {:3}  {:8.1}  {:4.1}  {}",
+                        h.seq,
+                        h.device_us as f64 * 1e-6,
+                        "head",
+                        h.position_mm.x,
+                        h.position_mm.y,
+                        h.position_mm.z,
+                        format!("+{} ms", h.prediction_ms),
+                        h.quality.receivers_used,
+                        h.quality.residual_mm(),
+                        h.quality.dop(),
+                        if h.no_fix { "no fix: last pose kept" } else { "" },
+                    )?;
+                }
+                printed += 1;
+            }
             Some(DeviceEvent::Found(name)) => eprintln!("penctl: attached {name}"),
             Some(DeviceEvent::Lost(why)) => eprintln!("penctl: device lost ({why}); waiting for it"),
             Some(DeviceEvent::Waiting(notice)) => eprintln!("penctl: {notice}"),

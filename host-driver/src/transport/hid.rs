@@ -94,7 +94,7 @@ impl Transport for HidTransport {
             return Ok(None);
         }
         match Message::decode(&buf[..n]) {
-            Ok(m @ (Message::Pen(_) | Message::Tof(_))) => Ok(Some(m)),
+            Ok(m @ (Message::Pen(_) | Message::Tof(_) | Message::Head(_))) => Ok(Some(m)),
             // The OS's pen report, for the OS's pen stack: the pen report carries all of it.
             Ok(Message::OsPen(_)) => Ok(None),
             _ => {

@@ -62,7 +62,7 @@ impl SerialTransport {
                 None => {}
                 Some(Err(_)) => self.dropped += 1,
                 Some(Ok(payload)) => match Message::decode(payload) {
-                    Ok(m @ (Message::Pen(_) | Message::Tof(_))) => self.inputs.push_back(m),
+                    Ok(m @ (Message::Pen(_) | Message::Tof(_) | Message::Head(_))) => self.inputs.push_back(m),
                     Ok(m) => self.answers.push_back(m),
                     // A frame that checks out but holds no valid report: a newer device, or a bug.
                     Err(_) => self.dropped += 1,

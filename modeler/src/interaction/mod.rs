@@ -547,6 +547,8 @@ impl Interaction {
                 self.stats.missed += count;
                 self.say(format!("{count} pen events were lost"));
             }
+            // The tracked head (issue 16) drives the view, not the pen's interaction.
+            EventKind::Head(_) => {}
         }
     }
 

@@ -1,0 +1,194 @@
+//! The tracked head end to end: the simulated base station's head reports (the exact device
+//! bytes) through pend's real socket as `head` events, in the display frame; a head behind the
+//! display refused with the reason and a count, the last pose kept; a report without a fix
+//! keeping the last pose and saying so.
+
+use std::io::{BufRead, BufReader};
+use std::os::unix::net::UnixStream;
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use glam::{DQuat, DVec3};
+use pen_host::calibration::{Calibration, DisplaySize};
+use pen_host::client::{Line, parse_line};
+use pen_host::events::{DisplayPoint, EventKind};
+use pen_host::head::{HeadPose, HeadSampler, HeadStatus, HeadTracker};
+use pen_host::wire::EVENTS_VERSION;
+use pen_protocol::{HeadReport, Message, Position, Quality};
+
+const GUARD: Duration = Duration::from_secs(60);
+
+struct Pend(Child);
+
+impl Drop for Pend {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn start_pend(socket: &Path, calibration: &Path) -> Pend {
+    let child = Command::new(env!("CARGO_BIN_EXE_pend"))
+        .args(["--source", "sim:viewer", "--speed", "0", "--socket"])
+        .arg(socket)
+        .arg("--calibration")
+        .arg(calibration)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("pend starts");
+    let end = Instant::now() + GUARD;
+    while UnixStream::connect(socket).is_err() {
+        assert!(Instant::now() < end, "pend did not listen");
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    Pend(child)
+}
+
+/// The first `n` head events a client of pend reads, with their report's device time, and the
+/// greeting's events version.
+fn head_events(calibration: Calibration, n: usize) -> (u32, Vec<(u64, HeadPose)>) {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let (socket, file) = (dir.path().join("pend.sock"), dir.path().join("calibration.toml"));
+    calibration.save(&file).expect("calibration saved");
+    let _pend = start_pend(&socket, &file);
+    let stream = UnixStream::connect(&socket).expect("connects");
+    stream.set_read_timeout(Some(GUARD)).expect("timeout");
+    let mut reader = BufReader::new(stream);
+    let mut line = String::new();
+    reader.read_line(&mut line).expect("greeting");
+    let greeting: serde_json::Value = serde_json::from_str(&line).expect("JSON");
+    let version = greeting["events"].as_u64().expect("events version") as u32;
+    let mut out = Vec::new();
+    let end = Instant::now() + GUARD;
+    while out.len() < n && Instant::now() < end {
+        line.clear();
+        assert!(reader.read_line(&mut line).expect("reads") > 0, "pend closed");
+        if let Line::Event(e) = parse_line(line.trim_end()).expect("a good line")
+            && let EventKind::Head(h) = e.kind
+        {
+            assert_eq!(e.point, None, "a head event is not the pen's");
+            let (_, device_us) = e.seq.expect("a head event comes from a report");
+            out.push((device_us, h));
+        }
+    }
+    (version, out)
+}
+
+#[test]
+fn pend_publishes_the_head_in_the_display_frame() {
+    let display = DisplaySize::REFERENCE;
+    let (version, events) = head_events(Calibration::identity(display), 300);
+    assert_eq!(version, EVENTS_VERSION);
+    assert_eq!(events.len(), 300);
+    // At least 60 a second of device time.
+    let span_s = (events[events.len() - 1].0 - events[0].0) as f64 * 1e-6;
+    assert!(
+        (events.len() - 1) as f64 / span_s >= 60.0,
+        "{} in {span_s} s",
+        events.len()
+    );
+    let mut last_good: Option<DisplayPoint> = None;
+    let mut tracked = 0;
+    for (_, h) in &events {
+        match h.status {
+            HeadStatus::Tracked => {
+                tracked += 1;
+                let p = h.at.expect("a tracked pose");
+                // The seated viewer (650 mm away, leaning in up to 220 mm, the emitter 95 mm in
+                // front of the head): in front of the display, over it give or take the sway.
+                assert!((250.0..700.0).contains(&p.h_mm), "{p:?}");
+                assert!((-100.0..display.width_mm + 100.0).contains(&p.u_mm), "{p:?}");
+                assert!(h.reason.is_none());
+                last_good = Some(p);
+            }
+            HeadStatus::Held => {
+                assert_eq!(h.at, last_good, "a report without a fix keeps the last pose");
+                assert!(h.reason.as_deref().is_some_and(|r| r.contains("keeping the last pose")));
+            }
+            HeadStatus::Refused => panic!("nothing is behind the display here: {h:?}"),
+        }
+        assert_eq!(h.refused, 0);
+    }
+    assert!(tracked >= 280, "{tracked} of 300 tracked");
+}
+
+#[test]
+fn a_head_behind_the_display_is_refused_and_counted() {
+    // A calibration turned over (180° about the display's u axis): every head comes out behind
+    // the surface, as a mirrored solution or a wrong calibration would put it.
+    let mut flipped = Calibration::identity(DisplaySize::REFERENCE);
+    flipped.transform.rotation = DQuat::from_rotation_x(std::f64::consts::PI);
+    let (_, events) = head_events(flipped, 40);
+    // The client joins a running pend: the count goes up by one per refusal from where it was.
+    let (mut refused, mut count) = (0, None);
+    for (_, h) in &events {
+        if h.status == HeadStatus::Refused {
+            refused += 1;
+            if let Some(before) = count {
+                assert_eq!(h.refused, before + 1, "the count goes up by one per refusal");
+            }
+            count = Some(h.refused);
+            assert_eq!(h.at, None, "no good pose to keep");
+            let reason = h.reason.as_deref().expect("a reason");
+            assert!(
+                reason.contains("behind the display") && reason.contains("refused"),
+                "{reason}"
+            );
+        }
+    }
+    assert!(refused >= 30, "{refused} of 40 refused");
+}
+
+#[test]
+fn head_bytes_through_the_sampler_and_tracker() {
+    // The device's bytes for a good pose, then no fix, then a pose behind the display.
+    let report = |no_fix: bool, z: i16, seq: u16| HeadReport {
+        no_fix,
+        display_frame: true,
+        position: Position { x: 3000, y: 1700, z },
+        prediction_ms: 20,
+        seq,
+        timestamp_us: (u32::MAX - 5).wrapping_add(seq as u32),
+        quality: if no_fix {
+            Quality::NONE
+        } else {
+            Quality {
+                receivers_used: 4,
+                residual: 3,
+                dop: 19,
+            }
+        },
+    };
+    let calibration = Calibration::identity(DisplaySize::REFERENCE);
+    let (mut sampler, mut tracker) = (HeadSampler::new(), HeadTracker::new());
+    let mut run = |r: HeadReport| {
+        let Ok(Message::Head(r)) = Message::decode(&r.to_bytes()) else {
+            panic!("the head report decodes");
+        };
+        let s = sampler.sample(&r, 0);
+        let e = tracker.on_sample(&s, calibration.point(s.position_mm), 0);
+        match e.kind {
+            EventKind::Head(h) => (s, h),
+            other => panic!("{other:?}"),
+        }
+    };
+    let (s, good) = run(report(false, 6500, 0));
+    assert_eq!(good.status, HeadStatus::Tracked);
+    assert_eq!(s.position_mm, DVec3::new(300.0, 170.0, 650.0));
+    let (_, held) = run(report(true, 6500, 1));
+    assert_eq!((held.status, held.at), (HeadStatus::Held, good.at));
+    let (s, behind) = run(report(false, -420, 10));
+    assert_eq!(
+        (behind.status, behind.at, behind.refused),
+        (HeadStatus::Refused, good.at, 1)
+    );
+    assert!(
+        behind.reason.as_deref().is_some_and(|r| r.contains("42.0 mm behind")),
+        "{behind:?}"
+    );
+    // The device clock wrapped between the first and the last report: unwrapped, it went on.
+    assert_eq!(s.device_us, (u32::MAX as u64 - 5) + 10);
+}
