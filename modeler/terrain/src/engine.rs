@@ -117,6 +117,30 @@ impl Rect {
     }
 }
 
+// A river's window and the engine's rectangle are the same cells; the rivers do not name the
+// engine (it names them).
+impl From<Rect> for crate::river::Window {
+    fn from(r: Rect) -> crate::river::Window {
+        crate::river::Window {
+            c0: r.c0,
+            r0: r.r0,
+            width: r.width as usize,
+            height: r.height as usize,
+        }
+    }
+}
+
+impl From<crate::river::Window> for Rect {
+    fn from(w: crate::river::Window) -> Rect {
+        Rect {
+            c0: w.c0,
+            r0: w.r0,
+            width: w.width as u32,
+            height: w.height as u32,
+        }
+    }
+}
+
 /// A run of cells in one row of a region's box: `start..end` in box columns.
 #[derive(Debug, Clone, Copy)]
 struct Run {

@@ -207,7 +207,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let last = shape.history.last();
     let line = format!(
-        "rivers[{}]: {} samples, {} × {} window, {} iterations: {} river cells, {} lakes ({} cells)",
+        "rivers[{}]: {} samples, {} × {} window, {} iterations: {} river cells; lakes: {} ({} cells)",
         args.index,
         samples.len(),
         w,

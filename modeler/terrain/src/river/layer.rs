@@ -9,7 +9,6 @@
 use super::carve::{self, Carve};
 use super::{Constants, Shape, Window};
 use crate::document::{Document, River};
-use crate::engine::Rect;
 use crate::export::Mesh;
 use crate::heightmap::Heightmap;
 
@@ -73,31 +72,36 @@ impl std::fmt::Debug for Layer {
     }
 }
 
-fn rect_of(w: &Window) -> Rect {
-    Rect {
-        c0: w.c0,
-        r0: w.r0,
-        width: w.width as u32,
-        height: w.height as u32,
-    }
+fn rect_of(w: &Window) -> Window {
+    *w
 }
 
-fn meets(a: &Rect, b: &Rect) -> bool {
+fn meets(a: &Window, b: &Window) -> bool {
     a.width > 0
         && a.height > 0
         && b.width > 0
         && b.height > 0
-        && a.c0 < b.c0 + b.width
-        && b.c0 < a.c0 + a.width
-        && a.r0 < b.r0 + b.height
-        && b.r0 < a.r0 + a.height
+        && (a.c0 as usize) < b.c0 as usize + b.width
+        && (b.c0 as usize) < a.c0 as usize + a.width
+        && (a.r0 as usize) < b.r0 as usize + b.height
+        && (b.r0 as usize) < a.r0 as usize + a.height
 }
 
-fn union(a: Option<Rect>, b: Rect) -> Option<Rect> {
-    if b.width == 0 || b.height == 0 {
+fn union(a: Option<Window>, b: Window) -> Option<Window> {
+    if b.is_empty() {
         return a;
     }
-    Some(a.map_or(b, |a| a.union(b)))
+    Some(a.map_or(b, |a| {
+        let (c0, r0) = (a.c0.min(b.c0), a.r0.min(b.r0));
+        let c1 = (a.c0 as usize + a.width).max(b.c0 as usize + b.width);
+        let r1 = (a.r0 as usize + a.height).max(b.r0 as usize + b.height);
+        Window {
+            c0,
+            r0,
+            width: c1 - c0 as usize,
+            height: r1 - r0 as usize,
+        }
+    }))
 }
 
 impl Layer {
@@ -113,10 +117,17 @@ impl Layer {
 
     /// Brings the rivers up to date with `doc` over `ground`, whose cells in `ground_changed`
     /// changed since the last call; returns the cells whose carved height or water may have
-    /// changed (beyond `ground_changed`).
-    pub fn sync(&mut self, doc: &Document, ground: &Heightmap, ground_changed: Rect) -> Option<Rect> {
+    /// changed (beyond `ground_changed`). The rectangles are the engine's
+    /// ([`crate::engine::Rect`], through `From`) or windows.
+    pub fn sync<R: From<Window> + Into<Window>>(
+        &mut self,
+        doc: &Document,
+        ground: &Heightmap,
+        ground_changed: R,
+    ) -> Option<R> {
+        let ground_changed: Window = ground_changed.into();
         let constants = Constants::default();
-        let mut dirty: Option<Rect> = None;
+        let mut dirty: Option<Window> = None;
         // Rivers gone.
         while self.cached.len() > doc.rivers.len() {
             if let Some(c) = self.cached.pop() {
@@ -152,13 +163,13 @@ impl Layer {
         }
         if self.cached.is_empty() {
             self.carved = None;
-            return dirty;
+            return dirty.map(R::from);
         }
-        let all = Rect {
+        let all = Window {
             c0: 0,
             r0: 0,
-            width: ground.cols(),
-            height: ground.rows(),
+            width: ground.cols() as usize,
+            height: ground.rows() as usize,
         };
         let (map, water) = self.carved.get_or_insert_with(|| {
             dirty = Some(all);
@@ -175,14 +186,14 @@ impl Layer {
         });
         let rect = union(dirty, ground_changed)?;
         composite(&self.cached, ground, map, water, &rect);
-        Some(rect)
+        Some(R::from(rect))
     }
 }
 
 /// `carved = min(ground, targets)` and the water, over `rect`.
-fn composite(cached: &[Cached], ground: &Heightmap, map: &mut Heightmap, water: &mut Water, rect: &Rect) {
+fn composite(cached: &[Cached], ground: &Heightmap, map: &mut Heightmap, water: &mut Water, rect: &Window) {
     let cols = ground.cols() as usize;
-    let (c1, r1) = (rect.c0 + rect.width, rect.r0 + rect.height);
+    let (c1, r1) = (rect.c0 + rect.width as u32, rect.r0 + rect.height as u32);
     {
         let out = map.heights_mut();
         for r in rect.r0..r1 {
