@@ -382,6 +382,7 @@ impl Picture {
             overlays: &self.overlays,
             rocks: &self.rocks,
             water: &self.water,
+            light_map: None,
             selection: self.selection,
             slope_bar: self.slope_bar.clone(),
             mode: &self.mode,

@@ -185,7 +185,13 @@ impl Renderer {
 
     /// Per-frame work shared by both eyes: the light.
     fn prepare(&mut self, scene: &Scene) -> RenderStats {
-        let skipped = shade::vertex_light(scene.terrain, scene.vertical_scale, &scene.style, &mut self.light);
+        let skipped = shade::vertex_light(
+            scene.terrain,
+            scene.vertical_scale,
+            &scene.style,
+            scene.light_map,
+            &mut self.light,
+        );
         RenderStats {
             skipped_vertices: skipped,
         }

@@ -132,6 +132,11 @@ pub struct Scene<'a> {
     /// Water surfaces (rivers and lakes: flat meshes at their level, the same frame), drawn in
     /// [`Style::water_colour`].
     pub water: &'a [(String, Mesh)],
+    /// The terrain's light per cell, 0 to 1, row-major like its heights — insolation from
+    /// `penmodel_terrain::ridge::sun` (seed 002). When given and of the terrain's size, it
+    /// replaces the style's Lambert light: a vertex's light is `ambient + (1 − ambient)·light`,
+    /// so cells in a shadow get the ambient light alone.
+    pub light_map: Option<&'a [f32]>,
     /// The index in `overlays` of the selected one, drawn in the selection colour and width.
     pub selection: Option<usize>,
     /// The slope bar, when shown.
@@ -155,6 +160,7 @@ impl<'a> Scene<'a> {
             overlays: &[],
             rocks: &[],
             water: &[],
+            light_map: None,
             selection: None,
             slope_bar: None,
             mode: "",

@@ -99,8 +99,16 @@ impl Ramp {
 }
 
 /// Per-vertex light, row-major like the heights; `NaN` where the height is not finite. Returns
-/// how many heights are not finite.
-pub fn vertex_light(map: &Heightmap, vertical_scale: f32, style: &Style, out: &mut Vec<f32>) -> usize {
+/// how many heights are not finite. With `given` (one value per cell, 0 to 1: see
+/// [`Scene::light_map`](super::scene::Scene::light_map)) the light is `ambient + (1 − ambient)·given`
+/// instead of Lambert's.
+pub fn vertex_light(
+    map: &Heightmap,
+    vertical_scale: f32,
+    style: &Style,
+    given: Option<&[f32]>,
+    out: &mut Vec<f32>,
+) -> usize {
     let (cols, rows) = (map.cols() as usize, map.rows() as usize);
     out.resize(cols * rows, 0.0);
     if cols == 0 || rows == 0 {
@@ -139,6 +147,11 @@ pub fn vertex_light(map: &Heightmap, vertical_scale: f32, style: &Style, out: &m
                 } else {
                     0.0
                 };
+                if let Some(g) = given.filter(|g| g.len() == cols * rows) {
+                    let v = g[r * cols + c];
+                    *o = ambient + (1.0 - ambient) * if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 };
+                    continue;
+                }
                 // n = (−dx, 1, −dz)/|…|
                 let inv = 1.0 / (dx * dx + 1.0 + dz * dz).sqrt();
                 let lambert = ((-dx * light[0] + light[1] - dz * light[2]) * inv).max(0.0);

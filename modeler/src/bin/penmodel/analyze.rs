@@ -58,7 +58,8 @@ pub struct Args {
     sky_directions: u32,
 }
 
-fn parse_sun(s: &str) -> Result<(f64, f64), String> {
+/// `AZ,EL` in degrees (`--sun`); `render --sun` reads it too.
+pub(crate) fn parse_sun(s: &str) -> Result<(f64, f64), String> {
     let (a, e) = s.split_once(',').ok_or("give AZ,EL in degrees, e.g. 135,25")?;
     let num = |t: &str| {
         t.trim()

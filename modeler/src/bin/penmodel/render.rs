@@ -7,6 +7,7 @@ use clap::ValueEnum;
 use penmodel_render::output;
 use penmodel_render::{self as render, Camera, Frame, Orbit, Renderer, Scene, Stereo, Tracked, View};
 use penmodel_terrain::editor::Editor;
+use penmodel_terrain::ridge::sun::{self, Field, Sun as SunPosition};
 
 /// Stereo modes on the command line.
 #[derive(Clone, Copy, ValueEnum)]
@@ -138,6 +139,15 @@ pub struct Args {
     /// Leave out the figures and region boundaries.
     #[arg(long)]
     no_overlays: bool,
+    /// Shade by insolation (seed 002) for a sun at azimuth AZ (degrees from +x towards +y) and
+    /// elevation EL (0, 90]: 0.8·direct (shadows exactly dark) + 0.2·sky view over 32 azimuths.
+    #[arg(long, value_name = "AZ,EL", value_parser = crate::analyze::parse_sun, allow_hyphen_values = true)]
+    sun: Option<(f64, f64)>,
+    /// Overlay the ridge and valley areas (seed 002): the valley network (cells passed by at
+    /// least 32 rain drops, along the flow) in blue, the ridge cells' crest lines (the document's
+    /// ridgelines and trees) in orange.
+    #[arg(long)]
+    areas: bool,
     /// One line of text at the top left.
     #[arg(long, default_value = "")]
     mode: String,
@@ -194,6 +204,24 @@ pub fn run(args: &Args) -> Result<()> {
             tilt: args.tilt.to_radians(),
         },
     );
+    let mut overlays = overlays;
+    if args.areas {
+        overlays.extend(ridge_overlays(editor.document(), map));
+    }
+    let light = match args.sun {
+        Some((az, el)) => {
+            let sun = SunPosition::degrees(az, el, "--sun").map_err(|e| anyhow::anyhow!(e))?;
+            let field = Field {
+                z: map.heights(),
+                cols: map.cols(),
+                rows: map.rows(),
+                cell: map.cell_size(),
+            };
+            Some(sun::insolation(&sun::direct(field, sun), &sun::sky_view(field, 32)))
+        }
+        None => None,
+    };
+    scene.light_map = light.as_deref();
     scene.overlays = &overlays;
     scene.rocks = editor.rocks().meshes();
     scene.water = &water;
@@ -266,4 +294,65 @@ fn show(frame: Frame) {
 /// The ramp's top for a terrain whose highest point is `hi` metres: snow on the highest tenth.
 pub fn ramp_top(hi: f32) -> f32 {
     if hi > 0.0 { hi / 0.9 } else { 1.0 }
+}
+
+/// Valley colour of `--areas`.
+const VALLEY_COLOUR: render::Rgba = [40, 110, 230, 255];
+/// Ridge colour of `--areas`.
+const RIDGE_COLOUR: render::Rgba = [245, 150, 30, 255];
+
+/// `--areas`: the valley network as draped lines along the rain's flow through valley cells
+/// (one line from each valley cell no valley cell flows into, down to where the flow leaves the
+/// valley cells), and the document's ridgelines and trees' segments at their elevations.
+fn ridge_overlays(doc: &penmodel_terrain::Document, map: &penmodel_terrain::Heightmap) -> Vec<render::Overlay> {
+    use penmodel_terrain::ridge::rain::{self, Classes, STOP};
+    let (cols, rows, cell) = (map.cols(), map.rows(), map.cell_size());
+    let next = rain::directions(map.heights(), cols, rows, cell);
+    let counts = rain::accumulate(&next);
+    let valley = |i: usize| counts[i] >= Classes::DEFAULT.valley_min;
+    let mut fed = vec![false; next.len()];
+    for (i, &n) in next.iter().enumerate() {
+        if n != STOP && valley(i) {
+            fed[n as usize] = true;
+        }
+    }
+    let centre = |i: u32| [(f64::from(i % cols) + 0.5) * cell, (f64::from(i / cols) + 0.5) * cell];
+    let mut out = Vec::new();
+    for (start, &is_fed) in fed.iter().enumerate() {
+        if !valley(start) || is_fed {
+            continue;
+        }
+        let mut points = vec![centre(start as u32)];
+        let mut i = start as u32;
+        while next[i as usize] != STOP && valley(next[i as usize] as usize) {
+            i = next[i as usize];
+            points.push(centre(i));
+        }
+        if points.len() > 1 {
+            out.push(render::Overlay {
+                points,
+                closed: false,
+                colour: VALLEY_COLOUR,
+                width: 2.0,
+                height: None,
+            });
+        }
+    }
+    if let Some(r) = &doc.ridges
+        && let Ok(skeletons) = penmodel_terrain::ridge::layer::skeletons(r)
+    {
+        for (_, s) in skeletons {
+            for [a, b] in s.edges {
+                let (p, q) = (s.nodes[a as usize], s.nodes[b as usize]);
+                out.push(render::Overlay {
+                    points: vec![[p[0], p[1]], [q[0], q[1]]],
+                    closed: false,
+                    colour: RIDGE_COLOUR,
+                    width: 3.0,
+                    height: None,
+                });
+            }
+        }
+    }
+    out
 }
