@@ -42,3 +42,28 @@ fn the_emulated_core_sends_the_host_builds_reports() {
         );
     }
 }
+
+/// Writes the replay fuzz target's seeds from real traffic: the cycles the simulated pen records
+/// (capture times with the acoustics' noise, echoes and dropouts, switch samples), as the QEMU
+/// replay format, into `firmware/core/fuzz/corpus/replay/sim-*` (docs/reliability.md). Run once
+/// when the format or the scenarios change: `cargo test -p pen-hil --test main
+/// write_replay_seeds -- --ignored`; the stable corpus test then replays them.
+#[test]
+#[ignore]
+fn write_replay_seeds() {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../firmware/core/fuzz/corpus/replay");
+    // Half a second each: enough cycles to reach the solver and the tracker, small enough that
+    // the corpus replays in seconds.
+    for (name, seed) in [
+        ("hand-sweep", 1),
+        ("echoes", 2),
+        ("draw-figures", 3),
+        ("dead-receiver", 4),
+    ] {
+        let s = scenarios::by_name(name).expect("scenario");
+        let records = Simulation::new(&s, seed).run_for(0.5);
+        let bytes = qemu::replay(&s.config, &records);
+        std::fs::write(dir.join(format!("sim-{name}")), &bytes).expect("write a seed");
+        eprintln!("sim-{name}: {} cycles, {} bytes", records.len(), bytes.len());
+    }
+}

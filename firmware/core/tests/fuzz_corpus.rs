@@ -1,6 +1,7 @@
 //! The fuzz target's corpus (firmware/core/fuzz/corpus/replay: replays of a pen moving over the
-//! golden configuration's receivers, grown by `cargo +nightly fuzz`) replayed on stable through
-//! the same property the target checks (docs/reliability.md).
+//! golden configuration's receivers, the simulated pen's recorded cycles (`sim-*`), grown by
+//! `cargo +nightly fuzz`) replayed on stable through the same property the target checks
+//! (docs/reliability.md).
 
 use std::fs;
 use std::path::Path;
