@@ -531,3 +531,28 @@ fn the_nearest_sample_field_is_the_distance_to_the_course() {
         }
     }
 }
+
+#[test]
+fn a_pull_under_a_river_recarves_it() {
+    use penmodel_terrain::{Edit, Editor, FigurePath, generate};
+    let d = river_doc();
+    let mut ed = Editor::new(d).expect("valid");
+    // The hill the course runs past, pulled up and then down: the ground under the river
+    // changes, and the carving follows it as a fresh generation would.
+    for height in [60.0, 5.0] {
+        ed.apply(Edit::SetHeight {
+            at: FigurePath::new(0, 0),
+            height,
+        })
+        .expect("pulled");
+        assert_eq!(
+            ed.heightmap(),
+            &generate(ed.document()).expect("valid"),
+            "height {height}"
+        );
+        let water = ed.water().expect("water");
+        let wet = (0..water.level.len()).filter(|&i| !water.level[i].is_nan());
+        assert!(wet.clone().count() > 0);
+        assert!(wet.into_iter().all(|i| water.level[i] > ed.heightmap().heights()[i]));
+    }
+}
