@@ -62,7 +62,7 @@ pub enum EventKind {
     /// This client lost `count` events because it did not read them fast enough.
     Missed { count: u64 },
     /// The tracked head's pose (a head report): fresh, held or refused.
-    Head(crate::head::HeadPose),
+    Head(HeadPose),
 }
 
 impl EventKind {
@@ -82,6 +82,51 @@ impl EventKind {
             EventKind::Head(_) => "head",
         }
     }
+}
+
+/// What a `head` event says about its pose.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HeadStatus {
+    /// A fresh pose from this report.
+    Tracked,
+    /// No fix in this report: the last pose, kept.
+    Held,
+    /// This report put the head behind the display: refused, the last pose kept.
+    Refused,
+}
+
+impl HeadStatus {
+    /// The status as the socket writes it.
+    pub fn name(self) -> &'static str {
+        match self {
+            HeadStatus::Tracked => "tracked",
+            HeadStatus::Held => "held",
+            HeadStatus::Refused => "refused",
+        }
+    }
+
+    /// The status written `name`.
+    pub fn from_name(name: &str) -> Option<HeadStatus> {
+        [HeadStatus::Tracked, HeadStatus::Held, HeadStatus::Refused]
+            .into_iter()
+            .find(|s| s.name() == name)
+    }
+}
+
+/// A `head` event's content.
+#[derive(Debug, Clone, PartialEq)]
+pub struct HeadPose {
+    /// The pose to use: fresh, or the last good one when held or refused; `None` before the
+    /// first good one.
+    pub at: Option<DisplayPoint>,
+    /// Whether `at` is fresh.
+    pub status: HeadStatus,
+    /// How far ahead of the report's device time the pose is predicted, ms.
+    pub prediction_ms: u8,
+    /// Head reports refused since pend started.
+    pub refused: u64,
+    /// Why the pose is not fresh, for a person (held and refused only).
+    pub reason: Option<String>,
 }
 
 /// An event with its time and, for positional events, where.

@@ -11,6 +11,7 @@ use pen_protocol::{HeadReport, Quality};
 use serde::Serialize;
 
 use crate::events::{DisplayPoint, EventKind, PenEvent};
+pub use crate::events::{HeadPose, HeadStatus};
 use crate::sample::unwrap_device_us;
 
 /// One head report, decoded and timed.
@@ -98,51 +99,6 @@ impl HeadSampler {
             quality: report.quality,
         }
     }
-}
-
-/// What a `head` event says about its pose.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum HeadStatus {
-    /// A fresh pose from this report.
-    Tracked,
-    /// No fix in this report: the last pose, kept.
-    Held,
-    /// This report put the head behind the display: refused, the last pose kept.
-    Refused,
-}
-
-impl HeadStatus {
-    /// The status as the socket writes it.
-    pub fn name(self) -> &'static str {
-        match self {
-            HeadStatus::Tracked => "tracked",
-            HeadStatus::Held => "held",
-            HeadStatus::Refused => "refused",
-        }
-    }
-
-    /// The status written `name`.
-    pub fn from_name(name: &str) -> Option<HeadStatus> {
-        [HeadStatus::Tracked, HeadStatus::Held, HeadStatus::Refused]
-            .into_iter()
-            .find(|s| s.name() == name)
-    }
-}
-
-/// A `head` event's content.
-#[derive(Debug, Clone, PartialEq)]
-pub struct HeadPose {
-    /// The pose to use: fresh, or the last good one when held or refused; `None` before the
-    /// first good one.
-    pub at: Option<DisplayPoint>,
-    /// Whether `at` is fresh.
-    pub status: HeadStatus,
-    /// How far ahead of the report's device time the pose is predicted, ms.
-    pub prediction_ms: u8,
-    /// Head reports refused since pend started.
-    pub refused: u64,
-    /// Why the pose is not fresh, for a person (held and refused only).
-    pub reason: Option<String>,
 }
 
 /// Keeps the last good head pose; turns head samples into `head` events.

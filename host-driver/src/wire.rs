@@ -9,8 +9,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::events::{DisplayPoint, EventKind, PenEvent};
-use crate::head::{HeadPose, HeadStatus};
+use crate::events::{DisplayPoint, EventKind, HeadPose, HeadStatus, PenEvent};
 
 /// The events schema's version, the greeting's `events`. Version 2 added the `refused` line and
 /// the events that bring a client up to date when it joins and after a `missed` notice; version
