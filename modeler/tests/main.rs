@@ -4,6 +4,7 @@ mod demo_cli;
 mod help_examples;
 mod interaction;
 mod kill_loop;
+mod ridges_cli;
 mod river_cli;
 mod rocks_cli;
 mod waiting_cli;
