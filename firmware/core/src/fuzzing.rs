@@ -2,10 +2,10 @@
 //! stable test that replays its corpus (`tests/fuzz_corpus.rs`) checks exactly the same thing.
 //! Not part of the core's API: hidden, and free to change with the target.
 
-use pen_protocol::{FirmwareVersion, Position};
+use pen_protocol::{FirmwareVersion, MAX_RECEIVERS, Position};
 
 use crate::replay::{self, CycleHead};
-use crate::{Cycle, Engine, Vec3};
+use crate::{Cycle, CycleResult, Engine, Vec3, ranging};
 
 /// Switch samples a cycle may carry here: pen-qemu's buffer.
 const MAX_SAMPLES: usize = 4096;
@@ -14,7 +14,10 @@ const MAX_SAMPLES: usize = 4096;
 /// reads are in canonical form (written again, they are the bytes read); and the cycles' capture
 /// times, whatever they are, through the engine give no fix that is not a finite position, and
 /// no report but from a fix, within what a report carries (±3.2767 m; a tighter bound, the
-/// tracker's volume, is still to come).
+/// tracker's volume, is still to come). The same values are also taken as raw capture ticks
+/// (receivers 0–3 on the fast 32-bit timer, 4–7 on the slow 16-bit one, converted as the board
+/// converts them, `ranging::ticks_to_ns`) through a second engine, with the same expectations:
+/// any sequence of ticks, no panic, no fix that is not a position.
 pub fn replay(bytes: &[u8]) {
     let mut src = bytes;
     let Ok(config) = replay::read_header(&mut src) else {
@@ -31,15 +34,18 @@ pub fn replay(bytes: &[u8]) {
         &bytes[..replay::HEADER_LEN],
         "the header is not canonical"
     );
-    let mut engine = Engine::new(
-        Some(config),
-        FirmwareVersion {
-            major: 0,
-            minor: 1,
-            patch: 0,
-        },
-        *b"penscape-fuz",
-    );
+    let new_engine = || {
+        Engine::new(
+            Some(config),
+            FirmwareVersion {
+                major: 0,
+                minor: 1,
+                patch: 0,
+            },
+            *b"penscape-fuz",
+        )
+    };
+    let (mut engine, mut from_ticks) = (new_engine(), new_engine());
     let mut samples = [0u8; MAX_SAMPLES];
     loop {
         let before = src;
@@ -49,20 +55,47 @@ pub fn replay(bytes: &[u8]) {
         };
         let consumed = &before[..before.len() - src.len()];
         check_cycle(&head, &samples[..head.samples as usize], consumed);
-        let result = engine.on_cycle(&Cycle {
+        check_result(&engine.on_cycle(&Cycle {
             t0_us: head.t0_us,
             arrival_ns: head.arrival_ns,
+        }));
+        check_result(&from_ticks.on_cycle(&Cycle {
+            t0_us: head.t0_us,
+            arrival_ns: as_ticks(&head.arrival_ns),
+        }));
+    }
+}
+
+/// The arrivals read as capture-timer ticks, in ns as the board converts them.
+fn as_ticks(values: &[Option<u32>; MAX_RECEIVERS]) -> [Option<u32>; MAX_RECEIVERS] {
+    let (fast, slow) = (
+        ranging::ns_per_tick(ranging::FAST_TIMER_HZ),
+        ranging::ns_per_tick(ranging::SLOW_TIMER_HZ),
+    );
+    let mut out = [None; MAX_RECEIVERS];
+    for (i, (o, v)) in out.iter_mut().zip(values).enumerate() {
+        // The slow timer is 16 bits wide: its captures never exceed 65535.
+        *o = v.map(|t| {
+            if i < 4 {
+                ranging::ticks_to_ns(t, fast)
+            } else {
+                ranging::ticks_to_ns(t & 0xFFFF, slow)
+            }
         });
-        if let Ok(fix) = result.fix {
-            assert!(finite(fix.position), "a fix at {:?}", fix.position);
-        }
-        if let Some(p) = result.reported_mm {
-            // Reported only from an accepted fix, and only where the report can carry it: a
-            // position that would saturate the report's ±3.2767 m is not a position.
-            assert!(result.fix.is_ok(), "a report at {p:?} without a fix");
-            let carried = Position::from_mm([p.x, p.y, p.z]);
-            assert!(carried.is_some(), "a report at {p:?}, beyond what a report carries");
-        }
+    }
+    out
+}
+
+fn check_result(result: &CycleResult) {
+    if let Ok(fix) = result.fix {
+        assert!(finite(fix.position), "a fix at {:?}", fix.position);
+    }
+    if let Some(p) = result.reported_mm {
+        // Reported only from an accepted fix, and only where the report can carry it: a
+        // position that would saturate the report's ±3.2767 m is not a position.
+        assert!(result.fix.is_ok(), "a report at {p:?} without a fix");
+        let carried = Position::from_mm([p.x, p.y, p.z]);
+        assert!(carried.is_some(), "a report at {p:?}, beyond what a report carries");
     }
 }
 
