@@ -13,8 +13,9 @@
 //! random draw comes from a ChaCha8 stream named by the seed, the layer and the cell.
 //!
 //! Stages run on all cores where they are independent: the diagrams' seeds and pixel labels one
-//! diagram per thread, the selected cells' polygons and meshes one rock per task. The selection
-//! is sequential by nature (each diagram sees what the larger ones took).
+//! diagram per thread (the labels in bands of rows), the selected cells' polygons and meshes in
+//! blocks of rocks ([`list`]). The selection is sequential by nature (each diagram sees what the
+//! larger ones took), so the blocks of a diagram are made while the next is being selected.
 
 pub mod cache;
 pub mod delaunay;
@@ -236,11 +237,12 @@ pub struct Timing {
     /// Of which the Voronoi labels and their grouping by cell, per diagram summed (CPU time
     /// across threads).
     pub diagrams: f64,
-    /// Exclusive selection.
+    /// Exclusive selection (one thread).
     pub selection: f64,
-    /// Polygons of the kept cells (in parallel).
+    /// Polygons of the kept cells, CPU time summed over the blocks of rocks (made in parallel,
+    /// during and after the selection).
     pub polygons: f64,
-    /// The rocks' meshes (in parallel).
+    /// The rocks' meshes, CPU time summed over the blocks of rocks, as `polygons`.
     pub meshes: f64,
     /// Everything.
     pub total: f64,

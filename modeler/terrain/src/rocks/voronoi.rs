@@ -7,9 +7,9 @@
 //! seed: about `3·A` steps for the whole image whatever the radius. Pixels no disk reached (the
 //! seed's unsaturated darts leave holes) are found by a search over the seed buckets.
 //!
-//! Polygons: a cell is the field's rectangle cut by the bisector of its seed and each neighbour,
-//! nearest first, ring by ring of seed buckets, until every seed within twice the cell's reach
-//! has cut it (no farther seed can). Only the selected cells need polygons.
+//! Polygons: a cell is the field's rectangle cut by the bisector of its seed and each seed in a
+//! square of buckets about it, the square widened until it holds every seed within twice the
+//! cell's reach (no farther seed can cut). Only the selected cells need polygons.
 
 /// Seeds sorted into square buckets of side `size`, for neighbour searches.
 pub(crate) struct Buckets {
