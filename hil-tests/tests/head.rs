@@ -100,3 +100,60 @@ fn the_head_shadows_receivers_when_leaning_in() {
     }
     assert!(shadowed_slots > 0, "the viewer never shadowed a receiver");
 }
+
+#[test]
+fn head_reports_cross_the_serial_link_beside_the_pen() {
+    use std::io::Write;
+    use std::time::{Duration, Instant};
+
+    use pen_host::transport::Transport;
+    use pen_host::transport::serial::SerialTransport;
+    use pen_protocol::{MAX_FRAME, encode_frame};
+    use serialport::{SerialPort, TTYPort};
+
+    let (mut master, slave) = TTYPort::pair().expect("a pty pair");
+    let path = slave.name().expect("the pty's path");
+    drop(slave);
+    master.set_timeout(Duration::from_secs(1)).expect("timeout");
+    let mut port = SerialTransport::open(&path).expect("the pty opens as a serial port");
+    // The device side: every report the simulated base station sends, framed, in order.
+    let writer = std::thread::spawn(move || {
+        let scenario = scenarios::by_name("viewer").expect("scenario");
+        let mut sim = Simulation::new(&scenario, 3);
+        let mut sent = Vec::new();
+        while sent.iter().filter(|m| matches!(m, Message::Head(_))).count() < 100 {
+            for s in sim.step().sent {
+                let mut frame = [0u8; MAX_FRAME];
+                let n = encode_frame(&s.bytes, &mut frame).expect("fits");
+                master.write_all(&frame[..n]).expect("write");
+                sent.push(Message::decode(&s.bytes).expect("the device's bytes decode"));
+            }
+            std::thread::sleep(Duration::from_micros(300));
+        }
+        // The master is handed back, not dropped: closing it hangs the line up, and what the
+        // reader has not read yet would be lost with it.
+        (sent, master)
+    });
+    let mut received = Vec::new();
+    let cap = Instant::now() + Duration::from_secs(300);
+    let mut last_heard = Instant::now();
+    while Instant::now() < cap {
+        if let Ok(Some(m)) = port.read(Duration::from_millis(100)) {
+            received.push(m);
+            last_heard = Instant::now();
+        } else if writer.is_finished() && last_heard.elapsed() > Duration::from_secs(2) {
+            break;
+        }
+    }
+    let (sent, _master) = writer.join().expect("writer");
+    // Every input report arrives, in order, the head's among the pen's.
+    let first_difference = received.iter().zip(&sent).position(|(a, b)| a != b);
+    assert_eq!(
+        (received.len(), first_difference),
+        (sent.len(), None),
+        "received {} of {} reports; first difference at {first_difference:?}",
+        received.len(),
+        sent.len()
+    );
+    assert_eq!(port.dropped(), 0);
+}
