@@ -90,10 +90,10 @@ pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
         }
     };
     if x_major {
-        sweep(z, cols, rows, cell, (dx, dy), &mut sink, None::<&mut Sink>);
+        sweep(z, cols, rows, cell, (dx, dy), false, &mut sink);
     } else {
         let zt = transpose(z, cols, rows);
-        sweep(&zt, rows, cols, cell, (dy, dx), &mut sink, None::<&mut Sink>);
+        sweep(&zt, rows, cols, cell, (dy, dx), false, &mut sink);
     }
     if !x_major {
         // Back to the grid's layout: the transposed grid is rows wide.
@@ -105,16 +105,16 @@ pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
     }
 }
 
-type Sink<'a> = dyn FnMut(&Line, usize, Option<f32>) + 'a;
-
-/// One section's samples, in increasing u: the lower cell's index, the interpolation weight of
-/// the cell one row further, the interpolated height and the position along the line.
+/// One section's samples, in increasing u from `u0`: the lower cell's index, the interpolation
+/// weight of the cell one row further, and the interpolated height; sample k lies `(u0 + k)·spacing`
+/// along the line.
 #[derive(Default)]
 struct Line {
     i0: Vec<u32>,
     frac: Vec<f32>,
     h: Vec<f32>,
-    s: Vec<f32>,
+    u0: f32,
+    spacing: f32,
     /// Grid columns (the row stride of `i0`).
     stride: usize,
 }
@@ -147,7 +147,7 @@ fn hull_pass(
 ) {
     hull.clear();
     for k in order {
-        let (s, h) = (sign * line.s[k], line.h[k]);
+        let (s, h) = (sign * (line.u0 + k as f32) * line.spacing, line.h[k]);
         // Pop the nearest hull point while it lies on or under the line to the next one.
         while hull.len() >= 2 {
             let (s1, h1) = hull[hull.len() - 1];
@@ -188,16 +188,16 @@ fn transpose(z: &[f32], cols: u32, rows: u32) -> Vec<f32> {
 }
 
 /// The horizon sweep for a direction `(du, dv)` with `|du| ≥ |dv|`, u along the columns of the
-/// `cols × rows` grid `z`: every line's samples through `ahead`, and, when given, through
-/// `behind` for the opposite direction (the same lines swept the other way).
+/// `cols × rows` grid `z`: every line's samples through `sink`, and with `both` again for the
+/// opposite direction (the same lines swept the other way).
 fn sweep(
     z: &[f32],
     cols: u32,
     rows: u32,
     cell: f64,
     (du, dv): (f64, f64),
-    ahead: &mut impl FnMut(&Line, usize, Option<f32>),
-    mut behind: Option<&mut Sink<'_>>,
+    both: bool,
+    sink: &mut impl FnMut(&Line, usize, Option<f32>),
 ) {
     let (nu, nv) = (cols, rows);
     // A step ahead (u += sign du) moves v by dv/|du|: line b is v = b + u·dv/du.
@@ -216,6 +216,7 @@ fn sweep(
     let mut hull: Vec<(f32, f32)> = Vec::with_capacity(nu as usize);
     let mut line = Line {
         stride: w,
+        spacing,
         ..Line::default()
     };
     let nvf = f64::from(nv);
@@ -232,12 +233,17 @@ fn sweep(
         line.i0.clear();
         line.frac.clear();
         line.h.clear();
-        line.s.clear();
+        // The samples on the grid are consecutive in u.
+        let mut first = None;
         for u in ua..=ub {
             let v = b as f64 + u as f64 * slope;
             if v < 0.0 || v > nvf - 1.0 {
+                if first.is_some() {
+                    break;
+                }
                 continue;
             }
+            first.get_or_insert(u);
             // v ≥ 0: truncation is the floor.
             let v0 = v as usize;
             let frac = (v - v0 as f64) as f32;
@@ -250,23 +256,18 @@ fn sweep(
             line.i0.push(i0 as u32);
             line.frac.push(frac);
             line.h.push(h);
-            line.s.push(u as f32 * spacing);
         }
+        line.u0 = first.unwrap_or(0) as f32;
         let n = line.h.len();
         if n == 0 {
             continue;
         }
         // From the far end back: the first samples swept are the farthest ahead.
-        if ahead_up {
-            hull_pass(&line, &mut hull, 1.0, (0..n).rev(), ahead);
-            if let Some(b) = behind.as_deref_mut() {
-                hull_pass(&line, &mut hull, -1.0, 0..n, &mut |l: &Line, k, t| b(l, k, t));
-            }
-        } else {
-            hull_pass(&line, &mut hull, -1.0, 0..n, ahead);
-            if let Some(b) = behind.as_deref_mut() {
-                hull_pass(&line, &mut hull, 1.0, (0..n).rev(), &mut |l: &Line, k, t| b(l, k, t));
-            }
+        if ahead_up || both {
+            hull_pass(&line, &mut hull, 1.0, (0..n).rev(), sink);
+        }
+        if !ahead_up || both {
+            hull_pass(&line, &mut hull, -1.0, 0..n, sink);
         }
     }
 }
@@ -328,7 +329,7 @@ pub fn direct(field: Field<'_>, sun: Sun) -> Vec<f32> {
 
 /// Azimuth pairs summed together on one thread; fixed so that the sum's order, and so its bits,
 /// do not depend on the number of threads.
-const GROUP: usize = 4;
+const GROUP: usize = 8;
 
 /// The sky-view fraction per cell from `k` azimuths (`2πi/k`): `1 − (1/k)·Σ sin² H_i`.
 ///
@@ -365,37 +366,11 @@ pub fn sky_view(field: Field<'_>, k: u32) -> Vec<f32> {
                 } else {
                     (rows, cols, (dy, dx))
                 };
-                let (sum2, weight2) = (
-                    std::cell::RefCell::new(&mut *sum),
-                    std::cell::RefCell::new(&mut *weight),
-                );
                 let mut add = |line: &Line, j: usize, t: Option<f32>| {
                     let m = t.unwrap_or(0.0).max(0.0);
-                    line.spread(
-                        j,
-                        m * m / (1.0 + m * m),
-                        &mut sum2.borrow_mut(),
-                        &mut weight2.borrow_mut(),
-                    );
+                    line.spread(j, m * m / (1.0 + m * m), sum, weight);
                 };
-                let mut add_behind = |line: &Line, j: usize, t: Option<f32>| {
-                    let m = t.unwrap_or(0.0).max(0.0);
-                    line.spread(
-                        j,
-                        m * m / (1.0 + m * m),
-                        &mut sum2.borrow_mut(),
-                        &mut weight2.borrow_mut(),
-                    );
-                };
-                sweep(
-                    grid,
-                    c,
-                    r,
-                    cell,
-                    dir,
-                    &mut add,
-                    opposite.map(|_| &mut add_behind as &mut Sink),
-                );
+                sweep(grid, c, r, cell, dir, opposite.is_some(), &mut add);
             }
             [acc, wt, acc_t, wt_t]
         })
