@@ -104,7 +104,7 @@ fn generate_writes_the_water_as_its_own_mesh() {
         .map(|l| l[2..].split_whitespace().map(|x| x.parse().expect("number")).collect())
         .collect();
     assert!(
-        !vertices.is_empty() && vertices.len() % 4 == 0,
+        !vertices.is_empty() && vertices.len().is_multiple_of(4),
         "a square of 4 vertices per wet cell"
     );
     // A square's first vertex is its cell's corner (x = c, z = r on 1 m cells): the water stands
