@@ -86,8 +86,34 @@ fn river_errors_name_the_flag() {
 #[test]
 fn generate_writes_the_water_as_its_own_mesh() {
     let dir = tempfile::tempdir().expect("dir");
-    let out = penmodel(dir.path(), &["generate", &omega(), "--obj", "t.obj", "--raw", "t.f32"]);
+    let out = penmodel(
+        dir.path(),
+        &[
+            "generate",
+            &omega(),
+            "--obj",
+            "t.obj",
+            "--raw",
+            "t.f32",
+            "--glb",
+            "t.glb",
+        ],
+    );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    // The glTF's JSON chunk names a node and a mesh "water" beside the terrain's.
+    let glb = std::fs::read(dir.path().join("t.glb")).expect("glb");
+    let json_len = u32::from_le_bytes([glb[12], glb[13], glb[14], glb[15]]) as usize;
+    let gltf: Value = serde_json::from_slice(&glb[20..20 + json_len]).expect("the JSON chunk");
+    let names = |key: &str| -> Vec<String> {
+        gltf[key]
+            .as_array()
+            .expect(key)
+            .iter()
+            .filter_map(|n| n["name"].as_str().map(str::to_string))
+            .collect()
+    };
+    assert!(names("nodes").contains(&"water".to_string()), "{:?}", names("nodes"));
+    assert!(names("meshes").contains(&"water".to_string()), "{:?}", names("meshes"));
     let obj = std::fs::read_to_string(dir.path().join("t.obj")).expect("obj");
     let objects: Vec<&str> = obj.lines().filter(|l| l.starts_with("o ")).collect();
     assert_eq!(objects, ["o terrain", "o water"]);
