@@ -157,3 +157,38 @@ fn head_reports_cross_the_serial_link_beside_the_pen() {
     );
     assert_eq!(port.dropped(), 0);
 }
+
+#[test]
+fn the_rooms_tail_reaches_a_slot_only_past_its_start() {
+    use pen_sim::acoustics::Acoustics;
+    use rand::SeedableRng;
+
+    let rig = pen_sim::rig::Rig::reference();
+    let acoustics = Acoustics {
+        reverb_rate: 1.0,
+        ..Acoustics::clean()
+    };
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    // An emitter at the workspace's far end, 1.3–1.4 m from the receivers.
+    let previous = DVec3::new(300.0, 170.0, 1300.0);
+    let c_mm_per_us = acoustics.air.speed_m_s(0.0) * 1e-3;
+    let (mut reached_short, mut reached_long) = (0, 0);
+    for _ in 0..200 {
+        // After a 4.42 ms slot, some tails of a 1.5 ms die-away cross into the next slot; after
+        // the pen-only 6.5 ms cycle none can (the longest: the farthest receiver plus 515 mm).
+        for (slot_us, reached) in [(4_420.0, &mut reached_short), (6_500.0, &mut reached_long)] {
+            let tails = acoustics.tails(&rig, previous, 0.0, slot_us, &mut rng);
+            for (i, t) in tails.iter().enumerate() {
+                if let Some(t) = t {
+                    *reached += 1;
+                    let latest = ((previous - rig.receivers_mm[i]).length() + acoustics.reverb_tail_mm) / c_mm_per_us
+                        + rig.delays_us[i]
+                        - slot_us;
+                    assert!(*t > 0.0 && *t <= latest + 1e-9, "receiver {i}: {t} µs");
+                }
+            }
+        }
+    }
+    assert!(reached_short > 0, "no tail crossed a 4.42 ms slot");
+    assert_eq!(reached_long, 0, "a tail crossed the 6.5 ms cycle");
+}

@@ -71,6 +71,13 @@ pub struct Acoustics {
     pub dead_mask: u8,
     /// A burst of echoes: from `.0` s to `.1` s the echo rate is `.2`.
     pub echo_burst: Option<(f64, f64, f64)>,
+    /// Probability per receiver and burst that the room sends back a reflection of the burst
+    /// strong enough to trigger the receiver after the direct sound (reverberation). It matters
+    /// only when the next burst comes before it has died away: the head's short slots.
+    pub reverb_rate: f64,
+    /// The reflection's path beyond the direct one: uniform up to this, mm (515 mm is the 1.5 ms
+    /// of die-away the pen-only cycle waits for).
+    pub reverb_tail_mm: f64,
     /// The air.
     pub air: Air,
 }
@@ -86,6 +93,8 @@ impl Acoustics {
             dropout_rate: 0.0,
             dead_mask: 0,
             echo_burst: None,
+            reverb_rate: 0.0,
+            reverb_tail_mm: 515.0,
             air: Air::room(),
         }
     }
@@ -115,11 +124,45 @@ impl Acoustics {
     /// The arrivals of a burst from `emitter` at `t_s`, within the pen-only cycle's listening
     /// window.
     pub fn hear(&self, rig: &Rig, emitter: DVec3, t_s: f64, rng: &mut ChaCha8Rng) -> Heard {
-        self.hear_slot(rig, emitter, t_s, LISTEN_US, 0, rng)
+        self.hear_slot(rig, emitter, t_s, LISTEN_US, 0, [None; MAX_RECEIVERS], rng)
+    }
+
+    /// The reflections of the previous burst, from `previous` fired `since_us` before this one,
+    /// that reach each receiver after this burst: µs after it, or `None`. Draws nothing while
+    /// [`reverb_rate`](Self::reverb_rate) is 0, so runs without reverberation are unchanged.
+    pub fn tails(
+        &self,
+        rig: &Rig,
+        previous: DVec3,
+        t_s: f64,
+        since_us: f64,
+        rng: &mut ChaCha8Rng,
+    ) -> [Option<f64>; MAX_RECEIVERS] {
+        let mut out = [None; MAX_RECEIVERS];
+        if self.reverb_rate <= 0.0 {
+            return out;
+        }
+        let c_mm_per_us = self.air.speed_m_s(t_s) * 1e-3;
+        for (i, receiver) in rig.receivers_mm.iter().enumerate().take(MAX_RECEIVERS) {
+            let reflected = rng.random_bool(self.reverb_rate.clamp(0.0, 1.0));
+            let extra = rng.random_range(0.0..self.reverb_tail_mm.max(1e-9));
+            if !reflected {
+                continue;
+            }
+            let path = (previous - *receiver).length() + extra;
+            let after_us = path / c_mm_per_us + rig.delays_us[i] - since_us;
+            if after_us > 0.0 {
+                out[i] = Some(after_us);
+            }
+        }
+        out
     }
 
     /// The arrivals of a burst from `emitter` at `t_s` that come within `listen_us` of it,
-    /// with the receivers in `blocked` (bit i: receiver i) shadowed (the viewer's own head).
+    /// with the receivers in `blocked` (bit i: receiver i) shadowed (the viewer's own head) and
+    /// the previous burst's `tails` ([`tails`](Self::tails)) triggering any receiver they reach
+    /// before the direct sound.
+    #[allow(clippy::too_many_arguments)]
     pub fn hear_slot(
         &self,
         rig: &Rig,
@@ -127,6 +170,7 @@ impl Acoustics {
         t_s: f64,
         listen_us: u64,
         blocked: u8,
+        tails: [Option<f64>; MAX_RECEIVERS],
         rng: &mut ChaCha8Rng,
     ) -> Heard {
         let mut heard = Heard {
@@ -146,16 +190,32 @@ impl Acoustics {
             // random sequence of the others.
             let dropped = rng.random_bool(self.dropout_rate.clamp(0.0, 1.0));
             let echo = rng.random_bool(echo_rate.clamp(0.0, 1.0));
-            if dropped || (self.dead_mask | blocked) & (1 << i) != 0 {
-                continue;
-            }
-            let mut path = (emitter - *receiver).length();
-            if echo {
-                path += self.echo_min_mm + extra.sample(rng);
-                heard.echo[i] = true;
-            }
-            let tof_us = path / c_mm_per_us + jitter.sample(rng);
-            let arrival_us = tof_us + rig.delays_us[i];
+            let dead = self.dead_mask & (1 << i) != 0;
+            let tail = tails[i].filter(|_| !dead);
+            let direct = if dropped || dead || blocked & (1 << i) != 0 {
+                None
+            } else {
+                let mut path = (emitter - *receiver).length();
+                if echo {
+                    path += self.echo_min_mm + extra.sample(rng);
+                    heard.echo[i] = true;
+                }
+                Some(path / c_mm_per_us + jitter.sample(rng) + rig.delays_us[i])
+            };
+            // The capture takes whichever triggers first: this burst, or the last one's tail.
+            let arrival_us = match (direct, tail) {
+                (Some(d), Some(t)) if t < d => {
+                    heard.echo[i] = true;
+                    t
+                }
+                (Some(d), _) => d,
+                (None, Some(t)) => {
+                    heard.echo[i] = true;
+                    t
+                }
+                (None, None) => continue,
+            };
+            let tof_us = arrival_us - rig.delays_us[i];
             if arrival_us <= 0.0 || arrival_us >= listen_us as f64 {
                 continue;
             }

@@ -142,6 +142,8 @@ struct World {
     pacer: Option<Pacer>,
     /// The listening window of the slot being fired, µs.
     listen_us: u64,
+    /// The previous burst: when, and from where (for the room's reverberation).
+    previous: Option<(u64, DVec3)>,
 }
 
 type Shared = Rc<RefCell<World>>;
@@ -161,32 +163,24 @@ impl Ranging for SimRanging {
         let w = &mut *w;
         let t_s = w.now_us as f64 * 1e-6;
         w.collected_at = None;
-        let heard = match (w.emitter, &w.viewer) {
-            (Emitter::Head, Some(viewer)) => {
-                let emitter = viewer.emitter(&w.rig, t_s);
-                let blocked = viewer.shadowed(&w.rig, t_s);
-                let listen = w.listen_us;
-                (
-                    emitter,
-                    w.acoustics.hear_slot(&w.rig, emitter, t_s, listen, blocked, &mut w.rng),
-                )
-            }
-            (Emitter::Head, None) => {
-                // Glasses scheduled but nobody wears them: the burst drives no emitter.
-                let emitter = w.hand.emitter(&w.rig, t_s);
-                let silent = w.acoustics.hear_slot(&w.rig, emitter, t_s, 0, u8::MAX, &mut w.rng);
-                (emitter, silent)
-            }
-            (Emitter::Pen, _) => {
-                let emitter = w.hand.emitter(&w.rig, t_s);
-                let listen = w.listen_us;
-                (
-                    emitter,
-                    w.acoustics.hear_slot(&w.rig, emitter, t_s, listen, 0, &mut w.rng),
-                )
-            }
+        let tails = match w.previous {
+            Some((t0, at)) => w
+                .acoustics
+                .tails(&w.rig, at, t_s, w.now_us.saturating_sub(t0) as f64, &mut w.rng),
+            None => [None; MAX_RECEIVERS],
         };
-        w.heard = Some(heard);
+        let listen = w.listen_us;
+        let (emitter, blocked) = match (w.emitter, &w.viewer) {
+            (Emitter::Head, Some(viewer)) => (viewer.emitter(&w.rig, t_s), viewer.shadowed(&w.rig, t_s)),
+            // Glasses scheduled but nobody wears them: the burst drives no emitter.
+            (Emitter::Head, None) => (w.hand.emitter(&w.rig, t_s), u8::MAX),
+            (Emitter::Pen, _) => (w.hand.emitter(&w.rig, t_s), 0),
+        };
+        let heard = w
+            .acoustics
+            .hear_slot(&w.rig, emitter, t_s, listen, blocked, tails, &mut w.rng);
+        w.previous = (blocked != u8::MAX).then_some((w.now_us, emitter));
+        w.heard = Some((emitter, heard));
     }
 
     fn collect(&mut self) -> [Option<u32>; MAX_RECEIVERS] {
@@ -314,6 +308,7 @@ impl Simulation {
             emitter: Emitter::Pen,
             collected_at: None,
             listen_us: pen_core::LISTEN_US,
+            previous: None,
             rng,
             heard: None,
             sent: Vec::new(),

@@ -102,6 +102,13 @@ enum Command {
         /// How far ahead the head's pose is predicted, ms (0…50).
         #[arg(long, default_value_t = 20)]
         prediction_ms: u8,
+        /// Probability per receiver and burst of a room reflection arriving up to 1.5 ms after
+        /// the direct sound, which the next slot can hear first (0…1; 0: none).
+        #[arg(long, default_value_t = 0.0)]
+        reverb: f64,
+        /// The reflections' path beyond the direct one: up to this, mm (515: 1.5 ms).
+        #[arg(long, default_value_t = 515.0)]
+        reverb_tail_mm: f64,
         /// Print the runs as one JSON object.
         #[arg(long)]
         json: bool,
@@ -256,8 +263,16 @@ fn run(cli: Cli) -> Result<()> {
             seed,
             ratios,
             prediction_ms,
+            reverb,
+            reverb_tail_mm,
             json,
         } => {
+            if !(0.0..=1.0).contains(&reverb) {
+                bail!("--reverb must be a probability, 0…1");
+            }
+            if !(reverb_tail_mm > 0.0 && reverb_tail_mm <= 10_000.0) {
+                bail!("--reverb-tail-mm must be 0…10000 mm");
+            }
             if !(seconds > 0.0 && seconds.is_finite()) {
                 bail!("--seconds must be a positive number");
             }
@@ -273,7 +288,9 @@ fn run(cli: Cli) -> Result<()> {
                 .iter()
                 .map(|r| head::parse_ratio(r).map_err(|e| anyhow::anyhow!("--ratio: {e}")))
                 .collect::<Result<Vec<_>>>()?;
-            let pen_only = scenario(&name)?;
+            let mut pen_only = scenario(&name)?;
+            pen_only.acoustics.reverb_rate = reverb;
+            pen_only.acoustics.reverb_tail_mm = reverb_tail_mm;
             let mut runs = vec![("pen alone".to_string(), head::run(&pen_only, seed, seconds))];
             for (label, schedule) in ratios.iter().zip(schedules) {
                 let s = pen_only.clone().with_head(pen_core::HeadSettings {
