@@ -285,7 +285,7 @@ impl Shape {
             .map(|b| level::level(b.abs() / self.cell_size, &self.river, self.cell_size, &self.constants))
             .collect();
         let pts: Vec<DVec2> = line.iter().map(|p| p.p).collect();
-        self.near = near::nearest(&self.window, &pts, self.radius + REACH);
+        near::nearest_into(&self.window, &pts, self.radius + REACH, &mut self.near);
         self.line = line;
     }
 

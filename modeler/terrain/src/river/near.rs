@@ -20,15 +20,27 @@ pub struct Near {
 }
 
 /// The field of the polyline `line` (cell coordinates of the grid: cell centres at integers) over
-/// `win`, for cells within `reach` cells of it. Each segment visits the cells of its bounding
-/// box grown by `reach`, so the cost is the line's length × (2·reach)².
+/// `win`, for cells within `reach` cells of it. Each segment visits its slab of cells (below),
+/// so the cost is about the band's area × (1 + 2·reach × the bend per sample).
 pub fn nearest(win: &Window, line: &[DVec2], reach: f64) -> Near {
-    let n = win.len();
     let mut near = Near {
-        owner: vec![NONE; n],
-        dist: vec![f32::INFINITY; n],
-        side: vec![0; n],
+        owner: Vec::new(),
+        dist: Vec::new(),
+        side: Vec::new(),
     };
+    nearest_into(win, line, reach, &mut near);
+    near
+}
+
+/// [`nearest`] into `near`'s buffers (reused from one iteration to the next).
+pub fn nearest_into(win: &Window, line: &[DVec2], reach: f64, near: &mut Near) {
+    let n = win.len();
+    near.owner.clear();
+    near.owner.resize(n, NONE);
+    near.dist.clear();
+    near.dist.resize(n, f32::INFINITY);
+    near.side.clear();
+    near.side.resize(n, 0);
     let origin = win.origin();
     let pts: Vec<DVec2> = line.iter().map(|p| *p - origin).collect();
     if pts.len() == 1 {
@@ -40,7 +52,7 @@ pub fn nearest(win: &Window, line: &[DVec2], reach: f64) -> Near {
                 near.owner[i] = 0;
             }
         });
-        return near;
+        return;
     }
     let segs = pts.len() - 1;
     let dir = |k: usize| (pts[k + 1] - pts[k]).normalize_or_zero();
@@ -59,14 +71,15 @@ pub fn nearest(win: &Window, line: &[DVec2], reach: f64) -> Near {
         };
         let before = widen(k.checked_sub(1));
         let after = widen((k + 1 < segs).then_some(k + 1));
+        let len2 = ab.length_squared();
         slab(win, a, b, before, after, reach, |i, p| {
-            let len2 = ab.length_squared();
             let t = if len2 > 0.0 {
                 ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
             } else {
                 0.0
             };
-            let d = p.distance(a + ab * t) as f32;
+            // Squared distances while searching; the roots once at the end.
+            let d = p.distance_squared(a + ab * t) as f32;
             if d < near.dist[i] {
                 near.dist[i] = d;
                 near.owner[i] = if t < 0.5 { k as u32 } else { k as u32 + 1 };
@@ -81,7 +94,9 @@ pub fn nearest(win: &Window, line: &[DVec2], reach: f64) -> Near {
             }
         });
     }
-    near
+    for d in &mut near.dist {
+        *d = d.sqrt();
+    }
 }
 
 /// Calls `f(index, local position)` for the window's cells in the box of `a`, `b` grown by `reach`.
