@@ -192,3 +192,25 @@ fn head_bytes_through_the_sampler_and_tracker() {
     // The device clock wrapped between the first and the last report: unwrapped, it went on.
     assert_eq!(s.device_us, (u32::MAX as u64 - 5) + 10);
 }
+
+#[test]
+fn penctl_head_on_needs_the_glasses() {
+    let penctl = |args: &[&str]| {
+        Command::new(env!("CARGO_BIN_EXE_penctl"))
+            .args(args)
+            .output()
+            .expect("penctl runs")
+    };
+    // The hand sweep's base station has no glasses' emitter: refused, with the device's word.
+    let out = penctl(&["head", "on", "--source", "sim:hand-sweep"]);
+    assert_eq!(out.status.code(), Some(1));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("not supported"), "{err}");
+    // The viewer's has them.
+    for state in ["on", "off"] {
+        let out = penctl(&["head", state, "--source", "sim:viewer"]);
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    }
+    let out = penctl(&["head", "sideways", "--source", "sim:viewer"]);
+    assert_eq!(out.status.code(), Some(2), "a usage error");
+}

@@ -168,6 +168,12 @@ pub enum Command {
     LoadDefaults = 2,
     /// Restart into the microcontroller's ROM USB DFU bootloader, for `dfu-util`.
     EnterBootloader = 3,
+    /// Protocol 2.1: start tracking the head — fire the glasses' emitter in its own slots
+    /// between the pen's and send head reports (not saved). A base station without the
+    /// glasses' emitter answers *not supported*.
+    HeadOn = 4,
+    /// Protocol 2.1: stop tracking the head; the pen has every cycle again.
+    HeadOff = 5,
 }
 
 impl Report for Command {
@@ -183,6 +189,8 @@ impl Report for Command {
             1 => Ok(Command::SaveConfig),
             2 => Ok(Command::LoadDefaults),
             3 => Ok(Command::EnterBootloader),
+            4 => Ok(Command::HeadOn),
+            5 => Ok(Command::HeadOff),
             _ => Err(DecodeError::OutOfRange {
                 report: ReportId::Command,
                 field: "command",

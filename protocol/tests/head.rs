@@ -124,3 +124,14 @@ fn described_in_the_vendor_collection() {
     let item = [0x85, 0x08, 0x09, 0x28, 0x75, 0x08, 0x95, 0x11, 0x81, 0x02];
     assert!(d.windows(item.len()).any(|w| w == item), "{d:02x?}");
 }
+
+#[test]
+fn head_tracking_commands() {
+    // Command report bytes 4 and 5 (protocol 2.1); 6 is still unknown.
+    assert_eq!(Message::decode(&[0x06, 4]), Ok(Message::Command(Command::HeadOn)));
+    assert_eq!(Message::decode(&[0x06, 5]), Ok(Message::Command(Command::HeadOff)));
+    assert!(matches!(
+        Message::decode(&[0x06, 6]),
+        Err(DecodeError::OutOfRange { field: "command", .. })
+    ));
+}

@@ -214,8 +214,10 @@ pub struct Engine {
     seq: u16,
     last_report_us: Option<u64>,
     counters: Counters,
-    /// Head tracking, when the glasses' emitter is fitted.
+    /// Head tracking, while it runs.
     head: Option<HeadState>,
+    /// The glasses' emitter is wired to this base station: the HeadOn command may start it.
+    head_fitted: bool,
 }
 
 /// The OS pen's extent for a configuration's display, if its size is known.
@@ -276,6 +278,7 @@ impl Engine {
             last_report_us: None,
             counters: Counters::default(),
             head: None,
+            head_fitted: false,
         }
     }
 
@@ -325,6 +328,16 @@ impl Engine {
     /// (`None`): the pen then has every cycle again.
     pub fn set_head(&mut self, settings: Option<HeadSettings>) {
         self.head = settings.map(HeadState::new);
+    }
+
+    /// Says whether the glasses' emitter is wired to this base station (the board knows; the
+    /// simulator fits it with a viewer). Without it the HeadOn command is answered *not
+    /// supported*.
+    pub fn set_head_emitter_fitted(&mut self, fitted: bool) {
+        self.head_fitted = fitted;
+        if !fitted {
+            self.head = None;
+        }
     }
 
     /// The head's settings, while it is tracked.
@@ -730,6 +743,17 @@ impl Engine {
                 (Status { request, ..status }, None)
             }
             Command::EnterBootloader => (Status::ok(request), Some(Action::EnterBootloader)),
+            Command::HeadOn if !self.head_fitted => (Status::failed(request, StatusCode::Unsupported), None),
+            Command::HeadOn => {
+                if self.head.is_none() {
+                    self.set_head(Some(HeadSettings::default()));
+                }
+                (Status::ok(request), None)
+            }
+            Command::HeadOff => {
+                self.set_head(None);
+                (Status::ok(request), None)
+            }
         }
     }
 

@@ -156,3 +156,45 @@ fn head_slots_leave_the_pen_alone() {
         }
     }
 }
+
+#[test]
+fn head_tracking_starts_and_stops_by_command_where_the_glasses_are_fitted() {
+    struct NoStore;
+    impl pen_core::ConfigStore for NoStore {
+        fn load(&mut self) -> Option<Config> {
+            None
+        }
+        fn save(&mut self, _: &Config) -> Result<(), pen_core::StoreError> {
+            Ok(())
+        }
+    }
+    let on = Message::Command(Command::HeadOn).encode_vec();
+    let off = Message::Command(Command::HeadOff).encode_vec();
+    let mut e = Engine::new(None, FIRMWARE, [7; 12]);
+    // The reference board has no glasses' emitter: not supported, and the pen keeps its cycle.
+    let (status, _) = e.set_feature(&on, &mut NoStore);
+    assert_eq!(status.code, StatusCode::Unsupported);
+    assert_eq!(e.next_slot().period_us, 6_500);
+    e.set_head_emitter_fitted(true);
+    let (status, _) = e.set_feature(&on, &mut NoStore);
+    assert_eq!(status.code, StatusCode::Ok);
+    assert_eq!(e.head_settings(), Some(HeadSettings::default()));
+    let heads = (0..7).filter(|_| e.next_slot().emitter == Emitter::Head).count();
+    assert_eq!(heads, 2);
+    let (status, _) = e.set_feature(&off, &mut NoStore);
+    assert_eq!(status.code, StatusCode::Ok);
+    assert_eq!(e.head_settings(), None);
+    assert_eq!(e.next_slot().emitter, Emitter::Pen);
+}
+
+trait EncodeVec {
+    fn encode_vec(&self) -> Vec<u8>;
+}
+
+impl EncodeVec for Message {
+    fn encode_vec(&self) -> Vec<u8> {
+        let mut buf = [0u8; MAX_PAYLOAD];
+        let n = self.encode(&mut buf).expect("fits");
+        buf[..n].to_vec()
+    }
+}

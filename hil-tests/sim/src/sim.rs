@@ -316,6 +316,8 @@ impl Simulation {
             pacer: None,
         }));
         let mut device = Engine::new(Some(scenario.config), SIM_FIRMWARE, scenario.unique_id);
+        // A viewer wears the glasses: their emitter is fitted, and tracked from the start.
+        device.set_head_emitter_fitted(scenario.head.is_some());
         device.set_head(scenario.head);
         let engine: SimEngine = Rc::new(Mutex::new(RefCell::new(device)));
         let station = Station::new(

@@ -91,6 +91,15 @@ enum Command {
         #[command(subcommand)]
         action: ConfigAction,
     },
+    /// Start or stop tracking the viewer's head (the glasses' emitter, protocol 2.1; not saved).
+    #[command(after_help = "Examples:\n  penctl head on\n  penctl head off --source serial:/dev/ttyACM0")]
+    Head {
+        /// `on` or `off`.
+        #[arg(value_parser = ["on", "off"])]
+        state: String,
+        #[command(flatten)]
+        device: DeviceArgs,
+    },
     /// Restart the device into its ROM USB DFU bootloader (docs/flashing.md).
     #[command(after_help = "Example:\n  penctl bootloader && sleep 2 && dfu-util -l")]
     Bootloader {
@@ -694,6 +703,20 @@ fn run(cli: Cli) -> Result<()> {
         Command::Info { device, json } => info(&device, json),
         Command::Monitor { device, json, count } => monitor(&device, json, count),
         Command::Config { action } => config(action),
+        Command::Head { state, device } => {
+            let mut d = attach(&device)?;
+            let (command, said) = if state == "on" {
+                (
+                    DeviceCommand::HeadOn,
+                    "head tracking on: head reports follow (`penctl monitor`)",
+                )
+            } else {
+                (DeviceCommand::HeadOff, "head tracking off: the pen has every cycle")
+            };
+            request(transport(&mut d)?, &Message::Command(command))?;
+            eprintln!("penctl: {said}");
+            Ok(())
+        }
         Command::Bootloader { device } => {
             let mut d = attach(&device)?;
             request(transport(&mut d)?, &Message::Command(DeviceCommand::EnterBootloader))?;

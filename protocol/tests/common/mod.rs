@@ -287,7 +287,9 @@ pub fn message() -> impl Strategy<Value = Message> {
         proptest::sample::select(vec![
             Command::SaveConfig,
             Command::LoadDefaults,
-            Command::EnterBootloader
+            Command::EnterBootloader,
+            Command::HeadOn,
+            Command::HeadOff
         ])
         .prop_map(Message::Command),
         proptest::sample::select(vec![ReportId::DeviceInfo, ReportId::Config, ReportId::Status])
