@@ -115,6 +115,15 @@ fn dot(at: Point, height: Option<f64>, colour: Rgba, width: f32) -> Overlay {
 impl Picture {
     /// What `session` shows now.
     pub fn of(session: &Session, look: &Look) -> Picture {
+        // The tracked head, once it reports, places the eyes (issue 16); until then the look's.
+        let tracked;
+        let look = match session.head_m() {
+            Some(head_m) => {
+                tracked = Look { head_m, ..look.clone() };
+                &tracked
+            }
+            None => look,
+        };
         let ui = &session.interaction;
         let doc = session.editor.document();
         if let (Some(c), crate::session::State::Running) = (session.calibrating(), session.state()) {

@@ -1,6 +1,6 @@
 //! A modeling session: a document being edited by the pen, fed from a [`feed`](crate::feed).
 
-use pen_host::events::PenEvent;
+use pen_host::events::{EventKind, PenEvent};
 
 use crate::feed::{Calibrating, Feed};
 use crate::interaction::{Interaction, Tuning, View};
@@ -39,6 +39,8 @@ pub struct Session {
     state: State,
     events: u64,
     last_event_us: Option<u64>,
+    /// The tracked head's last pose, display-centred metres (issue 16).
+    head_m: Option<[f64; 3]>,
 }
 
 impl Session {
@@ -53,6 +55,7 @@ impl Session {
             state: State::Running,
             events: 0,
             last_event_us: None,
+            head_m: None,
         }
     }
 
@@ -114,7 +117,23 @@ impl Session {
         if let Some((_, device_us)) = e.seq {
             self.last_event_us = Some(device_us);
         }
+        if let EventKind::Head(h) = &e.kind
+            && let Some(at) = h.at
+        {
+            // pend's pose is the last good one when held or refused: always usable. From the
+            // display frame (mm from the lower-left corner) to the camera's (metres from the
+            // centre); the emitter on the bridge stands for the point between the eyes.
+            let [w, hgt] = self.interaction.view().display_mm;
+            self.head_m = Some([(at.u_mm - 0.5 * w) * 1e-3, (at.v_mm - 0.5 * hgt) * 1e-3, at.h_mm * 1e-3]);
+        }
         self.interaction.handle(&mut self.editor, e);
+    }
+
+    /// Where the tracked head is, once a head event gave a pose: the point between the eyes in
+    /// the display's frame, metres from its centre (x right, y up the display, z towards the
+    /// viewer), as the camera takes it.
+    pub fn head_m(&self) -> Option<[f64; 3]> {
+        self.head_m
     }
 
     /// Whether the feed is still running.
@@ -158,5 +177,37 @@ mod tests {
         session.feed(Feed::Display([500.0, 300.0]));
         assert_eq!(session.interaction.view().display_mm, [500.0, 300.0]);
         assert_eq!(session.interaction.view().exaggeration, 2.5);
+    }
+
+    #[test]
+    fn the_tracked_head_places_the_eyes() {
+        use pen_host::events::{DisplayPoint, HeadPose, HeadStatus};
+        let editor = Editor::new(blank_document()).expect("a valid document");
+        let mut session = Session::new(editor, [600.0, 340.0], Tuning::default());
+        let head = |at: Option<(f64, f64, f64)>, status| PenEvent {
+            kind: EventKind::Head(HeadPose {
+                at: at.map(|(u, v, h)| DisplayPoint {
+                    u_mm: u,
+                    v_mm: v,
+                    h_mm: h,
+                    u_px: 0.0,
+                    v_px: 0.0,
+                }),
+                status,
+                prediction_ms: 20,
+                refused: 0,
+                reason: None,
+            }),
+            t_us: 0,
+            point: None,
+            sw: None,
+            seq: Some((0, 0)),
+        };
+        session.event(&head(None, HeadStatus::Held));
+        assert_eq!(session.head_m(), None, "no pose before the first one");
+        // 100 mm right of and 50 mm above the centre of the 600 × 340 display, 650 mm out.
+        session.event(&head(Some((400.0, 220.0, 650.0)), HeadStatus::Tracked));
+        let [x, y, z] = session.head_m().expect("a pose");
+        assert!((x - 0.1).abs() < 1e-12 && (y - 0.05).abs() < 1e-12 && (z - 0.65).abs() < 1e-12);
     }
 }
