@@ -713,7 +713,15 @@ fn run(cli: Cli) -> Result<()> {
             } else {
                 (DeviceCommand::HeadOff, "head tracking off: the pen has every cycle")
             };
-            request(transport(&mut d)?, &Message::Command(command))?;
+            let status = transport(&mut d)?.set_feature(&Message::Command(command))?;
+            match status.code {
+                StatusCode::Ok => {}
+                // The firmware knows the command; the base station has no glasses' emitter.
+                StatusCode::Unsupported => {
+                    bail!("this base station has no emitter for the glasses (the device answered: {status})")
+                }
+                _ => bail!("the device refused: {status}"),
+            }
             eprintln!("penctl: {said}");
             Ok(())
         }
