@@ -52,6 +52,9 @@ pub struct Look {
     /// The viewer's head in the display's frame, metres: x right, y up the display, z out of it.
     /// The default sits 70 cm from a desk-sized display, in front of its near half.
     pub head_m: [f64; 3],
+    /// The distance between the eyes, metres (stereo places each eye half of it from the head
+    /// point, along the display's x).
+    pub eye_separation_m: f64,
     /// Mono or stereo.
     pub stereo: Stereo,
     /// Colours and light.
@@ -62,6 +65,7 @@ impl Default for Look {
     fn default() -> Look {
         Look {
             head_m: [0.0, -0.35, 0.7],
+            eye_separation_m: 0.063,
             stereo: Stereo::None,
             style: Style {
                 // Terrain of hundreds of metres: snow from 900 m.
@@ -73,12 +77,12 @@ impl Default for Look {
 }
 
 /// The camera of a view: the display is the screen, the head looks through it.
-pub fn camera(view: &View, head_m: [f64; 3]) -> Camera {
+pub fn camera(view: &View, head_m: [f64; 3], eye_separation_m: f64) -> Camera {
     Camera {
         view: penmodel_render::View::Tracked(Tracked {
             display: [view.display_mm[0] * 1e-3, view.display_mm[1] * 1e-3],
             head: head_m,
-            eye_separation: 0.063,
+            eye_separation: eye_separation_m,
             centre: view.centre,
             scale: view.scale * 1e-3,
         }),
@@ -216,7 +220,7 @@ impl Picture {
             selection: None,
             slope_bar: None,
             mode,
-            camera: camera(view, look.head_m),
+            camera: camera(view, look.head_m, look.eye_separation_m),
             vertical_scale: view.exaggeration as f32,
             look: look.clone(),
             rocks: Arc::default(),
@@ -334,7 +338,7 @@ impl Picture {
             selection,
             slope_bar,
             mode,
-            camera: camera(view, look.head_m),
+            camera: camera(view, look.head_m, look.eye_separation_m),
             vertical_scale: view.exaggeration as f32,
             look: look.clone(),
             rocks: Arc::default(),

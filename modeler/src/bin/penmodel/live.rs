@@ -91,6 +91,10 @@ pub struct LiveArgs {
     #[arg(long, value_name = "X,Y,Z", value_parser = head, allow_hyphen_values = true, hide = true,
           conflicts_with = "head_mm")]
     head: Option<[f64; 3]>,
+    /// The distance between the viewer's eyes, mm (40…80): stereo places each eye half of it
+    /// from the head, the tracked one's or --head-mm's.
+    #[arg(long, value_name = "MM", default_value_t = 63.0, value_parser = eye_separation_mm)]
+    eye_separation_mm: f64,
     /// Vertical scale of the terrain (exaggeration; 1: true heights). A pull follows it: the
     /// figure stays at the pen's tip.
     #[arg(long, default_value_t = 1.0, value_parser = vertical_scale, alias = "exaggeration", allow_negative_numbers = true)]
@@ -294,6 +298,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
     if let Some(h) = args.head_mm.or(args.head) {
         look.head_m = h;
     }
+    look.eye_separation_m = args.eye_separation_mm * 1e-3;
     look.stereo = match args.stereo {
         StereoArg::None => Stereo::None,
         StereoArg::Anaglyph => Stereo::Anaglyph,
@@ -538,6 +543,14 @@ impl Painter {
     fn session(&mut self, session: &Session, look: &Look) -> Result<&Frame> {
         let picture = Picture::of(session, look);
         self.draw(&picture, session.editor.heightmap())
+    }
+}
+
+/// `--eye-separation-mm`: a number of mm an adult's eyes can be apart, 40…80.
+fn eye_separation_mm(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(mm) if (40.0..=80.0).contains(&mm) => Ok(mm),
+        _ => Err(format!("{s:?} is not a distance between eyes of 40…80 mm")),
     }
 }
 
@@ -824,6 +837,16 @@ fn write_results(
 mod tests {
     use super::*;
     use penmodel::interaction::View;
+
+    #[test]
+    fn eye_separation_is_a_plausible_distance() {
+        assert_eq!(eye_separation_mm("63"), Ok(63.0));
+        assert_eq!(eye_separation_mm(" 70.5 "), Ok(70.5));
+        for bad in ["", "abc", "39.9", "81", "NaN", "-63"] {
+            let e = eye_separation_mm(bad).expect_err(bad);
+            assert!(e.contains("40…80 mm"), "{e}");
+        }
+    }
 
     #[test]
     fn every_layout_draws_at_any_size() {
