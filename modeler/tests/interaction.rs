@@ -487,6 +487,7 @@ fn the_river_tool_draws_ages_reshapes_and_widens_a_river() {
     assert_eq!(pen.doc().regions[0].figures.len(), 0, "the course is no figure");
     let river = pen.doc().rivers[0].clone();
     assert_eq!(river.points.len() % 3, 1, "whole cubic segments");
+    assert_eq!(pen.ui.stats().rivers, 1);
     assert!(near(river.points[0], pen.ground(100.0, 250.0), 15.0));
     assert!(near(
         *river.points.last().expect("points"),

@@ -128,6 +128,8 @@ pub struct Stats {
     pub regions: u32,
     /// Rock fields drawn and added.
     pub rock_fields: u32,
+    /// Rivers drawn and added.
+    pub rivers: u32,
     /// Grabs committed with a height change.
     pub pulls: u32,
     /// Grabs committed with a slope change.
@@ -1215,6 +1217,7 @@ impl Interaction {
         let index = editor.document().rivers.len();
         let points = river.points.len();
         if self.commit(editor, Edit::AddRiver { index, river }, &format!("river {index}")) {
+            self.stats.rivers += 1;
             self.say(format!(
                 "river {index}: {points} control points | SW3 click over it: one year"
             ));

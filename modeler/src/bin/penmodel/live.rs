@@ -394,13 +394,13 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
                 "regions": stats.regions, "figures": stats.figures, "pulls": stats.pulls,
                 "slopes": stats.slopes, "moves": stats.moves, "deletes": stats.deletes,
                 "undos": stats.undos, "redos": stats.redos, "refused": stats.refused,
-                "missed": stats.missed, "rock_fields": stats.rock_fields,
+                "missed": stats.missed, "rock_fields": stats.rock_fields, "rivers": stats.rivers,
             },
         });
         println!("{summary}");
     } else {
         println!(
-            "{state}: {}; {}, {}, {}, {}, {}, {}; terrain {lo:.0} to {hi:.0} m",
+            "{state}: {}; {}, {}, {}, {}, {}, {}, {}; terrain {lo:.0} to {hi:.0} m",
             count(session.events(), "pen event"),
             count(stats.regions as u64, "region"),
             count(stats.figures as u64, "figure"),
@@ -408,6 +408,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
             count(stats.slopes as u64, "slope"),
             count(stats.undos as u64, "undo"),
             count(stats.rock_fields as u64, "rock field"),
+            count(stats.rivers as u64, "river"),
         );
         let what = match (written.shown, &written.animation) {
             (true, _) => format!("showed {}; wrote", count(written.frames as u64, "frame")),
