@@ -95,6 +95,28 @@ fn bench(c: &mut Criterion) {
     });
 
     let z = full.heights().to_vec();
+    {
+        let field = Field {
+            z: &z,
+            cols: 1024,
+            rows: 1024,
+            cell: 1.0,
+        };
+        let sun = Sun::degrees(135.0, 25.0, "sun").expect("a sun above the horizon");
+        let mut d = Dtm::build(512, 512, 1.0, Filter::DEFAULT, &ids(&small));
+        let mut flip = false;
+        eprintln!(
+            "CPU time per call (all threads), ms: move_segment/512 {:.3}, full_dtm/200seg/1024 {:.1}, sky32/1024 {:.0}, direct/1024 {:.1}, rain/1024 {:.1}",
+            cpu_per_call(2000, || {
+                flip = !flip;
+                d.set(small.len() as u32, Some(if flip { &b } else { &a }));
+            }),
+            cpu_per_call(20, || drop(Dtm::build(1024, 1024, 1.0, Filter::DEFAULT, &ids(&big)))),
+            cpu_per_call(5, || drop(sun::sky_view(field, 32))),
+            cpu_per_call(20, || drop(sun::direct(field, sun))),
+            cpu_per_call(20, || drop(rain::counts(&z, 1024, 1024, 1.0))),
+        );
+    }
     let field = Field {
         z: &z,
         cols: 1024,
@@ -116,6 +138,34 @@ fn bench(c: &mut Criterion) {
         bch.iter(|| rain::counts(black_box(&z), 1024, 1024, 1.0))
     });
     g.finish();
+}
+
+/// CPU time (user + system) this process has used, ms, from `/proc/self/stat` (Linux; 0
+/// elsewhere). Other builds on the machine stretch wall times, much less the CPU time a run
+/// needs; half of it is what two idle cores would take at best.
+fn cpu_ms() -> f64 {
+    let Ok(stat) = std::fs::read_to_string("/proc/self/stat") else {
+        return 0.0;
+    };
+    // Fields after the command's closing parenthesis; utime and stime are the 14th and 15th.
+    let rest = stat.rsplit_once(')').map_or("", |(_, r)| r);
+    let f: Vec<f64> = rest
+        .split_whitespace()
+        .skip(11)
+        .take(2)
+        .filter_map(|v| v.parse().ok())
+        .collect();
+    // Clock ticks of 10 ms (USER_HZ is 100 on Linux).
+    f.iter().sum::<f64>() * 10.0
+}
+
+/// CPU ms per call of `f`, over `n` calls.
+fn cpu_per_call(n: u32, mut f: impl FnMut()) -> f64 {
+    let t = cpu_ms();
+    for _ in 0..n {
+        f();
+    }
+    (cpu_ms() - t) / f64::from(n)
 }
 
 /// The brute force beside the sweep, on every 16th cell of every 16th row in `k` azimuths.
