@@ -263,6 +263,9 @@ pub enum Defect {
     /// A river width, depth, water amount or hardness that is not above 0.
     #[error("{} must be above 0", Num(*_0))]
     NotPositive(f64),
+    /// A river wider than [`crate::river::MAX_WIDTH_CELLS`] cells.
+    #[error("{} m is more than the {} m ({} cells) a river may be wide", Num(*width), Num(*max), crate::river::MAX_WIDTH_CELLS)]
+    RiverTooWide { width: f64, max: f64 },
     /// More river iterations than [`crate::river::MAX_ITERATIONS`].
     #[error("{0} iterations is more than the {max} a river may have", max = crate::river::MAX_ITERATIONS)]
     TooManyIterations(u32),
@@ -544,7 +547,9 @@ pub fn ridges(doc: &Document) -> Result<(), ValidationError> {
 
 /// Checks every river: at least two control points, all on the grid (a Bézier course stays
 /// within its control points' hull, so the course cannot leave the grid), a width, depth, water
-/// amount and hardness above 0, and at most [`crate::river::MAX_ITERATIONS`] iterations.
+/// amount and hardness above 0, a width of at most [`crate::river::MAX_WIDTH_CELLS`] cells (the
+/// work per course sample grows with its square), and at most [`crate::river::MAX_ITERATIONS`]
+/// iterations.
 pub fn rivers(doc: &Document) -> Result<(), ValidationError> {
     for (i, r) in doc.rivers.iter().enumerate() {
         let path = format!("rivers[{i}]");
@@ -565,6 +570,13 @@ pub fn rivers(doc: &Document) -> Result<(), ValidationError> {
             if v <= 0.0 {
                 return Err(ValidationError::new(format!("{path}.{name}"), Defect::NotPositive(v)));
             }
+        }
+        let max = crate::river::MAX_WIDTH_CELLS * doc.grid.cell_size;
+        if r.width > max {
+            return Err(ValidationError::new(
+                format!("{path}.width"),
+                Defect::RiverTooWide { width: r.width, max },
+            ));
         }
         if r.iterations > crate::river::MAX_ITERATIONS {
             return Err(ValidationError::new(

@@ -426,6 +426,10 @@ fn river_entries_load_validate_and_name_the_element() {
     bad(&|r| r.depth = -1.0, "rivers[0].depth: -1 must be above 0");
     bad(&|r| r.hardness = 0.0, "rivers[0].hardness: 0 must be above 0");
     bad(
+        &|r| r.width = 65.0,
+        "rivers[0].width: 65 m is more than the 64 m (64 cells) a river may be wide",
+    );
+    bad(
         &|r| r.points[2] = [250.0, 10.0],
         "rivers[0].points[2]: (250, 10) lies outside the grid [0, 200) × [0, 200) m",
     );

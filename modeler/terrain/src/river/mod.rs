@@ -37,6 +37,10 @@ use near::{NONE, Near};
 /// The most iterations a river may ask for (validation refuses more).
 pub const MAX_ITERATIONS: u32 = 20;
 
+/// The widest river (the disc's radius) in cells: each course sample visits cells across it, so the
+/// work grows with the width's square (validation refuses wider).
+pub const MAX_WIDTH_CELLS: f64 = 64.0;
+
 /// Course samples per cell of length (spacing 1 cell).
 pub const SPACING: f64 = 1.0;
 
