@@ -19,6 +19,7 @@ use std::hint::black_box;
 use std::time::{Duration, Instant};
 
 use criterion::{Criterion, criterion_group, criterion_main};
+use penmodel_terrain::ridge::polygon::{self, Polygon};
 use penmodel_terrain::ridge::sun::{self, Field, Sun};
 use penmodel_terrain::ridge::{Dtm, Filter, Skeleton, rain};
 use rand::{RngExt, SeedableRng};
@@ -94,6 +95,47 @@ fn bench(c: &mut Criterion) {
         bch.iter(|| Dtm::build(1024, 1024, 1.0, Filter::DEFAULT, black_box(&ids(&big))))
     });
 
+    // Alg. 2.2 on the drag scene: the same one-segment move.
+    {
+        let mut lists = Lists::new(512, 512);
+        let mut id = 0u32;
+        for sk in &small {
+            for (_, poly) in polygon::polygons(sk) {
+                lists.insert(id, &poly);
+                id += 1;
+            }
+        }
+        let pa: Vec<Polygon> = polygon::polygons(&a).into_iter().map(|(_, p)| p).collect();
+        let pb: Vec<Polygon> = polygon::polygons(&b).into_iter().map(|(_, p)| p).collect();
+        for (k, p) in pa.iter().enumerate() {
+            lists.insert(id + k as u32, p);
+        }
+        let mut flip = false;
+        let per_move = cpu_per_call(400, || {
+            flip = !flip;
+            let (from, to) = if flip { (&pa, &pb) } else { (&pb, &pa) };
+            for (k, p) in from.iter().enumerate() {
+                lists.remove(id + k as u32, p);
+            }
+            for (k, p) in to.iter().enumerate() {
+                lists.insert(id + k as u32, p);
+            }
+        });
+        // Alg. 2.3 likewise without the filter, for the same work.
+        let mut d = Dtm::build(512, 512, 1.0, Filter::NONE, &ids(&small));
+        d.set(extra, Some(&a));
+        let mut flip = false;
+        let per_move_23 = cpu_per_call(2000, || {
+            flip = !flip;
+            d.set(extra, Some(if flip { &b } else { &a }));
+        });
+        eprintln!(
+            "move_segment/512 raster only, CPU ms: Alg. 2.3 (winner array) {per_move_23:.3}, Alg. 2.2 (sorted per-cell lists, one thread) {per_move:.3}; Alg. 2.2 holds {} entries ({:.1} per cell, {:.1} MB at 8 bytes), Alg. 2.3 4 bytes per cell (1.0 MB)",
+            lists.entries(),
+            lists.entries() as f64 / (512.0 * 512.0),
+            lists.entries() as f64 * 8.0 / 1e6
+        );
+    }
     let z = full.heights().to_vec();
     {
         let field = Field {
@@ -138,6 +180,66 @@ fn bench(c: &mut Criterion) {
         bch.iter(|| rain::counts(black_box(&z), 1024, 1024, 1.0))
     });
     g.finish();
+}
+
+/// Alg. 2.2 for comparison: per cell a list of (elevation, polygon id), highest first; a
+/// polygon's removal deletes its entries from the lists of its cells, an insertion puts them in
+/// order; a cell's value is its list's head. Only the raster layer (no filter), one thread.
+struct Lists {
+    cols: u32,
+    rows: u32,
+    lists: Vec<Vec<(f32, u32)>>,
+}
+
+impl Lists {
+    fn new(cols: u32, rows: u32) -> Lists {
+        Lists {
+            cols,
+            rows,
+            lists: vec![Vec::new(); cols as usize * rows as usize],
+        }
+    }
+
+    /// Visits the cells of `poly` with their elevation.
+    fn cells(&self, poly: &Polygon, mut f: impl FnMut(usize, f32)) {
+        let (prepared, outlines) = (poly.prepare(), poly.outlines());
+        let rect = poly.cells(self.cols, self.rows, 1.0);
+        for r in rect.r0..rect.r0 + rect.height {
+            let y = f64::from(r) + 0.5;
+            let Some((x0, x1)) = polygon::span(&outlines, y) else {
+                continue;
+            };
+            let c0 = (x0 - 1.5).ceil().max(f64::from(rect.c0)) as u32;
+            let c1 = ((x1 + 0.5).floor().min(f64::from(rect.c0 + rect.width) - 1.0)).max(-1.0) as i64;
+            for c in c0..(c1 + 1).max(i64::from(c0)) as u32 {
+                if let Some(v) = prepared.value([f64::from(c) + 0.5, y]) {
+                    f(r as usize * self.cols as usize + c as usize, v as f32);
+                }
+            }
+        }
+    }
+
+    fn insert(&mut self, id: u32, poly: &Polygon) {
+        let mut hits = Vec::new();
+        self.cells(poly, |i, v| hits.push((i, v)));
+        for (i, v) in hits {
+            let l = &mut self.lists[i];
+            let at = l.partition_point(|e| e.0 >= v);
+            l.insert(at, (v, id));
+        }
+    }
+
+    fn remove(&mut self, id: u32, poly: &Polygon) {
+        let mut hits = Vec::new();
+        self.cells(poly, |i, _| hits.push(i));
+        for i in hits {
+            self.lists[i].retain(|e| e.1 != id);
+        }
+    }
+
+    fn entries(&self) -> usize {
+        self.lists.iter().map(Vec::len).sum()
+    }
 }
 
 /// CPU time (user + system) this process has used, ms, from `/proc/self/stat` (Linux; 0

@@ -17,12 +17,11 @@
 //! depend on order, so the result equals a full rebuild bit for bit (the `ridges` tests check
 //! it). Which polygon is recorded as the winner may differ where two polygons tie exactly.
 //!
-//! Why Alg. 2.3 and not Alg. 2.2 (per-cell lists sorted by elevation): a cell under a ridge is
-//! covered by every nearby segment's flanks and the joints' fans — tens of entries in hilly
-//! parts — so the lists cost tens of bytes per cell and a sorted insert per polygon per cell on
-//! every build and every drag, whereas the winner array costs 4 bytes per cell and a delete
-//! re-evaluates only the polygons overlapping the cells that were won by the deleted ones,
-//! typically a few neighbours. See docs/ridgelines.md for the measured figures.
+//! Why Alg. 2.3 and not Alg. 2.2 (per-cell lists sorted by elevation): the lists grow by an
+//! entry per covering polygon (flanks of every nearby segment, joint fans) and need a sorted
+//! insert per polygon per cell on every build and drag; the winner array is 4 bytes per cell
+//! whatever the overlap. On the bench's one-segment move the two take the same time
+//! (docs/ridgelines.md), so the fixed memory decides.
 
 use std::collections::HashMap;
 
