@@ -34,6 +34,7 @@ pub mod journal;
 mod json;
 pub mod persist;
 pub mod profile;
+pub mod rect;
 pub mod ridge;
 pub mod river;
 pub mod rocks;

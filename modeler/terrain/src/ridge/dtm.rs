@@ -30,7 +30,7 @@ use rayon::prelude::*;
 use super::Skeleton;
 use super::filter::{self, Filter};
 use super::polygon::{self, Part, Polygon, Prepared};
-use crate::engine::Rect;
+use crate::rect::Rect;
 
 /// No polygon won the cell (it is ground).
 pub const NONE: u32 = u32::MAX;

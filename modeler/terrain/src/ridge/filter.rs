@@ -8,7 +8,7 @@
 
 use rayon::prelude::*;
 
-use crate::engine::Rect;
+use crate::rect::Rect;
 
 /// The filter's parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -17,8 +17,8 @@ use std::collections::BTreeMap;
 use super::tree::Tree;
 use super::{Dtm, Filter, RidgeError, Skeleton, check_slope};
 use crate::document::{Document, Ridges};
-use crate::engine::Rect;
 use crate::heightmap::Heightmap;
+use crate::rect::Rect;
 
 /// The first tree's skeleton id.
 pub const TREE_ID: u32 = 1 << 31;

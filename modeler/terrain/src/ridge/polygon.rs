@@ -17,7 +17,7 @@
 use std::f64::consts::{FRAC_PI_2, PI, TAU};
 
 use super::Skeleton;
-use crate::engine::Rect;
+use crate::rect::Rect;
 
 /// What a polygon belongs to: its skeleton and its segment or node there. Keys are how an
 /// incremental update matches a changed skeleton's polygons with the old ones.

@@ -118,7 +118,7 @@ impl Layer {
     /// Brings the rivers up to date with `doc` over `ground`, whose cells in `ground_changed`
     /// changed since the last call; returns the cells whose carved height or water may have
     /// changed (beyond `ground_changed`). The rectangles are the engine's
-    /// ([`crate::engine::Rect`], through `From`) or windows.
+    /// (the cell rectangle of the `rect` module, through `From`) or windows.
     pub fn sync<R: From<Window> + Into<Window>>(
         &mut self,
         doc: &Document,
