@@ -1,5 +1,27 @@
 //! What every tool's command line promises: an example in each command's `--help`. The tools
 //! (pend, penctl, penmodel, pen-sim) check it over all their commands with [`without_examples`].
+//! And that a reader who goes away (`penmodel ridges DOC --elevations | head`) ends the tool
+//! quietly, as any Unix tool: output goes through [`outln!`](crate::outln), which returns the
+//! failed write instead of panicking, and `main` treats a [`broken_pipe`] as success.
+
+/// `println!` that returns a failed write (a closed pipe) from the enclosing function, as an
+/// `std::io::Error` through `?`, instead of panicking.
+#[macro_export]
+macro_rules! outln {
+    ($($arg:tt)*) => {{
+        use ::std::io::Write as _;
+        writeln!(::std::io::stdout().lock(), $($arg)*)?
+    }};
+}
+
+/// Whether `e` is, or was caused by, a write to a pipe whose reader went away.
+pub fn broken_pipe(e: &anyhow::Error) -> bool {
+    e.chain().any(|cause| {
+        cause
+            .downcast_ref::<std::io::Error>()
+            .is_some_and(|io| io.kind() == std::io::ErrorKind::BrokenPipe)
+    })
+}
 
 /// The commands under `command` (itself included, as `"tool sub sub"`) whose `--help` gives no
 /// example: no "Example" in their after-help text.

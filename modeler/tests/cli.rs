@@ -351,3 +351,22 @@ fn generate_says_when_it_skips_a_stale_journal() {
     assert_eq!(code, Some(0));
     assert!(err.contains("d.json.journal was not replayed"), "{err}");
 }
+
+#[test]
+fn a_reader_that_goes_away_ends_penmodel_quietly() {
+    // `penmodel generate DOC | head -0`: the pipe's reader is gone before penmodel writes, so
+    // its first line meets a broken pipe — every time, not by a race.
+    let dir = tempfile::tempdir().unwrap();
+    let png = dir.path().join("t.png");
+    let (reader, writer) = std::io::pipe().unwrap();
+    drop(reader);
+    let out = Command::new(env!("CARGO_BIN_EXE_penmodel"))
+        .args(["generate", &example("04-volcano.json"), "--png", s(&png)])
+        .stdout(writer)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(png.exists(), "the work is done before the summary line");
+}

@@ -21,12 +21,7 @@ use pen_protocol::{
 };
 use serde::Serialize;
 
-/// `println!` that reports a failed write (a closed pipe) instead of panicking.
-macro_rules! outln {
-    ($($arg:tt)*) => {
-        writeln!(std::io::stdout().lock(), $($arg)*)?
-    };
-}
+use pen_host::outln;
 
 #[derive(Parser)]
 #[command(
@@ -745,12 +740,7 @@ fn main() -> ExitCode {
     match run(Cli::parse()) {
         Ok(()) => ExitCode::SUCCESS,
         // The reader went away (`penctl monitor | head`): not an error, as for any Unix tool.
-        Err(e)
-            if e.downcast_ref::<std::io::Error>()
-                .is_some_and(|e| e.kind() == std::io::ErrorKind::BrokenPipe) =>
-        {
-            ExitCode::SUCCESS
-        }
+        Err(e) if pen_host::help::broken_pipe(&e) => ExitCode::SUCCESS,
         // Flags that parse but do not go together: a usage error.
         Err(e) if e.downcast_ref::<UsageError>().is_some() || e.downcast_ref::<source::SourceError>().is_some() => {
             eprintln!("penctl: {e:#}");

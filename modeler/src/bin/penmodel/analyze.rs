@@ -92,7 +92,7 @@ fn write(like: &Heightmap, path: &Option<PathBuf>, values: &[f32], png: impl Fn(
     let map = Heightmap::from_heights(like.cols(), like.rows(), like.cell_size(), v)
         .context("a map of another size than the grid")?;
     write_map(&map, path)?;
-    println!("wrote {}", path.display());
+    pen_host::outln!("wrote {}", path.display());
     Ok(())
 }
 

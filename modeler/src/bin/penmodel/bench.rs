@@ -263,14 +263,14 @@ pub fn run(args: &Args) -> Result<()> {
             "peak_rss_mb": memory.peak.map(mb),
             "rss_before_mb": memory.before.map(mb),
         });
-        println!(
+        pen_host::outln!(
             "{}",
             serde_json::json!({"render": render, "pull_update": pull, "memory": memory})
         );
     } else {
-        println!("grid        frame {w}×{h}   frames/s   terrain on screen   pull update");
+        pen_host::outln!("grid        frame {w}×{h}   frames/s   terrain on screen   pull update");
         for r in &results {
-            println!(
+            pen_host::outln!(
                 "{:>4}×{:<4}   {:>8.2} ms   {:>9.1}   {:>16.0} %   {:>8.3} ms",
                 r.grid,
                 r.grid,
@@ -280,9 +280,11 @@ pub fn run(args: &Args) -> Result<()> {
                 r.pull_ms
             );
         }
-        println!("medians of {FRAMES} frames and {PULLS} pull updates per grid; targets at 512×512: ≤ 16.7 ms, ≤ 2 ms");
+        pen_host::outln!(
+            "medians of {FRAMES} frames and {PULLS} pull updates per grid; targets at 512×512: ≤ 16.7 ms, ≤ 2 ms"
+        );
         let show = |v: Option<u64>| v.map_or("unknown".to_owned(), |b| format!("{} MB", mb(b)));
-        println!(
+        pen_host::outln!(
             "memory: {} figures on {}×{}: peak resident {} (before building {}), bound {} MB (limit {} MB)",
             memory.figures,
             memory.grid,

@@ -94,6 +94,6 @@ pub fn run(args: &Args) -> Result<()> {
     } else {
         String::new()
     };
-    println!("{} × {} cells, heights {lo} to {hi} m{journal}", map.cols(), map.rows());
+    pen_host::outln!("{} × {} cells, heights {lo} to {hi} m{journal}", map.cols(), map.rows());
     Ok(())
 }

@@ -397,9 +397,9 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
                 "missed": stats.missed, "rock_fields": stats.rock_fields, "rivers": stats.rivers,
             },
         });
-        println!("{summary}");
+        pen_host::outln!("{summary}");
     } else {
-        println!(
+        pen_host::outln!(
             "{state}: {}; {}, {}, {}, {}, {}, {}, {}; terrain {lo:.0} to {hi:.0} m",
             count(session.events(), "pen event"),
             count(stats.regions as u64, "region"),
@@ -427,7 +427,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
             (false, None) => "wrote".to_string(),
         };
         let meshes = if args.meshes { ", its meshes" } else { "" };
-        println!(
+        pen_host::outln!(
             "{what} the terrain{meshes}, its render and the document to {}/ (document: {})",
             args.out.display(),
             doc_path.display()

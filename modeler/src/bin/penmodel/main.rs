@@ -90,6 +90,8 @@ fn main() -> ExitCode {
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
+        // The reader went away (`penmodel … | head`): not an error, as for any Unix tool.
+        Err(e) if pen_host::help::broken_pipe(&e) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("penmodel: {e:#}");
             ExitCode::FAILURE

@@ -240,7 +240,7 @@ pub fn run(args: &Args) -> Result<()> {
         bail!("{} heights are not finite", stats.skipped_vertices);
     }
     output::write_png(&frame, &args.png)?;
-    println!(
+    pen_host::outln!(
         "{} × {} frame of {} × {} cells written to {}",
         w,
         h,
@@ -261,7 +261,7 @@ pub fn run(args: &Args) -> Result<()> {
             seq.push(&turn)?;
         }
         if let Some(anim) = seq.finish()? {
-            println!("{n} frames and {} written", anim.display());
+            pen_host::outln!("{n} frames and {} written", anim.display());
         }
     }
     if args.window {

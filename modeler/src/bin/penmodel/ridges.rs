@@ -78,16 +78,20 @@ pub fn run(args: &Args) -> Result<()> {
                     })).collect::<Vec<_>>(),
                 })).collect::<Vec<_>>(),
             });
-            println!("{}", serde_json::to_string_pretty(&out)?);
+            pen_host::outln!("{}", serde_json::to_string_pretty(&out)?);
         } else {
             for (j, t, d, z) in &trees {
-                println!("ridges.trees[{j}]: theta {}°, h_end {} m", t.theta, t.h_end);
-                println!(
+                pen_host::outln!("ridges.trees[{j}]: theta {}°, h_end {} m", t.theta, t.h_end);
+                pen_host::outln!(
                     "{:>6} {:>10} {:>10} {:>10} {:>10}",
-                    "node", "x", "y", "distance", "elevation"
+                    "node",
+                    "x",
+                    "y",
+                    "distance",
+                    "elevation"
                 );
                 for (i, p) in t.nodes.iter().enumerate() {
-                    println!("{i:>6} {:>10.3} {:>10.3} {:>10.3} {:>10.3}", p[0], p[1], d[i], z[i]);
+                    pen_host::outln!("{i:>6} {:>10.3} {:>10.3} {:>10.3} {:>10.3}", p[0], p[1], d[i], z[i]);
                 }
             }
         }
@@ -124,7 +128,7 @@ pub fn run(args: &Args) -> Result<()> {
     r.slope = grown.slope.to_degrees();
     doc2.save(out)
         .with_context(|| format!("cannot save {}", out.display()))?;
-    println!(
+    pen_host::outln!(
         "grew {n} ridgelines in {rounds} rounds; slope now {:.1}°; saved {}",
         r_slope(&doc2),
         out.display()

@@ -424,7 +424,7 @@ pub fn run(args: &Args) -> Result<()> {
     if args.json.as_deref() == Some(Path::new("-")) {
         eprintln!("{line}");
     } else {
-        println!("{line}");
+        pen_host::outln!("{line}");
     }
     Ok(())
 }
