@@ -5,7 +5,7 @@
 use pen_protocol::{FirmwareVersion, MAX_RECEIVERS, Position};
 
 use crate::replay::{self, CycleHead};
-use crate::{Cycle, CycleResult, Engine, Vec3, ranging};
+use crate::{Cycle, CycleResult, Engine, Vec3, ranging, solve};
 
 /// Switch samples a cycle may carry here: pen-qemu's buffer.
 const MAX_SAMPLES: usize = 4096;
@@ -13,8 +13,10 @@ const MAX_SAMPLES: usize = 4096;
 /// Any bytes as a replay file (`crate::replay`): never a panic; the header and every cycle that
 /// reads are in canonical form (written again, they are the bytes read); and the cycles' capture
 /// times, whatever they are, through the engine give no fix that is not a finite position, and
-/// no report but from a fix, within what a report carries (±3.2767 m; a tighter bound, the
-/// tracker's volume, is still to come). The same values are also taken as raw capture ticks
+/// no report but from a fix, within what a report carries (±3.2767 m), and no fix outside the
+/// tracker's volume: within the listening window's flight of every receiver it used (its range
+/// at most that, the fix within the consistency limit's residual of its range). The same values
+/// are also taken as raw capture ticks
 /// (receivers 0–3 on the fast 32-bit timer, 4–7 on the slow 16-bit one, converted as the board
 /// converts them, `ranging::ticks_to_ns`) through a second engine, with the same expectations:
 /// any sequence of ticks, no panic, no fix that is not a position.
@@ -55,14 +57,16 @@ pub fn replay(bytes: &[u8]) {
         };
         let consumed = &before[..before.len() - src.len()];
         check_cycle(&head, &samples[..head.samples as usize], consumed);
-        check_result(&engine.on_cycle(&Cycle {
+        let result = engine.on_cycle(&Cycle {
             t0_us: head.t0_us,
             arrival_ns: head.arrival_ns,
-        }));
-        check_result(&from_ticks.on_cycle(&Cycle {
+        });
+        check_result(&result, &engine);
+        let result = from_ticks.on_cycle(&Cycle {
             t0_us: head.t0_us,
             arrival_ns: as_ticks(&head.arrival_ns),
-        }));
+        });
+        check_result(&result, &from_ticks);
     }
 }
 
@@ -86,9 +90,25 @@ fn as_ticks(values: &[Option<u32>; MAX_RECEIVERS]) -> [Option<u32>; MAX_RECEIVER
     out
 }
 
-fn check_result(result: &CycleResult) {
+fn check_result(result: &CycleResult, engine: &Engine) {
     if let Ok(fix) = result.fix {
         assert!(finite(fix.position), "a fix at {:?}", fix.position);
+        // The tracker's volume: a range is at most the window's flight (arrivals after it are
+        // none), and a consistent fix is within the residuals' limit of each range; 1 mm for
+        // single precision.
+        let s = engine.settings();
+        let reach_mm = ranging::range_mm((engine.listen_us() * 1000) as u32, s.speed_m_s);
+        let slack_mm = crate::math::sqrt(solve::sse_limit(fix.used as usize)) + 1.0;
+        for (i, r) in s.receivers[..s.count].iter().enumerate() {
+            if fix.used_mask & (1 << i) != 0 {
+                let d = (fix.position - *r).length();
+                assert!(
+                    d <= reach_mm + slack_mm,
+                    "a fix at {:?}, {d} mm from receiver {i}, beyond the {reach_mm} mm it can hear",
+                    fix.position
+                );
+            }
+        }
     }
     if let Some(p) = result.reported_mm {
         // Reported only from an accepted fix, and only where the report can carry it: a

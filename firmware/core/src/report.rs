@@ -318,6 +318,15 @@ impl Engine {
         }
     }
 
+    /// How long after a burst its arrivals are listened to, µs: the pen's [`LISTEN_US`], or
+    /// with the head tracked every slot's window.
+    pub fn listen_us(&self) -> u64 {
+        match self.head {
+            Some(_) => self.mux_listen_us(),
+            None => LISTEN_US,
+        }
+    }
+
     fn mux_listen_us(&self) -> u64 {
         let s = &self.settings;
         let max_delay = s.delays_ns[..s.count].iter().copied().max().unwrap_or(0);
@@ -353,12 +362,12 @@ impl Engine {
     /// The next slot of the measurement loop (and the schedule moves on): every one the pen's
     /// without the head, else the schedule's pattern.
     pub fn next_slot(&mut self) -> Slot {
-        let period_us = self.cycle_period_us();
+        let (period_us, listen_us) = (self.cycle_period_us(), self.listen_us());
         let Some(head) = self.head.as_mut() else {
             return Slot {
                 emitter: Emitter::Pen,
                 period_us,
-                listen_us: LISTEN_US,
+                listen_us,
             };
         };
         let schedule = head.settings.schedule;
@@ -367,7 +376,7 @@ impl Engine {
         Slot {
             emitter,
             period_us,
-            listen_us: period_us - MUX_GUARD_US,
+            listen_us,
         }
     }
 
@@ -453,13 +462,19 @@ impl Engine {
         result
     }
 
-    /// Each configured receiver's range (mm) and time of flight (ns) in `cycle`.
+    /// Each configured receiver's range (mm) and time of flight (ns) in `cycle`. An arrival
+    /// after the listening window is none: the station collects them when the window closes,
+    /// but a replay or a faulty capture may still carry one, and a consistent set of ranges
+    /// beyond the workspace would solve to a fix far outside it. So every fix lies within the
+    /// window's flight of the receivers it used (the fuzz property checks it).
     fn ranges(&self, cycle: &Cycle) -> ([Option<f32>; MAX_RECEIVERS], [u32; MAX_RECEIVERS]) {
         let s = &self.settings;
+        let window_ns = self.listen_us() * 1000;
         let mut ranges = [None; MAX_RECEIVERS];
         let mut tof_ns = [NO_ARRIVAL; MAX_RECEIVERS];
         for i in 0..s.count {
-            if let Some(t) = cycle.arrival_ns[i].and_then(|a| time_of_flight_ns(a, s.delays_ns[i])) {
+            let arrival = cycle.arrival_ns[i].filter(|&a| u64::from(a) <= window_ns);
+            if let Some(t) = arrival.and_then(|a| time_of_flight_ns(a, s.delays_ns[i])) {
                 tof_ns[i] = t;
                 ranges[i] = Some(range_mm(t, s.speed_m_s));
             }

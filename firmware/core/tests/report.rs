@@ -438,3 +438,24 @@ fn a_new_display_size_saved_restarts_the_device() {
     let reports = run(&mut e, 0, 3, Vec3::new(300.0, 100.0, 80.0));
     assert!(e.os_report(reports.last().expect("reports")).in_range);
 }
+
+#[test]
+fn arrivals_after_the_listening_window_are_none_so_no_fix_lies_beyond_hearing() {
+    // A pen 3 m in front of the display: every capture consistent, but each after the window
+    // (at most LISTEN_US of flight, about 1.7 m): before, these solved to a fix 3 m away.
+    let mut e = engine();
+    let far = Vec3::new(200.0, 150.0, 3_000.0);
+    let c = cycle_at(&e, 0, far);
+    let window_ns = e.listen_us() * 1000;
+    assert!(c.arrival_ns.iter().flatten().all(|&a| u64::from(a) > window_ns));
+    // Not solved at all (with them taken as ranges the solver found the far fix, which the
+    // tracking gate then held as its first, `Acquiring`).
+    assert_eq!(e.on_cycle(&c).fix.err(), Some(NoFix::TooFewRanges));
+    // The same pen within reach is fixed once the gate has seen it twice.
+    let near = Vec3::new(200.0, 150.0, 300.0);
+    let results: Vec<_> = (1..4)
+        .map(|k| e.on_cycle(&cycle_at(&e, k * PERIOD_US, near)).fix)
+        .collect();
+    let fix = results[2].expect("a fix within reach");
+    assert!((fix.position - near).length() < 5.0, "{:?}", fix.position);
+}
