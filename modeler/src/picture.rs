@@ -12,9 +12,9 @@ use penmodel_terrain::document::{Document, Figure, FigureKind, Point};
 use penmodel_terrain::export::Mesh;
 
 use crate::feed::Calibrating;
-use crate::interaction::river;
 use crate::interaction::rocks::{self, Tool};
 use crate::interaction::{Interaction, View};
+use crate::interaction::{ridge, river};
 use crate::session::Session;
 
 /// Colour of a rock field's outline.
@@ -25,6 +25,8 @@ pub const RIVER_COLOUR: Rgba = [90, 160, 255, 255];
 pub const EROSION_COLOUR: Rgba = [230, 40, 30, 255];
 /// Colour of the cells the next iteration deposits (the seed's light blue).
 pub const DEPOSITION_COLOUR: Rgba = [160, 215, 255, 255];
+/// Colour of ridgelines and ridgeline trees.
+pub const RIDGE_COLOUR: Rgba = [150, 110, 60, 255];
 /// Colour of the palette button while the rock tool is on.
 pub const PALETTE_ON_COLOUR: Rgba = [255, 200, 90, 255];
 /// Colour of the palette button while figures are drawn.
@@ -309,6 +311,56 @@ impl Picture {
                 PALETTE_OFF_COLOUR
             },
             width: if ui.tool() == Tool::Rivers { 5.0 } else { 2.0 },
+            height: None,
+        });
+        // Ridgelines and trees (their nodes as dots with the ridge tool), the ridge stroke being
+        // drawn (its air part at the pen's height), the ridge button.
+        let ridges_on = ui.tool() == Tool::Ridges;
+        let ridge_lines = doc.ridges.iter().flat_map(|r| {
+            let lines = r.lines.iter().enumerate().map(|(i, l)| {
+                let pts: Vec<Point> = l.points.iter().map(|p| [p[0], p[1]]).collect();
+                (ridge::Part::Line(i), pts)
+            });
+            let trees = r.trees.iter().enumerate().flat_map(|(j, t)| {
+                t.edges.iter().filter_map(move |&[a, b]| {
+                    Some((
+                        ridge::Part::Tree(j),
+                        vec![*t.nodes.get(a as usize)?, *t.nodes.get(b as usize)?],
+                    ))
+                })
+            });
+            lines.chain(trees)
+        });
+        for (part, pts) in ridge_lines {
+            if ridges_on && ui.ridge_hover() == Some(part) && selection.is_none() {
+                selection = Some(overlays.len());
+            }
+            if ridges_on {
+                overlays.extend(pts.iter().map(|p| dot(*p, None, RIDGE_COLOUR, 4.0)));
+            }
+            overlays.push(Overlay {
+                points: pts,
+                closed: false,
+                colour: RIDGE_COLOUR,
+                width: if ridges_on { 2.0 } else { 1.0 },
+                height: None,
+            });
+        }
+        if let Some(samples) = ui.ridge_drawing() {
+            overlays.extend(samples.iter().map(|s| {
+                let h = (s.h_mm > 0.0).then(|| view.height_at(s.h_mm));
+                dot(s.at, h, DRAWING_COLOUR, 3.0)
+            }));
+        }
+        overlays.push(Overlay {
+            points: ridge::palette_outline(view),
+            closed: true,
+            colour: if ridges_on {
+                PALETTE_ON_COLOUR
+            } else {
+                PALETTE_OFF_COLOUR
+            },
+            width: if ridges_on { 5.0 } else { 2.0 },
             height: None,
         });
         if let Some(drawn) = ui.drawing() {

@@ -535,3 +535,163 @@ fn the_river_tool_draws_ages_reshapes_and_widens_a_river() {
     pen.hover(18.0, 42.0).touch().lift(HOVER);
     assert_eq!(pen.ui.tool(), Tool::Figures);
 }
+
+#[test]
+fn the_ridge_tool_draws_lines_in_the_air_trees_on_the_surface_pulls_grows_and_deletes() {
+    use penmodel::interaction::ridge::Part;
+    use penmodel::interaction::rocks::Tool;
+    use penmodel_terrain::ridge::layer::tree_of;
+    let mut pen = Pen::new(blank());
+    // The ridge button: the top right corner, 572 to 592 mm across, 8 to 28 mm down.
+    pen.hover(582.0, 18.0).touch().lift(HOVER);
+    assert_eq!(pen.ui.tool(), Tool::Ridges);
+    let view = pen.view();
+    // A 3D ridgeline: touch at its start, lift and draw in the air at 30 then 50 mm, touch
+    // again at its end (snapped to the surface), SW3.
+    pen.hover(100.0, 150.0).touch().lift(30.0);
+    pen.move_to(DVec3::new(200.0, 150.0, 30.0));
+    pen.move_to(DVec3::new(300.0, 170.0, 50.0));
+    pen.move_to(DVec3::new(380.0, 170.0, 20.0)).touch();
+    pen.lift(HOVER).click(2);
+    let r = pen.doc().ridges.clone().expect("a ridges entry");
+    assert_eq!((r.lines.len(), r.trees.len()), (1, 0), "{:?}", pen.ui.take_messages());
+    let line = &r.lines[0].points;
+    // Independently: each node's elevation is the pen's height above its place on the straight
+    // moves drawn (0 at the two touches, where the ground was flat).
+    let height_along = |x: f64| {
+        let u = view.to_display([x, 0.0])[0];
+        let legs = [
+            (100.0, 0.0),
+            (100.0, 30.0),
+            (200.0, 30.0),
+            (300.0, 50.0),
+            (380.0, 20.0),
+            (380.0, 0.0),
+        ];
+        legs.windows(2)
+            .find(|w| u >= w[0].0 && u <= w[1].0 && w[1].0 > w[0].0)
+            .map_or(0.0, |w| w[0].1 + (u - w[0].0) / (w[1].0 - w[0].0) * (w[1].1 - w[0].1))
+    };
+    assert!(line.len() >= 10, "{line:?}");
+    for p in &line[1..line.len() - 1] {
+        let want = view.height_at(height_along(p[0]));
+        assert!((p[2] - want).abs() <= view.height_at(1.0), "{p:?} vs {want}");
+    }
+    assert!(
+        line[0][2].abs() < 1e-9 && line[line.len() - 1][2].abs() < 1e-9,
+        "snapped: {line:?}"
+    );
+    let top = line.iter().map(|p| p[2]).fold(0.0, f64::max);
+    assert!((top - view.height_at(50.0)).abs() <= view.height_at(1.0));
+    // The terrain follows: the heightmap under the top node is at its elevation (filtered).
+    let peak = pen.editor.heightmap().range().1 as f64;
+    assert!(peak > 0.8 * top && peak <= top + 1e-6, "peak {peak} vs {top}");
+    assert_eq!(pen.ui.stats().ridgelines, 1);
+
+    // A tree on the surface: a stroke, then a branch from its middle node.
+    pen.stroke(&[(150.0, 250.0), (250.0, 250.0), (350.0, 250.0)]);
+    let r = pen.doc().ridges.clone().expect("ridges");
+    assert_eq!(r.trees.len(), 1, "{:?}", pen.ui.take_messages());
+    let mid = pen.view().to_display(r.trees[0].nodes[6]);
+    pen.stroke(&[(mid[0], mid[1]), (mid[0], mid[1] + 60.0)]);
+    let t = pen.doc().ridges.clone().expect("ridges").trees[0].clone();
+    assert_eq!(
+        pen.doc().ridges.as_ref().map(|r| r.trees.len()),
+        Some(1),
+        "a branch, no new tree"
+    );
+    let degree = |k: usize| t.edges.iter().filter(|e| e.contains(&(k as u32))).count();
+    assert_eq!(degree(6), 3, "the branch joins node 6: {t:?}");
+    assert_eq!(t.edges.len() + 1, t.nodes.len(), "a tree");
+    // Alg. 2.4 independently: Bellman-Ford relaxation from the end nodes.
+    let mut d: Vec<f64> = (0..t.nodes.len())
+        .map(|k| if degree(k) == 1 { 0.0 } else { f64::INFINITY })
+        .collect();
+    for _ in 0..t.nodes.len() {
+        for &[a, b] in &t.edges {
+            let (a, b) = (a as usize, b as usize);
+            let len = (t.nodes[a][0] - t.nodes[b][0]).hypot(t.nodes[a][1] - t.nodes[b][1]);
+            d[a] = d[a].min(d[b] + len);
+            d[b] = d[b].min(d[a] + len);
+        }
+    }
+    let z = tree_of(&t).elevations();
+    for k in 0..t.nodes.len() {
+        let want = t.h_end + d[k] * t.theta.to_radians().tan();
+        assert!((z[k] - want).abs() < 1e-6, "node {k}: {} vs {want}", z[k]);
+    }
+
+    // Grab node 5 of the ridgeline and pull it to 80 mm: live, then one undoable edit.
+    let before = pen.doc().ridges.clone();
+    let n5 = pen.doc().ridges.as_ref().expect("ridges").lines[0].points[5];
+    let at = pen.view().to_display([n5[0], n5[1]]);
+    pen.grab(at[0], at[1]).pull_to(80.0);
+    assert!(pen.editor.previewing(), "the terrain follows the pull live");
+    let live = pen.doc().ridges.as_ref().expect("ridges").lines[0].points[5][2];
+    assert!((live - view.height_at(80.0)).abs() <= view.height_at(1.0));
+    pen.let_go();
+    assert!(!pen.editor.previewing());
+    let pulled = pen.doc().ridges.clone().expect("ridges");
+    assert!((pulled.lines[0].points[5][2] - view.height_at(80.0)).abs() <= view.height_at(1.0));
+    assert_eq!(
+        pulled.lines[0].points[4],
+        before.as_ref().expect("ridges").lines[0].points[4]
+    );
+    // A tree's end node pulled sets h_end.
+    let end = pen.view().to_display(t.nodes[0]);
+    pen.grab(end[0], end[1]).pull_to(20.0).let_go();
+    let h_end = pen.doc().ridges.as_ref().expect("ridges").trees[0].h_end;
+    assert!(
+        (h_end - view.height_at(20.0)).abs() <= view.height_at(1.0),
+        "h_end {h_end}"
+    );
+    // Slide the ridgeline's last node on the surface.
+    let last = *pen.doc().ridges.as_ref().expect("ridges").lines[0]
+        .points
+        .last()
+        .expect("nodes");
+    let at = pen.view().to_display([last[0], last[1]]);
+    pen.grab(at[0], at[1])
+        .drag_to(at[0] + 20.0, at[1] + 10.0)
+        .lift(HOVER)
+        .let_go();
+    let moved = *pen.doc().ridges.as_ref().expect("ridges").lines[0]
+        .points
+        .last()
+        .expect("nodes");
+    let want = pen.ground(at[0] + 20.0, at[1] + 10.0);
+    assert!(
+        near([moved[0], moved[1]], want, view.metres(1.0)),
+        "{moved:?} vs {want:?}"
+    );
+    // Undo the slide and the h_end: back to the pulled state.
+    pen.editor.undo().expect("undo");
+    pen.editor.undo().expect("undo");
+    assert_eq!(pen.doc().ridges.as_ref(), Some(&pulled));
+
+    // An SW3 click over the ridgeline grows a round of valleys: new lines that start on a
+    // ridge and run downhill (elevations never rising along them).
+    let on = pen.view().to_display([line[8][0], line[8][1]]);
+    pen.hover(on[0], on[1]);
+    assert_eq!(pen.ui.ridge_hover(), Some(Part::Line(0)));
+    pen.click(2);
+    let grown = pen.doc().ridges.clone().expect("ridges");
+    assert!(grown.lines.len() > 1, "{:?}", pen.ui.take_messages());
+    assert_eq!(pen.ui.stats().grown, 1);
+    assert!(grown.slope > pulled.slope, "each round steepens the flanks");
+    for l in &grown.lines[1..] {
+        assert!(l.points[1..].windows(2).all(|w| w[1][2] <= w[0][2] + 1e-3), "{l:?}");
+    }
+    // Delete the highlighted ridgeline; undo brings it back.
+    pen.hover(on[0], on[1]);
+    pen.ui.command(&mut pen.editor, KeyCommand::Delete);
+    assert_eq!(
+        pen.doc().ridges.as_ref().map(|r| r.lines.len()),
+        Some(grown.lines.len() - 1)
+    );
+    pen.editor.undo().expect("undo");
+    assert_eq!(pen.doc().ridges.as_ref(), Some(&grown));
+    // Back to figures.
+    pen.hover(582.0, 18.0).touch().lift(HOVER);
+    assert_eq!(pen.ui.tool(), Tool::Figures);
+}

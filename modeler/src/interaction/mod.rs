@@ -17,6 +17,10 @@
 //! | rock tool: SW1 outline, SW3 | a closed outline becomes a rock field, its rocks on the terrain |
 //! | rock tool: SW2 + touch in a field, slide | moves the field (the same rocks) |
 //! | rock tool: field held, SW3 held, move | sideways: density; up and down: rock size; release SW3 sets both |
+//! | ridge tool ([`ridge`]): touch, lift and draw in the air, SW3 | a 3D ridgeline at the pen's height |
+//! | ridge tool: draw on the surface, SW3 | a 2D ridgeline tree (or a branch of the tree it starts on) |
+//! | ridge tool: SW2 + touch a node, slide or lift | carries or pulls the node, the terrain following; release SW2 sets it |
+//! | ridge tool: SW3 click over a ridgeline | grows one round of valleys (Alg. 2.5) |
 //!
 //! [`KeyCommand`]s give the same edits to a keyboard or a script. Times come from the device clock
 //! that reports carry (a click is timed the same at any replay speed); events that are not from
@@ -24,6 +28,7 @@
 //! A refused edit is a message and a count, never a lost document: the editor keeps it valid.
 
 pub mod pick;
+pub mod ridge;
 pub mod river;
 pub mod rocks;
 pub mod stroke;
@@ -130,6 +135,10 @@ pub struct Stats {
     pub rock_fields: u32,
     /// Rivers drawn and added.
     pub rivers: u32,
+    /// Ridgelines and ridgeline trees (or branches) drawn and added.
+    pub ridgelines: u32,
+    /// Rounds of valleys grown from the ridgelines.
+    pub grown: u32,
     /// Grabs committed with a height change.
     pub pulls: u32,
     /// Grabs committed with a slope change.
@@ -189,6 +198,10 @@ enum State {
     Field(rocks::FieldGrab),
     /// A river (or one of its control points) held with SW2.
     River(river::RiverGrab),
+    /// A ridge stroke being drawn (ridge tool): the pen's positions since the first touch.
+    RidgeStroke(Vec<ridge::Sample>),
+    /// A ridgeline's or tree's node held with SW2, with the ridges from before the grab.
+    Node(ridge::NodeGrab, Box<penmodel_terrain::document::Ridges>),
     /// SW3 held with nothing drawn or grabbed: a click (undo) or a pan.
     Sw3 {
         t0: u64,
@@ -232,6 +245,8 @@ pub struct Interaction {
     river_hover: Option<usize>,
     /// The held river's next erosion and deposition cells (ground metres), while it is edited.
     river_preview: Option<(Vec<Point>, Vec<Point>)>,
+    /// The ridgeline or tree under the pen, with the ridge tool.
+    ridge_hover: Option<ridge::Part>,
 }
 
 /// The event's time on the device's clock, µs; `None` for events not from a report (device
@@ -275,6 +290,23 @@ impl Interaction {
             field_hover: None,
             river_hover: None,
             river_preview: None,
+            ridge_hover: None,
+        }
+    }
+
+    /// The ridgeline or tree under the pen (ridge tool), or whose node is held.
+    pub fn ridge_hover(&self) -> Option<ridge::Part> {
+        match &self.state {
+            State::Node(g, _) => Some(g.node.0),
+            _ => self.ridge_hover,
+        }
+    }
+
+    /// The ridge stroke being drawn: ground points and the pen's height, mm.
+    pub fn ridge_drawing(&self) -> Option<&[ridge::Sample]> {
+        match &self.state {
+            State::RidgeStroke(samples) => Some(samples),
+            _ => None,
         }
     }
 
@@ -442,7 +474,33 @@ impl Interaction {
                 (None, Some(k)) if g.moving => format!("river {}: moving point {k} | lift to set", g.index),
                 (None, _) => format!("river {}: slide a point to reshape | SW3 + move: width, depth", g.index),
             },
+            State::Idle if self.tool == rocks::Tool::Ridges => match self.ridge_hover {
+                Some(part) => format!(
+                    "ridges: {}: SW3 click grows valleys | SW2 + touch a node grabs it",
+                    part.name()
+                ),
+                None => {
+                    "ridges: touch, lift and draw in the air (a ridgeline), or on the surface (a tree) | SW3 ends it"
+                        .to_string()
+                }
+            },
+            State::Armed if self.tool == rocks::Tool::Ridges => {
+                "ridges: SW2: touch a node to grab it | SW3: redo".to_string()
+            }
+            State::RidgeStroke(samples) => match samples.last() {
+                Some(s) if s.h_mm > 0.0 => format!(
+                    "ridgeline: {:.0} m high | touch: on the surface | SW3 ends it",
+                    self.view.height_at(s.h_mm)
+                ),
+                _ => "ridge stroke on the surface | lift to draw in the air | SW3 ends it".to_string(),
+            },
+            State::Node(g, _) => match (g.height, g.moving) {
+                (Some(h), _) => format!("{} node {}: {h:.0} m | release SW2 to set", g.node.0.name(), g.node.1),
+                (None, true) => format!("moving {} node {} | lift to set", g.node.0.name(), g.node.1),
+                (None, false) => format!("{} node {}: slide to move, lift to pull", g.node.0.name(), g.node.1),
+            },
             State::Palette => match self.tool {
+                rocks::Tool::Ridges => "ridge tool".to_string(),
                 rocks::Tool::Rocks => "rock tool".to_string(),
                 rocks::Tool::Rivers => "river tool".to_string(),
                 rocks::Tool::Figures => "figures".to_string(),
@@ -559,6 +617,7 @@ impl Interaction {
         match command {
             KeyCommand::Undo => self.undo(editor),
             KeyCommand::Redo => self.redo(editor),
+            KeyCommand::Delete if self.tool == rocks::Tool::Ridges => self.delete_ridge(editor),
             KeyCommand::Delete if self.tool == rocks::Tool::Rivers => {
                 let Some(index) = self.river_hover() else {
                     self.say("no river highlighted to delete".into());
@@ -623,6 +682,15 @@ impl Interaction {
         let Some((g, p)) = self.ground() else { return };
         let s = self.tuning;
         match &mut self.state {
+            State::Idle | State::Armed if self.tool == rocks::Tool::Ridges => {
+                self.hover = None;
+                self.ridge_hover = ridge::part_at(editor.document(), g, self.view.metres(s.pick_mm));
+            }
+            State::RidgeStroke(samples) => {
+                let h_mm = if self.sw[0] { 0.0 } else { p.h_mm.max(0.0) };
+                samples.push(ridge::Sample { at: g, h_mm });
+            }
+            State::Node(..) => self.follow_node(editor, g, p),
             State::Idle | State::Armed if self.tool == rocks::Tool::Rivers => {
                 self.hover = None;
                 self.river_hover = river::river_at(editor.document(), g, self.view.metres(s.pick_mm));
@@ -751,6 +819,47 @@ impl Interaction {
     fn on_tip_down(&mut self, editor: &mut Editor) {
         let Some((g, p)) = self.ground() else { return };
         match &mut self.state {
+            State::Idle if ridge::on_palette(&self.view, p.u_mm, p.v_mm) => {
+                self.tool = match self.tool {
+                    rocks::Tool::Ridges => rocks::Tool::Figures,
+                    _ => rocks::Tool::Ridges,
+                };
+                self.hover = None;
+                self.field_hover = None;
+                self.river_hover = None;
+                self.ridge_hover = None;
+                self.state = State::Palette;
+                self.say(match self.tool {
+                    rocks::Tool::Ridges => {
+                        "ridge tool: touch, lift and draw a ridgeline in the air, or draw a tree on the surface; SW3 ends it"
+                            .into()
+                    }
+                    _ => "figures: draw with the tip".into(),
+                });
+            }
+            State::Idle if self.tool == rocks::Tool::Ridges => {
+                self.state = State::RidgeStroke(vec![ridge::Sample { at: g, h_mm: 0.0 }]);
+            }
+            State::RidgeStroke(samples) => samples.push(ridge::Sample { at: g, h_mm: 0.0 }),
+            State::Armed if self.tool == rocks::Tool::Ridges => {
+                let doc = editor.document();
+                match ridge::node_at(doc, g, self.view.metres(self.tuning.pick_mm)) {
+                    Some(node) => {
+                        let base = Box::new(doc.ridges.clone().unwrap_or_default());
+                        self.state = State::Node(
+                            ridge::NodeGrab {
+                                node,
+                                at_mm: [p.u_mm, p.v_mm],
+                                by: [0.0, 0.0],
+                                moving: false,
+                                height: None,
+                            },
+                            base,
+                        );
+                    }
+                    None => self.say("no ridgeline node here to grab".into()),
+                }
+            }
             State::Idle if river::on_palette(p.u_mm, p.v_mm) => {
                 self.tool = match self.tool {
                     rocks::Tool::Rivers => rocks::Tool::Figures,
@@ -841,7 +950,12 @@ impl Interaction {
                     None => self.say("nothing here to grab".into()),
                 }
             }
-            State::Grabbed(_) | State::Sw3 { .. } | State::Palette | State::Field(_) | State::River(_) => {}
+            State::Grabbed(_)
+            | State::Sw3 { .. }
+            | State::Palette
+            | State::Field(_)
+            | State::River(_)
+            | State::Node(..) => {}
         }
     }
 
@@ -871,6 +985,10 @@ impl Interaction {
                 _ => {}
             },
             State::Palette => self.state = State::Idle,
+            State::Node(grab, _) if grab.moving => {
+                self.commit_node(editor);
+                self.state = State::Armed;
+            }
             State::Field(grab) if grab.moving => {
                 self.drop_field(editor);
                 self.state = State::Armed;
@@ -930,6 +1048,11 @@ impl Interaction {
     }
 
     fn on_sw2_up(&mut self, editor: &mut Editor) {
+        if let State::Node(..) = &self.state {
+            self.commit_node(editor);
+            self.state = State::Idle;
+            return;
+        }
         if let State::River(_) = &self.state {
             self.drop_river(editor);
             self.state = State::Idle;
@@ -960,6 +1083,11 @@ impl Interaction {
                 let positions = std::mem::take(positions);
                 self.state = State::Idle;
                 self.finish(editor, &positions);
+            }
+            State::RidgeStroke(samples) => {
+                let samples = std::mem::take(samples);
+                self.state = State::Idle;
+                self.finish_ridge(editor, &samples);
             }
             State::Idle => {
                 let Some((at_mm, h0)) = at else { return };
@@ -999,7 +1127,7 @@ impl Interaction {
                     grab.tuning = Some(([p.u_mm, p.h_mm], 1.0, 1.0));
                 }
             }
-            State::Sw3 { .. } | State::Palette => {}
+            State::Sw3 { .. } | State::Palette | State::Node(..) => {}
         }
     }
 
@@ -1049,7 +1177,10 @@ impl Interaction {
                 self.state = State::Idle;
                 // With the river tool, a click over a river is one more year of its change.
                 let over = self.river_hover.filter(|_| self.tool == rocks::Tool::Rivers);
-                if click && let Some(index) = over {
+                let ridge_over = self.ridge_hover.filter(|_| self.tool == rocks::Tool::Ridges);
+                if click && let Some(part) = ridge_over {
+                    self.grow(editor, part);
+                } else if click && let Some(index) = over {
                     let Some(river) = editor.document().rivers.get(index).and_then(river::aged) else {
                         self.say(format!("river {index} has had the most years a river may have"));
                         return;
@@ -1075,6 +1206,16 @@ impl Interaction {
             State::River(_) => {
                 self.say(format!("pen lost ({reason}): the river stays as it was"));
                 self.state = State::Idle;
+            }
+            State::Node(..) => {
+                if let Err(e) = editor.cancel_preview() {
+                    self.say(format!("cannot restore the ridgeline: {e}"));
+                }
+                self.say(format!("pen lost ({reason}): the node stays where it was"));
+                self.state = State::Idle;
+            }
+            State::RidgeStroke(_) => {
+                self.say(format!("pen lost ({reason}): the ridge stroke is kept; SW3 ends it"));
             }
             State::Grabbed(_) => {
                 if let Err(e) = editor.cancel_preview() {
@@ -1336,5 +1477,133 @@ fn describe(doc: &Document, curve: &CurvePath) -> String {
             Some(f) => format!("{} {}", f.kind.name(), short(at)),
             None => short(at),
         },
+    }
+}
+
+impl Interaction {
+    /// Ends the ridge stroke: a 3D ridgeline if it went into the air, else a tree or a branch.
+    fn finish_ridge(&mut self, editor: &mut Editor, samples: &[ridge::Sample]) {
+        let map = editor.heightmap();
+        let surface = |g: Point| {
+            let cell = map.cell_size();
+            let c = ((g[0] / cell).floor().max(0.0) as u32).min(map.cols() - 1);
+            let r = ((g[1] / cell).floor().max(0.0) as u32).min(map.rows() - 1);
+            f64::from(map.get(c, r))
+        };
+        let tol = (self.tuning.lift_mm, self.tuning.close_mm);
+        let doc = editor.document();
+        let (ridges, what) = match ridge::drawn(samples, &self.view, tol, surface) {
+            None => {
+                self.say("a ridgeline needs a longer stroke".into());
+                return;
+            }
+            Some(ridge::Drawn::Line(points)) => {
+                let n = points.len();
+                let top = points.iter().map(|p| p[2]).fold(f64::MIN, f64::max);
+                let r = ridge::with_line(doc, points);
+                let i = r.lines.len() - 1;
+                (r, format!("ridgeline {i}: {n} nodes, up to {top:.0} m"))
+            }
+            Some(ridge::Drawn::Tree(points)) => {
+                let before = doc.ridges.as_ref().map_or(0, |r| r.trees.len());
+                let (r, j) = ridge::with_tree_stroke(doc, &points, self.view.metres(self.tuning.pick_mm));
+                let how = if j < before { "a branch of" } else { "new" };
+                (r, format!("{how} ridgeline tree {j}: elevations computed"))
+            }
+        };
+        if self.commit(editor, Edit::SetRidges { ridges: Some(ridges) }, "the ridgeline") {
+            self.stats.ridgelines += 1;
+            self.say(what);
+        }
+    }
+
+    /// The held node follows the pen: carried along the surface, or pulled to the pen's height.
+    fn follow_node(&mut self, editor: &mut Editor, g: Point, p: DisplayPoint) {
+        let s = self.tuning;
+        let touching = self.sw[0];
+        let State::Node(grab, base) = &mut self.state else {
+            return;
+        };
+        let slid = (p.u_mm - grab.at_mm[0]).hypot(p.v_mm - grab.at_mm[1]);
+        if touching && grab.height.is_none() && (grab.moving || slid > s.move_mm) {
+            grab.moving = true;
+            grab.by = minus(g, self.view.to_ground(grab.at_mm[0], grab.at_mm[1]));
+        } else if !touching && !grab.moving && p.h_mm > s.lift_mm {
+            grab.height = Some(self.view.height_at(p.h_mm));
+        } else {
+            return;
+        }
+        let ridges = ridge::with_node(base, grab.node, grab.by, grab.height);
+        if let Err(e) = editor.preview_ridges(Some(ridges)) {
+            self.stats.refused += 1;
+            self.say(format!("cannot show the change: {e}"));
+        }
+    }
+
+    /// Records the held node's move or pull.
+    fn commit_node(&mut self, editor: &mut Editor) {
+        let State::Node(grab, _) = &self.state else { return };
+        let (moved, pulled) = (grab.moving, grab.height.is_some());
+        match editor.commit_ridges_preview() {
+            Ok(Some(_)) => {
+                self.stats.moves += u32::from(moved);
+                self.stats.pulls += u32::from(pulled);
+            }
+            Ok(None) => {}
+            Err(e) => {
+                self.stats.refused += 1;
+                self.say(format!("the ridgeline change was not recorded: {e}"));
+            }
+        }
+    }
+
+    /// One round of valleys (Alg. 2.5) grown from the whole ridge network.
+    fn grow(&mut self, editor: &mut Editor, part: ridge::Part) {
+        let doc = editor.document();
+        let seed = doc
+            .ridges
+            .as_ref()
+            .map_or(0, |r| (r.lines.len() + r.trees.len()) as u64);
+        match ridge::grown(doc, seed) {
+            Ok((ridges, n)) => {
+                let slope = ridges.slope;
+                if self.commit(editor, Edit::SetRidges { ridges: Some(ridges) }, "the grown valleys") {
+                    self.stats.grown += 1;
+                    self.say(format!(
+                        "grew {n} valley lines from {} and the rest; slope now {slope:.0}°",
+                        part.name()
+                    ));
+                }
+            }
+            Err(e) => {
+                self.stats.refused += 1;
+                self.say(format!("cannot grow valleys: {e}"));
+            }
+        }
+    }
+
+    /// Deletes the highlighted ridgeline or tree.
+    fn delete_ridge(&mut self, editor: &mut Editor) {
+        let Some(part) = self.ridge_hover() else {
+            self.say("no ridgeline highlighted to delete".into());
+            return;
+        };
+        let Some(mut r) = editor.document().ridges.clone() else {
+            return;
+        };
+        match part {
+            ridge::Part::Line(i) if i < r.lines.len() => {
+                r.lines.remove(i);
+            }
+            ridge::Part::Tree(j) if j < r.trees.len() => {
+                r.trees.remove(j);
+            }
+            _ => return,
+        }
+        if self.commit(editor, Edit::SetRidges { ridges: Some(r) }, "delete") {
+            self.stats.deletes += 1;
+            self.ridge_hover = None;
+            self.say(format!("{} deleted", part.name()));
+        }
     }
 }

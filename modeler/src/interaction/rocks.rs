@@ -38,6 +38,8 @@ pub enum Tool {
     Rocks,
     /// Rivers (seed 003; [`super::river`]).
     Rivers,
+    /// Ridgelines (seed 002; [`super::ridge`]).
+    Ridges,
 }
 
 /// Whether display point `(u, v)` mm is on the palette button.

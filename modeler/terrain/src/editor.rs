@@ -139,6 +139,8 @@ pub struct Editor {
     redo: Vec<UndoStep>,
     store: Option<Store>,
     preview: Option<Preview>,
+    /// The `ridges` entry from before an unrecorded ridge preview ([`Editor::preview_ridges`]).
+    ridge_preview: Option<Option<crate::document::Ridges>>,
     /// The rock fields standing on the terrain, following every change.
     rocks: Seated,
 }
@@ -198,6 +200,7 @@ impl Editor {
             redo: Vec::new(),
             store: None,
             preview: None,
+            ridge_preview: None,
         })
     }
 
@@ -384,6 +387,9 @@ impl Editor {
 
     /// Applies `edit`, journals it and makes it undoable.
     pub fn apply(&mut self, edit: Edit) -> Result<Outcome, EditorError> {
+        if self.ridge_preview.is_some() {
+            self.cancel_preview()?;
+        }
         // Committing the previewed property: undo returns to the value before the preview.
         // (Only a preview of that one property: a preview of both is recorded by
         // [`Editor::commit_preview`].)
@@ -499,6 +505,9 @@ impl Editor {
     /// first restores them.
     pub fn preview(&mut self, edit: &Edit) -> Result<Outcome, EditorError> {
         let (at, property, _) = preview_target(edit).ok_or(EditorError::NotPreviewable)?;
+        if self.ridge_preview.is_some() {
+            self.cancel_preview()?;
+        }
         if self.preview.as_ref().is_some_and(|p| p.at != at) {
             self.cancel_preview()?;
         }
@@ -523,7 +532,48 @@ impl Editor {
 
     /// Whether a preview is showing.
     pub fn previewing(&self) -> bool {
-        self.preview.is_some()
+        self.preview.is_some() || self.ridge_preview.is_some()
+    }
+
+    /// Shows `ridges` as the `ridges` entry at once without recording it: the frames of a
+    /// ridgeline's node dragged with the pen, the terrain following incrementally.
+    /// [`Editor::commit_ridges_preview`] records what is shown as one `set_ridges` step whose
+    /// undo returns to the entry from before the preview; any other operation, or
+    /// [`Editor::cancel_preview`], first restores it.
+    pub fn preview_ridges(&mut self, ridges: Option<crate::document::Ridges>) -> Result<Outcome, EditorError> {
+        if self.preview.is_some() {
+            self.cancel_preview()?;
+        }
+        let outcome = self.change(&Edit::SetRidges { ridges })?;
+        if self.ridge_preview.is_none()
+            && let Edit::SetRidges { ridges: old } = &outcome.inverse
+        {
+            self.ridge_preview = Some(old.clone());
+        }
+        Ok(outcome)
+    }
+
+    /// Records the previewed `ridges` entry as one undoable `set_ridges` step and returns it;
+    /// `None` when no ridge preview is showing. If the journal cannot be written, the preview is
+    /// undone and the error returned.
+    pub fn commit_ridges_preview(&mut self) -> Result<Option<Edit>, EditorError> {
+        let Some(old) = self.ridge_preview.take() else {
+            return Ok(None);
+        };
+        let edit = Edit::SetRidges {
+            ridges: self.doc.ridges.clone(),
+        };
+        let inverse = Edit::SetRidges { ridges: old };
+        if let Err(e) = self.log(&Entry::Do { edit: edit.clone() }) {
+            self.change(&inverse)?;
+            return Err(e);
+        }
+        self.push_undo(UndoStep {
+            edit: edit.clone(),
+            inverse,
+        });
+        self.redo.clear();
+        Ok(Some(edit))
     }
 
     /// Records the previewed values as one undoable step (a `set_height`, a `set_slope`, or a
@@ -562,6 +612,9 @@ impl Editor {
 
     /// Restores the values from before an unrecorded preview; `None` when there is none.
     pub fn cancel_preview(&mut self) -> Result<Option<Outcome>, EditorError> {
+        if let Some(old) = self.ridge_preview.take() {
+            return Ok(Some(self.change(&Edit::SetRidges { ridges: old })?));
+        }
         let Some(p) = self.preview.take() else { return Ok(None) };
         let restore = p.restore();
         let edit = match <[Edit; 1]>::try_from(restore) {
