@@ -10,7 +10,7 @@
 use crate::ReportId;
 use crate::codec::{Reader, Report, Writer};
 use crate::error::DecodeError;
-use crate::pen::{MAX_RECEIVERS, POSITION_LOGICAL_MAX, Position, Quality};
+use crate::pen::{MAX_RECEIVERS, Position, Quality};
 
 /// The longest prediction the report carries, ms: beyond it a constant-velocity guess of a head
 /// is worse than the stale pose (the IS-900 stops at 50 ms too).
@@ -47,34 +47,16 @@ impl Report for HeadReport {
 
     fn write_body(&self, w: &mut Writer<'_>) {
         w.u8(if self.no_fix { NO_FIX } else { 0 } | if self.display_frame { DISPLAY_FRAME } else { 0 });
-        w.i16(self.position.x);
-        w.i16(self.position.y);
-        w.i16(self.position.z);
+        self.position.write(w);
         w.u8(self.prediction_ms);
         w.u16(self.seq);
         w.u32(self.timestamp_us);
-        w.u8(self.quality.receivers_used);
-        w.u8(self.quality.residual);
-        w.u8(self.quality.dop);
+        self.quality.write(w);
     }
 
     fn read_body(r: &mut Reader<'_>) -> Result<Self, DecodeError> {
         let flags = r.flags(NO_FIX | DISPLAY_FRAME)?;
-        let mut axis = |field| {
-            let v = r.i16()?;
-            if v < -POSITION_LOGICAL_MAX {
-                return Err(DecodeError::OutOfRange {
-                    report: ReportId::Head,
-                    field,
-                });
-            }
-            Ok(v)
-        };
-        let position = Position {
-            x: axis("x")?,
-            y: axis("y")?,
-            z: axis("z")?,
-        };
+        let position = Position::read(r, ReportId::Head)?;
         let prediction_ms = r.u8()?;
         if prediction_ms > MAX_PREDICTION_MS {
             return Err(DecodeError::OutOfRange {

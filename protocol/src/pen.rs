@@ -147,6 +147,41 @@ const IN_RANGE: u8 = 1 << 3;
 const DISPLAY_FRAME: u8 = 1 << 4;
 const SWITCH_BITS: u8 = SW1 | SW2 | SW3 | IN_RANGE | DISPLAY_FRAME;
 
+impl Position {
+    /// Writes the three axes, as every report with a position carries them.
+    pub(crate) fn write(&self, w: &mut Writer<'_>) {
+        w.i16(self.x);
+        w.i16(self.y);
+        w.i16(self.z);
+    }
+
+    /// Reads three axes of `report`, refusing the one value no axis holds (below
+    /// −[`POSITION_LOGICAL_MAX`]), named by its field.
+    pub(crate) fn read(r: &mut Reader<'_>, report: ReportId) -> Result<Position, DecodeError> {
+        let mut axis = |field| {
+            let v = r.i16()?;
+            if v < -POSITION_LOGICAL_MAX {
+                return Err(DecodeError::OutOfRange { report, field });
+            }
+            Ok(v)
+        };
+        Ok(Position {
+            x: axis("x")?,
+            y: axis("y")?,
+            z: axis("z")?,
+        })
+    }
+}
+
+impl Quality {
+    /// Writes receivers used, residual and dilution of precision, in that order.
+    pub(crate) fn write(&self, w: &mut Writer<'_>) {
+        w.u8(self.receivers_used);
+        w.u8(self.residual);
+        w.u8(self.dop);
+    }
+}
+
 impl Report for PenReport {
     const ID: ReportId = ReportId::Pen;
     const LEN: usize = 17;
@@ -158,33 +193,15 @@ impl Report for PenReport {
             | bit(self.sw3, SW3)
             | bit(self.in_range, IN_RANGE)
             | bit(self.display_frame, DISPLAY_FRAME));
-        w.i16(self.position.x);
-        w.i16(self.position.y);
-        w.i16(self.position.z);
+        self.position.write(w);
         w.u16(self.seq);
         w.u32(self.timestamp_us);
-        w.u8(self.quality.receivers_used);
-        w.u8(self.quality.residual);
-        w.u8(self.quality.dop);
+        self.quality.write(w);
     }
 
     fn read_body(r: &mut Reader<'_>) -> Result<Self, DecodeError> {
         let switches = r.flags(SWITCH_BITS)?;
-        let mut axis = |field| {
-            let v = r.i16()?;
-            if v < -POSITION_LOGICAL_MAX {
-                return Err(DecodeError::OutOfRange {
-                    report: ReportId::Pen,
-                    field,
-                });
-            }
-            Ok(v)
-        };
-        let position = Position {
-            x: axis("x")?,
-            y: axis("y")?,
-            z: axis("z")?,
-        };
+        let position = Position::read(r, ReportId::Pen)?;
         let seq = r.u16()?;
         let timestamp_us = r.u32()?;
         let receivers_used = r.u8()?;
