@@ -2,25 +2,16 @@
 //! slot without a fix holding the pose, and the pen untouched by the head's slots.
 
 use pen_core::head::{Schedule, mux_listen_us};
-use pen_core::{Cycle, Emitter, Engine, HeadSettings, Vec3};
+use pen_core::{Emitter, Engine, HeadSettings, Vec3};
 use pen_protocol::*;
+
+use crate::common::cycle_at;
 
 const FIRMWARE: FirmwareVersion = FirmwareVersion {
     major: 1,
     minor: 2,
     patch: 3,
 };
-
-/// The captures an emitter at `p` produces for the engine's configuration.
-fn cycle_at(e: &Engine, t0_us: u64, p: Vec3) -> Cycle {
-    let s = e.settings();
-    let mut arrival_ns = [None; MAX_RECEIVERS];
-    for ((slot, r), delay) in arrival_ns.iter_mut().zip(&s.receivers[..s.count]).zip(s.delays_ns) {
-        let tof_ns = (p - *r).length() as f64 / (s.speed_m_s as f64 * 1e-6);
-        *slot = Some((tof_ns + delay as f64).round() as u32);
-    }
-    Cycle { t0_us, arrival_ns }
-}
 
 fn head_engine(prediction_ms: u8) -> Engine {
     let mut e = Engine::new(None, FIRMWARE, [7; 12]);

@@ -3,6 +3,8 @@
 use pen_core::{Action, ConfigStore, Cycle, Engine, NoFix, StoreError, Vec3, default_config};
 use pen_protocol::*;
 
+use crate::common::cycle_at;
+
 const FIRMWARE: FirmwareVersion = FirmwareVersion {
     major: 1,
     minor: 2,
@@ -32,17 +34,6 @@ impl ConfigStore for RamStore {
 
 fn engine() -> Engine {
     Engine::new(None, FIRMWARE, [7; 12])
-}
-
-/// The captures a pen at `p` produces for the engine's configuration.
-fn cycle_at(e: &Engine, t0_us: u64, p: Vec3) -> Cycle {
-    let s = e.settings();
-    let mut arrival_ns = [None; MAX_RECEIVERS];
-    for ((slot, r), delay) in arrival_ns.iter_mut().zip(&s.receivers[..s.count]).zip(s.delays_ns) {
-        let tof_ns = (p - *r).length() as f64 / (s.speed_m_s as f64 * 1e-6);
-        *slot = Some((tof_ns + delay as f64).round() as u32);
-    }
-    Cycle { t0_us, arrival_ns }
 }
 
 fn encode(m: &Message) -> Vec<u8> {

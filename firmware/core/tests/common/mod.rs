@@ -1,7 +1,7 @@
 //! Geometry and noise for the core's tests.
 #![allow(dead_code)]
 
-use pen_core::Vec3;
+use pen_core::{Cycle, Engine, Vec3};
 use pen_protocol::MAX_RECEIVERS;
 
 /// A small deterministic generator (SplitMix64) with Gaussian samples (Box–Muller), so the tests
@@ -56,4 +56,16 @@ pub fn exact_ranges(receivers: &[Vec3], p: Vec3) -> [Option<f32>; MAX_RECEIVERS]
 
 pub fn distance(a: Vec3, b: Vec3) -> f32 {
     (a - b).length()
+}
+
+/// The captures an emitter at `p` produces for the engine's configuration: each receiver's
+/// flight at the engine's speed of sound plus its transducer delay, to the nearest ns.
+pub fn cycle_at(e: &Engine, t0_us: u64, p: Vec3) -> Cycle {
+    let s = e.settings();
+    let mut arrival_ns = [None; MAX_RECEIVERS];
+    for ((slot, r), delay) in arrival_ns.iter_mut().zip(&s.receivers[..s.count]).zip(s.delays_ns) {
+        let tof_ns = (p - *r).length() as f64 / (s.speed_m_s as f64 * 1e-6);
+        *slot = Some((tof_ns + delay as f64).round() as u32);
+    }
+    Cycle { t0_us, arrival_ns }
 }
