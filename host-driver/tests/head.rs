@@ -5,9 +5,10 @@
 
 use std::io::{BufRead, BufReader};
 use std::os::unix::net::UnixStream;
-use std::path::Path;
-use std::process::{Child, Command, Stdio};
-use std::time::{Duration, Instant};
+use std::process::Command;
+use std::time::Instant;
+
+use crate::common::{GUARD, start_pend};
 
 use glam::{DQuat, DVec3};
 use pen_host::calibration::{Calibration, DisplaySize};
@@ -17,43 +18,17 @@ use pen_host::head::{HeadPose, HeadSampler, HeadStatus, HeadTracker};
 use pen_host::wire::EVENTS_VERSION;
 use pen_protocol::{HeadReport, Message, Position, Quality};
 
-const GUARD: Duration = Duration::from_secs(60);
-
-struct Pend(Child);
-
-impl Drop for Pend {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn start_pend(socket: &Path, calibration: &Path) -> Pend {
-    let child = Command::new(env!("CARGO_BIN_EXE_pend"))
-        .args(["--source", "sim:viewer", "--speed", "0", "--socket"])
-        .arg(socket)
-        .arg("--calibration")
-        .arg(calibration)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("pend starts");
-    let end = Instant::now() + GUARD;
-    while UnixStream::connect(socket).is_err() {
-        assert!(Instant::now() < end, "pend did not listen");
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    Pend(child)
-}
-
 /// The first `n` head events a client of pend reads, with their report's device time, and the
 /// greeting's events version.
 fn head_events(calibration: Calibration, n: usize) -> (u32, Vec<(u64, HeadPose)>) {
     let dir = tempfile::tempdir().expect("tempdir");
     let (socket, file) = (dir.path().join("pend.sock"), dir.path().join("calibration.toml"));
     calibration.save(&file).expect("calibration saved");
-    let _pend = start_pend(&socket, &file);
+    let calibration = file.to_str().expect("a UTF-8 temporary path");
+    let _pend = start_pend(
+        &socket,
+        &["--source", "sim:viewer", "--speed", "0", "--calibration", calibration],
+    );
     let stream = UnixStream::connect(&socket).expect("connects");
     stream.set_read_timeout(Some(GUARD)).expect("timeout");
     let mut reader = BufReader::new(stream);

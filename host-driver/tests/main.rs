@@ -1,5 +1,6 @@
 //! The integration tests of pen-host, in one binary: a module per area.
 mod calibration;
+mod common;
 mod daemon;
 mod delays;
 mod events;

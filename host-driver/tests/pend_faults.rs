@@ -10,44 +10,16 @@
 use std::io::{BufRead, BufReader, Write};
 use std::os::unix::net::UnixStream;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::{Duration, Instant};
 
+use crate::common::{GUARD, Pend, start_pend};
+
 use pen_host::client::{Line, parse_line};
 use pen_host::daemon::{DEFAULT_MAX_CLIENTS, DEFAULT_QUEUE};
 use pen_host::events::EventKind;
-
-/// A hang guard only: a loaded machine is slow, never this slow.
-const GUARD: Duration = Duration::from_secs(60);
-
-/// Kills pend when the test ends, however it ends.
-struct Pend(Child);
-
-impl Drop for Pend {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
-fn start_pend(path: &Path) -> Pend {
-    let child = Command::new(env!("CARGO_BIN_EXE_pend"))
-        .args(["--source", "sim:hold", "--socket"])
-        .arg(path)
-        .stdin(Stdio::null())
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("pend starts");
-    let end = Instant::now() + GUARD;
-    while UnixStream::connect(path).is_err() {
-        assert!(Instant::now() < end, "pend did not listen");
-        std::thread::sleep(Duration::from_millis(20));
-    }
-    Pend(child)
-}
 
 fn socket_path(name: &str) -> (tempfile::TempDir, PathBuf) {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -135,7 +107,7 @@ fn memory_bound_kb() -> u64 {
 #[test]
 fn pend_outlives_bad_clients_in_bounded_memory_and_live_clients_lose_nothing() {
     let (_dir, path) = socket_path("abuse");
-    let pend = start_pend(&path);
+    let pend = start_pend(&path, &["--source", "sim:hold"]);
     let pid = pend.0.id();
 
     let stop = Arc::new(AtomicBool::new(false));
@@ -236,7 +208,7 @@ fn first_line(path: &Path) -> (UnixStream, String) {
 #[test]
 fn a_second_pend_refuses_and_a_killed_pends_socket_is_replaced() {
     let (_dir, path) = socket_path("second");
-    let mut first = start_pend(&path);
+    let mut first = start_pend(&path, &["--source", "sim:hold"]);
     let (client, hello) = first_line(&path);
     assert!(hello.contains(r#""type":"hello""#), "{hello}");
 
@@ -263,7 +235,7 @@ fn a_second_pend_refuses_and_a_killed_pends_socket_is_replaced() {
     first.0.wait().expect("reaped");
     assert!(path.exists(), "a killed pend leaves its socket behind");
     assert!(UnixStream::connect(&path).is_err(), "and nobody answers on it");
-    let _next = start_pend(&path);
+    let _next = start_pend(&path, &["--source", "sim:hold"]);
     let (_, hello) = first_line(&path);
     assert!(hello.contains(r#""type":"hello""#), "{hello}");
 }
