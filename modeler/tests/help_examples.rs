@@ -2,17 +2,8 @@
 //! (issue 19.7: one named a file that was not there), and generate's outputs are each optional.
 
 use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
 
-fn penmodel(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_penmodel"))
-        .current_dir(dir)
-        .args(args)
-        .env_remove("DISPLAY")
-        .env_remove("WAYLAND_DISPLAY")
-        .output()
-        .expect("penmodel runs")
-}
+use crate::common::penmodel;
 
 /// The repository's folder, where the examples are run from.
 fn repository() -> PathBuf {

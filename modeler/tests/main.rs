@@ -1,5 +1,6 @@
 //! The integration tests of penmodel, in one binary: a module per area.
 mod cli;
+mod common;
 mod demo_cli;
 mod help_examples;
 mod interaction;

@@ -2,25 +2,11 @@
 //! end: map sizes and values checked against the document's own numbers, errors naming the
 //! flag or element.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::Path;
 
 use serde_json::Value;
 
-fn penmodel(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_penmodel"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("penmodel runs")
-}
-
-fn example() -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("examples/ridges/ridgelines.json")
-        .display()
-        .to_string()
-}
+use crate::common::{example, penmodel};
 
 fn floats(path: &Path) -> Vec<f32> {
     std::fs::read(path)
@@ -37,7 +23,7 @@ fn analyze_writes_every_map_with_the_grids_size() {
         dir.path(),
         &[
             "analyze",
-            &example(),
+            &example("ridges/ridgelines.json"),
             "--flow",
             "f.f32",
             "--ridges",
@@ -59,7 +45,7 @@ fn analyze_writes_every_map_with_the_grids_size() {
         dir.path(),
         &[
             "analyze",
-            &example(),
+            &example("ridges/ridgelines.json"),
             "--insolation",
             "i.f32",
             "--sun",
@@ -106,12 +92,22 @@ fn analyze_refuses_a_sun_below_the_horizon_and_a_missing_sun() {
     let dir = tempfile::tempdir().expect("dir");
     let out = penmodel(
         dir.path(),
-        &["analyze", &example(), "--sun", "30,-2", "--direct", "d.f32"],
+        &[
+            "analyze",
+            &example("ridges/ridgelines.json"),
+            "--sun",
+            "30,-2",
+            "--direct",
+            "d.f32",
+        ],
     );
     assert_eq!(out.status.code(), Some(1));
     let e = String::from_utf8_lossy(&out.stderr);
     assert!(e.contains("--sun") && e.contains("horizon"), "{e}");
-    let out = penmodel(dir.path(), &["analyze", &example(), "--direct", "d.f32"]);
+    let out = penmodel(
+        dir.path(),
+        &["analyze", &example("ridges/ridgelines.json"), "--direct", "d.f32"],
+    );
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--sun"));
 }
@@ -119,7 +115,10 @@ fn analyze_refuses_a_sun_below_the_horizon_and_a_missing_sun() {
 #[test]
 fn ridges_prints_elevations_and_grows_a_document_that_generates() {
     let dir = tempfile::tempdir().expect("dir");
-    let out = penmodel(dir.path(), &["ridges", &example(), "--elevations", "--json"]);
+    let out = penmodel(
+        dir.path(),
+        &["ridges", &example("ridges/ridgelines.json"), "--elevations", "--json"],
+    );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let json: Value = serde_json::from_slice(&out.stdout).expect("JSON");
     let nodes = json["trees"][0]["nodes"].as_array().expect("nodes");
@@ -133,7 +132,16 @@ fn ridges_prints_elevations_and_grows_a_document_that_generates() {
     assert!((at(6, "elevation") - (5.0 + d6 * 25f64.to_radians().tan())).abs() < 1e-9);
     let out = penmodel(
         dir.path(),
-        &["ridges", &example(), "--grow", "1", "--seed", "3", "--out", "g.json"],
+        &[
+            "ridges",
+            &example("ridges/ridgelines.json"),
+            "--grow",
+            "1",
+            "--seed",
+            "3",
+            "--out",
+            "g.json",
+        ],
     );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let grown: Value = serde_json::from_slice(&std::fs::read(dir.path().join("g.json")).expect("saved")).expect("JSON");
@@ -141,7 +149,10 @@ fn ridges_prints_elevations_and_grows_a_document_that_generates() {
     assert_eq!(grown["ridges"]["slope"].as_f64(), Some(35.0));
     let out = penmodel(dir.path(), &["generate", "g.json", "--raw", "g.f32"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let out = penmodel(dir.path(), &["generate", &example(), "--raw", "e.f32"]);
+    let out = penmodel(
+        dir.path(),
+        &["generate", &example("ridges/ridgelines.json"), "--raw", "e.f32"],
+    );
     assert!(out.status.success());
     // The ridgelines are in the export: the example's top is its ridgeline's (140 m), filtered.
     let top = floats(&dir.path().join("e.f32")).into_iter().fold(0.0f32, f32::max);
@@ -150,7 +161,7 @@ fn ridges_prints_elevations_and_grows_a_document_that_generates() {
         dir.path(),
         &[
             "render",
-            &example(),
+            &example("ridges/ridgelines.json"),
             "--png",
             "f.png",
             "--size",

@@ -1,32 +1,27 @@
 //! `penmodel river` and the rivers in `penmodel generate` end to end: the masks and JSON of
 //! docs/rivers.md, the water mesh, errors naming the flag, and the examples of its --help.
 
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::PathBuf;
 
 use serde_json::Value;
 
-fn penmodel(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_penmodel"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("penmodel runs")
-}
-
-fn omega() -> String {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-        .join("examples/rivers/omega.json")
-        .display()
-        .to_string()
-}
+use crate::common::{example, penmodel};
 
 #[test]
 fn river_writes_masks_preview_and_json() {
     let dir = tempfile::tempdir().expect("dir");
     let out = penmodel(
         dir.path(),
-        &["river", &omega(), "--masks", "m", "--json", "r.json", "--morph", "3"],
+        &[
+            "river",
+            &example("rivers/omega.json"),
+            "--masks",
+            "m",
+            "--json",
+            "r.json",
+            "--morph",
+            "3",
+        ],
     );
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let json: Value = serde_json::from_slice(&std::fs::read(dir.path().join("r.json")).expect("json")).expect("parses");
@@ -72,14 +67,17 @@ fn river_writes_masks_preview_and_json() {
 #[test]
 fn river_errors_name_the_flag() {
     let dir = tempfile::tempdir().expect("dir");
-    let out = penmodel(dir.path(), &["river", &omega(), "--index", "3"]);
+    let out = penmodel(dir.path(), &["river", &example("rivers/omega.json"), "--index", "3"]);
     assert_eq!(out.status.code(), Some(1));
     assert!(
         String::from_utf8_lossy(&out.stderr).contains("--index 3"),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
-    let out = penmodel(dir.path(), &["river", &omega(), "--iterations", "21"]);
+    let out = penmodel(
+        dir.path(),
+        &["river", &example("rivers/omega.json"), "--iterations", "21"],
+    );
     assert!(String::from_utf8_lossy(&out.stderr).contains("--iterations 21"));
 }
 
@@ -90,7 +88,7 @@ fn generate_writes_the_water_as_its_own_mesh() {
         dir.path(),
         &[
             "generate",
-            &omega(),
+            &example("rivers/omega.json"),
             "--obj",
             "t.obj",
             "--raw",

@@ -2,17 +2,10 @@
 //! same seed, flags named in errors, and the examples of its --help.
 
 use std::path::Path;
-use std::process::{Command, Output};
 
 use serde_json::Value;
 
-fn penmodel(dir: &Path, args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_penmodel"))
-        .current_dir(dir)
-        .args(args)
-        .output()
-        .expect("penmodel runs")
-}
+use crate::common::penmodel;
 
 fn text(b: &[u8]) -> String {
     String::from_utf8_lossy(b).into_owned()
