@@ -1,4 +1,5 @@
 //! The integration tests of penmodel-render, in one binary: a module per area.
+mod common;
 mod outputs;
 mod render;
 mod rocks;

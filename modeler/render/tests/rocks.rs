@@ -1,10 +1,12 @@
 //! Rock meshes in the renderer: drawn in the rock colour where they stand, hidden behind a
 //! nearer hill, and the same picture from one tile or many.
 
-use penmodel_render::{Camera, Frame, Orbit, Renderer, Scene, View};
+use penmodel_render::{Frame, Renderer, Scene};
 use penmodel_terrain::Heightmap;
 use penmodel_terrain::export::Mesh;
 use penmodel_terrain::rocks::place::normals;
+
+use crate::common::{above, lit_pixels};
 
 /// A square pyramid (a rock) of half-width `r` and height `h` at `(x, z)` on the ground `g`.
 fn pyramid(x: f32, z: f32, r: f32, h: f32, g: f32) -> Mesh {
@@ -29,33 +31,9 @@ fn flat(n: u32, h: f32) -> Heightmap {
     Heightmap::from_heights(n, n, 1.0, vec![h; (n * n) as usize]).expect("heights")
 }
 
-fn above(n: f64) -> Camera {
-    Camera {
-        view: View::Orbit(Orbit {
-            target: [n / 2.0, n / 2.0],
-            target_height: 0.0,
-            azimuth: 0.0,
-            elevation: 80f64.to_radians(),
-            distance: n * 1.5,
-            fov_y: 45f64.to_radians(),
-            separation: 1.0 / 30.0,
-        }),
-        tilt: 0.0,
-    }
-}
-
+/// Lit rock: a grey of the rock colour's hue, within its brightness.
 fn rock_pixels(frame: &Frame, colour: [u8; 4]) -> usize {
-    // Lit rock: a grey of the rock colour's hue, within its brightness.
-    frame
-        .pixels()
-        .iter()
-        .filter(|p| {
-            let k = f32::from(p[0]) / f32::from(colour[0]);
-            k > 0.2
-                && (f32::from(p[1]) - k * f32::from(colour[1])).abs() < 3.0
-                && (f32::from(p[2]) - k * f32::from(colour[2])).abs() < 3.0
-        })
-        .count()
+    lit_pixels(frame, colour, 0)
 }
 
 #[test]

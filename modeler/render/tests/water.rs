@@ -1,37 +1,15 @@
 //! Water in the renderer (issue 13): a river's flat surface drawn in the water colour above the
 //! bed it covers, hidden where the ground stands above it.
 
-use penmodel_render::{Camera, Frame, Orbit, Renderer, Scene, View};
+use penmodel_render::{Frame, Renderer, Scene};
 use penmodel_terrain::Heightmap;
 use penmodel_terrain::river::layer::Water;
 
-fn above(n: f64) -> Camera {
-    Camera {
-        view: View::Orbit(Orbit {
-            target: [n / 2.0, n / 2.0],
-            target_height: 0.0,
-            azimuth: 0.0,
-            elevation: 80f64.to_radians(),
-            distance: n * 1.5,
-            fov_y: 45f64.to_radians(),
-            separation: 1.0 / 30.0,
-        }),
-        tilt: 0.0,
-    }
-}
+use crate::common::{above, lit_pixels};
 
 /// Pixels of the water colour's hue (lit: the colour times a light from 0.2 to 1).
 fn water_pixels(frame: &Frame, colour: [u8; 4]) -> usize {
-    frame
-        .pixels()
-        .iter()
-        .filter(|p| {
-            let k = f32::from(p[2]) / f32::from(colour[2]);
-            k > 0.2
-                && (f32::from(p[0]) - k * f32::from(colour[0])).abs() < 3.0
-                && (f32::from(p[1]) - k * f32::from(colour[1])).abs() < 3.0
-        })
-        .count()
+    lit_pixels(frame, colour, 2)
 }
 
 #[test]
