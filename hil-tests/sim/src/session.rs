@@ -5,7 +5,7 @@
 
 use glam::DVec2;
 
-use crate::script::{SW3, Script, Timeline};
+use crate::script::{SW1, SW3, Script, Timeline};
 
 /// What to do with a figure once drawn.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -152,6 +152,36 @@ pub fn river_step() -> RiverStep {
     }
 }
 
+/// The session's ridgeline (issue 12): the ridge button tapped (the ridgeline tool), a touch where
+/// the ridge starts, the pen lifted and carried through the air (its height the ridge's
+/// elevation), SW3 in the air to end it; then an SW3 click over it grows one round of valleys
+/// (Alg. 2.5), and the button is tapped again (back to figures).
+#[derive(Debug, Clone, PartialEq)]
+pub struct RidgeStep {
+    /// The ridge button's centre, display mm (the modeler's button is the 20 mm square 8 mm
+    /// from the display's top right corner: 572 to 592 mm across on the 600 mm display).
+    pub button: DVec2,
+    /// The ridge as drawn: display mm and the pen's height, mm; the first is the touch (0 mm).
+    pub path: Vec<glam::DVec3>,
+    /// Where the hand clicks SW3 to grow valleys: over the ridge.
+    pub over: DVec2,
+}
+
+/// The ridgeline of the demo's session, after the river: across the lower left of the region.
+pub fn ridge_step() -> RidgeStep {
+    let p = glam::DVec3::new;
+    RidgeStep {
+        button: v(582.0, 18.0),
+        path: vec![
+            p(80.0, 270.0, 0.0),
+            p(80.0, 270.0, 25.0),
+            p(170.0, 300.0, 45.0),
+            p(280.0, 290.0, 30.0),
+        ],
+        over: v(170.0, 300.0),
+    }
+}
+
 /// The hand's timeline for `steps`, from and back to `home`.
 pub fn timeline(steps: &[ModelingStep], home: glam::DVec3) -> Timeline {
     let mut s = Script::new(home);
@@ -192,6 +222,20 @@ pub fn timeline(steps: &[ModelingStep], home: glam::DVec3) -> Timeline {
         s.hover(river.over).click(SW3).hold(0.3);
     }
     s.hover(river.button).touch().lift(8.0);
+    let ridge = ridge_step();
+    // The ridgeline tool: tap its button, touch, lift and draw in the air, SW3 there; a click
+    // over it grows valleys; tap the button again.
+    s.hover(ridge.button).touch().lift(8.0);
+    if let Some((first, rest)) = ridge.path.split_first() {
+        s.hover(first.truncate()).touch();
+        s.release(SW1);
+        for p in rest {
+            s.move_to(*p);
+        }
+        s.hold(0.2).click(SW3);
+    }
+    s.hover(ridge.over).click(SW3).hold(0.3);
+    s.hover(ridge.button).touch().lift(8.0);
     s.move_to(home);
     s.build()
 }
