@@ -60,29 +60,42 @@ impl Skeleton {
     /// (`ridges.lines[2]`).
     pub fn check(&self, what: &str) -> Result<(), RidgeError> {
         check_slope(self.slope, what)?;
-        if self.nodes.len() < 2 || self.edges.is_empty() {
-            return Err(RidgeError::TooShort {
-                what: what.to_string(),
-                points: self.nodes.len(),
-            });
-        }
-        for (i, p) in self.nodes.iter().enumerate() {
-            if !p.iter().all(|v| v.is_finite()) {
-                return Err(RidgeError::NotFinite {
-                    what: format!("{what}.points[{i}]"),
-                });
-            }
-        }
-        for (i, e) in self.edges.iter().enumerate() {
-            if e.iter().any(|&n| n as usize >= self.nodes.len()) || e[0] == e[1] {
-                return Err(RidgeError::BadEdge {
-                    what: format!("{what}.edges[{i}]"),
-                    nodes: self.nodes.len(),
-                });
-            }
-        }
+        check_graph(&self.nodes, &self.edges, what, "points")?;
         Ok(())
     }
+}
+
+/// Checks what the lines and the trees share: at least two nodes and an edge, every coordinate
+/// finite (`{what}.{nodes_field}[i]` names one that is not), every edge joining two different
+/// existing nodes.
+fn check_graph<const D: usize>(
+    nodes: &[[f64; D]],
+    edges: &[[u32; 2]],
+    what: &str,
+    nodes_field: &str,
+) -> Result<(), RidgeError> {
+    if nodes.len() < 2 || edges.is_empty() {
+        return Err(RidgeError::TooShort {
+            what: what.to_string(),
+            points: nodes.len(),
+        });
+    }
+    for (i, p) in nodes.iter().enumerate() {
+        if !p.iter().all(|v| v.is_finite()) {
+            return Err(RidgeError::NotFinite {
+                what: format!("{what}.{nodes_field}[{i}]"),
+            });
+        }
+    }
+    for (i, e) in edges.iter().enumerate() {
+        if e.iter().any(|&n| n as usize >= nodes.len()) || e[0] == e[1] {
+            return Err(RidgeError::BadEdge {
+                what: format!("{what}.edges[{i}]"),
+                nodes: nodes.len(),
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Checks a flank or tree slope in radians: strictly between 0° and 90°.

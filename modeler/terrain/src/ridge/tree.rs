@@ -35,19 +35,7 @@ impl Tree {
                 what: format!("{what}.h_end"),
             });
         }
-        if self.nodes.len() < 2 || self.edges.is_empty() {
-            return Err(RidgeError::TooShort {
-                what: what.to_string(),
-                points: self.nodes.len(),
-            });
-        }
-        for (i, p) in self.nodes.iter().enumerate() {
-            if !p.iter().all(|v| v.is_finite()) {
-                return Err(RidgeError::NotFinite {
-                    what: format!("{what}.nodes[{i}]"),
-                });
-            }
-        }
+        super::check_graph(&self.nodes, &self.edges, what, "nodes")?;
         // Union-find: an edge joining two nodes already connected closes a cycle.
         let mut parent: Vec<usize> = (0..self.nodes.len()).collect();
         fn root(p: &mut [usize], mut i: usize) -> usize {
@@ -58,12 +46,6 @@ impl Tree {
             i
         }
         for (i, e) in self.edges.iter().enumerate() {
-            if e.iter().any(|&n| n as usize >= self.nodes.len()) || e[0] == e[1] {
-                return Err(RidgeError::BadEdge {
-                    what: format!("{what}.edges[{i}]"),
-                    nodes: self.nodes.len(),
-                });
-            }
             let (a, b) = (root(&mut parent, e[0] as usize), root(&mut parent, e[1] as usize));
             if a == b {
                 return Err(RidgeError::Cycle {
