@@ -71,6 +71,31 @@ fn diamonds_equal_the_iterated_cross() {
 }
 
 #[test]
+fn the_distance_to_the_other_value_is_the_nearest_cell_of_it() {
+    // Brute force: the least |dx| + |dy| to a cell of the other value, none: u16::MAX.
+    for (w, h, fill, seed) in [
+        (31, 19, 0.05, 5),
+        (40, 40, 0.5, 6),
+        (23, 29, 0.95, 7),
+        (1, 12, 0.4, 8),
+        (9, 1, 0.4, 9),
+    ] {
+        for img in [noise(w, h, seed, fill), vec![0; w * h], vec![1; w * h]] {
+            let d = morph::distance_to_other(&img, w, h);
+            for i in 0..w * h {
+                let (c, r) = ((i % w) as i64, (i / w) as i64);
+                let want = (0..w * h)
+                    .filter(|&j| (img[j] != 0) != (img[i] != 0))
+                    .map(|j| ((j % w) as i64 - c).abs() + ((j / w) as i64 - r).abs())
+                    .min()
+                    .map_or(u16::MAX, |m| m as u16);
+                assert_eq!(d[i], want, "{w}x{h} fill {fill}, cell ({c}, {r})");
+            }
+        }
+    }
+}
+
+#[test]
 fn curvature_of_a_circle_is_one_over_r_and_of_a_line_zero() {
     for r in [0.5, 3.0, 40.0] {
         for k in 0..16 {
@@ -534,6 +559,48 @@ fn the_nearest_sample_field_is_the_distance_to_the_course() {
             }
         }
     }
+}
+
+#[test]
+fn the_nearest_sample_field_is_the_same_filled_in_two_bands() {
+    use penmodel_terrain::river::near;
+    // 100 × 300 cells is filled as two bands of rows (split at row 150), 100 × 160 in one pass;
+    // their common rows 0..160 have the same local coordinates, so they must agree bit for bit,
+    // the band boundary included. The Ω's course, moved to cross row 150.
+    let line: Vec<DVec2> = course::sample(
+        &omega(18.0)
+            .iter()
+            .map(|p| DVec2::new(p[0] - 50.0, p[1] + 20.0))
+            .collect::<Vec<_>>(),
+        1.0,
+    )
+    .iter()
+    .map(|s| s.p)
+    .collect();
+    let (tall, short) = (
+        river::Window {
+            c0: 0,
+            r0: 0,
+            width: 100,
+            height: 300,
+        },
+        river::Window {
+            c0: 0,
+            r0: 0,
+            width: 100,
+            height: 160,
+        },
+    );
+    let (a, b) = (near::nearest(&tall, &line, 9.0), near::nearest(&short, &line, 9.0));
+    let n = short.len();
+    assert!(
+        b.owner.iter().filter(|&&o| o != near::NONE).count() > 1000,
+        "the course is in the window"
+    );
+    assert_eq!(a.owner[..n], b.owner[..]);
+    assert_eq!(a.side[..n], b.side[..]);
+    let bits = |d: &[f32]| d.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&a.dist[..n]), bits(&b.dist));
 }
 
 #[test]

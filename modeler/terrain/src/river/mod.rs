@@ -302,8 +302,8 @@ impl Shape {
     /// banks), as window indices.
     fn changes(&self) -> (Vec<usize>, Vec<usize>) {
         let (w, h) = (self.window.width, self.window.height);
-        let to_water = morph::distance(&self.mask, w, h, true, false);
-        let to_land = morph::distance(&self.mask, w, h, false, false);
+        // Land cells: the distance to the water; water cells: to the land.
+        let to_other = morph::distance_to_other(&self.mask, w, h);
         let (mut add, mut remove) = (Vec::new(), Vec::new());
         for (i, &o) in self.near.owner.iter().enumerate() {
             if o == NONE {
@@ -317,10 +317,10 @@ impl Shape {
             // Bending left, the centre of the bend is on the left: the outer bank is the right.
             let outer = side == -turn;
             if self.mask[i] == 0 {
-                if outer && to_water[i] <= reach {
+                if outer && to_other[i] <= reach {
                     add.push(i);
                 }
-            } else if !outer && to_land[i] <= reach {
+            } else if !outer && to_other[i] <= reach {
                 remove.push(i);
             }
         }

@@ -32,7 +32,14 @@ pub fn nearest(win: &Window, line: &[DVec2], reach: f64) -> Near {
     near
 }
 
+/// Windows of at least this many cells fill their field on two row bands at once.
+const SPLIT_CELLS: usize = 16_384;
+
 /// [`nearest`] into `near`'s buffers (reused from one iteration to the next).
+///
+/// A large window is filled as two bands of rows on the thread pool: each band runs every
+/// segment over its own rows, in the same order, so each cell sees the same candidates in the
+/// same order as a single pass and the field is the same bit for bit (a test checks).
 pub fn nearest_into(win: &Window, line: &[DVec2], reach: f64, near: &mut Near) {
     let n = win.len();
     near.owner.clear();
@@ -43,19 +50,57 @@ pub fn nearest_into(win: &Window, line: &[DVec2], reach: f64, near: &mut Near) {
     near.side.resize(n, 0);
     let origin = win.origin();
     let pts: Vec<DVec2> = line.iter().map(|p| *p - origin).collect();
+    if n < SPLIT_CELLS || win.height < 2 {
+        fill(
+            win,
+            &pts,
+            reach,
+            0..win.height,
+            &mut near.owner,
+            &mut near.dist,
+            &mut near.side,
+        );
+        return;
+    }
+    let mid = win.height / 2;
+    let at = mid * win.width;
+    let (o0, o1) = near.owner.split_at_mut(at);
+    let (d0, d1) = near.dist.split_at_mut(at);
+    let (s0, s1) = near.side.split_at_mut(at);
+    let pts = &pts;
+    rayon::join(
+        || fill(win, pts, reach, 0..mid, o0, d0, s0),
+        || fill(win, pts, reach, mid..win.height, o1, d1, s1),
+    );
+}
+
+/// The field of the polyline `pts` (window-local) over the window's rows `rows`, into buffers
+/// that hold those rows only (reset to [`NONE`], ∞, 0).
+fn fill(
+    win: &Window,
+    pts: &[DVec2],
+    reach: f64,
+    rows: std::ops::Range<usize>,
+    owner: &mut [u32],
+    dist: &mut [f32],
+    side: &mut [i8],
+) {
+    let base = rows.start * win.width;
     if pts.len() == 1 {
         // One point: a disc.
-        visit(win, pts[0], pts[0], reach, |i, p| {
+        visit(win, rows.clone(), pts[0], pts[0], reach, |i, p| {
             let d = p.distance(pts[0]);
-            if (d as f32) < near.dist[i] {
-                near.dist[i] = d as f32;
-                near.owner[i] = 0;
+            if (d as f32) < dist[i - base] {
+                dist[i - base] = d as f32;
+                owner[i - base] = 0;
             }
         });
         return;
     }
-    let segs = pts.len() - 1;
-    let dir = |k: usize| (pts[k + 1] - pts[k]).normalize_or_zero();
+    let segs = pts.len().saturating_sub(1);
+    let dir: Vec<DVec2> = (0..segs).map(|k| (pts[k + 1] - pts[k]).normalize_or_zero()).collect();
+    // The turn at each joint, once (the angle's size does not depend on the order).
+    let bend: Vec<f64> = (1..segs).map(|k| dir[k - 1].angle_to(dir[k]).abs()).collect();
     for k in 0..segs {
         let (a, b) = (pts[k], pts[k + 1]);
         let ab = b - a;
@@ -66,13 +111,13 @@ pub fn nearest_into(win: &Window, line: &[DVec2], reach: f64, near: &mut Near) {
         let widen = |other: Option<usize>| -> f64 {
             match other {
                 None => reach,
-                Some(j) => reach * dir(k).angle_to(dir(j)).abs() + 0.6,
+                Some(j) => reach * bend[j] + 0.6,
             }
         };
         let before = widen(k.checked_sub(1));
-        let after = widen((k + 1 < segs).then_some(k + 1));
+        let after = widen((k + 1 < segs).then_some(k));
         let len2 = ab.length_squared();
-        slab(win, a, b, before, after, reach, |i, p| {
+        slab(win, rows.clone(), a, b, before, after, reach, |i, p| {
             let t = if len2 > 0.0 {
                 ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
             } else {
@@ -80,11 +125,12 @@ pub fn nearest_into(win: &Window, line: &[DVec2], reach: f64, near: &mut Near) {
             };
             // Squared distances while searching; the roots once at the end.
             let d = p.distance_squared(a + ab * t) as f32;
-            if d < near.dist[i] {
-                near.dist[i] = d;
-                near.owner[i] = if t < 0.5 { k as u32 } else { k as u32 + 1 };
+            let j = i - base;
+            if d < dist[j] {
+                dist[j] = d;
+                owner[j] = if t < 0.5 { k as u32 } else { k as u32 + 1 };
                 let cross = ab.perp_dot(p - a);
-                near.side[i] = if cross > 1e-9 {
+                side[j] = if cross > 1e-9 {
                     1
                 } else if cross < -1e-9 {
                     -1
@@ -94,13 +140,14 @@ pub fn nearest_into(win: &Window, line: &[DVec2], reach: f64, near: &mut Near) {
             }
         });
     }
-    for d in &mut near.dist {
+    for d in dist.iter_mut() {
         *d = d.sqrt();
     }
 }
 
-/// Calls `f(index, local position)` for the window's cells in the box of `a`, `b` grown by `reach`.
-fn visit(win: &Window, a: DVec2, b: DVec2, reach: f64, mut f: impl FnMut(usize, DVec2)) {
+/// Calls `f(index, local position)` for the window's cells of rows `rows` in the box of `a`, `b`
+/// grown by `reach`.
+fn visit(win: &Window, rows: std::ops::Range<usize>, a: DVec2, b: DVec2, reach: f64, mut f: impl FnMut(usize, DVec2)) {
     let lo = a.min(b) - DVec2::splat(reach);
     let hi = a.max(b) + DVec2::splat(reach);
     let (w, h) = (win.width as f64, win.height as f64);
@@ -109,7 +156,7 @@ fn visit(win: &Window, a: DVec2, b: DVec2, reach: f64, mut f: impl FnMut(usize, 
     }
     let (c0, c1) = (lo.x.ceil().max(0.0) as usize, (hi.x.floor().min(w - 1.0)) as usize);
     let (r0, r1) = (lo.y.ceil().max(0.0) as usize, (hi.y.floor().min(h - 1.0)) as usize);
-    for r in r0..=r1 {
+    for r in r0.max(rows.start)..(r1 + 1).min(rows.end) {
         for c in c0..=c1 {
             f(r * win.width + c, DVec2::new(c as f64, r as f64));
         }
@@ -118,12 +165,22 @@ fn visit(win: &Window, a: DVec2, b: DVec2, reach: f64, mut f: impl FnMut(usize, 
 
 /// Calls `f(index, local position)` for the window's cells within `reach` of the line through
 /// `a`, `b` whose projection on it lies from `before` before `a` to `after` past `b` (distances
-/// along the line), row by row: each row's cells form one interval.
-fn slab(win: &Window, a: DVec2, b: DVec2, before: f64, after: f64, reach: f64, mut f: impl FnMut(usize, DVec2)) {
+/// along the line), row by row (of `rows` only): each row's cells form one interval.
+#[allow(clippy::too_many_arguments)]
+fn slab(
+    win: &Window,
+    rows: std::ops::Range<usize>,
+    a: DVec2,
+    b: DVec2,
+    before: f64,
+    after: f64,
+    reach: f64,
+    mut f: impl FnMut(usize, DVec2),
+) {
     let ab = b - a;
     let len = ab.length();
     if len == 0.0 {
-        return visit(win, a, b, reach, f);
+        return visit(win, rows, a, b, reach, f);
     }
     let u = ab / len;
     let (lo_t, hi_t) = (-before, len + after);
@@ -136,7 +193,7 @@ fn slab(win: &Window, a: DVec2, b: DVec2, before: f64, after: f64, reach: f64, m
     }
     let (r0, r1) = (lo.y.ceil().max(0.0) as usize, hi.y.floor().min(h - 1.0) as usize);
     let (cmin, cmax) = (lo.x.ceil().max(0.0), hi.x.floor().min(w - 1.0));
-    for r in r0..=r1 {
+    for r in r0.max(rows.start)..(r1 + 1).min(rows.end) {
         let dy = r as f64 - a.y;
         // Along: s(c) = (c − a.x)·u.x + dy·u.y in [lo_t, hi_t]; across: n(c) = (c − a.x)·u.y − dy·u.x
         // (up to sign) in [−reach, reach]. Both are linear in c.
@@ -148,8 +205,8 @@ fn slab(win: &Window, a: DVec2, b: DVec2, before: f64, after: f64, reach: f64, m
                 }
             } else {
                 let (x0, x1) = ((range.0 - off) / k + a.x, (range.1 - off) / k + a.x);
-                c0 = c0.max(x0.min(x1).ceil());
-                c1 = c1.min(x0.max(x1).floor());
+                c0 = c0.max(ceil(x0.min(x1)));
+                c1 = c1.min(floor(x0.max(x1)));
             }
         }
         if c1 < c0 {
@@ -161,6 +218,28 @@ fn slab(win: &Window, a: DVec2, b: DVec2, before: f64, after: f64, reach: f64, m
     }
 }
 
+/// `x.ceil()` up to the sign of a zero, inline: without SSE4.1 `f64::ceil` is a call into libm,
+/// and a slab pays two per row, which made it most of the field's time.
+fn ceil(x: f64) -> f64 {
+    let t = trunc(x);
+    if t < x { t + 1.0 } else { t }
+}
+
+/// `x.floor()` up to the sign of a zero, inline (see [`ceil`]).
+fn floor(x: f64) -> f64 {
+    let t = trunc(x);
+    if t > x { t - 1.0 } else { t }
+}
+
+/// `x` rounded towards zero; values of 2⁵² and more (and NaN, ∞) are already whole.
+fn trunc(x: f64) -> f64 {
+    if x.abs() < 4_503_599_627_370_496.0 {
+        x as i64 as f64
+    } else {
+        x
+    }
+}
+
 /// Sets `mask` to 1 on the window's cells within `radius` cells of the segment `a`–`b` (grid
 /// cell coordinates): the sweep of a disc along it.
 pub fn sweep_segment(win: &Window, mask: &mut [u8], a: DVec2, b: DVec2, radius: f64) {
@@ -168,7 +247,7 @@ pub fn sweep_segment(win: &Window, mask: &mut [u8], a: DVec2, b: DVec2, radius: 
     let (a, b) = (a - origin, b - origin);
     let ab = b - a;
     let len2 = ab.length_squared();
-    visit(win, a, b, radius, |i, p| {
+    visit(win, 0..win.height, a, b, radius, |i, p| {
         let t = if len2 > 0.0 {
             ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
         } else {
