@@ -695,3 +695,27 @@ fn the_ridge_tool_draws_lines_in_the_air_trees_on_the_surface_pulls_grows_and_de
     pen.hover(582.0, 18.0).touch().lift(HOVER);
     assert_eq!(pen.ui.tool(), Tool::Figures);
 }
+
+/// The pen lost while a ridgeline's node is pulled: the ridges and terrain are as before the grab.
+#[test]
+fn losing_the_pen_mid_node_pull_restores_the_ridges() {
+    let mut pen = Pen::new(blank());
+    pen.hover(582.0, 18.0).touch().lift(HOVER);
+    pen.hover(100.0, 150.0).touch().lift(30.0);
+    pen.move_to(DVec3::new(250.0, 150.0, 30.0)).click(2);
+    let before = pen.doc().clone();
+    assert_eq!(before.ridges.as_ref().map(|r| r.lines.len()), Some(1));
+    let n = before.ridges.as_ref().expect("ridges").lines[0].points[3];
+    let at = pen.view().to_display([n[0], n[1]]);
+    pen.grab(at[0], at[1]).pull_to(90.0);
+    assert_ne!(pen.doc(), &before, "the pull shows");
+    let mut out = Vec::new();
+    pen.detector.on_device_lost(pen.t_us, "unplugged", &mut out);
+    for ev in &out {
+        pen.ui.handle(&mut pen.editor, ev);
+    }
+    assert_eq!(pen.doc(), &before);
+    assert_eq!(pen.editor.heightmap(), &generate(&before).expect("valid"));
+    assert!(!pen.editor.previewing());
+    assert!(pen.ui.take_messages().iter().any(|m| m.contains("pen lost")));
+}

@@ -706,3 +706,54 @@ fn ridges_round_trip_and_need_version_3() {
     let v2 = plain.to_json().replacen("\"version\": 3", "\"version\": 2", 1);
     assert_eq!(Document::from_json(&v2).expect("a v2 document loads"), plain);
 }
+
+#[test]
+fn a_ridge_preview_shows_each_frame_and_records_one_undoable_step() {
+    use penmodel_terrain::{Edit, Editor, generate};
+    let d = ridge_doc();
+    let mut ed = Editor::new(d.clone()).expect("valid");
+    let fresh = |doc: &penmodel_terrain::Document| generate(doc).expect("valid");
+    let mut r = d.ridges.clone().expect("ridges");
+    // A node dragged over three frames: each shown at once, none recorded.
+    for k in 1..=3 {
+        r.lines[0].points[1] = [30.0 + f64::from(k), 26.0, 24.0 + 2.0 * f64::from(k)];
+        ed.preview_ridges(Some(r.clone())).expect("shown");
+        assert!(ed.previewing());
+        assert_eq!(ed.heightmap(), &fresh(ed.document()));
+    }
+    assert!(!ed.can_undo(), "a preview is not recorded");
+    let edit = ed.commit_ridges_preview().expect("recorded").expect("a preview");
+    assert_eq!(
+        edit,
+        Edit::SetRidges {
+            ridges: Some(r.clone())
+        }
+    );
+    assert!(!ed.previewing());
+    ed.undo().expect("undo").expect("one step");
+    assert_eq!(ed.document(), &d, "one undo returns to before the drag");
+    assert!(!ed.can_undo());
+    ed.redo().expect("redo");
+    assert_eq!(ed.document().ridges.as_ref(), Some(&r));
+    // A preview cancelled, or followed by another edit, is restored first.
+    let mut s = r.clone();
+    s.slope = 45.0;
+    ed.preview_ridges(Some(s.clone())).expect("shown");
+    ed.cancel_preview().expect("restored");
+    assert_eq!(ed.document().ridges.as_ref(), Some(&r));
+    assert_eq!(ed.heightmap(), &fresh(ed.document()));
+    ed.preview_ridges(Some(s)).expect("shown");
+    ed.apply(Edit::SetRidges { ridges: None }).expect("removed");
+    ed.undo().expect("undo");
+    assert_eq!(
+        ed.document().ridges.as_ref(),
+        Some(&r),
+        "the preview did not leak into the undo"
+    );
+    // A refused preview leaves the document as it was.
+    let mut bad = r.clone();
+    bad.slope = 95.0;
+    assert!(ed.preview_ridges(Some(bad)).is_err());
+    assert_eq!(ed.document().ridges.as_ref(), Some(&r));
+    assert!(!ed.previewing());
+}

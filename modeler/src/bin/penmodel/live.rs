@@ -395,12 +395,13 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
                 "slopes": stats.slopes, "moves": stats.moves, "deletes": stats.deletes,
                 "undos": stats.undos, "redos": stats.redos, "refused": stats.refused,
                 "missed": stats.missed, "rock_fields": stats.rock_fields, "rivers": stats.rivers,
+                "ridgelines": stats.ridgelines, "valley_rounds": stats.grown,
             },
         });
         pen_host::outln!("{summary}");
     } else {
         pen_host::outln!(
-            "{state}: {}; {}, {}, {}, {}, {}, {}, {}; terrain {lo:.0} to {hi:.0} m",
+            "{state}: {}; {}, {}, {}, {}, {}, {}, {}, {}; terrain {lo:.0} to {hi:.0} m",
             count(session.events(), "pen event"),
             count(stats.regions as u64, "region"),
             count(stats.figures as u64, "figure"),
@@ -409,6 +410,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
             count(stats.undos as u64, "undo"),
             count(stats.rock_fields as u64, "rock field"),
             count(stats.rivers as u64, "river"),
+            count(stats.ridgelines as u64, "ridgeline"),
         );
         let what = match (written.shown, &written.animation) {
             (true, _) => format!("showed {}; wrote", count(written.frames as u64, "frame")),
