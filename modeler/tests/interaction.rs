@@ -536,6 +536,54 @@ fn the_river_tool_draws_ages_reshapes_and_widens_a_river() {
     assert_eq!(pen.ui.tool(), Tool::Figures);
 }
 
+/// Several years in one gesture (issue 13): SW3 held still over a river counts on past the click,
+/// one year per `river::YEAR_HOLD_US`, the count on the status line; the release commits them as
+/// one edit; a press that moves pans and commits none; the count stops at the most years.
+#[test]
+fn sw3_held_over_a_river_commits_the_years_counted() {
+    use penmodel::interaction::river::YEAR_HOLD_US;
+    use penmodel_terrain::river::MAX_ITERATIONS;
+    let mut pen = Pen::new(blank());
+    pen.closed(&REGION);
+    pen.hover(18.0, 42.0).touch().lift(HOVER);
+    pen.stroke(&[(100.0, 250.0), (200.0, 170.0), (300.0, 230.0), (400.0, 160.0)]);
+    assert_eq!(pen.doc().rivers.len(), 1, "{:?}", pen.ui.take_messages());
+    let click_us = Tuning::default().click_us;
+    // The years a press from `t0` to `t1` should give: 1, and one per YEAR_HOLD_US past a click.
+    let want = |t0: u64, t1: u64| 1 + (t1 - t0).saturating_sub(click_us) / YEAR_HOLD_US;
+    pen.hover(200.0, 170.0);
+    let t0 = pen.t_us;
+    pen.set(2, true).hold(1.4);
+    let t1 = pen.t_us;
+    let n = want(t0, t1);
+    assert!(n >= 2, "held {} µs", t1 - t0);
+    let status = pen.ui.status(pen.doc());
+    assert!(status.contains(&format!("+{n} years")), "{status}");
+    assert_eq!(pen.doc().rivers[0].iterations, 0, "nothing committed while held");
+    pen.set(2, false);
+    let years = pen.doc().rivers[0].iterations;
+    assert_eq!(u64::from(years), n, "{:?}", pen.ui.take_messages());
+    // One edit: one undo takes them all back.
+    pen.editor.undo().expect("undo");
+    assert_eq!(pen.doc().rivers[0].iterations, 0);
+    pen.editor.redo().expect("redo");
+    // A click is still one year.
+    pen.click(2);
+    assert_eq!(u64::from(pen.doc().rivers[0].iterations), n + 1);
+    // Held and moved: a pan, no year.
+    let before = pen.doc().clone();
+    pen.set(2, true)
+        .move_to(DVec3::new(260.0, 120.0, HOVER))
+        .hold(1.4)
+        .set(2, false);
+    assert_eq!(pen.doc(), &before, "a pan commits no year");
+    // Held long: the most years a river may have, and no more.
+    pen.ui.command(&mut pen.editor, KeyCommand::Fit);
+    pen.hover(200.0, 170.0).set(2, true).hold(12.0).set(2, false);
+    let years = pen.doc().rivers[0].iterations;
+    assert_eq!(years, MAX_ITERATIONS, "{:?}", pen.ui.take_messages());
+}
+
 #[test]
 fn the_ridge_tool_draws_lines_in_the_air_trees_on_the_surface_pulls_grows_and_deletes() {
     use penmodel::interaction::ridge::Part;

@@ -548,6 +548,21 @@ impl Interaction {
                 }
             }
             State::Sw3 { moved: true, .. } => format!("view: 1 mm = {:.1} m", 1.0 / self.view.scale),
+            State::Sw3 { t0, .. } if self.tool == rocks::Tool::Rivers && self.river_hover.is_some() => {
+                let index = self.river_hover.unwrap_or_default();
+                let held = self.last_t.unwrap_or(*t0).saturating_sub(*t0);
+                let years = river::years_held(held, self.tuning.click_us);
+                let had = doc.rivers.get(index).map_or(0, |r| r.iterations);
+                let to = doc
+                    .rivers
+                    .get(index)
+                    .and_then(|r| river::aged(r, years))
+                    .map_or(had, |r| r.iterations);
+                format!(
+                    "river {index}: +{} years ({to} in all) | hold to count on, release to commit, move to pan",
+                    to - had
+                )
+            }
             State::Sw3 { .. } => "SW3: release to undo, or move to pan and zoom".to_string(),
         };
         match (&self.last_message, self.last_t) {
@@ -1174,19 +1189,21 @@ impl Interaction {
             }
             State::Sw3 { t0, moved, .. } => {
                 let click = !*moved && t.saturating_sub(*t0) < self.tuning.click_us;
+                // With the river tool, a click over a river is one more year of its change, and
+                // a press held still there one more per `river::YEAR_HOLD_US` past the click.
+                let held = (!*moved).then(|| river::years_held(t.saturating_sub(*t0), self.tuning.click_us));
                 self.state = State::Idle;
-                // With the river tool, a click over a river is one more year of its change.
                 let over = self.river_hover.filter(|_| self.tool == rocks::Tool::Rivers);
                 let ridge_over = self.ridge_hover.filter(|_| self.tool == rocks::Tool::Ridges);
                 if click && let Some(part) = ridge_over {
                     self.grow(editor, part);
-                } else if click && let Some(index) = over {
-                    let Some(river) = editor.document().rivers.get(index).and_then(river::aged) else {
+                } else if let (Some(index), Some(more)) = (over, held) {
+                    let Some(river) = editor.document().rivers.get(index).and_then(|r| river::aged(r, more)) else {
                         self.say(format!("river {index} has had the most years a river may have"));
                         return;
                     };
                     let years = river.iterations;
-                    if self.commit(editor, Edit::ReplaceRiver { index, river }, "the river's year") {
+                    if self.commit(editor, Edit::ReplaceRiver { index, river }, "the river's years") {
                         self.say(format!("river {index}: {years} years of erosion and deposition"));
                     }
                 } else if click {

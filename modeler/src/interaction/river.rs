@@ -14,8 +14,10 @@
 //!   move: sideways widens (right) or narrows (left), up and down deepens or shallows —
 //!   × e^(k·d), k = [`GAIN_PER_MM`] per mm, the same sideways SW3 gesture as slope; releasing
 //!   SW3 sets both as one undoable edit.
-//! - **Commit a year**: an SW3 click over a river adds one iteration (elsewhere it undoes, as
-//!   everywhere).
+//! - **Commit a year, or several**: an SW3 click over a river adds one iteration (elsewhere it
+//!   undoes, as everywhere). Holding SW3 still over it counts on, one more year every
+//!   [`YEAR_HOLD_US`] past the click's time, shown on the status line as it counts; releasing
+//!   commits them as one undoable edit, moving (a pan) commits none.
 
 use glam::DVec2;
 use penmodel_terrain::document::{Document, Grid, Point, River};
@@ -31,6 +33,16 @@ pub const GAIN_PER_MM: f64 = 0.02;
 pub const WIDTH_MM: f64 = 2.0;
 /// Stroke length per Bézier segment, mm.
 pub const SEGMENT_MM: f64 = 25.0;
+/// Holding SW3 still over a river past a click's time counts one more year per this many µs
+/// (as a key repeats: slow enough to stop on the count wanted, about two years a second).
+pub const YEAR_HOLD_US: u64 = 450_000;
+
+/// The years an SW3 press held `held_us` over a river commits: 1 for a click (shorter than
+/// `click_us`), then one more per [`YEAR_HOLD_US`].
+pub fn years_held(held_us: u64, click_us: u64) -> u32 {
+    let more = (held_us.saturating_sub(click_us) / YEAR_HOLD_US).min(u64::from(MAX_ITERATIONS));
+    1 + more as u32
+}
 
 /// Whether display point `(u, v)` mm is on the river button.
 pub fn on_palette(u_mm: f64, v_mm: f64) -> bool {
@@ -116,10 +128,11 @@ pub fn moved(river: &River, k: usize, by: Point) -> River {
     r
 }
 
-/// The river with one more iteration, if it may have one.
-pub fn aged(river: &River) -> Option<River> {
+/// The river with `years` more iterations, as many as it may still have (at most
+/// [`MAX_ITERATIONS`] in all); `None` if it may have no more.
+pub fn aged(river: &River, years: u32) -> Option<River> {
     (river.iterations < MAX_ITERATIONS).then(|| River {
-        iterations: river.iterations + 1,
+        iterations: river.iterations.saturating_add(years).min(MAX_ITERATIONS),
         ..river.clone()
     })
 }
