@@ -767,3 +767,31 @@ fn losing_the_pen_mid_node_pull_restores_the_ridges() {
     assert!(!pen.editor.previewing());
     assert!(pen.ui.take_messages().iter().any(|m| m.contains("pen lost")));
 }
+
+/// Holding a ridgeline's node, SW3 and a move sideways set the flank slope α: left steeper.
+#[test]
+fn sw3_sideways_on_a_held_node_sets_the_flank_slope() {
+    use penmodel::interaction::ridge::SLOPE_DEG_PER_MM;
+    let mut pen = Pen::new(blank());
+    pen.hover(582.0, 18.0).touch().lift(HOVER);
+    pen.hover(100.0, 150.0).touch().lift(30.0);
+    pen.move_to(DVec3::new(250.0, 150.0, 30.0)).click(2);
+    let before = pen.doc().clone();
+    let r0 = before.ridges.clone().expect("ridges");
+    let n = r0.lines[0].points[3];
+    let at = pen.view().to_display([n[0], n[1]]);
+    pen.grab(at[0], at[1]).set(2, true);
+    pen.move_to(DVec3::new(at[0] - 20.0, at[1], 0.0));
+    let live = pen.doc().ridges.as_ref().expect("ridges").slope;
+    assert!(pen.ui.status(pen.doc()).contains("flank slope"));
+    pen.set(2, false).let_go();
+    let r = pen.doc().ridges.clone().expect("ridges");
+    let want = r0.slope + 20.0 * SLOPE_DEG_PER_MM;
+    assert!((r.slope - want).abs() < 1e-6, "α {} vs {want}", r.slope);
+    assert_eq!(live, r.slope, "shown live");
+    assert_eq!(r.lines, r0.lines, "the node stays where it was");
+    assert_eq!(pen.editor.heightmap(), &generate(pen.doc()).expect("valid"));
+    assert_eq!(pen.ui.stats().slopes, 1);
+    pen.editor.undo().expect("undo");
+    assert_eq!(pen.doc(), &before);
+}

@@ -20,6 +20,7 @@
 //! | ridge tool ([`ridge`]): touch, lift and draw in the air, SW3 | a 3D ridgeline at the pen's height |
 //! | ridge tool: draw on the surface, SW3 | a 2D ridgeline tree (or a branch of the tree it starts on) |
 //! | ridge tool: SW2 + touch a node, slide or lift | carries or pulls the node, the terrain following; release SW2 sets it |
+//! | ridge tool: node held, SW3 held, move left/right | the flank slope α: left steeper, right gentler |
 //! | ridge tool: SW3 click over a ridgeline | grows one round of valleys (Alg. 2.5) |
 //!
 //! [`KeyCommand`]s give the same edits to a keyboard or a script. Times come from the device clock
@@ -494,6 +495,10 @@ impl Interaction {
                 ),
                 _ => "ridge stroke on the surface | lift to draw in the air | SW3 ends it".to_string(),
             },
+            State::Node(g, _) if g.slope_from.is_some() => format!(
+                "flank slope {:.1}° | left steeper, right gentler | release SW2 to set",
+                g.slope.unwrap_or(0.0)
+            ),
             State::Node(g, _) => match (g.height, g.moving) {
                 (Some(h), _) => format!("{} node {}: {h:.0} m | release SW2 to set", g.node.0.name(), g.node.1),
                 (None, true) => format!("moving {} node {} | lift to set", g.node.0.name(), g.node.1),
@@ -868,6 +873,8 @@ impl Interaction {
                                 by: [0.0, 0.0],
                                 moving: false,
                                 height: None,
+                                slope_from: None,
+                                slope: None,
                             },
                             base,
                         );
@@ -1142,12 +1149,18 @@ impl Interaction {
                     grab.tuning = Some(([p.u_mm, p.h_mm], 1.0, 1.0));
                 }
             }
-            State::Sw3 { .. } | State::Palette | State::Node(..) => {}
+            State::Node(grab, base) => {
+                if let Some(p) = self.pen {
+                    grab.slope_from = Some((p.u_mm, grab.slope.unwrap_or(base.slope)));
+                }
+            }
+            State::Sw3 { .. } | State::Palette => {}
         }
     }
 
     fn on_sw3_up(&mut self, editor: &mut Editor, t: u64) {
         match &mut self.state {
+            State::Node(grab, _) => grab.slope_from = None,
             State::Grabbed(grab) => {
                 if let Action::Slope { .. } = grab.action {
                     grab.action = if grab.pulled { Action::Pull } else { Action::Pending };
@@ -1542,7 +1555,10 @@ impl Interaction {
             return;
         };
         let slid = (p.u_mm - grab.at_mm[0]).hypot(p.v_mm - grab.at_mm[1]);
-        if touching && grab.height.is_none() && (grab.moving || slid > s.move_mm) {
+        if let Some((u0, a0)) = grab.slope_from {
+            let (lo, hi) = ridge::SLOPE_LIMITS;
+            grab.slope = Some((a0 - (p.u_mm - u0) * ridge::SLOPE_DEG_PER_MM).clamp(lo, hi));
+        } else if touching && grab.height.is_none() && grab.slope.is_none() && (grab.moving || slid > s.move_mm) {
             grab.moving = true;
             grab.by = minus(g, self.view.to_ground(grab.at_mm[0], grab.at_mm[1]));
         } else if !touching && !grab.moving && p.h_mm > s.lift_mm {
@@ -1550,8 +1566,7 @@ impl Interaction {
         } else {
             return;
         }
-        let ridges = ridge::with_node(base, grab.node, grab.by, grab.height);
-        if let Err(e) = editor.preview_ridges(Some(ridges)) {
+        if let Err(e) = editor.preview_ridges(Some(grab.ridges(base))) {
             self.stats.refused += 1;
             self.say(format!("cannot show the change: {e}"));
         }
@@ -1560,11 +1575,12 @@ impl Interaction {
     /// Records the held node's move or pull.
     fn commit_node(&mut self, editor: &mut Editor) {
         let State::Node(grab, _) = &self.state else { return };
-        let (moved, pulled) = (grab.moving, grab.height.is_some());
+        let (moved, pulled, sloped) = (grab.moving, grab.height.is_some(), grab.slope.is_some());
         match editor.commit_ridges_preview() {
             Ok(Some(_)) => {
                 self.stats.moves += u32::from(moved);
                 self.stats.pulls += u32::from(pulled);
+                self.stats.slopes += u32::from(sloped);
             }
             Ok(None) => {}
             Err(e) => {

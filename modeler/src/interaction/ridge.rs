@@ -17,6 +17,8 @@
 //!   node to the pen's height; a tree's end node sets the tree's `h_end`, an inner node its θ
 //!   (the slope that puts that node at the pen's height). The terrain follows live; releasing
 //!   SW2 (or lifting after a slide) records it as one undoable edit.
+//! - **Flank slope**: holding a node, SW3 held and the pen moved sideways sets α for all
+//!   ridgelines: left steeper, right gentler, [`SLOPE_DEG_PER_MM`] per mm, live.
 //! - **Grow valleys**: an SW3 click over a ridgeline or tree grows one round of Alg. 2.5 from the
 //!   whole network (elsewhere the click undoes, as everywhere).
 //! - **Delete**: the Delete key removes the highlighted ridgeline or tree.
@@ -338,4 +340,25 @@ pub struct NodeGrab {
     pub moving: bool,
     /// The elevation it is pulled to, while lifted.
     pub height: Option<f64>,
+    /// SW3 held: the pen's `u` (mm) when it went down and the flank slope α then, degrees.
+    pub slope_from: Option<(f64, f64)>,
+    /// The flank slope α the SW3 gesture set, degrees.
+    pub slope: Option<f64>,
 }
+
+impl NodeGrab {
+    /// The ridges as the pen is making them from `base`: the node carried or pulled, α set.
+    pub fn ridges(&self, base: &Ridges) -> Ridges {
+        let mut r = with_node(base, self.node, self.by, self.height);
+        if let Some(a) = self.slope {
+            r.slope = a;
+        }
+        r
+    }
+}
+
+/// α's change per mm of sideways pen travel with SW3 held, degrees (right gentler, left steeper:
+/// the figures' slope gesture, left sharper).
+pub const SLOPE_DEG_PER_MM: f64 = 0.25;
+/// The range the SW3 gesture keeps α in, degrees.
+pub const SLOPE_LIMITS: (f64, f64) = (5.0, 80.0);
