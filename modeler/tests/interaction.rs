@@ -727,8 +727,14 @@ fn the_ridge_tool_draws_lines_in_the_air_trees_on_the_surface_pulls_grows_and_de
     assert!(grown.lines.len() > 1, "{:?}", pen.ui.take_messages());
     assert_eq!(pen.ui.stats().grown, 1);
     assert!(grown.slope > pulled.slope, "each round steepens the flanks");
+    let clicked: Vec<Point> = pulled.lines[0].points.iter().map(|p| [p[0], p[1]]).collect();
     for l in &grown.lines[1..] {
         assert!(l.points[1..].windows(2).all(|w| w[1][2] <= w[0][2] + 1e-3), "{l:?}");
+        let start = [l.points[0][0], l.points[0][1]];
+        assert!(
+            penmodel::interaction::pick::line_distance(&clicked, start) < 1e-6,
+            "grown from the clicked ridgeline only: {start:?}"
+        );
     }
     // Delete the highlighted ridgeline; undo brings it back.
     pen.hover(on[0], on[1]);

@@ -1590,20 +1590,20 @@ impl Interaction {
         }
     }
 
-    /// One round of valleys (Alg. 2.5) grown from the whole ridge network.
+    /// One round of valleys (Alg. 2.5) grown from the clicked ridgeline or tree.
     fn grow(&mut self, editor: &mut Editor, part: ridge::Part) {
         let doc = editor.document();
         let seed = doc
             .ridges
             .as_ref()
             .map_or(0, |r| (r.lines.len() + r.trees.len()) as u64);
-        match ridge::grown(doc, seed) {
+        match ridge::grown(doc, part, seed) {
             Ok((ridges, n)) => {
                 let slope = ridges.slope;
                 if self.commit(editor, Edit::SetRidges { ridges: Some(ridges) }, "the grown valleys") {
                     self.stats.grown += 1;
                     self.say(format!(
-                        "grew {n} valley lines from {} and the rest; slope now {slope:.0}°",
+                        "grew {n} valley lines from {}; slope now {slope:.0}°",
                         part.name()
                     ));
                 }

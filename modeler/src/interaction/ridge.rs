@@ -19,8 +19,8 @@
 //!   SW2 (or lifting after a slide) records it as one undoable edit.
 //! - **Flank slope**: holding a node, SW3 held and the pen moved sideways sets α for all
 //!   ridgelines: left steeper, right gentler, [`SLOPE_DEG_PER_MM`] per mm, live.
-//! - **Grow valleys**: an SW3 click over a ridgeline or tree grows one round of Alg. 2.5 from the
-//!   whole network (elsewhere the click undoes, as everywhere).
+//! - **Grow valleys**: an SW3 click over a ridgeline or tree grows one round of Alg. 2.5 from it,
+//!   on the terrain of the whole network (elsewhere the click undoes, as everywhere).
 //! - **Delete**: the Delete key removes the highlighted ridgeline or tree.
 
 use glam::DVec2;
@@ -301,9 +301,10 @@ pub fn with_node(ridges: &Ridges, (part, k): (Part, usize), by: Point, height: O
     r
 }
 
-/// The ridges with one round of Alg. 2.5 grown from all their lines and trees (`seed`), the
-/// grown lines added and the slope the round's next; `Err` names why it cannot grow.
-pub fn grown(doc: &Document, seed: u64) -> Result<(Ridges, usize), String> {
+/// The ridges with one round of Alg. 2.5 grown from `from` (`seed`) on the DTM of all their
+/// lines and trees, the grown lines added and the slope the next round's; `Err` names why it
+/// cannot grow.
+pub fn grown(doc: &Document, from: Part, seed: u64) -> Result<(Ridges, usize), String> {
     let r = doc.ridges.as_ref().ok_or("no ridgelines to grow from")?;
     let grid = doc.grid;
     let base: Vec<_> = layer::skeletons(r)
@@ -311,9 +312,15 @@ pub fn grown(doc: &Document, seed: u64) -> Result<(Ridges, usize), String> {
         .into_iter()
         .map(|(_, s)| s)
         .collect();
+    let k = match from {
+        Part::Line(i) => i,
+        Part::Tree(j) => r.lines.len() + j,
+    };
+    let first = base.get(k).cloned().ok_or("no such ridgeline")?;
     let g = Growth::new(1, seed, grid.cell_size);
-    let out = grow::grow(
+    let out = grow::grow_from(
         &base,
+        &[first],
         (grid.cols, grid.rows, grid.cell_size),
         layer::filter_of(r),
         r.slope.to_radians(),

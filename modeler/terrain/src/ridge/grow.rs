@@ -63,6 +63,19 @@ pub struct Grown {
 /// `slope`) on a `cols × rows` grid of `cell` metres.
 pub fn grow(
     base: &[Skeleton],
+    grid: (u32, u32, f64),
+    filter: Filter,
+    slope: f64,
+    g: Growth,
+) -> Result<Grown, RidgeError> {
+    grow_from(base, base, grid, filter, slope, g)
+}
+
+/// As [`grow`], but the first round's drops fall from `first` only (the pen's click on one
+/// ridgeline); the DTM of every round is still that of all of `base` and the grown lines.
+pub fn grow_from(
+    base: &[Skeleton],
+    first: &[Skeleton],
     (cols, rows, cell): (u32, u32, f64),
     filter: Filter,
     slope: f64,
@@ -88,7 +101,7 @@ pub fn grow(
     let mut rng = ChaCha8Rng::seed_from_u64(g.seed);
     let mut lines: Vec<Vec<[f64; 3]>> = Vec::new();
     // The lines drops fall from: the base, then each round's new lines.
-    let mut sources: Vec<Skeleton> = base.to_vec();
+    let mut sources: Vec<Skeleton> = first.to_vec();
     let (mut alpha, mut d) = (slope, g.spacing);
     for _ in 0..g.rounds {
         let mut all: Vec<Skeleton> = base
