@@ -362,6 +362,9 @@ impl Shape {
         let old_owner = std::mem::take(&mut self.near.owner);
         let mut lake_cells: Vec<(usize, u16)> = Vec::new();
         for (i, &o) in old_owner.iter().enumerate() {
+            if cuts.is_empty() {
+                break;
+            }
             if o == NONE || self.mask[i] == 0 {
                 continue;
             }
@@ -378,26 +381,23 @@ impl Shape {
             near::sweep_segment(&self.window, &mut self.mask, neck.0, neck.1, self.radius);
             self.necks.push((neck.0 + neck.1) * 0.5);
         }
-        // The plug: lake cells next to the river's new course silt up.
-        for (i, l) in self.lakes.iter_mut().enumerate() {
-            if *l != 0 && (f64::from(self.near.dist[i]) <= self.radius + PLUG || self.mask[i] != 0) {
+        // The plug: lake cells next to the river's new course silt up; in the same pass, the
+        // river's area and each lake's.
+        let mut lake_area = vec![0usize; self.necks.len() + 1];
+        let mut area = 0;
+        let plug = self.radius + PLUG;
+        for ((l, &m), &d) in self.lakes.iter_mut().zip(&self.mask).zip(&self.near.dist) {
+            if *l != 0 && (f64::from(d) <= plug || m != 0) {
                 *l = 0;
             }
+            area += usize::from(m != 0);
+            lake_area[*l as usize] += 1;
         }
         let first_new = self.necks.len() - cuts.len();
-        for k in first_new..self.necks.len() {
-            let area = self.lakes.iter().filter(|&&l| l as usize == k + 1).count();
-            record.oxbows.push(area);
-        }
-        record.area = self.mask.iter().filter(|&&m| m != 0).count();
-        record.lake_area = self.lakes.iter().filter(|&&l| l != 0).count();
-        record.lakes = {
-            let mut seen = vec![false; self.necks.len() + 1];
-            for &l in &self.lakes {
-                seen[l as usize] = true;
-            }
-            seen.iter().skip(1).filter(|&&s| s).count()
-        };
+        record.oxbows = lake_area[first_new + 1..].to_vec();
+        record.area = area;
+        record.lake_area = lake_area[1..].iter().sum();
+        record.lakes = lake_area[1..].iter().filter(|&&a| a > 0).count();
         self.history.push(record);
     }
 
@@ -475,7 +475,7 @@ impl Shape {
         // Buckets of `reach` cells: a close pair is in the same or neighbouring buckets.
         let b = reach.max(1.0);
         let key = |p: DVec2| ((p.x / b).floor() as i64, (p.y / b).floor() as i64);
-        let mut buckets: std::collections::HashMap<(i64, i64), Vec<usize>> = std::collections::HashMap::new();
+        let mut buckets: std::collections::HashMap<(i64, i64), Vec<usize>, CellHash> = Default::default();
         for (i, p) in pts.iter().enumerate() {
             buckets.entry(key(*p)).or_default().push(i);
         }
@@ -514,3 +514,30 @@ impl Shape {
         (out, cuts)
     }
 }
+
+/// A hasher for small integer keys (bucket coordinates): a multiply and a rotate per word, where
+/// the default SipHash was a tenth of a step. No key comes from outside.
+#[derive(Default)]
+struct CellHasher(u64);
+
+impl std::hash::Hasher for CellHasher {
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+
+    fn write_u64(&mut self, n: u64) {
+        self.0 = (self.0.rotate_left(5) ^ n).wrapping_mul(0x517c_c1b7_2722_0a95);
+    }
+
+    fn write_i64(&mut self, n: i64) {
+        self.write_u64(n as u64);
+    }
+
+    fn finish(&self) -> u64 {
+        self.0
+    }
+}
+
+type CellHash = std::hash::BuildHasherDefault<CellHasher>;

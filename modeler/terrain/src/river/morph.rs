@@ -112,11 +112,53 @@ pub fn distance_to_other(image: &[u8], width: usize, height: usize) -> Vec<u16> 
             }
         }
     }
-    transform(&mut d, width, height, FAR);
+    separable(&mut d, width, height);
     for v in &mut d {
         *v = v.saturating_add(1);
     }
     d
+}
+
+/// The exact city-block distance transform of `d` (0 at the targets, [`FAR`] elsewhere, nothing
+/// beyond the edge), as two 1-D passes: along each row, then down and up each column (the
+/// city-block distance is the least `|dy|` + the row distance of row `y + dy`). Rows are
+/// independent, and so are columns, so each pass runs as two halves on the thread pool; the
+/// distance is unique, so this equals [`transform`]'s.
+fn separable(d: &mut [u16], width: usize, height: usize) {
+    let rows = |chunk: &mut [u16]| {
+        for row in chunk.chunks_mut(width) {
+            let mut left = FAR;
+            for v in row.iter_mut() {
+                left = (*v).min(left.saturating_add(1));
+                *v = left;
+            }
+            let mut right = FAR;
+            for v in row.iter_mut().rev() {
+                right = (*v).min(right.saturating_add(1));
+                *v = right;
+            }
+        }
+    };
+    let (top, bottom) = d.split_at_mut(height / 2 * width);
+    rayon::join(|| rows(top), || rows(bottom));
+    // Columns: each half of every row, down then up, vectorised along the row.
+    let columns = |mut part: Vec<&mut [u16]>| {
+        for r in 1..part.len() {
+            let (above, here) = part.split_at_mut(r);
+            for (v, &u) in here[0].iter_mut().zip(above[r - 1].iter()) {
+                *v = (*v).min(u.saturating_add(1));
+            }
+        }
+        for r in (0..part.len().saturating_sub(1)).rev() {
+            let (here, below) = part.split_at_mut(r + 1);
+            for (v, &u) in here[r].iter_mut().zip(below[0].iter()) {
+                *v = (*v).min(u.saturating_add(1));
+            }
+        }
+    };
+    let (left, right): (Vec<&mut [u16]>, Vec<&mut [u16]>) =
+        d.chunks_mut(width).map(|row| row.split_at_mut(width / 2)).unzip();
+    rayon::join(|| columns(left), || columns(right));
 }
 
 /// The image dilated by the diamond of `level` (the cells within `level − 1` of the set).
