@@ -8,7 +8,7 @@
 //! which runs this machine's `penmodel rocks` on the same radius and area in the same run.
 //!
 //! `reseat/fig1/512`: fig. 1's rocks stood again on a changed 512² terrain (the edit target:
-//! one frame, ≤ 5 ms).
+//! one frame, ≤ 5 ms); `reseat-move/fig1/512`: the same after each move of the field.
 //!
 //! Run: `cargo bench -p penmodel-terrain --bench rocks` (filter with e.g. `-- fig1`).
 
@@ -72,13 +72,14 @@ fn bench(c: &mut Criterion) {
         least(|t| t.total),
         median,
     );
-    // One thread's CPU time per scatter (see `thread_cpu_ns`): the fastest of five.
+    // One thread's CPU time per scatter (see `thread_cpu_ns`): the fastest of five (none with
+    // `ROCKS_COLD_RUNS=0`).
     let one = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
         .expect("a pool of one thread");
     let cpu = one.install(|| {
-        (0..5)
+        (0..cold.min(5))
             .filter_map(|_| {
                 let before = thread_cpu_ns()?;
                 let s = scatter(&fig1, None).expect("fig. 1 is a valid recipe");
@@ -117,29 +118,56 @@ fn bench(c: &mut Criterion) {
         cell_size: 1.0,
     };
     let flat = place::Flat::of(&once);
-    let mut seated = flat.seat(at, place::ground(&map));
+    let ground = place::ground(&map);
+    let mut seated = flat.seat(at, ground.surface());
+    let mut samples = place::Samples::default();
     let t = std::time::Instant::now();
-    flat.seat_into(at, place::ground(&map), &mut seated);
+    flat.seat_on(at, &map, &mut samples, &mut seated);
     eprintln!(
         "reseat/fig1/512: {} vertices, {} triangles, once {:.2} ms",
         flat.vertices.len(),
         flat.indices.len() / 3,
         t.elapsed().as_secs_f64() * 1e3
     );
+    // Moving the field: every re-seat at another place (a third of a cell apart, so every vertex
+    // falls elsewhere in its heightmap square), finding every vertex's square again.
+    let moves = [
+        at,
+        Placement {
+            origin: [1.0 / 3.0, 2.0 / 3.0],
+            ..at
+        },
+    ];
     // CPU time of one thread per re-seat, which other processes on a loaded machine do not
-    // inflate as they do wall time (Linux: the scheduler's count for the thread).
-    let per_reseat = one.install(|| {
-        let before = thread_cpu_ns()?;
-        for _ in 0..50 {
-            flat.seat_into(at, place::ground(&map), &mut seated);
-        }
-        Some((thread_cpu_ns()? - before) as f64 / 50.0 / 1e6)
-    });
-    if let Some(ms) = per_reseat {
-        eprintln!("reseat/fig1/512: one thread, CPU time {ms:.2} ms a re-seat (50 re-seats)");
+    // inflate as they do wall time (Linux: the scheduler's count for the thread). 50 re-seats
+    // of each kind (one with `ROCKS_COLD_RUNS=0`, to count their instructions).
+    let reseats = if cold == 0 { 1 } else { 50 };
+    let mut cpu_per = |moving: bool| {
+        one.install(|| {
+            let before = thread_cpu_ns()?;
+            for step in 0..reseats {
+                let at = if moving { moves[(step + 1) % 2] } else { at };
+                flat.seat_on(at, &map, &mut samples, &mut seated);
+            }
+            Some((thread_cpu_ns()? - before) as f64 / reseats as f64 / 1e6)
+        })
+    };
+    if let (Some(moving), Some(still)) = (cpu_per(true), cpu_per(false)) {
+        eprintln!(
+            "reseat/fig1/512: one thread, CPU time {still:.2} ms a re-seat after a terrain change, {moving:.2} ms after a move ({reseats} re-seats each)"
+        );
     }
+    // The terrain changed under the field (the same place: the heights are read again).
+    flat.seat_on(at, &map, &mut samples, &mut seated);
     g.bench_function("reseat/fig1/512", |b| {
-        b.iter(|| black_box(&flat).seat_into(at, place::ground(&map), &mut seated))
+        b.iter(|| black_box(&flat).seat_on(at, &map, &mut samples, &mut seated))
+    });
+    let mut step = 0;
+    g.bench_function("reseat-move/fig1/512", |b| {
+        b.iter(|| {
+            step += 1;
+            black_box(&flat).seat_on(moves[step % 2], &map, &mut samples, &mut seated)
+        })
     });
     // The rocks' triangulations alone: ours against delaunator on the same point sets.
     let sets: Vec<(Vec<[f64; 2]>, usize)> = once

@@ -340,3 +340,38 @@ fn an_edit_away_from_a_field_leaves_its_rocks_alone() {
         &Rocks::of(ed.document()).seated(ed.heightmap())[..]
     );
 }
+
+/// Pulls under a field one after another (the editor finds where each vertex reads the
+/// heightmap on its second seat at a place and reads only the heights after that), moves
+/// between them: after each edit the editor's rocks are what seating afresh gives, and stand on
+/// the terrain by the test's own interpolation.
+#[test]
+fn rocks_follow_successive_pulls_and_moves() {
+    let mut ed = Editor::new(doc()).expect("valid");
+    let pull = |ed: &mut Editor, height: f64| {
+        ed.apply(Edit::SetHeight {
+            at: FigurePath::new(0, 0),
+            height,
+        })
+        .expect("pulled");
+    };
+    let same = |ed: &Editor| {
+        assert_eq!(
+            ed.rocks().meshes(),
+            &Rocks::of(ed.document()).seated(ed.heightmap())[..]
+        );
+        assert!(check_seated(&Rocks::of(ed.document()), ed.heightmap()) > 100);
+    };
+    for (k, height) in [40.0, 55.0, 20.0, 65.0].into_iter().enumerate() {
+        pull(&mut ed, height);
+        same(&ed);
+        if k == 1 {
+            ed.apply(Edit::MoveRocks {
+                index: 0,
+                by: [1.3, -0.7],
+            })
+            .expect("moved");
+            same(&ed);
+        }
+    }
+}

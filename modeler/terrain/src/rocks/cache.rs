@@ -95,7 +95,8 @@ impl Rocks {
 
     /// Each field's rocks standing on `map`, as meshes named `rocks N` in the exports' frame.
     pub fn seated(&self, map: &Heightmap) -> Vec<(String, Mesh)> {
-        let ground = place::ground(map);
+        let g = place::ground(map);
+        let ground = g.surface();
         self.fields
             .iter()
             .enumerate()
@@ -118,6 +119,8 @@ pub struct Seated {
     rocks: Rocks,
     /// Per mesh, the rocks and the place it was seated with.
     seated_as: Vec<Option<(Arc<Flat>, Placement)>>,
+    /// Per mesh, where its vertices read the heightmap (found again only when the field moves).
+    samples: Vec<place::Samples>,
     /// Shared with the pictures being drawn; copied on write only while one holds it.
     meshes: Arc<Vec<(String, Mesh)>>,
 }
@@ -142,7 +145,7 @@ impl Seated {
         self.rocks.update(doc);
         let n = self.rocks.fields.len();
         self.seated_as.resize(n, None);
-        let ground = place::ground(map);
+        self.samples.resize(n, place::Samples::default());
         let s = map.cell_size();
         let placements: Vec<Placement> = self
             .rocks
@@ -201,12 +204,14 @@ impl Seated {
                     .is_some_and(|(flat, _)| Arc::ptr_eq(flat, &f.flat));
                 if !same_rocks {
                     *mesh = Mesh::default();
+                    self.samples[i].clear();
                 }
-                f.flat.seat_into(placements[i], &ground, mesh);
+                f.flat.seat_on(placements[i], map, &mut self.samples[i], mesh);
                 self.seated_as[i] = Some((Arc::clone(&f.flat), placements[i]));
             }
         }
         self.seated_as.truncate(n);
+        self.samples.truncate(n);
     }
 
     /// Each field's rocks as a mesh named `rocks N`, in the exports' frame.

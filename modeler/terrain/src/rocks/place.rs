@@ -161,6 +161,117 @@ impl Flat {
     }
 }
 
+impl Flat {
+    /// Stands the rocks on heightmap `map` at `at` in `mesh`, as [`Flat::seat_into`] with
+    /// [`ground`], and keeps in `samples` where each vertex reads the heightmap. When the place
+    /// and the grid are those of the last call with the same `samples` and `mesh`, only the
+    /// heights are read again: a change of the terrain under a field leaves every vertex's
+    /// square of the heightmap, its weights and its x and z as they were (finding them was
+    /// about half of a re-seat). The samples are written on the second seat at a place, not
+    /// while the field moves. `samples` belongs to `mesh` (clear it when the mesh is reset).
+    pub fn seat_on(&self, at: Placement, map: &Heightmap, samples: &mut Samples, mesh: &mut Mesh) {
+        let g = ground(map);
+        let key = Some((at, map.cols(), map.rows(), map.cell_size().to_bits()));
+        let n = self.vertices.len();
+        let again = samples.key == key
+            && samples.at.len() == n
+            && mesh.positions.len() == n
+            && mesh.normals.len() == n
+            && mesh.indices.len() == self.indices.len()
+            && g.wide;
+        // The samples are found on the second seat at one place: while a field is being moved
+        // every seat is at a new place, and writing them would only slow those seats down.
+        if !again && samples.last != key {
+            samples.key = None;
+            samples.last = key;
+            return self.seat_into(at, g.surface(), mesh);
+        }
+        samples.last = key;
+        if !again {
+            samples.key = None;
+            samples.at.resize(n, Sample::default());
+        }
+        if mesh.indices.len() != self.indices.len() {
+            mesh.indices.clone_from(&self.indices);
+        }
+        mesh.positions.resize(n, [0.0; 3]);
+        mesh.normals.resize(n, [0.0; 3]);
+        let mut parts = Vec::with_capacity(self.blocks.len());
+        let (mut positions, mut normals, mut sampled) =
+            (&mut mesh.positions[..], &mut mesh.normals[..], &mut samples.at[..]);
+        for w in self.blocks.windows(2) {
+            let len = w[1].0 - w[0].0;
+            let (p, rest_p) = std::mem::take(&mut positions).split_at_mut(len);
+            let (q, rest_q) = std::mem::take(&mut normals).split_at_mut(len);
+            let (r, rest_r) = std::mem::take(&mut sampled).split_at_mut(len);
+            (positions, normals, sampled) = (rest_p, rest_q, rest_r);
+            parts.push((w[0], w[1], p, q, r));
+        }
+        parts
+            .into_par_iter()
+            .for_each(|((v0, k0), (_, k1), out, norms, sampled)| {
+                for w in self.starts[k0..=k1].windows(2) {
+                    let ((a, t0), (b, t1)) = (w[0], w[1]);
+                    let (a, b) = (a as usize - v0, b as usize - v0);
+                    let verts = &self.vertices[a + v0..b + v0];
+                    let (out, sampled) = (&mut out[a..b], &mut sampled[a..b]);
+                    if again {
+                        for ((o, v), q) in out.iter_mut().zip(verts).zip(&*sampled) {
+                            o[1] = (g.at(*q) + f64::from(v[2]) * at.cell_size) as f32;
+                        }
+                    } else {
+                        for ((o, v), q) in out.iter_mut().zip(verts).zip(sampled.iter_mut()) {
+                            let (x, y) = place(at, *v);
+                            *q = g.sample(x, y);
+                            *o = [x as f32, (g.at(*q) + f64::from(v[2]) * at.cell_size) as f32, y as f32];
+                        }
+                    }
+                    normals_of(out, &self.local[t0 as usize..t1 as usize], &mut norms[a..b]);
+                }
+            });
+        samples.key = key;
+    }
+}
+
+/// Where the vertices of a [`Flat`] read a heightmap, for [`Flat::seat_on`].
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Samples {
+    /// The place and the grid (columns, rows, cell size's bits) they were found for.
+    key: Option<(Placement, u32, u32, u64)>,
+    /// The same for the last seat, with or without samples.
+    last: Option<(Placement, u32, u32, u64)>,
+    at: Vec<Sample>,
+}
+
+impl Samples {
+    /// Forgets them (the next seat finds them again).
+    pub fn clear(&mut self) {
+        self.key = None;
+        self.last = None;
+        self.at.clear();
+    }
+}
+
+/// A point's square of the heightmap and its place in it.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Sample {
+    /// The square's upper left centre, `row · columns + column`.
+    corner: u32,
+    /// Along the columns and the rows, 0 to 1 (as computed, so that a height read again is the
+    /// one [`Ground::height`] gives).
+    u: f64,
+    v: f64,
+}
+
+/// Vertex `v`'s `(x, y)` in metres at `at`.
+#[inline]
+fn place(at: Placement, v: [f32; 3]) -> (f64, f64) {
+    (
+        at.origin[0] + f64::from(v[0]) * at.cell_size,
+        at.origin[1] + f64::from(v[1]) * at.cell_size,
+    )
+}
+
 /// Stands one rock: its vertices on `ground`, then its normals from its triangles (indices into
 /// its own vertices, so every access stays within a few hundred bytes), summed in triangle
 /// order and normalised.
@@ -174,12 +285,21 @@ fn seat_rock(
     norms: &mut [[f32; 3]],
 ) {
     for (o, v) in out.iter_mut().zip(verts) {
-        let v = v.map(f64::from);
-        let (x, y) = (at.origin[0] + v[0] * at.cell_size, at.origin[1] + v[1] * at.cell_size);
-        *o = [x as f32, (ground(x, y) + v[2] * at.cell_size) as f32, y as f32];
+        let (x, y) = place(at, *v);
+        *o = [
+            x as f32,
+            (ground(x, y) + f64::from(v[2]) * at.cell_size) as f32,
+            y as f32,
+        ];
     }
+    normals_of(out, tris, norms);
+}
+
+/// A rock's normals from its positions and its triangles (indices into its own vertices, so
+/// every access stays within a few hundred bytes): summed in triangle order and normalised.
+#[inline(always)]
+fn normals_of(out: &[[f32; 3]], tris: &[[u16; 3]], norms: &mut [[f32; 3]]) {
     norms.fill([0.0; 3]);
-    let out = &*out;
     for t in tris {
         let [a, b, c] = t.map(usize::from);
         let (pa, pb, pc) = (out[a], out[b], out[c]);
@@ -207,35 +327,81 @@ fn seat_rock(
     }
 }
 
-/// The terrain's height at `(x, y)` metres, on the surface its mesh draws: heights at cell
+/// The terrain's surface, its height at `(x, y)` metres the one its mesh draws: heights at cell
 /// centres, two triangles per square of four centres split along the diagonal from the upper
 /// right to the lower left centre (as [`crate::export::Mesh`]); held flat beyond the outer
 /// centres.
-pub fn ground(map: &Heightmap) -> impl Fn(f64, f64) -> f64 + Sync + '_ {
-    let (cols, rows, s) = (map.cols(), map.rows(), map.cell_size());
-    let h = map.heights();
-    let (last_c, last_r) = (f64::from(cols - 1), f64::from(rows - 1));
-    let (max_c, max_r) = (cols.saturating_sub(2), rows.saturating_sub(2));
-    // With two or more columns and rows, the square's four corners are in the grid as they are
-    // (`c ≤ cols − 2`); only a grid one cell wide needs its indices held in.
-    let wide = cols >= 2 && rows >= 2;
-    let stride = cols as usize;
-    // Multiplied, not divided: two divisions per rock vertex were a tenth of a re-seat.
-    let per_metre = 1.0 / s;
-    move |x: f64, y: f64| {
-        let fx = (x * per_metre - 0.5).clamp(0.0, last_c);
-        let fy = (y * per_metre - 0.5).clamp(0.0, last_r);
-        let (c, r) = ((fx as u32).min(max_c), (fy as u32).min(max_r));
-        let (u, v) = (fx - f64::from(c), fy - f64::from(r));
-        let (a, b, d, e) = if wide {
-            let i = r as usize * stride + c as usize;
-            let (top, bottom) = (&h[i..i + 2], &h[i + stride..i + stride + 2]);
-            (top[0], top[1], bottom[0], bottom[1])
+pub fn ground(map: &Heightmap) -> Ground<'_> {
+    let (cols, rows) = (map.cols(), map.rows());
+    Ground {
+        h: map.heights(),
+        cols,
+        rows,
+        last: [f64::from(cols - 1), f64::from(rows - 1)],
+        max: [cols.saturating_sub(2), rows.saturating_sub(2)],
+        // With two or more columns and rows, the square's four corners are in the grid as they
+        // are (`c ≤ cols − 2`); only a grid one cell wide needs its indices held in.
+        wide: cols >= 2 && rows >= 2,
+        // Multiplied, not divided: two divisions per rock vertex were a tenth of a re-seat.
+        per_metre: 1.0 / map.cell_size(),
+    }
+}
+
+/// A heightmap's surface ([`ground`]): [`Ground::height`], or a point's [`Sample`] found once
+/// and its height read at each change of the terrain ([`Ground::at`]).
+#[derive(Debug, Clone, Copy)]
+pub struct Ground<'a> {
+    h: &'a [f32],
+    cols: u32,
+    rows: u32,
+    last: [f64; 2],
+    max: [u32; 2],
+    wide: bool,
+    per_metre: f64,
+}
+
+impl<'a> Ground<'a> {
+    /// The height at `(x, y)` metres.
+    #[inline(always)]
+    pub fn height(&self, x: f64, y: f64) -> f64 {
+        self.at(self.sample(x, y))
+    }
+
+    /// Where `(x, y)` metres reads the heightmap.
+    #[inline(always)]
+    pub fn sample(&self, x: f64, y: f64) -> Sample {
+        let fx = (x * self.per_metre - 0.5).clamp(0.0, self.last[0]);
+        let fy = (y * self.per_metre - 0.5).clamp(0.0, self.last[1]);
+        let (c, r) = ((fx as u32).min(self.max[0]), (fy as u32).min(self.max[1]));
+        Sample {
+            corner: r * self.cols + c,
+            u: fx - f64::from(c),
+            v: fy - f64::from(r),
+        }
+    }
+
+    /// The height at sample `q`.
+    // Inlined into the seating loops (called, it took a third of a re-seat, reloading the
+    // ground's fields at every vertex).
+    #[inline(always)]
+    pub fn at(&self, q: Sample) -> f64 {
+        let h = self.h;
+        let i = q.corner as usize;
+        let (a, b, d, e) = if self.wide {
+            let stride = self.cols as usize;
+            // Two range checks for the square's four corners.
+            match (h.get(i..i + 2), h.get(i + stride..i + stride + 2)) {
+                (Some(&[a, b]), Some(&[d, e])) => (a, b, d, e),
+                _ => (0.0, 0.0, 0.0, 0.0),
+            }
         } else {
+            let (cols, rows) = (self.cols, self.rows);
+            let (c, r) = (q.corner % cols, q.corner / cols);
             let at = |c: u32, r: u32| h[(r.min(rows - 1) * cols + c.min(cols - 1)) as usize];
             (at(c, r), at(c + 1, r), at(c, r + 1), at(c + 1, r + 1))
         };
         let (a, b, d, e) = (f64::from(a), f64::from(b), f64::from(d), f64::from(e));
+        let (u, v) = (q.u, q.v);
         // The lower triangle `a + u·(b − a) + v·(d − a)` or the upper one, `e + (1 − u)·(d − e)
         // + (1 − v)·(b − e)` = `(b + d − e) + u·(e − d) + v·(e − b)`, blended by a 0 or 1
         // rather than branched on: which half a rock vertex falls in is random, and the
@@ -245,6 +411,11 @@ pub fn ground(map: &Heightmap) -> impl Fn(f64, f64) -> f64 + Sync + '_ {
         let along_u = (b - a) + upper * (e - d - (b - a));
         let along_v = (d - a) + upper * (e - b - (d - a));
         base + u * along_u + v * along_v
+    }
+
+    /// The same as a function of `(x, y)`, for [`Flat::seat_into`] and [`mesh`].
+    pub fn surface(self) -> impl Fn(f64, f64) -> f64 + Sync + 'a {
+        move |x, y| self.height(x, y)
     }
 }
 
