@@ -108,6 +108,17 @@ pub struct Picture {
     water: Arc<Vec<(String, Mesh)>>,
 }
 
+/// A tool button's outline: bright and thick while its tool is on.
+fn button(points: Vec<Point>, on: bool) -> Overlay {
+    Overlay {
+        points,
+        closed: true,
+        colour: if on { PALETTE_ON_COLOUR } else { PALETTE_OFF_COLOUR },
+        width: if on { 5.0 } else { 2.0 },
+        height: None,
+    }
+}
+
 fn dot(at: Point, height: Option<f64>, colour: Rgba, width: f32) -> Overlay {
     Overlay {
         points: vec![at],
@@ -263,17 +274,7 @@ impl Picture {
                 height: None,
             });
         }
-        overlays.push(Overlay {
-            points: rocks::palette_outline(view),
-            closed: true,
-            colour: if ui.tool() == Tool::Rocks {
-                PALETTE_ON_COLOUR
-            } else {
-                PALETTE_OFF_COLOUR
-            },
-            width: if ui.tool() == Tool::Rocks { 5.0 } else { 2.0 },
-            height: None,
-        });
+        overlays.push(button(rocks::palette_outline(view), ui.tool() == Tool::Rocks));
         // Rivers: each control polygon and its points (the held river as the pen makes it), the
         // next iteration's erosion and deposition while one is edited, the river button.
         let moving_river = ui.river_moving(doc);
@@ -302,17 +303,7 @@ impl Picture {
             overlays.extend(erosion.iter().map(|p| dot(*p, None, EROSION_COLOUR, 2.0)));
             overlays.extend(deposition.iter().map(|p| dot(*p, None, DEPOSITION_COLOUR, 2.0)));
         }
-        overlays.push(Overlay {
-            points: river::palette_outline(view),
-            closed: true,
-            colour: if ui.tool() == Tool::Rivers {
-                PALETTE_ON_COLOUR
-            } else {
-                PALETTE_OFF_COLOUR
-            },
-            width: if ui.tool() == Tool::Rivers { 5.0 } else { 2.0 },
-            height: None,
-        });
+        overlays.push(button(river::palette_outline(view), ui.tool() == Tool::Rivers));
         // Ridgelines and trees (their nodes as dots with the ridge tool), the ridge stroke being
         // drawn (its air part at the pen's height), the ridge button.
         let ridges_on = ui.tool() == Tool::Ridges;
@@ -352,17 +343,7 @@ impl Picture {
                 dot(s.at, h, DRAWING_COLOUR, 3.0)
             }));
         }
-        overlays.push(Overlay {
-            points: ridge::palette_outline(view),
-            closed: true,
-            colour: if ridges_on {
-                PALETTE_ON_COLOUR
-            } else {
-                PALETTE_OFF_COLOUR
-            },
-            width: if ridges_on { 5.0 } else { 2.0 },
-            height: None,
-        });
+        overlays.push(button(ridge::palette_outline(view), ridges_on));
         if let Some(drawn) = ui.drawing() {
             overlays.push(Overlay {
                 points: drawn.to_vec(),

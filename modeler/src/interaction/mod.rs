@@ -28,6 +28,7 @@
 //! a report (device found or lost) do not move it.
 //! A refused edit is a message and a count, never a lost document: the editor keeps it valid.
 
+pub mod palette;
 pub mod pick;
 pub mod ridge;
 pub mod river;

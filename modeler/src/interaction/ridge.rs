@@ -28,6 +28,7 @@ use penmodel_terrain::document::{Document, Point, RidgeTree, Ridgeline, Ridges};
 use penmodel_terrain::ridge::grow::{self, Growth};
 use penmodel_terrain::ridge::layer;
 
+use super::palette::Button;
 use super::pick::line_distance;
 use super::view::View;
 
@@ -38,27 +39,22 @@ pub const NODE_MM: f64 = 8.0;
 /// A tree node pulled up sets θ within these limits, degrees (Alg. 2.4 needs (0°, 90°)).
 const THETA_LIMITS: (f64, f64) = (0.5, 85.0);
 
-/// The ridge button's corner on the display, mm.
-fn button(view: &View) -> [f64; 2] {
-    [view.display_mm[0] - 8.0 - BUTTON_MM, 8.0]
+/// The ridge button: in the display's top right corner, 8 mm in.
+fn button(view: &View) -> Button {
+    Button {
+        corner_mm: [view.display_mm[0] - 8.0 - BUTTON_MM, 8.0],
+        side_mm: BUTTON_MM,
+    }
 }
 
 /// Whether display point `(u, v)` mm is on the ridge button.
 pub fn on_palette(view: &View, u_mm: f64, v_mm: f64) -> bool {
-    let [u0, v0] = button(view);
-    (u0..=u0 + BUTTON_MM).contains(&u_mm) && (v0..=v0 + BUTTON_MM).contains(&v_mm)
+    button(view).contains(u_mm, v_mm)
 }
 
 /// The ridge button's outline on the ground (closed), for drawing.
 pub fn palette_outline(view: &View) -> Vec<Point> {
-    let [u0, v0] = button(view);
-    let s = BUTTON_MM;
-    let mut pts: Vec<Point> = [[u0, v0], [u0 + s, v0], [u0 + s, v0 + s], [u0, v0 + s]]
-        .iter()
-        .map(|c| view.to_ground(c[0], c[1]))
-        .collect();
-    pts.push(pts[0]);
-    pts
+    button(view).outline(view)
 }
 
 /// One pen position of a ridge stroke: ground metres and the pen's height, mm (0 on the surface).

@@ -23,10 +23,14 @@ use glam::DVec2;
 use penmodel_terrain::document::{Document, Grid, Point, River};
 use penmodel_terrain::river::{Constants, MAX_ITERATIONS, Shape, course};
 
+use super::palette::Button;
 use super::view::View;
 
-/// The river button's corner and side on the display, mm (below the rock tool's).
-pub const PALETTE_MM: ([f64; 2], f64) = ([8.0, 32.0], 20.0);
+/// The river button on the display (below the rock tool's).
+pub const BUTTON: Button = Button {
+    corner_mm: [8.0, 32.0],
+    side_mm: 20.0,
+};
 /// Gain of the width and depth gestures, per mm.
 pub const GAIN_PER_MM: f64 = 0.02;
 /// A new river's width (the disc radius) on the display, mm.
@@ -46,19 +50,12 @@ pub fn years_held(held_us: u64, click_us: u64) -> u32 {
 
 /// Whether display point `(u, v)` mm is on the river button.
 pub fn on_palette(u_mm: f64, v_mm: f64) -> bool {
-    let ([u0, v0], side) = PALETTE_MM;
-    (u0..=u0 + side).contains(&u_mm) && (v0..=v0 + side).contains(&v_mm)
+    BUTTON.contains(u_mm, v_mm)
 }
 
 /// The river button's outline on the ground (closed), for drawing.
 pub fn palette_outline(view: &View) -> Vec<Point> {
-    let ([u0, v0], s) = PALETTE_MM;
-    let mut pts: Vec<Point> = [[u0, v0], [u0 + s, v0], [u0 + s, v0 + s], [u0, v0 + s]]
-        .iter()
-        .map(|c| view.to_ground(c[0], c[1]))
-        .collect();
-    pts.push(pts[0]);
-    pts
+    BUTTON.outline(view)
 }
 
 /// A river along a stroke (ground metres): its Bézier fit, [`WIDTH_MM`] wide on the display, half

@@ -19,10 +19,14 @@ use penmodel_terrain::Editor;
 use penmodel_terrain::document::{Document, Point, RockField, RockLayer};
 use penmodel_terrain::geometry::{Side, locate};
 
+use super::palette::Button;
 use super::view::View;
 
-/// The palette button's corner and side on the display, mm.
-pub const PALETTE_MM: ([f64; 2], f64) = ([8.0, 8.0], 20.0);
+/// The rock tool's button on the display.
+pub const BUTTON: Button = Button {
+    corner_mm: [8.0, 8.0],
+    side_mm: 20.0,
+};
 /// Gain of the density and size gestures, per mm.
 pub const GAIN_PER_MM: f64 = 0.02;
 /// The largest rocks' radius on the display, mm: sets a new field's cell size.
@@ -44,19 +48,12 @@ pub enum Tool {
 
 /// Whether display point `(u, v)` mm is on the palette button.
 pub fn on_palette(u_mm: f64, v_mm: f64) -> bool {
-    let ([u0, v0], side) = PALETTE_MM;
-    (u0..=u0 + side).contains(&u_mm) && (v0..=v0 + side).contains(&v_mm)
+    BUTTON.contains(u_mm, v_mm)
 }
 
 /// The palette button's outline on the ground (closed), for drawing.
 pub fn palette_outline(view: &View) -> Vec<Point> {
-    let ([u0, v0], s) = PALETTE_MM;
-    let mut pts: Vec<Point> = [[u0, v0], [u0 + s, v0], [u0 + s, v0 + s], [u0, v0 + s]]
-        .iter()
-        .map(|c| view.to_ground(c[0], c[1]))
-        .collect();
-    pts.push(pts[0]);
-    pts
+    BUTTON.outline(view)
 }
 
 /// The field whose outline holds ground point `g`, the last drawn first.
