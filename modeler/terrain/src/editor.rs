@@ -564,16 +564,7 @@ impl Editor {
             ridges: self.doc.ridges.clone(),
         };
         let inverse = Edit::SetRidges { ridges: old };
-        if let Err(e) = self.log(&Entry::Do { edit: edit.clone() }) {
-            self.change(&inverse)?;
-            return Err(e);
-        }
-        self.push_undo(UndoStep {
-            edit: edit.clone(),
-            inverse,
-        });
-        self.redo.clear();
-        Ok(Some(edit))
+        self.record_previewed(edit, inverse).map(Some)
     }
 
     /// Records the previewed values as one undoable step (a `set_height`, a `set_slope`, or a
@@ -598,6 +589,12 @@ impl Editor {
         } else {
             (Edit::Group { edits }, Edit::Group { edits: inverse })
         };
+        self.record_previewed(edit, inverse).map(Some)
+    }
+
+    /// Journals a preview already applied as `edit` and makes it one undo step; if the journal
+    /// cannot be written, undoes it with `inverse` and returns the error.
+    fn record_previewed(&mut self, edit: Edit, inverse: Edit) -> Result<Edit, EditorError> {
         if let Err(e) = self.log(&Entry::Do { edit: edit.clone() }) {
             self.change(&inverse)?;
             return Err(e);
@@ -607,7 +604,7 @@ impl Editor {
             inverse,
         });
         self.redo.clear();
-        Ok(Some(edit))
+        Ok(edit)
     }
 
     /// Restores the values from before an unrecorded preview; `None` when there is none.
