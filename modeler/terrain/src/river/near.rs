@@ -126,18 +126,15 @@ fn fill(
             // Squared distances while searching; the roots once at the end.
             let d = p.distance_squared(a + ab * t) as f32;
             let j = i - base;
-            if d < dist[j] {
-                dist[j] = d;
-                owner[j] = if t < 0.5 { k as u32 } else { k as u32 + 1 };
-                let cross = ab.perp_dot(p - a);
-                side[j] = if cross > 1e-9 {
-                    1
-                } else if cross < -1e-9 {
-                    -1
-                } else {
-                    0
-                };
-            }
+            // Without a branch: which segment is nearest changes from cell to cell in no
+            // pattern a predictor learns.
+            let better = d < dist[j];
+            let cross = ab.perp_dot(p - a);
+            let s = i8::from(cross > 1e-9) - i8::from(cross < -1e-9);
+            let o = if t < 0.5 { k as u32 } else { k as u32 + 1 };
+            dist[j] = if better { d } else { dist[j] };
+            owner[j] = if better { o } else { owner[j] };
+            side[j] = if better { s } else { side[j] };
         });
     }
     for d in dist.iter_mut() {
