@@ -107,12 +107,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let (editor, _) = Editor::open_read_only(&args.doc)?;
     let map = editor.heightmap();
-    let field = Field {
-        z: map.heights(),
-        cols: map.cols(),
-        rows: map.rows(),
-        cell: map.cell_size(),
-    };
+    let field = Field::of(map);
     if args.flow.is_some() || args.ridges.is_some() || args.valleys.is_some() {
         let t = Instant::now();
         let next = rain::directions(field.z, field.cols, field.rows, field.cell);

@@ -211,12 +211,7 @@ pub fn run(args: &Args) -> Result<()> {
     let light = match args.sun {
         Some((az, el)) => {
             let sun = SunPosition::degrees(az, el, "--sun").map_err(|e| anyhow::anyhow!(e))?;
-            let field = Field {
-                z: map.heights(),
-                cols: map.cols(),
-                rows: map.rows(),
-                cell: map.cell_size(),
-            };
+            let field = Field::of(map);
             Some(sun::insolation(&sun::direct(field, sun), &sun::sky_view(field, 32)))
         }
         None => None,

@@ -29,6 +29,7 @@ use rayon::prelude::*;
 
 use super::RidgeError;
 use super::gradient::sobel;
+use crate::Heightmap;
 
 /// The diffuse share of clear-sky light used by [`insolation`].
 pub const DIFFUSE: f64 = 0.2;
@@ -74,6 +75,18 @@ pub struct Field<'a> {
     pub rows: u32,
     /// Cell size, metres.
     pub cell: f64,
+}
+
+impl<'a> Field<'a> {
+    /// The terrain of `map`.
+    pub fn of(map: &'a Heightmap) -> Field<'a> {
+        Field {
+            z: map.heights(),
+            cols: map.cols(),
+            rows: map.rows(),
+            cell: map.cell_size(),
+        }
+    }
 }
 
 /// Calls `f(cell index, horizon tangent)` for every cell, for azimuth `azimuth` (radians); the
