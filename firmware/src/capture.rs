@@ -1,13 +1,18 @@
 //! The ultrasonic front end: the 40 kHz burst and the receivers' first arrivals.
 //!
-//! * TIM1 channel 1 (PA8) drives the transducer's gate driver with a burst of
+//! * TIM1 channel 1 (PA8) drives the pen transducer's gate driver with a burst of
 //!   [`BURST_CYCLES`] periods at 40 kHz, in one-pulse mode with the repetition counter, so the
 //!   burst length is exact and needs no interrupt. PWM mode 2 keeps the pin low at rest; the
 //!   first rising edge comes 12.49 µs after the counter starts, and is subtracted.
+//! * TIM1 channel 2 (PA9) drives the glasses' emitter (head tracking, issue 16) the same way,
+//!   with the same compare value: the same timer makes both bursts, so both start the capture
+//!   counters alike and have the same first edge. Before each burst the station names the slot's
+//!   emitter; the other channel is forced inactive (driven low), so exactly one transducer sounds.
 //! * TIM1's trigger output fires when its counter is enabled; TIM2 and TIM3 take it as a start
 //!   (trigger mode, ITR0) and run in one-pulse mode to the end of the listening window, so their
 //!   counters start at the burst in hardware, stop when the window closes, and a capture value
-//!   is the time since the trigger.
+//!   is the time since the trigger. The window is the slot's: 5 ms for the pen alone, 1.5 m of
+//!   flight (4.4 ms) while the head is tracked, when the next burst follows 20 µs after it.
 //! * TIM2 (32-bit, 96 MHz, 10.4 ns per tick) captures receivers 0–3 on PA15, PB3, PB10, PA3;
 //!   TIM3 (16-bit, prescaled to 8 MHz, 125 ns) captures receivers 4–7 on PA6, PA7, PB0, PB1.
 //! * Each receiver's comparator output rises on the first arrival. The capture interrupt
@@ -29,7 +34,7 @@ use embassy_stm32::timer::simple_pwm::PwmPin;
 use embassy_stm32::timer::{Ch1, Ch2, Ch3, Ch4, Channel};
 use embassy_stm32::{Peri, interrupt, pac};
 use pen_core::ranging::{SLOW_TIMER_HZ, ns_per_tick, ticks_to_ns};
-use pen_core::{LISTEN_US, Ranging};
+use pen_core::{Emitter, LISTEN_US, Ranging};
 use pen_protocol::MAX_RECEIVERS;
 
 /// Periods of 40 kHz per burst: long enough for the transducer to ring up, short enough to end
@@ -128,8 +133,10 @@ pub type CapturePins<'d, T> = (
     reason = "held, not read: dropping a pin would release its alternate function"
 )]
 pub struct Pins<'d> {
-    /// PA8: TIM1 channel 1, the burst.
+    /// PA8: TIM1 channel 1, the pen's burst.
     pub burst: PwmPin<'d, TIM1, Ch1>,
+    /// PA9: TIM1 channel 2, the glasses' burst (head tracking).
+    pub glasses: PwmPin<'d, TIM1, Ch2>,
     /// Receivers 0–3 on TIM2.
     pub tim2: CapturePins<'d, TIM2>,
     /// Receivers 4–7 on TIM3.
@@ -147,7 +154,24 @@ pub struct BoardRanging<'d> {
     ns_per_tick_tim3: f32,
     /// The burst's first rising edge after the trigger, ns.
     edge_ns: u32,
+    /// TIM2's clock, Hz.
+    fast_hz: u32,
+    /// The listening window the capture counters stop at, µs.
+    listen_us: u64,
     _pins: Pins<'d>,
+}
+
+/// TIM1's channel for each emitter.
+const fn burst_channel(emitter: Emitter) -> Channel {
+    match emitter {
+        Emitter::Pen => Channel::Ch1,
+        Emitter::Head => Channel::Ch2,
+    }
+}
+
+/// A listening window in ticks of a timer at `hz`.
+fn window_ticks(listen_us: u64, hz: u32) -> u32 {
+    (listen_us * hz as u64 / 1_000_000) as u32
 }
 
 impl<'d> BoardRanging<'d> {
@@ -165,11 +189,15 @@ impl<'d> BoardRanging<'d> {
         let half = burst.get_max_compare_value() / 2;
         burst.set_output_compare_mode(Channel::Ch1, OutputCompareMode::PwmMode2);
         burst.set_compare_value(Channel::Ch1, half);
+        // The glasses' channel: the same waveform when its slot comes, held low until then.
+        burst.set_output_compare_mode(Channel::Ch2, OutputCompareMode::ForceInactive);
+        burst.set_compare_value(Channel::Ch2, half);
         burst.set_repetition_counter(BURST_CYCLES - 1);
         // One-pulse mode: the counter stops at the update event after RCR + 1 periods.
         burst.regs_advanced().cr1().modify(|w| w.set_opm(true));
         burst.set_master_mode(MasterMode::ENABLE);
         burst.enable_channel(Channel::Ch1, true);
+        burst.enable_channel(Channel::Ch2, true);
         burst.set_moe(true);
         // Load the repetition counter and prescaler without starting.
         burst.generate_update_event();
@@ -196,11 +224,10 @@ impl<'d> BoardRanging<'d> {
         // captures 0 and is blanked; TIM3 can no longer wrap (8.19 ms) and alias a late edge
         // to a short flight.
         let fast_hz = tim2.get_clock_frequency().0;
-        let window_ticks = |hz: u32| (LISTEN_US * hz as u64 / 1_000_000) as u32;
-        tim2.regs_gp32().arr().write_value(window_ticks(fast_hz));
+        tim2.regs_gp32().arr().write_value(window_ticks(LISTEN_US, fast_hz));
         tim3.regs_gp16()
             .arr()
-            .write(|w| w.set_arr(window_ticks(SLOW_TIMER_HZ).min(u16::MAX as u32) as u16));
+            .write(|w| w.set_arr(window_ticks(LISTEN_US, SLOW_TIMER_HZ).min(u16::MAX as u32) as u16));
         tim2.regs_gp32().cr1().modify(|w| w.set_opm(true));
         tim3.regs_gp16().cr1().modify(|w| w.set_opm(true));
         tim2.set_slave_mode(SlaveMode::TRIGGER_MODE);
@@ -237,6 +264,8 @@ impl<'d> BoardRanging<'d> {
             ns_per_tick_tim2,
             ns_per_tick_tim3,
             edge_ns,
+            fast_hz,
+            listen_us: LISTEN_US,
             _pins: pins,
         }
     }
@@ -269,9 +298,42 @@ impl Ranging for BoardRanging<'_> {
         self.receivers = count.min(MAX_RECEIVERS);
     }
 
+    /// The emitter's channel makes the burst; the other is forced low.
+    fn set_emitter(&mut self, emitter: Emitter) {
+        for e in [Emitter::Pen, Emitter::Head] {
+            let mode = if e == emitter {
+                OutputCompareMode::PwmMode2
+            } else {
+                OutputCompareMode::ForceInactive
+            };
+            self.burst.set_output_compare_mode(burst_channel(e), mode);
+        }
+    }
+
+    /// The capture counters' auto-reload: they stop when the window closes.
+    fn set_listen_us(&mut self, listen_us: u64) {
+        if listen_us == self.listen_us {
+            return;
+        }
+        self.listen_us = listen_us;
+        let slow = window_ticks(listen_us, SLOW_TIMER_HZ).min(u16::MAX as u32) as u16;
+        self.tim2
+            .regs_gp32()
+            .arr()
+            .write_value(window_ticks(listen_us, self.fast_hz));
+        self.tim3.regs_gp16().arr().write(|w| w.set_arr(slow));
+    }
+
     fn fire(&mut self) {
         for c in &CAPTURES {
             c.store(NO_CAPTURE, Ordering::Relaxed);
+        }
+        // The counters stop by themselves when a window closes; should the previous window still
+        // run (a slot started early), trigger mode would not restart it: stop and zero them, so
+        // that every capture counts from this burst.
+        for tim in [self.tim2.regs_gp16(), self.tim3.regs_gp16()] {
+            tim.cr1().modify(|w| w.set_cen(false));
+            tim.cnt().write(|w| w.set_cnt(0));
         }
         self.arm(true);
         // Enabling TIM1's counter starts the burst and, through its trigger output, resets the
@@ -308,5 +370,10 @@ where
 
 /// Helper for main: the burst pin.
 pub fn burst_pin<'d>(pin: Peri<'d, impl embassy_stm32::timer::TimerPin<TIM1, Ch1>>) -> PwmPin<'d, TIM1, Ch1> {
+    PwmPin::new(pin, OutputType::PushPull)
+}
+
+/// Helper for main: the glasses' burst pin (the head's emitter).
+pub fn glasses_pin<'d>(pin: Peri<'d, impl embassy_stm32::timer::TimerPin<TIM1, Ch2>>) -> PwmPin<'d, TIM1, Ch2> {
     PwmPin::new(pin, OutputType::PushPull)
 }

@@ -37,7 +37,7 @@ use pen_core::{ConfigStore, Engine, LogStore, Station, WakeOnPress};
 use pen_protocol::{FirmwareVersion, PROTOCOL_VERSION, USB_PID, USB_VID, report_descriptor};
 use {defmt_rtt as _, panic_probe as _};
 
-use crate::capture::{BoardRanging, Pins, burst_pin, capture_pin};
+use crate::capture::{BoardRanging, Pins, burst_pin, capture_pin, glasses_pin};
 use crate::clock::BoardClock;
 use crate::flash_store::ConfigSector;
 use crate::switches::BoardSwitches;
@@ -126,12 +126,22 @@ async fn main(_spawner: Spawner) {
     if saved.is_none() {
         info!("no saved configuration: using the defaults");
     }
-    let engine = Mutex::new(RefCell::new(Engine::new(saved, FIRMWARE, uid::uid())));
-    let receivers = engine.lock(|e| e.borrow().settings().count);
+    let engine = Mutex::new(RefCell::new(Engine::new(saved.map(|s| s.config), FIRMWARE, uid::uid())));
+    // The glasses' emitter has its own channel (PA9): HeadOn may start head tracking, and a
+    // SaveConfig while it ran starts it again here.
+    let (receivers, head) = engine.lock(|e| {
+        let mut e = e.borrow_mut();
+        e.set_head_emitter_fitted(true);
+        (e.settings().count, e.resume_head(saved.is_some_and(|s| s.head)))
+    });
+    if head {
+        info!("head tracking on, as saved");
+    }
 
     // The front end, the switches, the clock.
     let pins = Pins {
         burst: burst_pin(p.PA8),
+        glasses: glasses_pin(p.PA9),
         tim2: (
             capture_pin(p.PA15),
             capture_pin(p.PB3),

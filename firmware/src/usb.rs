@@ -15,7 +15,9 @@ use embassy_usb::class::hid::{HidWriter, ReportId as HidReportId, RequestHandler
 use embassy_usb::control::OutResponse;
 use embassy_usb::driver::Driver;
 use pen_core::{Action, LogStore, ReportSink, SharedEngine};
-use pen_protocol::{FrameDecoder, MAX_FRAME, MAX_PAYLOAD, OsPenReport, PenReport, Report, TofReport, encode_frame};
+use pen_protocol::{
+    FrameDecoder, HeadReport, MAX_FRAME, MAX_PAYLOAD, OsPenReport, PenReport, Report, TofReport, encode_frame,
+};
 
 use crate::flash_store::ConfigSector;
 
@@ -39,7 +41,8 @@ pub struct SerialFrame {
     buf: [u8; MAX_FRAME],
 }
 
-/// Reports waiting for the HID endpoint: the pen and the OS pen report of each cycle.
+/// Reports waiting for the HID endpoint: the pen and the OS pen report of each cycle, and the
+/// head report of each head slot.
 pub type HidQueue = Channel<ThreadModeRawMutex, HidPacket, 16>;
 /// Frames waiting for the serial link.
 pub type SerialQueue = Channel<ThreadModeRawMutex, SerialFrame, 8>;
@@ -166,6 +169,11 @@ impl ReportSink for BoardSink<'_, '_> {
     /// HID only: the serial link's host reads the project's own reports.
     async fn os_pen(&mut self, report: &OsPenReport) {
         self.send_hid(report);
+    }
+
+    /// The vendor collection's head report on HID, and the same bytes framed on the serial link.
+    async fn head(&mut self, report: &HeadReport) {
+        self.send(report);
     }
 }
 

@@ -44,4 +44,4 @@ pub use report::{Action, Counters, Cycle, CycleResult, Engine, HeadCounters, LIS
 pub use settings::{DisplayFrame, Settings, default_config};
 pub use solve::{Fix, NoFix};
 pub use station::{Clock, Ranging, ReportSink, SharedEngine, Station, Switches, WakeOnPress};
-pub use store::{ConfigStore, FlashRegion, LogStore, StoreError};
+pub use store::{ConfigStore, FlashRegion, LogStore, Saved, StoreError};

@@ -19,7 +19,7 @@ use crate::math::Vec3;
 use crate::ranging::{range_mm, time_of_flight_ns};
 use crate::settings::{Settings, default_config};
 use crate::solve::{self, Fix, Geometry, NoFix};
-use crate::store::ConfigStore;
+use crate::store::{ConfigStore, Saved};
 use crate::track::Track;
 
 /// The shortest measurement cycle, µs: the listening window plus time for the echoes of the
@@ -347,6 +347,16 @@ impl Engine {
         if !fitted {
             self.head = None;
         }
+    }
+
+    /// Starts head tracking as it was saved (a SaveConfig while it ran, [`Saved::head`]), where
+    /// the glasses' emitter is fitted: call after
+    /// [`set_head_emitter_fitted`](Self::set_head_emitter_fitted). Returns whether it runs.
+    pub fn resume_head(&mut self, saved_on: bool) -> bool {
+        if saved_on && self.head_fitted && self.head.is_none() {
+            self.set_head(Some(HeadSettings::default()));
+        }
+        self.head.is_some()
     }
 
     /// The head's settings, while it is tracked.
@@ -745,7 +755,11 @@ impl Engine {
     fn command(&mut self, command: Command, store: &mut impl ConfigStore) -> (Status, Option<Action>) {
         let request = ReportId::Command as u8;
         match command {
-            Command::SaveConfig => match store.save(&self.settings.config) {
+            // The head mode is saved with the configuration, so a power cycle keeps it.
+            Command::SaveConfig => match store.save(&Saved {
+                config: self.settings.config,
+                head: self.head.is_some(),
+            }) {
                 // A new display size takes a new USB descriptor: restart to enumerate again.
                 Ok(()) if display_extent(&self.settings.config) != self.os_extent => {
                     (Status::ok(request), Some(Action::Restart))

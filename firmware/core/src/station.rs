@@ -25,6 +25,11 @@ pub trait Ranging {
     /// burst). A front end with only the pen's emitter never hears of the head: the engine
     /// schedules it only while head tracking is on.
     fn set_emitter(&mut self, _emitter: Emitter) {}
+    /// How long the next burst is listened to, µs (the station says so before every burst): the
+    /// pen-only cycle's [`LISTEN_US`](crate::LISTEN_US), or a multiplexed slot's shorter window
+    /// while the head is tracked. A front end that closes its window in hardware must close it
+    /// before the next slot's burst.
+    fn set_listen_us(&mut self, _listen_us: u64) {}
     /// Fires a burst; the capture time base starts with it.
     fn fire(&mut self);
     /// The first arrival at each receiver since the last burst, ns after it; `None` for a
@@ -145,6 +150,7 @@ where
         let listen = t0 + slot.listen_us;
         self.ranging.set_receivers(receivers);
         self.ranging.set_emitter(slot.emitter);
+        self.ranging.set_listen_us(slot.listen_us);
         self.ranging.fire();
         let mut result = None;
         // Ticks at t0, t0 + TICK_US, … up to the end of the period, and one when the listening

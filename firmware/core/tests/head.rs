@@ -152,10 +152,10 @@ fn head_slots_leave_the_pen_alone() {
 fn head_tracking_starts_and_stops_by_command_where_the_glasses_are_fitted() {
     struct NoStore;
     impl pen_core::ConfigStore for NoStore {
-        fn load(&mut self) -> Option<Config> {
+        fn load(&mut self) -> Option<pen_core::Saved> {
             None
         }
-        fn save(&mut self, _: &Config) -> Result<(), pen_core::StoreError> {
+        fn save(&mut self, _: &pen_core::Saved) -> Result<(), pen_core::StoreError> {
             Ok(())
         }
     }
@@ -176,6 +176,50 @@ fn head_tracking_starts_and_stops_by_command_where_the_glasses_are_fitted() {
     assert_eq!(status.code, StatusCode::Ok);
     assert_eq!(e.head_settings(), None);
     assert_eq!(e.next_slot().emitter, Emitter::Pen);
+}
+
+/// HeadOn, then SaveConfig: after a power cycle (a new engine from what the store loads) a base
+/// station with the glasses' emitter tracks the head again; HeadOff saved: it does not. One
+/// without the emitter never does.
+#[test]
+fn head_mode_saved_survives_a_power_cycle() {
+    #[derive(Default)]
+    struct RamStore(Option<pen_core::Saved>);
+    impl pen_core::ConfigStore for RamStore {
+        fn load(&mut self) -> Option<pen_core::Saved> {
+            self.0
+        }
+        fn save(&mut self, saved: &pen_core::Saved) -> Result<(), pen_core::StoreError> {
+            self.0 = Some(*saved);
+            Ok(())
+        }
+    }
+    let command = |c| Message::Command(c).encode_vec();
+    use pen_core::ConfigStore;
+    let boot = |store: &mut RamStore, fitted: bool| {
+        let saved = store.load();
+        let mut e = Engine::new(saved.map(|s| s.config), FIRMWARE, [7; 12]);
+        e.set_head_emitter_fitted(fitted);
+        e.resume_head(saved.is_some_and(|s| s.head));
+        e
+    };
+    let mut store = RamStore::default();
+    let mut e = boot(&mut store, true);
+    assert_eq!(e.head_settings(), None, "nothing saved: the pen alone");
+    e.set_feature(&command(Command::HeadOn), &mut store);
+    // HeadOn alone is not saved.
+    assert_eq!(boot(&mut store, true).head_settings(), None);
+    let (status, _) = e.set_feature(&command(Command::SaveConfig), &mut store);
+    assert_eq!(status.code, StatusCode::Ok);
+    assert_eq!(store.0.map(|s| s.head), Some(true));
+    let mut again = boot(&mut store, true);
+    assert_eq!(again.head_settings(), Some(HeadSettings::default()));
+    let heads = (0..7).filter(|_| again.next_slot().emitter == Emitter::Head).count();
+    assert_eq!(heads, 2, "the 5:2 schedule runs from the start");
+    assert_eq!(boot(&mut store, false).head_settings(), None, "no emitter: not started");
+    again.set_feature(&command(Command::HeadOff), &mut store);
+    again.set_feature(&command(Command::SaveConfig), &mut store);
+    assert_eq!(boot(&mut store, true).head_settings(), None);
 }
 
 trait EncodeVec {

@@ -1,6 +1,6 @@
 //! The engine: cycles to reports, switches, configuration requests, serial requests.
 
-use pen_core::{Action, ConfigStore, Cycle, Engine, NoFix, StoreError, Vec3, default_config};
+use pen_core::{Action, ConfigStore, Cycle, Engine, NoFix, Saved, StoreError, Vec3, default_config};
 use pen_protocol::*;
 
 use crate::common::cycle_at;
@@ -15,19 +15,19 @@ const PERIOD_US: u64 = 6_500;
 /// A store in RAM that can be told to fail.
 #[derive(Default)]
 struct RamStore {
-    saved: Option<Config>,
+    saved: Option<Saved>,
     fail: bool,
 }
 
 impl ConfigStore for RamStore {
-    fn load(&mut self) -> Option<Config> {
+    fn load(&mut self) -> Option<Saved> {
         self.saved
     }
-    fn save(&mut self, config: &Config) -> Result<(), StoreError> {
+    fn save(&mut self, saved: &Saved) -> Result<(), StoreError> {
         if self.fail {
             return Err(StoreError::Flash);
         }
-        self.saved = Some(*config);
+        self.saved = Some(*saved);
         Ok(())
     }
 }
@@ -294,7 +294,7 @@ fn commands() {
     e.set_feature(&encode(&Message::Config(c)), &mut store);
     let save = encode(&Message::Command(Command::SaveConfig));
     assert_eq!(e.set_feature(&save, &mut store).0.code, StatusCode::Ok);
-    assert_eq!(store.saved, Some(c));
+    assert_eq!(store.saved, Some(Saved::config(c)));
     store.fail = true;
     assert_eq!(e.set_feature(&save, &mut store).0.code, StatusCode::StorageFailed);
     let defaults = encode(&Message::Command(Command::LoadDefaults));
@@ -424,7 +424,7 @@ fn a_new_display_size_saved_restarts_the_device() {
     assert!(!e.os_report(reports.last().expect("reports")).in_range);
     assert_eq!(e.set_feature(&save, &mut store).1, Some(Action::Restart));
     // After the restart the engine starts from the saved configuration: in range again.
-    let mut e = Engine::new(store.load(), FIRMWARE, [7; 12]);
+    let mut e = Engine::new(store.load().map(|s| s.config), FIRMWARE, [7; 12]);
     assert_eq!(e.os_extent(), Some([5200, 2900]));
     let reports = run(&mut e, 0, 3, Vec3::new(300.0, 100.0, 80.0));
     assert!(e.os_report(reports.last().expect("reports")).in_range);

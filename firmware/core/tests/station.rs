@@ -94,10 +94,10 @@ impl ReportSink for Sink {
 struct NoStore;
 
 impl pen_core::ConfigStore for NoStore {
-    fn load(&mut self) -> Option<pen_protocol::Config> {
+    fn load(&mut self) -> Option<pen_core::Saved> {
         None
     }
-    fn save(&mut self, _: &pen_protocol::Config) -> Result<(), pen_core::StoreError> {
+    fn save(&mut self, _: &pen_core::Saved) -> Result<(), pen_core::StoreError> {
         Err(pen_core::StoreError::Flash)
     }
 }

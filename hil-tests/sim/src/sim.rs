@@ -14,7 +14,7 @@ use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
 use glam::DVec3;
 use pen_core::{
-    Clock, ConfigStore, CycleResult, Emitter, Engine, HeadSettings, Ranging, ReportSink, SharedEngine, Station,
+    Clock, ConfigStore, CycleResult, Emitter, Engine, HeadSettings, Ranging, ReportSink, Saved, SharedEngine, Station,
     StoreError, Switches,
 };
 use pen_protocol::{Config, FirmwareVersion, HeadReport, MAX_RECEIVERS, PenReport, Report, TofReport};
@@ -242,17 +242,17 @@ impl ReportSink for SimSink {
 /// The simulated device's configuration storage: memory that lasts as long as the simulation.
 #[derive(Debug, Default)]
 pub struct MemoryStore {
-    /// The saved configuration.
-    pub saved: Option<Config>,
+    /// The saved configuration and head mode.
+    pub saved: Option<Saved>,
 }
 
 impl ConfigStore for MemoryStore {
-    fn load(&mut self) -> Option<Config> {
+    fn load(&mut self) -> Option<Saved> {
         self.saved
     }
 
-    fn save(&mut self, config: &Config) -> Result<(), StoreError> {
-        self.saved = Some(*config);
+    fn save(&mut self, saved: &Saved) -> Result<(), StoreError> {
+        self.saved = Some(*saved);
         Ok(())
     }
 }
