@@ -24,6 +24,7 @@ fn pyramid(x: f32, z: f32, r: f32, h: f32, g: f32) -> Mesh {
         positions,
         normals,
         indices,
+        colors: Vec::new(),
     }
 }
 

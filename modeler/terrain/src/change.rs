@@ -65,4 +65,7 @@ pub enum Scope {
     /// The `ridges` entry changed: the ridge layer ([`crate::ridge::layer::Layer`]) compares
     /// each ridgeline and tree with the last it saw and re-rasterises only those that differ.
     Ridges,
+    /// A tree or grove was added, removed, moved or replaced: the terrain is unchanged (trees
+    /// stand on it; [`crate::trees::Forest`] follows the document).
+    Trees,
 }

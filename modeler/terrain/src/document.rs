@@ -8,7 +8,7 @@
 use serde::{Deserialize, Serialize};
 
 /// The format version this build writes (and reads).
-pub const VERSION: u32 = 3;
+pub const VERSION: u32 = 4;
 
 /// The oldest version this build reads: a version 1 or 2 document (no rock fields, no rivers) loads
 /// as version 3.
@@ -39,6 +39,12 @@ pub struct Document {
     /// Ridgelines (seed 002), a height layer combined with the regions' terrain; version 3 on.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub ridges: Option<Ridges>,
+    /// Trees (seed 004) standing on the terrain; version 4 on.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub trees: Vec<Tree>,
+    /// Groves of trees (seed 004) scattered in a region; version 4 on.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub groves: Vec<Grove>,
 }
 
 /// Ridgeline terrain (seed 002, `crate::ridge`): 3D ridgelines and 2D ridgeline trees whose
@@ -321,6 +327,114 @@ impl Document {
             rocks: Vec::new(),
             rivers: Vec::new(),
             ridges: None,
+            trees: Vec::new(),
+            groves: Vec::new(),
         }
     }
+}
+
+/// One map of a tree's IFS (seed 004): `ω = Trans(0, y, 0)·Rot_y(θy)·Rot_z(−θz)·Scale(s)`, in
+/// the tree's own unit (its trunk grows from the origin up +Y; `crate::trees::species`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IfsMap {
+    /// Where the branch leaves the trunk, as a fraction of the tree's unit height.
+    pub y: f64,
+    /// The branch's scale, `0 < s < 1` (the IFS contracts).
+    pub s: f64,
+    /// The branch's lean from the vertical, degrees (`θz`).
+    pub theta_z: f64,
+    /// The branch's turn about the trunk, degrees (`θy`).
+    pub theta_y: f64,
+}
+
+/// A tree (seed 004): an IFS tree standing on the terrain at `at`. Its shape is a preset's or
+/// its own maps; its base height is the terrain's under `at`, so it follows the terrain.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Tree {
+    /// Where the trunk meets the ground, metres.
+    pub at: Point,
+    /// The tree's height, metres (> 0).
+    pub height: f64,
+    /// A preset's name (`crate::trees::species::Preset`); `table-3.1` when neither this nor
+    /// `maps` is given.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub preset: Option<String>,
+    /// The tree's own IFS maps, instead of a preset.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub maps: Option<Vec<IfsMap>>,
+    /// Turns the tree about its trunk (`seed`-derived angle), so that trees of one species differ.
+    #[serde(default)]
+    pub seed: u64,
+    /// Sway in the wind; still when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wind: Option<Wind>,
+}
+
+/// Wind sway (seed 004): branches of generation g lean `θ_g = A_g·sin(2π f_g t) + θ0_g` about
+/// the horizontal axis across the wind, composed down the branch hierarchy.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Wind {
+    /// The direction the wind blows towards, degrees from +x towards +y.
+    #[serde(default)]
+    pub direction: f64,
+    /// Per generation (0 the trunk); the last entry holds for every deeper generation.
+    pub generations: Vec<Sway>,
+}
+
+/// One generation's sway.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Sway {
+    /// The amplitude `A_g`, degrees.
+    pub amplitude: f64,
+    /// The frequency `f_g`, hertz.
+    pub frequency: f64,
+    /// The rest lean `θ0_g`, degrees (a steady wind's bend).
+    #[serde(default)]
+    pub rest: f64,
+}
+
+/// A grove (seed 004): trees scattered inside a region at a density (Poisson-disk spacing), each
+/// a preset drawn from a weighted mix; a pure function of these fields.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Grove {
+    /// The closed outline (last point repeats the first), metres.
+    pub region: Vec<Point>,
+    /// Trees per hectare (10 000 m²), > 0.
+    pub density: f64,
+    /// The presets and their weights; `table-3.1` alone when empty.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub mix: Vec<GroveSpecies>,
+    /// The trees' mean height, metres; each tree varies by up to ±20 %.
+    #[serde(default = "default_grove_height")]
+    pub height: f64,
+    /// The random seed: the same seed, the same grove.
+    #[serde(default)]
+    pub seed: u64,
+    /// Sway in the wind for every tree of the grove; still when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub wind: Option<Wind>,
+}
+
+fn default_grove_height() -> f64 {
+    10.0
+}
+
+/// One preset of a grove's mix.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct GroveSpecies {
+    /// The preset's name.
+    pub preset: String,
+    /// Its share, relative to the others' (> 0).
+    #[serde(default = "default_weight")]
+    pub weight: f64,
+}
+
+fn default_weight() -> f64 {
+    1.0
 }

@@ -11,7 +11,7 @@ use thiserror::Error;
 use crate::address::{CurvePath, FigurePath};
 use crate::cells::{self, Mask};
 use crate::change::{FigureList, ListChange, Scope};
-use crate::document::{Document, Figure, FigureKind, Point, Region, Ridges, River, RockField};
+use crate::document::{Document, Figure, FigureKind, Grove, Point, Region, Ridges, River, RockField, Tree};
 use crate::validate::{self, ValidationError};
 
 /// One change to a document. Serialised (in the journal) as an object tagged by `"op"`.
@@ -85,6 +85,30 @@ pub enum Edit {
     /// Replaces the `ridges` entry (`null` removes it): a ridgeline drawn, a node dragged, a
     /// tree grown. Only the ridgelines and trees that differ are re-rasterised.
     SetRidges { ridges: Option<Ridges> },
+    /// Inserts a tree at `index`.
+    AddTree { index: usize, tree: Tree },
+    /// Removes tree `index`.
+    DeleteTree { index: usize },
+    /// Moves tree `index` by `by` metres (its `at`; it stands on the ground there).
+    MoveTree {
+        index: usize,
+        /// Displacement `[dx, dy]`.
+        by: Point,
+    },
+    /// Replaces tree `index` (its height, species, seed or wind).
+    ReplaceTree { index: usize, tree: Tree },
+    /// Inserts a grove at `index`.
+    AddGrove { index: usize, grove: Grove },
+    /// Removes grove `index`.
+    DeleteGrove { index: usize },
+    /// Moves grove `index`'s region by `by` metres.
+    MoveGrove {
+        index: usize,
+        /// Displacement `[dx, dy]`.
+        by: Point,
+    },
+    /// Replaces grove `index` (its region, density, mix, height, seed or wind).
+    ReplaceGrove { index: usize, grove: Grove },
 }
 
 /// Why an edit was refused. The document is unchanged.
@@ -109,6 +133,12 @@ pub enum EditError {
     /// No river at that index.
     #[error("there is no rivers[{0}]")]
     NoRiver(usize),
+    /// No tree at that index.
+    #[error("there is no trees[{0}]")]
+    NoTree(usize),
+    /// No grove at that index.
+    #[error("there is no groves[{0}]")]
+    NoGrove(usize),
     /// [`Edit::apply_to`] was given a group, whose edits are applied one at a time.
     #[error("a group of edits is applied edit by edit")]
     Group,
@@ -390,6 +420,74 @@ fn apply(doc: &mut Document, edit: &Edit) -> Result<Applied, EditError> {
                 scope: Scope::Ridges,
             })
         }
+        Edit::AddTree { index, tree } => {
+            if *index > doc.trees.len() {
+                return Err(EditError::NoTree(*index));
+            }
+            doc.trees.insert(*index, tree.clone());
+            if let Err(e) = validate::trees(doc) {
+                doc.trees.remove(*index);
+                return Err(e.into());
+            }
+            Ok(Applied {
+                inverse: Edit::DeleteTree { index: *index },
+                scope: Scope::Trees,
+            })
+        }
+        Edit::DeleteTree { index } => {
+            if *index >= doc.trees.len() {
+                return Err(EditError::NoTree(*index));
+            }
+            let tree = doc.trees.remove(*index);
+            Ok(Applied {
+                inverse: Edit::AddTree { index: *index, tree },
+                scope: Scope::Trees,
+            })
+        }
+        Edit::MoveTree { index, by } => {
+            let mut tree = doc.trees.get(*index).ok_or(EditError::NoTree(*index))?.clone();
+            tree.at = [tree.at[0] + by[0], tree.at[1] + by[1]];
+            replace_tree(doc, *index, tree)
+        }
+        Edit::ReplaceTree { index, tree } => {
+            doc.trees.get(*index).ok_or(EditError::NoTree(*index))?;
+            replace_tree(doc, *index, tree.clone())
+        }
+        Edit::AddGrove { index, grove } => {
+            if *index > doc.groves.len() {
+                return Err(EditError::NoGrove(*index));
+            }
+            doc.groves.insert(*index, grove.clone());
+            if let Err(e) = validate::groves(doc) {
+                doc.groves.remove(*index);
+                return Err(e.into());
+            }
+            Ok(Applied {
+                inverse: Edit::DeleteGrove { index: *index },
+                scope: Scope::Trees,
+            })
+        }
+        Edit::DeleteGrove { index } => {
+            if *index >= doc.groves.len() {
+                return Err(EditError::NoGrove(*index));
+            }
+            let grove = doc.groves.remove(*index);
+            Ok(Applied {
+                inverse: Edit::AddGrove { index: *index, grove },
+                scope: Scope::Trees,
+            })
+        }
+        Edit::MoveGrove { index, by } => {
+            let mut grove = doc.groves.get(*index).ok_or(EditError::NoGrove(*index))?.clone();
+            for p in &mut grove.region {
+                *p = [p[0] + by[0], p[1] + by[1]];
+            }
+            replace_grove(doc, *index, grove)
+        }
+        Edit::ReplaceGrove { index, grove } => {
+            doc.groves.get(*index).ok_or(EditError::NoGrove(*index))?;
+            replace_grove(doc, *index, grove.clone())
+        }
     }
 }
 
@@ -429,6 +527,30 @@ fn replace_rocks(doc: &mut Document, index: usize, new: RockField) -> Result<App
     Ok(Applied {
         inverse: Edit::ReplaceRocks { index, field: old },
         scope: Scope::Rocks(index),
+    })
+}
+
+fn replace_tree(doc: &mut Document, index: usize, new: Tree) -> Result<Applied, EditError> {
+    let old = std::mem::replace(&mut doc.trees[index], new);
+    if let Err(e) = validate::trees(doc) {
+        doc.trees[index] = old;
+        return Err(e.into());
+    }
+    Ok(Applied {
+        inverse: Edit::ReplaceTree { index, tree: old },
+        scope: Scope::Trees,
+    })
+}
+
+fn replace_grove(doc: &mut Document, index: usize, new: Grove) -> Result<Applied, EditError> {
+    let old = std::mem::replace(&mut doc.groves[index], new);
+    if let Err(e) = validate::groves(doc) {
+        doc.groves[index] = old;
+        return Err(e.into());
+    }
+    Ok(Applied {
+        inverse: Edit::ReplaceGrove { index, grove: old },
+        scope: Scope::Trees,
     })
 }
 

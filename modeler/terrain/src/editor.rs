@@ -28,6 +28,7 @@ use crate::heightmap::Heightmap;
 use crate::journal::{self, Entry, JournalError, Replay, UndoStep, Writer};
 use crate::persist::{self, LoadError, SaveError};
 use crate::rocks::cache::Seated;
+use crate::trees::Forest;
 use crate::validate::ValidationError;
 
 /// The most undo steps kept; older ones are forgotten.
@@ -143,6 +144,8 @@ pub struct Editor {
     ridge_preview: Option<Option<crate::document::Ridges>>,
     /// The rock fields standing on the terrain, following every change.
     rocks: Seated,
+    /// The trees and groves standing on the terrain, following every change.
+    trees: Forest,
 }
 
 /// Moves a stale journal to `JOURNAL.stale`, or `.stale.2`, `.stale.3`, … when one set aside
@@ -194,6 +197,7 @@ impl Editor {
         let terrain = TerrainEngine::new(&doc)?;
         Ok(Editor {
             rocks: Seated::of(&doc, terrain.heightmap()),
+            trees: Forest::of(&doc, terrain.heightmap()),
             terrain,
             doc,
             undo: Vec::new(),
@@ -320,6 +324,11 @@ impl Editor {
         &self.rocks
     }
 
+    /// The document's trees and groves standing on [`Editor::heightmap`].
+    pub fn trees(&self) -> &Forest {
+        &self.trees
+    }
+
     /// Applies `edit` to the document and the terrain, with no history or journal. On error
     /// nothing changes.
     fn change(&mut self, edit: &Edit) -> Result<Outcome, EditError> {
@@ -330,6 +339,7 @@ impl Editor {
         let changed = self.terrain.update(&self.doc, &applied.scope);
         let cells = (changed.c0, changed.r0, changed.width, changed.height);
         self.rocks.follow(&self.doc, self.terrain.heightmap(), Some(cells));
+        self.trees.follow(&self.doc, self.terrain.heightmap());
         Ok(Outcome {
             inverse: applied.inverse,
             changed,

@@ -514,7 +514,7 @@ impl TerrainEngine {
             return None;
         }
         let rect = match scope {
-            Scope::Rocks(_) | Scope::Rivers(_) | Scope::Ridges => Rect {
+            Scope::Rocks(_) | Scope::Rivers(_) | Scope::Ridges | Scope::Trees => Rect {
                 c0: 0,
                 r0: 0,
                 width: 0,

@@ -38,6 +38,7 @@ pub mod rect;
 pub mod ridge;
 pub mod river;
 pub mod rocks;
+pub mod trees;
 pub mod validate;
 
 pub use address::{CurvePath, FigurePath};

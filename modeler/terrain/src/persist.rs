@@ -92,6 +92,12 @@ impl Document {
         if doc.version < 3 && doc.ridges.is_some() {
             return Err(ValidationError::new("ridges", Defect::NeedsVersion(3)).into());
         }
+        if doc.version < 4 && !doc.trees.is_empty() {
+            return Err(ValidationError::new("trees", Defect::NeedsVersion(4)).into());
+        }
+        if doc.version < 4 && !doc.groves.is_empty() {
+            return Err(ValidationError::new("groves", Defect::NeedsVersion(4)).into());
+        }
         doc.version = VERSION;
         validate::document(&doc)?;
         Ok(doc)

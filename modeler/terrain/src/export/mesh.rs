@@ -12,6 +12,10 @@ pub struct Mesh {
     pub normals: Vec<[f32; 3]>,
     /// Three vertex indices per triangle, counter-clockwise seen from +Y.
     pub indices: Vec<u32>,
+    /// Linear RGB (0 to 1) per vertex, or empty: the mesh has no colours of its own (the
+    /// terrain, rocks) and the renderer and exports use theirs. Trees colour bark and leaves
+    /// (`crate::trees`).
+    pub colors: Vec<[f32; 3]>,
 }
 
 impl Mesh {
@@ -54,6 +58,7 @@ impl Mesh {
             positions,
             normals,
             indices,
+            colors: Vec::new(),
         })
     }
 }

@@ -118,6 +118,7 @@ impl Flat {
             positions: Vec::new(),
             normals: Vec::new(),
             indices: self.indices.clone(),
+            colors: Vec::new(),
         };
         self.seat_into(at, ground, &mut mesh);
         mesh
