@@ -14,7 +14,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use pen_core::replay;
+use pen_core::{HeadSettings, replay};
 use pen_protocol::Config;
 use thiserror::Error;
 
@@ -53,13 +53,22 @@ impl From<std::io::Error> for QemuError {
     }
 }
 
-/// The replay file for `records`, run with `config`.
-pub fn replay(config: &Config, records: &[CycleRecord]) -> Vec<u8> {
+/// The replay file for `records`, run with `config` and, when it tracked the head from the
+/// start, `head` (the scenario's).
+pub fn replay(config: &Config, head: Option<HeadSettings>, records: &[CycleRecord]) -> Vec<u8> {
     let mut out = Vec::new();
     let mut push = |bytes: &[u8]| out.extend_from_slice(bytes);
-    replay::write_header(config, &mut push);
+    let header = replay::Header::new(*config, head);
+    replay::write_header(&header, &mut push);
     for r in records {
-        replay::write_cycle(r.t0_us, &r.heard.arrival_ns, &r.switch_samples, &mut push);
+        replay::write_cycle(
+            &header,
+            r.emitter,
+            r.t0_us,
+            &r.heard.arrival_ns,
+            &r.switch_samples,
+            &mut push,
+        );
     }
     out
 }

@@ -11,13 +11,22 @@ use pen_sim::{Sent, Simulation, scenarios};
 #[test]
 fn the_emulated_core_sends_the_host_builds_reports() {
     let elf = qemu::build_pen_qemu().expect("pen-qemu builds");
-    for (name, seconds) in [("hand-sweep", 4.0), ("echoes", 4.0), ("draw-figures", 4.0)] {
+    for (name, seconds) in [
+        ("hand-sweep", 4.0),
+        ("echoes", 4.0),
+        ("draw-figures", 4.0),
+        ("viewer", 4.0),
+    ] {
         let s = scenarios::by_name(name).expect("scenario");
         let mut sim = Simulation::new(&s, 11);
         let records = sim.run_for(seconds);
         let host: Vec<Sent> = records.iter().flat_map(|r| r.sent.clone()).collect();
-        let run = qemu::run(&elf, &qemu::replay(&s.config, &records), Duration::from_secs(300))
-            .unwrap_or_else(|e| panic!("{name}: {e}"));
+        let run = qemu::run(
+            &elf,
+            &qemu::replay(&s.config, s.head, &records),
+            Duration::from_secs(300),
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
         assert_eq!(run.cycles as usize, records.len(), "{name}: cycles replayed");
         assert_eq!(run.reports.len(), host.len(), "{name}: report count");
         if let Some(i) = host.iter().zip(&run.reports).position(|(a, b)| a != b) {
@@ -62,7 +71,7 @@ fn write_replay_seeds() {
     ] {
         let s = scenarios::by_name(name).expect("scenario");
         let records = Simulation::new(&s, seed).run_for(0.5);
-        let bytes = qemu::replay(&s.config, &records);
+        let bytes = qemu::replay(&s.config, s.head, &records);
         std::fs::write(dir.join(format!("sim-{name}")), &bytes).expect("write a seed");
         eprintln!("sim-{name}: {} cycles, {} bytes", records.len(), bytes.len());
     }

@@ -5,13 +5,14 @@
 use pen_protocol::{FirmwareVersion, MAX_RECEIVERS, Position};
 
 use crate::replay::{self, CycleHead};
-use crate::{Cycle, CycleResult, Engine, Vec3, ranging, solve};
+use crate::{Cycle, CycleResult, Emitter, Engine, Vec3, ranging, solve};
 
 /// Switch samples a cycle may carry here: pen-qemu's buffer.
 const MAX_SAMPLES: usize = 4096;
 
-/// Any bytes as a replay file (`crate::replay`): never a panic; the header and every cycle that
-/// reads are in canonical form (written again, they are the bytes read); and the cycles' capture
+/// Any bytes as a replay file (`crate::replay`, either version): never a panic; the header and
+/// every cycle that reads are in canonical form (written again, they are the bytes read); and the
+/// cycles' capture
 /// times, whatever they are, through the engine give no fix that is not a finite position, and
 /// no report but from a fix, within what a report carries (±3.2767 m), and no fix outside the
 /// tracker's volume: within the listening window's flight of every receiver it used (its range
@@ -22,51 +23,58 @@ const MAX_SAMPLES: usize = 4096;
 /// any sequence of ticks, no panic, no fix that is not a position.
 pub fn replay(bytes: &[u8]) {
     let mut src = bytes;
-    let Ok(config) = replay::read_header(&mut src) else {
+    let Ok(header) = replay::read_header(&mut src) else {
         return;
     };
     let mut written = [0u8; replay::HEADER_LEN];
     let mut n = 0;
-    replay::write_header(&config, &mut |b: &[u8]| {
+    replay::write_header(&header, &mut |b: &[u8]| {
         written[n..n + b.len()].copy_from_slice(b);
         n += b.len();
     });
     assert_eq!(
         &written[..n],
-        &bytes[..replay::HEADER_LEN],
+        &bytes[..header.encoded_len()],
         "the header is not canonical"
     );
     let new_engine = || {
-        Engine::new(
-            Some(config),
+        let mut e = Engine::new(
+            Some(header.config),
             FirmwareVersion {
                 major: 0,
                 minor: 1,
                 patch: 0,
             },
             *b"penscape-fuz",
-        )
+        );
+        e.set_head_emitter_fitted(header.head.is_some());
+        e.set_head(header.head);
+        e
     };
     let (mut engine, mut from_ticks) = (new_engine(), new_engine());
     let mut samples = [0u8; MAX_SAMPLES];
     loop {
         let before = src;
-        let head = match replay::read_cycle(&mut src, &mut samples) {
+        let head = match replay::read_cycle(&mut src, &header, &mut samples) {
             Ok(Some(head)) => head,
             Ok(None) | Err(_) => return,
         };
         let consumed = &before[..before.len() - src.len()];
-        check_cycle(&head, &samples[..head.samples as usize], consumed);
-        let result = engine.on_cycle(&Cycle {
-            t0_us: head.t0_us,
-            arrival_ns: head.arrival_ns,
-        });
-        check_result(&result, &engine);
-        let result = from_ticks.on_cycle(&Cycle {
-            t0_us: head.t0_us,
-            arrival_ns: as_ticks(&head.arrival_ns),
-        });
-        check_result(&result, &from_ticks);
+        check_cycle(&header, &head, &samples[..head.samples as usize], consumed);
+        for (engine, arrival_ns) in [
+            (&mut engine, head.arrival_ns),
+            (&mut from_ticks, as_ticks(&head.arrival_ns)),
+        ] {
+            let cycle = Cycle {
+                t0_us: head.t0_us,
+                arrival_ns,
+            };
+            let result = match head.emitter {
+                Emitter::Pen => engine.on_cycle(&cycle),
+                Emitter::Head => engine.on_head_cycle(&cycle),
+            };
+            check_result(&result, engine);
+        }
     }
 }
 
@@ -119,13 +127,14 @@ fn check_result(result: &CycleResult, engine: &Engine) {
     }
 }
 
-fn check_cycle(head: &CycleHead, samples: &[u8], consumed: &[u8]) {
+fn check_cycle(header: &replay::Header, head: &CycleHead, samples: &[u8], consumed: &[u8]) {
     let mut written = [0u8; replay::CYCLE_HEAD_LEN + MAX_SAMPLES];
     let mut n = 0;
-    replay::write_cycle(head.t0_us, &head.arrival_ns, samples, &mut |b: &[u8]| {
+    let mut push = |b: &[u8]| {
         written[n..n + b.len()].copy_from_slice(b);
         n += b.len();
-    });
+    };
+    replay::write_cycle(header, head.emitter, head.t0_us, &head.arrival_ns, samples, &mut push);
     assert_eq!(&written[..n], consumed, "a cycle is not canonical: {head:?}");
 }
 

@@ -33,7 +33,7 @@ fn the_corpus_reaches_the_solver() {
     for entry in fs::read_dir(&dir).expect("corpus") {
         let bytes = fs::read(entry.expect("entry").path()).expect("file");
         let mut src = bytes.as_slice();
-        let Ok(config) = pen_core::replay::read_header(&mut src) else {
+        let Ok(header) = pen_core::replay::read_header(&mut src) else {
             continue;
         };
         let version = pen_protocol::FirmwareVersion {
@@ -41,14 +41,20 @@ fn the_corpus_reaches_the_solver() {
             minor: 1,
             patch: 0,
         };
-        let mut engine = pen_core::Engine::new(Some(config), version, *b"penscape-fuz");
+        let mut engine = pen_core::Engine::new(Some(header.config), version, *b"penscape-fuz");
+        engine.set_head_emitter_fitted(header.head.is_some());
+        engine.set_head(header.head);
         let mut samples = [0u8; 4096];
-        while let Ok(Some(head)) = pen_core::replay::read_cycle(&mut src, &mut samples) {
+        while let Ok(Some(head)) = pen_core::replay::read_cycle(&mut src, &header, &mut samples) {
             let cycle = pen_core::Cycle {
                 t0_us: head.t0_us,
                 arrival_ns: head.arrival_ns,
             };
-            fixes += usize::from(engine.on_cycle(&cycle).reported_mm.is_some());
+            let result = match head.emitter {
+                pen_core::Emitter::Pen => engine.on_cycle(&cycle),
+                pen_core::Emitter::Head => engine.on_head_cycle(&cycle),
+            };
+            fixes += usize::from(result.reported_mm.is_some());
         }
     }
     assert!(fixes >= 50, "only {fixes} reported positions");

@@ -20,9 +20,10 @@ use cortex_m_semihosting::{debug, hio, syscall};
 use embassy_futures::block_on;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::NoopRawMutex;
+use pen_core::replay::Header;
 use pen_core::replay::{self, ReplayError};
-use pen_core::{Clock, Cycle, Engine, Ranging, ReportSink, SharedEngine, Station, Switches};
-use pen_protocol::{FirmwareVersion, MAX_RECEIVERS, PenReport, Report, TofReport};
+use pen_core::{Clock, Cycle, Emitter, Engine, Ranging, ReportSink, SharedEngine, Station, Switches};
+use pen_protocol::{FirmwareVersion, HeadReport, MAX_RECEIVERS, PenReport, Report, TofReport};
 
 /// Switch samples a cycle may have: the longest cycle, 1 s at a 1 Hz report rate, has 2000.
 const MAX_TICKS: usize = 2048;
@@ -70,6 +71,7 @@ impl replay::Source for HostFile {
 
 /// One recorded cycle, as `pen_core::replay` reads it.
 struct CycleIn {
+    emitter: Emitter,
     t0_us: u64,
     arrival_ns: [Option<u32>; MAX_RECEIVERS],
     ticks: usize,
@@ -77,10 +79,11 @@ struct CycleIn {
 }
 
 /// The next cycle of the replay; `None` at its end; a damaged replay ends the run.
-fn next_cycle(file: &mut HostFile, out: &mut hio::HostStream) -> Option<CycleIn> {
+fn next_cycle(file: &mut HostFile, header: &Header, out: &mut hio::HostStream) -> Option<CycleIn> {
     let mut switches = [0u8; MAX_TICKS];
-    match replay::read_cycle(file, &mut switches) {
+    match replay::read_cycle(file, header, &mut switches) {
         Ok(Some(head)) => Some(CycleIn {
+            emitter: head.emitter,
             t0_us: head.t0_us,
             arrival_ns: head.arrival_ns,
             ticks: head.samples as usize,
@@ -94,8 +97,10 @@ fn next_cycle(file: &mut HostFile, out: &mut hio::HostStream) -> Option<CycleIn>
 fn replay_error(e: ReplayError) -> &'static str {
     match e {
         ReplayError::NotAReplay => "cycles.bin is not a replay",
-        ReplayError::Version(_) => "cycles.bin is not a version 1 replay",
+        ReplayError::Version(_) => "cycles.bin is not a version 2 or 3 replay",
         ReplayError::BadConfig => "bad configuration in cycles.bin",
+        ReplayError::BadHead => "bad head schedule in cycles.bin",
+        ReplayError::BadEmitter(_) => "a cycle of cycles.bin names an emitter the run does not have",
         ReplayError::Truncated => "cycles.bin ends inside a cycle",
         ReplayError::TooManySamples(_) => "a cycle of cycles.bin has more switch samples than pen-qemu holds",
     }
@@ -108,11 +113,19 @@ struct Replay {
     tick: usize,
     /// Samples asked for beyond those recorded: the replay and the station disagree.
     overrun: bool,
+    /// The station fired another emitter than the recorded cycle's: the schedules disagree.
+    wrong_emitter: bool,
 }
 
 struct R<'a>(&'a RefCell<Replay>);
 
 impl Ranging for R<'_> {
+    fn set_emitter(&mut self, emitter: Emitter) {
+        let mut r = self.0.borrow_mut();
+        if r.cycle.as_ref().is_some_and(|c| c.emitter != emitter) {
+            r.wrong_emitter = true;
+        }
+    }
     fn fire(&mut self) {}
     fn collect(&mut self) -> [Option<u32>; MAX_RECEIVERS] {
         self.0
@@ -199,6 +212,9 @@ impl ReportSink for Printer<'_> {
     async fn tof(&mut self, report: &TofReport) {
         self.print(report);
     }
+    async fn head(&mut self, report: &HeadReport) {
+        self.print(report);
+    }
 }
 
 /// SysTick counts since `start`, on the 24-bit down-counter.
@@ -241,7 +257,7 @@ fn main() -> ! {
         fail(&mut out, "cannot open cycles.bin")
     };
     let mut file = file;
-    let config = replay::read_header(&mut file).unwrap_or_else(|e| fail(&mut out, replay_error(e)));
+    let header = replay::read_header(&mut file).unwrap_or_else(|e| fail(&mut out, replay_error(e)));
     let firmware = FirmwareVersion {
         major: 0,
         minor: 1,
@@ -249,13 +265,22 @@ fn main() -> ! {
     };
     let id = *b"penscape-sim";
 
+    // The engine as the recorded device ran: with the glasses' emitter fitted and scheduled
+    // when the run tracked the head.
+    let new_engine = || {
+        let mut e = Engine::new(Some(header.config), firmware, id);
+        e.set_head_emitter_fitted(header.head.is_some());
+        e.set_head(header.head);
+        e
+    };
     // Pass 1: the station, exactly as the board runs it, printing every report.
-    let engine: SharedEngine<NoopRawMutex> = Mutex::new(RefCell::new(Engine::new(Some(config), firmware, id)));
+    let engine: SharedEngine<NoopRawMutex> = Mutex::new(RefCell::new(new_engine()));
     let replay = RefCell::new(Replay {
         now_us: 0,
         cycle: None,
         tick: 0,
         overrun: false,
+        wrong_emitter: false,
     });
     let printer = Printer {
         replay: &replay,
@@ -264,7 +289,7 @@ fn main() -> ! {
     };
     let mut station = Station::new(&engine, R(&replay), R(&replay), R(&replay), printer);
     let mut cycles = 0u32;
-    while let Some(c) = next_cycle(&mut file, &mut out) {
+    while let Some(c) = next_cycle(&mut file, &header, &mut out) {
         {
             let mut r = replay.borrow_mut();
             r.now_us = c.t0_us;
@@ -277,6 +302,10 @@ fn main() -> ! {
             drop(r);
             fail(&mut out, "the replay's switch samples do not match the station's ticks");
         }
+        if r.wrong_emitter {
+            drop(r);
+            fail(&mut out, "the replay's emitters do not follow the head schedule");
+        }
         cycles += 1;
     }
 
@@ -285,16 +314,19 @@ fn main() -> ! {
         fail(&mut out, "cannot reopen cycles.bin")
     };
     let mut skip = [0u8; replay::HEADER_LEN];
-    let _ = replay::Source::read_exact(&mut file, &mut skip);
-    let mut engine = Engine::new(Some(config), firmware, id);
+    let _ = replay::Source::read_exact(&mut file, &mut skip[..header.encoded_len()]);
+    let mut engine = new_engine();
     let (mut total, mut worst, mut n) = (0u64, 0u32, 0u32);
-    while let Some(c) = next_cycle(&mut file, &mut out) {
+    while let Some(c) = next_cycle(&mut file, &header, &mut out) {
         let cycle = Cycle {
             t0_us: c.t0_us,
             arrival_ns: c.arrival_ns,
         };
         let start = SYST::get_current();
-        let result = engine.on_cycle(&cycle);
+        let result = match c.emitter {
+            Emitter::Pen => engine.on_cycle(&cycle),
+            Emitter::Head => engine.on_head_cycle(&cycle),
+        };
         let counts = elapsed(start);
         core::hint::black_box(result);
         total += counts as u64;

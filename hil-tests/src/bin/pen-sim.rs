@@ -366,7 +366,7 @@ fn run(cli: Cli) -> Result<()> {
             let elf = qemu::build_pen_qemu()?;
             let run = qemu::run(
                 &elf,
-                &qemu::replay(&s.config, &records),
+                &qemu::replay(&s.config, s.head, &records),
                 std::time::Duration::from_secs(600),
             )?;
             let identical = run.reports == host;
