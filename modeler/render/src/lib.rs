@@ -28,7 +28,7 @@ pub mod clip;
 pub mod frame;
 pub mod overlay;
 pub mod rasterise;
-pub mod rocks;
+pub mod meshes;
 pub mod scene;
 pub mod shade;
 pub mod stereo;
@@ -43,7 +43,8 @@ pub use camera::{Camera, Eye, Orbit, Projection, Tracked, View, Viewport};
 pub use frame::{Frame, RenderError, Rgba};
 pub use scene::{Overlay, Scene, SlopeBar, Stereo, Style};
 
-use rasterise::{Bounds, Capsule, Sample};
+use meshes::Paint;
+use rasterise::{Bounds, Capsule, Sample, Surface};
 use transform::{Affine, Projected};
 
 /// What a render found in its input.
@@ -72,9 +73,8 @@ pub const TILE_ROWS: usize = 32;
 struct EyeBuffers {
     projected: Projected,
     capsules: Vec<Capsule>,
-    rocks: rocks::Projected,
-    /// The water meshes, drawn as the rocks are, in the water colour.
-    water: rocks::Projected,
+    /// Rocks, water and trees, in that order.
+    meshes: meshes::Projected,
 }
 
 /// Renders scenes into frames, keeping its buffers from one frame to the next.
@@ -221,22 +221,13 @@ impl Renderer {
             &mut self.eye.projected,
         );
         overlay::capsules(scene, &projection, &mut self.eye.capsules);
-        self.eye.rocks.project(
-            scene.rocks,
-            &affine,
-            scene.terrain.cell_size(),
-            near,
-            &scene.style,
-            (height as usize, self.tile_rows),
-        );
-        self.eye.water.project(
-            scene.water,
-            &affine,
-            scene.terrain.cell_size(),
-            near,
-            &scene.style,
-            (height as usize, self.tile_rows),
-        );
+        let meshes = &mut self.eye.meshes;
+        let cell = scene.terrain.cell_size();
+        meshes.clear((height as usize, self.tile_rows));
+        let rocks = scene.rocks.iter().map(|(_, m)| m);
+        meshes.add(rocks, Paint::Whole(Surface::Rock), &affine, cell, near, &scene.style);
+        let water = scene.water.iter().map(|(_, m)| m);
+        meshes.add(water, Paint::Whole(Surface::Water), &affine, cell, near, &scene.style);
         (affine, near)
     }
 
@@ -255,8 +246,7 @@ impl Renderer {
         };
         tiles::render(
             &pass,
-            &self.eye.rocks,
-            &self.eye.water,
+            &self.eye.meshes,
             &self.eye.capsules,
             &ramp,
             &scene.style,

@@ -75,7 +75,8 @@ pub struct Sample {
     pub hw: f32,
     /// Light / w.
     pub lw: f32,
-    /// Whose surface: the terrain's (the height ramp), a rock's or the water's (their colours).
+    /// Whose surface: the terrain's (the height ramp), a rock's or the water's (their colours), or
+    /// a colour of its own.
     pub surface: Surface,
 }
 
@@ -89,6 +90,9 @@ pub enum Surface {
     Rock,
     /// River or lake water: [`crate::Style::water_colour`].
     Water,
+    /// A colour of its own, sRGB, before light: a tree's bark or leaf, a texel of a simplified
+    /// shape ([`crate::meshes`], [`crate::textured`]).
+    Colour([u8; 3]),
 }
 
 /// Where covered pixels go.

@@ -189,6 +189,7 @@ pub fn resolve(
                 let c = match s.surface {
                     Surface::Rock => flat(style.rock_colour),
                     Surface::Water => flat(style.water_colour),
+                    Surface::Colour([r, g, b]) => [f32::from(r), f32::from(g), f32::from(b)],
                     Surface::Terrain => ramp.get(s.hw * w),
                 };
                 let l = (s.lw * w).clamp(0.0, 1.0);

@@ -111,8 +111,7 @@ impl EyePass<'_> {
 #[allow(clippy::too_many_arguments)]
 pub fn render(
     pass: &EyePass,
-    rocks: &super::rocks::Projected,
-    water: &super::rocks::Projected,
+    meshes: &super::meshes::Projected,
     capsules: &[Capsule],
     ramp: &Ramp,
     style: &Style,
@@ -148,8 +147,7 @@ pub fn render(
                 surface: rasterise::Surface::Terrain,
             };
             pass.terrain(&bounds, &mut sink);
-            rocks.draw(&bounds, smp, width, pass.near, rasterise::Surface::Rock);
-            water.draw(&bounds, smp, width, pass.near, rasterise::Surface::Water);
+            meshes.draw(&bounds, smp, width, pass.near);
             shade::resolve(smp, pix, width, (x0, x1), y0, frame_height, ramp, style);
             let (top, bottom) = (bounds.y0 as f32, bounds.y1 as f32);
             for cap in capsules {
