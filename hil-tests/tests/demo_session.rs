@@ -48,6 +48,7 @@ fn expected(view: &View, tuning: &Tuning) -> Document {
     plateau.figures.push(figure(&s[5]));
     let mut doc = blank_document();
     doc.regions.push(Region {
+        metric: None,
         boundary,
         figures: vec![figure(&s[1]), figure(&s[2]), figure(&s[3]), plateau],
     });

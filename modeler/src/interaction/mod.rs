@@ -1428,6 +1428,7 @@ impl Interaction {
             None if shape.kind == FigureKind::Closed => Edit::AddRegion {
                 index: doc.regions.len(),
                 region: Region {
+                    metric: None,
                     boundary: shape.points,
                     figures: Vec::new(),
                 },

@@ -167,6 +167,7 @@ mod tests {
             cell_size: 1.0,
         });
         d.regions.push(Region {
+            metric: None,
             boundary: square(5.0, 5.0, 90.0),
             figures: vec![
                 figure(FigureKind::Point, vec![[20.0, 20.0]], vec![]),

@@ -148,6 +148,7 @@ fn validation(c: &mut Criterion) {
             cell_size: 1.0,
         });
         doc.regions.push(Region {
+            metric: None,
             boundary: ripple([500.0, 500.0], 450.0, n),
             figures: vec![Figure {
                 kind: FigureKind::Closed,

@@ -8,8 +8,14 @@
 //!
 //! Maps are laid out over the region mask's bounding box, row-major; cells outside the region
 //! hold [`UNREACHABLE`].
+//!
+//! [`figure_map`] and [`edge_map`] give the maps the engine reads in either metric, as `f32`
+//! (infinite where unreachable): these 4-neighbour ones for `taxicab` (integers, exact in `f32`,
+//! so seed 000's numbers are unchanged to the bit), [`crate::edt`]'s for `euclidean`.
 
 use crate::cells::{Cell, Mask};
+use crate::document::Metric;
+use crate::edt;
 
 /// Distance of a cell no path within the region reaches (and of cells outside the region).
 pub const UNREACHABLE: u32 = u32::MAX;
@@ -77,4 +83,27 @@ pub fn edge_layers(mask: &Mask) -> Vec<u32> {
     }
     bfs(mask, &mut dist, &mut queue);
     dist
+}
+
+/// A taxicab map as the engine reads it: [`UNREACHABLE`] becomes infinite.
+fn real(d: Vec<u32>) -> Vec<f32> {
+    d.into_iter()
+        .map(|d| if d == UNREACHABLE { f32::INFINITY } else { d as f32 })
+        .collect()
+}
+
+/// `dp` in `metric`: [`from_sources`] or [`edt::from_sources`].
+pub fn figure_map(metric: Metric, mask: &Mask, sources: &[Cell]) -> Vec<f32> {
+    match metric {
+        Metric::Taxicab => real(from_sources(mask, sources)),
+        Metric::Euclidean => edt::from_sources(mask, sources),
+    }
+}
+
+/// `df` in `metric`: [`edge_layers`] or [`edt::to_edge`].
+pub fn edge_map(metric: Metric, mask: &Mask) -> Vec<f32> {
+    match metric {
+        Metric::Taxicab => real(edge_layers(mask)),
+        Metric::Euclidean => edt::to_edge(mask),
+    }
 }

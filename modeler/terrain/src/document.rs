@@ -10,8 +10,8 @@ use serde::{Deserialize, Serialize};
 /// The format version this build writes (and reads).
 pub const VERSION: u32 = 4;
 
-/// The oldest version this build reads: a version 1 or 2 document (no rock fields, no rivers) loads
-/// as version 3.
+/// The oldest version this build reads: a version 1 to 3 document (no rock fields, no rivers, no
+/// terrain settings) loads as the current version, with seed 000's taxicab distances.
 pub const OLDEST_VERSION: u32 = 1;
 
 /// A point in the ground plane, `[x, y]` in metres: x along columns, y along rows.
@@ -45,6 +45,48 @@ pub struct Document {
     /// Groves of trees (seed 004) scattered in a region; version 4 on.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub groves: Vec<Grove>,
+    /// How the regions' terrain is made from the figures: the distance metric; version 4 on. Left out, the defaults ([`TerrainSettings::default`]).
+    #[serde(default, skip_serializing_if = "TerrainSettings::is_default")]
+    pub terrain: TerrainSettings,
+}
+
+/// The distances eq. 1–3 read (`dp` from a figure, `df` from the region's edge).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Metric {
+    /// Seed 000's 4-neighbour path lengths, exactly: a point peak becomes a four-sided pyramid.
+    /// What documents of versions 1 to 3 use.
+    Taxicab,
+    /// Exact Euclidean distances (`crate::edt`): a point peak becomes a cone. The default of
+    /// new documents.
+    #[default]
+    Euclidean,
+}
+
+impl Metric {
+    /// The name the document uses.
+    pub fn name(self) -> &'static str {
+        match self {
+            Metric::Taxicab => "taxicab",
+            Metric::Euclidean => "euclidean",
+        }
+    }
+}
+
+/// Document-wide terrain settings (version 4).
+#[derive(Debug, Clone, PartialEq, Default, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TerrainSettings {
+    /// The distance metric of every region that does not choose its own ([`Region::metric`]).
+    #[serde(default)]
+    pub metric: Metric,
+}
+
+impl TerrainSettings {
+    /// Whether these are the defaults (then the document leaves them out).
+    pub fn is_default(&self) -> bool {
+        *self == TerrainSettings::default()
+    }
 }
 
 /// Ridgeline terrain (seed 002, `crate::ridge`): 3D ridgelines and 2D ridgeline trees whose
@@ -249,6 +291,10 @@ pub struct Region {
     /// The control figures inside it.
     #[serde(default)]
     pub figures: Vec<Figure>,
+    /// This region's distance metric (and its nested regions'), instead of the document's
+    /// [`TerrainSettings::metric`]; version 4 on.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub metric: Option<Metric>,
 }
 
 /// What a figure is.
@@ -329,7 +375,13 @@ impl Document {
             ridges: None,
             trees: Vec::new(),
             groves: Vec::new(),
+            terrain: TerrainSettings::default(),
         }
+    }
+
+    /// The metric region `r` uses: its own, or the document's.
+    pub fn metric_of(&self, r: &Region) -> Metric {
+        r.metric.unwrap_or(self.terrain.metric)
     }
 }
 

@@ -57,7 +57,7 @@
 use crate::cells::{self, Cell, Mask};
 use crate::change::{FigureList, ListChange, Scope};
 use crate::distance;
-use crate::document::{Document, Figure, FigureKind, Grid, Point, Region};
+use crate::document::{Document, Figure, FigureKind, Grid, Metric, Point, Region};
 use crate::heightmap::Heightmap;
 use crate::profile;
 use crate::river::layer::{Layer, Water};
@@ -80,7 +80,7 @@ struct Run {
 
 /// Per-figure caches, over the owning region's box.
 struct FigureNode {
-    dp: Vec<u32>,
+    dp: Vec<f32>,
     share: Vec<f32>,
     coef: Vec<f32>,
     /// The nested region of a closed figure.
@@ -90,7 +90,9 @@ struct FigureNode {
 /// Per-region caches, over the region's box.
 struct RegionNode {
     mask: Mask,
-    df: Vec<u32>,
+    /// The distances' metric, the region's (its nested regions inherit it).
+    metric: Metric,
+    df: Vec<f32>,
     /// The cells this region decides: its cells minus its nested regions'.
     owned: Vec<Run>,
     figures: Vec<FigureNode>,
@@ -116,13 +118,13 @@ fn sources(grid: &Grid, f: &Figure, child: Option<&RegionNode>) -> Vec<Cell> {
 }
 
 impl FigureNode {
-    fn build(grid: &Grid, region: &Mask, f: &Figure) -> FigureNode {
+    fn build(grid: &Grid, region: &Mask, metric: Metric, f: &Figure) -> FigureNode {
         let child = (f.kind == FigureKind::Closed).then(|| {
             let mask = nested_mask(grid, &f.points, region);
-            Box::new(RegionNode::build(grid, mask, &f.figures, Some(f.slope)))
+            Box::new(RegionNode::build(grid, mask, metric, &f.figures, Some(f.slope)))
         });
         FigureNode {
-            dp: distance::from_sources(region, &sources(grid, f, child.as_deref())),
+            dp: distance::figure_map(metric, region, &sources(grid, f, child.as_deref())),
             share: Vec::new(),
             coef: Vec::new(),
             child,
@@ -131,11 +133,12 @@ impl FigureNode {
 }
 
 impl RegionNode {
-    fn build(grid: &Grid, mask: Mask, figs: &[Figure], outer: Option<f64>) -> RegionNode {
-        let df = distance::edge_layers(&mask);
-        let figures = figs.iter().map(|f| FigureNode::build(grid, &mask, f)).collect();
+    fn build(grid: &Grid, mask: Mask, metric: Metric, figs: &[Figure], outer: Option<f64>) -> RegionNode {
+        let df = distance::edge_map(metric, &mask);
+        let figures = figs.iter().map(|f| FigureNode::build(grid, &mask, metric, f)).collect();
         let mut node = RegionNode {
             mask,
+            metric,
             df,
             owned: Vec::new(),
             figures,
@@ -149,9 +152,9 @@ impl RegionNode {
     /// New cells for the region; its figures' nested regions are kept.
     fn reshape(&mut self, grid: &Grid, mask: Mask, figs: &[Figure], outer: Option<f64>) {
         self.mask = mask;
-        self.df = distance::edge_layers(&self.mask);
+        self.df = distance::edge_map(self.metric, &self.mask);
         for (f, node) in figs.iter().zip(&mut self.figures) {
-            node.dp = distance::from_sources(&self.mask, &sources(grid, f, node.child.as_deref()));
+            node.dp = distance::figure_map(self.metric, &self.mask, &sources(grid, f, node.child.as_deref()));
         }
         self.settle(figs, outer);
     }
@@ -168,7 +171,7 @@ impl RegionNode {
             );
         }
         let node = &mut self.figures[k];
-        node.dp = distance::from_sources(&self.mask, &sources(grid, f, node.child.as_deref()));
+        node.dp = distance::figure_map(self.metric, &self.mask, &sources(grid, f, node.child.as_deref()));
     }
 
     /// Recomputes what depends on the set of figures: owned cells, shares, coefficients.
@@ -240,19 +243,22 @@ impl RegionNode {
         for run in owned.iter() {
             let b = run.row as usize * w;
             for i in b + run.start as usize..b + run.end as usize {
-                let on = figures.iter().filter(|f| f.dp[i] == 0).count();
+                let on = figures.iter().filter(|f| f.dp[i] == 0.0).count();
                 if on > 0 {
                     let each = 1.0 / on as f64;
                     for f in figures.iter_mut() {
-                        if f.dp[i] == 0 {
+                        if f.dp[i] == 0.0 {
                             f.share[i] = each as f32;
                         }
                     }
                 } else {
-                    let total: f64 = figures.iter().map(|f| profile::inverse_distance(f.dp[i])).sum();
+                    let total: f64 = figures
+                        .iter()
+                        .map(|f| profile::inverse_distance_real(f64::from(f.dp[i])))
+                        .sum();
                     if total > 0.0 {
                         for f in figures.iter_mut() {
-                            f.share[i] = (profile::inverse_distance(f.dp[i]) / total) as f32;
+                            f.share[i] = (profile::inverse_distance_real(f64::from(f.dp[i])) / total) as f32;
                         }
                     }
                 }
@@ -270,7 +276,7 @@ impl RegionNode {
             let b = run.row as usize * w;
             let cells = b + run.start as usize..b + run.end as usize;
             for (i, out) in cells.clone().zip(&mut coef[cells]) {
-                let wk = profile::weight(self.df[i], node.dp[i]);
+                let wk = profile::weight_real(f64::from(self.df[i]), f64::from(node.dp[i]));
                 let s = outer.map_or(s1, |s0| profile::nested_slope(s1, s0, wk));
                 *out = (profile::shape(wk, s) * f64::from(node.share[i])) as f32;
             }
@@ -407,8 +413,14 @@ fn locate<'a, 'd>(
     }
 }
 
-fn region_node(grid: &Grid, r: &Region) -> RegionNode {
-    RegionNode::build(grid, cells::closed_mask(grid, &r.boundary), &r.figures, None)
+fn region_node(doc: &Document, r: &Region) -> RegionNode {
+    RegionNode::build(
+        &doc.grid,
+        cells::closed_mask(&doc.grid, &r.boundary),
+        doc.metric_of(r),
+        &r.figures,
+        None,
+    )
 }
 
 impl TerrainEngine {
@@ -421,7 +433,7 @@ impl TerrainEngine {
     /// Generates the terrain of a valid document.
     fn build(doc: &Document) -> TerrainEngine {
         let grid = doc.grid;
-        let regions: Vec<RegionNode> = doc.regions.iter().map(|r| region_node(&grid, r)).collect();
+        let regions: Vec<RegionNode> = doc.regions.iter().map(|r| region_node(doc, r)).collect();
         let mut map = Heightmap::new(&grid);
         for (node, r) in regions.iter().zip(&doc.regions) {
             node.paint_all(&r.figures, 0.0, &mut map);
@@ -566,11 +578,15 @@ impl TerrainEngine {
                     return None;
                 }
                 match *change {
-                    ListChange::Added(k) => node.figures.insert(k, FigureNode::build(&grid, &node.mask, &figs[k])),
+                    ListChange::Added(k) => node
+                        .figures
+                        .insert(k, FigureNode::build(&grid, &node.mask, node.metric, &figs[k])),
                     ListChange::Removed(k) => {
                         node.figures.remove(k);
                     }
-                    ListChange::Replaced(k) => node.figures[k] = FigureNode::build(&grid, &node.mask, &figs[k]),
+                    ListChange::Replaced(k) => {
+                        node.figures[k] = FigureNode::build(&grid, &node.mask, node.metric, &figs[k])
+                    }
                     ListChange::Outline(k) => node.outline(&grid, k, figs),
                 }
                 if node.figures.len() != figs.len() {
@@ -582,7 +598,7 @@ impl TerrainEngine {
             }
             Scope::RegionAdded(i) => {
                 let r = doc.regions.get(*i)?;
-                let node = region_node(&grid, r);
+                let node = region_node(doc, r);
                 node.paint_all(&r.figures, 0.0, map);
                 let rect = Rect::of(&node.mask);
                 regions.insert(*i, node);
@@ -598,7 +614,7 @@ impl TerrainEngine {
             }
             Scope::RegionReplaced(i) => {
                 let r = doc.regions.get(*i)?;
-                let old = std::mem::replace(regions.get_mut(*i)?, region_node(&grid, r));
+                let old = std::mem::replace(regions.get_mut(*i)?, region_node(doc, r));
                 old.clear(map);
                 regions[*i].paint_all(&r.figures, 0.0, map);
                 Rect::of(&old.mask).union(Rect::of(&regions[*i].mask))

@@ -23,6 +23,7 @@ pub mod distance;
 pub mod document;
 pub mod edit;
 pub mod editor;
+pub mod edt;
 pub mod engine;
 pub mod export;
 // The fuzz targets' properties, shared with the stable test that replays their corpora.
@@ -42,7 +43,7 @@ pub mod trees;
 pub mod validate;
 
 pub use address::{CurvePath, FigurePath};
-pub use document::{Document, Figure, FigureKind, Grid, Point, Region, River};
+pub use document::{Document, Figure, FigureKind, Grid, Metric, Point, Region, River, TerrainSettings};
 pub use edit::{Edit, EditError};
 pub use editor::{Editor, Outcome};
 pub use engine::{Rect, TerrainEngine, generate};

@@ -68,6 +68,14 @@ struct VersionOnly {
     version: serde_json::Value,
 }
 
+/// Whether a document states terrain settings: a left-out entry means the defaults in version 4
+/// and seed 000's taxicab distances before, so an older document must not state one.
+#[derive(Deserialize)]
+struct TerrainStated {
+    #[serde(default)]
+    terrain: Option<serde::de::IgnoredAny>,
+}
+
 impl Document {
     /// Parses and validates a document.
     pub fn from_json(text: &str) -> Result<Document, LoadError> {
@@ -81,8 +89,8 @@ impl Document {
             }
         }
         let mut doc: Document = parse(text)?;
-        // Version 1 had no rock fields, version 2 no rivers; both read as the current version and
-        // are saved as such.
+        // Version 1 had no rock fields, version 2 no rivers, 3 no terrain settings; all read as the
+        // current version and are saved as such.
         if doc.version < 2 && !doc.rocks.is_empty() {
             return Err(ValidationError::new("rocks", Defect::NeedsVersion(2)).into());
         }
@@ -91,6 +99,17 @@ impl Document {
         }
         if doc.version < 3 && doc.ridges.is_some() {
             return Err(ValidationError::new("ridges", Defect::NeedsVersion(3)).into());
+        }
+        if doc.version < 4 {
+            // The text parsed as a document, so it parses as this; a failure would only mean no entry.
+            if serde_json::from_str::<TerrainStated>(text).is_ok_and(|t| t.terrain.is_some()) {
+                return Err(ValidationError::new("terrain", Defect::NeedsVersion(4)).into());
+            }
+            if let Some(i) = doc.regions.iter().position(|r| r.metric.is_some()) {
+                return Err(ValidationError::new(format!("regions[{i}].metric"), Defect::NeedsVersion(4)).into());
+            }
+            // Terrain made before version 4 keeps seed 000's distances, to the bit.
+            doc.terrain.metric = crate::document::Metric::Taxicab;
         }
         if doc.version < 4 && !doc.trees.is_empty() {
             return Err(ValidationError::new("trees", Defect::NeedsVersion(4)).into());

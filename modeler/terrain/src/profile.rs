@@ -9,10 +9,23 @@ use crate::distance::UNREACHABLE;
 /// (`dp = 0`, even where `df = 0`). A cell the figure cannot reach (`dp` = [`UNREACHABLE`]) has
 /// `w = 0`.
 pub fn weight(df: u32, dp: u32) -> f64 {
-    match dp {
-        0 => 1.0,
-        UNREACHABLE => 0.0,
-        _ => f64::from(df) / (f64::from(df) + f64::from(dp)),
+    weight_real(f64::from(df), real(dp))
+}
+
+/// A taxicab distance as a real one: [`UNREACHABLE`] is infinite.
+fn real(d: u32) -> f64 {
+    if d == UNREACHABLE { f64::INFINITY } else { f64::from(d) }
+}
+
+/// Eq. 1 for distances of either metric (`dp` infinite where the figure cannot reach): the same
+/// numbers as [`weight`] on whole distances.
+pub fn weight_real(df: f64, dp: f64) -> f64 {
+    if dp == 0.0 {
+        1.0
+    } else if dp == f64::INFINITY {
+        0.0
+    } else {
+        df / (df + dp)
     }
 }
 
@@ -43,7 +56,12 @@ pub fn nested_slope(s1: f64, s0: f64, w: f64) -> f64 {
 
 /// Eq. 3's inverse-distance weight of a figure at distance `dp ≥ 1` (0 when unreachable).
 pub fn inverse_distance(dp: u32) -> f64 {
-    if dp == UNREACHABLE { 0.0 } else { 1.0 / f64::from(dp) }
+    inverse_distance_real(real(dp))
+}
+
+/// Eq. 3's weight for a distance of either metric: `1/dp`, 0 when infinite.
+pub fn inverse_distance_real(dp: f64) -> f64 {
+    1.0 / dp
 }
 
 /// Eq. 3: the relief of a cell from each figure's `(dp, relief)`. A cell on one or more figures

@@ -9,7 +9,7 @@ use common::*;
 use penmodel_terrain::change::Scope;
 use penmodel_terrain::editor::{Editor, EditorError, OpenReport};
 use penmodel_terrain::{
-    CurvePath, Defect, Document, Edit, EditError, Figure, FigurePath, TerrainEngine, generate, journal,
+    CurvePath, Defect, Document, Edit, EditError, Figure, FigurePath, Metric, TerrainEngine, generate, journal,
 };
 use proptest::prelude::*;
 
@@ -138,6 +138,10 @@ fn edit_for(doc: &Document, op: &Op) -> Option<Edit> {
     })
 }
 
+fn metric() -> impl Strategy<Value = Metric> {
+    prop_oneof![Just(Metric::Taxicab), Just(Metric::Euclidean)]
+}
+
 #[track_caller]
 fn assert_matches_full(editor: &Editor, context: &str) {
     let full = generate(editor.document()).unwrap();
@@ -152,9 +156,10 @@ proptest! {
 
     /// After any sequence of edits (refused ones included), the incrementally updated terrain
     /// equals a full regeneration of the document within the summation-order tolerance, and a
-    /// refused edit leaves the document and terrain exactly as they were.
+    /// refused edit leaves the document and terrain exactly as they were; in either metric.
     #[test]
-    fn incremental_equals_full(doc in nested_document(), ops in prop::collection::vec(op(), 1..14)) {
+    fn incremental_equals_full(mut doc in nested_document(), ops in prop::collection::vec(op(), 1..14), metric in metric()) {
+        doc.terrain.metric = metric;
         let mut editor = Editor::new(doc).unwrap();
         for (n, op) in ops.iter().enumerate() {
             let Some(edit) = edit_for(editor.document(), op) else { continue };
@@ -172,7 +177,8 @@ proptest! {
     /// Undo all returns the exact first document, redo all the exact last one; each undo and redo
     /// step regenerates correctly.
     #[test]
-    fn undo_redo_exact(doc in nested_document(), ops in prop::collection::vec(op(), 1..12)) {
+    fn undo_redo_exact(mut doc in nested_document(), ops in prop::collection::vec(op(), 1..12), metric in metric()) {
+        doc.terrain.metric = metric;
         let mut editor = Editor::new(doc.clone()).unwrap();
         let mut docs = vec![doc.clone()];
         for op in &ops {
@@ -230,6 +236,7 @@ fn sample() -> Document {
     document(
         40,
         vec![penmodel_terrain::Region {
+            metric: None,
             boundary: polygon([20.0, 20.0], 15.0, 8, 0.1),
             figures: vec![
                 point([14.2, 18.3], 30.0, -1.0),
@@ -413,6 +420,7 @@ fn an_edit_regenerates_only_its_region() {
     doc.regions[0].boundary = polygon([12.0, 20.0], 9.0, 8, 0.1);
     doc.regions[0].figures = vec![point([11.0, 19.0], 30.0, -1.0)];
     doc.regions.push(penmodel_terrain::Region {
+        metric: None,
         boundary: polygon([31.0, 20.0], 7.0, 8, 0.1),
         figures: vec![point([31.0, 21.0], 20.0, 0.0)],
     });

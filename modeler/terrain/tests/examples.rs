@@ -64,3 +64,73 @@ fn examples_generate() {
         assert_eq!(Document::from_json(&doc.to_json()).unwrap(), doc, "{name}");
     }
 }
+
+/// The examples are version 1 files: they load with seed 000's taxicab distances, and their
+/// terrain is the seed method's to the bit (saved again as version 4, they say so and stay so).
+#[test]
+fn older_versions_keep_taxicab_terrain_to_the_bit() {
+    for (name, doc) in examples() {
+        assert_eq!(doc.terrain.metric, penmodel_terrain::Metric::Taxicab, "{name}");
+        let map = generate(&doc).unwrap();
+        assert_eq!(map, crate::baseline::generate(&doc).unwrap(), "{name}");
+        let again = Document::from_json(&doc.to_json()).unwrap();
+        assert_eq!(again, doc, "{name}");
+        assert_eq!(generate(&again).unwrap(), map, "{name}");
+    }
+}
+
+/// A new document uses Euclidean distances: a point peak in a round region is a cone, its
+/// height depending on the distance from the peak alone (to within a cell's rasterisation of the
+/// boundary), where taxicab distances make a four-sided pyramid.
+#[test]
+fn a_new_document_makes_a_cone() {
+    use penmodel_terrain::{Grid, Metric, Region};
+    let mut doc = Document::new(Grid {
+        cols: 101,
+        rows: 101,
+        cell_size: 1.0,
+    });
+    assert_eq!(doc.terrain.metric, Metric::Euclidean);
+    let boundary: Vec<[f64; 2]> = (0..=64)
+        .map(|i| {
+            let t = std::f64::consts::TAU * f64::from(i % 64) / 64.0;
+            [50.5 + 48.0 * t.cos(), 50.5 + 48.0 * t.sin()]
+        })
+        .collect();
+    doc.regions.push(Region {
+        boundary,
+        figures: vec![Figure {
+            kind: FigureKind::Point,
+            points: vec![[50.5, 50.5]],
+            height: 100.0,
+            slope: 0.0,
+            figures: vec![],
+        }],
+        metric: None,
+    });
+    // On a ring of cells 29.5 to 30.5 cells from the peak the heights spread by the ring's width
+    // and the boundary's rasterisation only; with taxicab distances, whose rings are diamonds,
+    // by much more.
+    let spread = |doc: &Document| {
+        let map = generate(doc).unwrap();
+        let ring = (0..101u32)
+            .flat_map(|r| (0..101u32).map(move |c| (c, r)))
+            .filter(|&(c, r)| {
+                let d = (f64::from(c) - 50.0).hypot(f64::from(r) - 50.0);
+                (29.5..30.5).contains(&d)
+            });
+        let (lo, hi) = ring.fold((f32::MAX, f32::MIN), |(lo, hi), (c, r)| {
+            let h = map.get(c, r);
+            (lo.min(h), hi.max(h))
+        });
+        f64::from(hi - lo)
+    };
+    let euclidean = spread(&doc);
+    doc.terrain.metric = Metric::Taxicab;
+    let taxicab = spread(&doc);
+    // Measured: 2.0 m (the ring's width of one cell on a slope of about 2 m a cell) and 5.8 m.
+    assert!(
+        euclidean < 0.5 * taxicab,
+        "ring spread: euclidean {euclidean} m, taxicab {taxicab} m"
+    );
+}

@@ -25,8 +25,9 @@ fn volcano_with(from: &str, to: &str) -> String {
     text.replacen(from, to, 1)
 }
 
-/// An error message fit to show: short whatever the input's size.
-const MAX_MESSAGE: usize = 400;
+/// An error message fit to show: short whatever the input's size (a cut 200-character element,
+/// the cut message and serde's list of the document's ten keys).
+const MAX_MESSAGE: usize = 480;
 
 /// Loads `text`, expecting an error naming `element` (a document path, or "" for the text
 /// itself) and saying `says`.

@@ -17,6 +17,7 @@ fn one_region(n: u32, figures: Vec<penmodel_terrain::Figure>) -> Document {
     document(
         n,
         vec![Region {
+            metric: None,
             boundary: square(1.0, f64::from(n) - 1.0),
             figures,
         }],
@@ -434,6 +435,7 @@ fn the_curve_checks_find_what_checking_every_pair_finds() {
         let doc = document(
             40,
             vec![Region {
+                metric: None,
                 boundary: pts.clone(),
                 figures: vec![],
             }],
@@ -465,6 +467,7 @@ fn large_curves_are_checked_correctly() {
     let good = document(
         1000,
         vec![Region {
+            metric: None,
             boundary: boundary.clone(),
             figures: vec![
                 closed(inner.clone(), 30.0, 0.0, vec![]),

@@ -5,8 +5,8 @@ use crate::common;
 
 use common::*;
 use penmodel_terrain::cells::{self, Mask};
-use penmodel_terrain::distance::{self, UNREACHABLE};
-use penmodel_terrain::{FigureKind, Region, generate, profile};
+use penmodel_terrain::distance;
+use penmodel_terrain::{FigureKind, Metric, Region, generate, profile};
 use proptest::prelude::*;
 
 /// A random set of cells in a w × h box, and some sources among them.
@@ -51,6 +51,7 @@ fn single_figure_document() -> impl Strategy<Value = penmodel_terrain::Document>
             document(
                 24,
                 vec![Region {
+                    metric: None,
                     boundary,
                     figures: vec![figure],
                 }],
@@ -66,6 +67,44 @@ proptest! {
     fn bfs_equals_seed_sweeps((mask, sources) in random_mask()) {
         prop_assert_eq!(distance::from_sources(&mask, &sources), baseline::from_sources(&mask, &sources));
         prop_assert_eq!(distance::edge_layers(&mask), baseline::edge_layers(&mask));
+    }
+
+    /// The Euclidean maps equal brute force: `dp` the smallest distance to a source in the region,
+    /// `df` the smallest distance to a cell outside the region (the box's surroundings included)
+    /// less one, each compared as the square root of the exact squared distance.
+    #[test]
+    fn euclidean_maps_equal_brute_force((mask, sources) in random_mask()) {
+        let dp = penmodel_terrain::edt::from_sources(&mask, &sources);
+        let df = penmodel_terrain::edt::to_edge(&mask);
+        let (w, h) = (i64::from(mask.width), i64::from(mask.height));
+        let inside = |x: i64, y: i64| (0..w).contains(&x) && (0..h).contains(&y) && mask.bits()[(y * w + x) as usize];
+        let srcs: Vec<(i64, i64)> = sources
+            .iter()
+            .map(|&(c, r)| (i64::from(c) - i64::from(mask.c0), i64::from(r) - i64::from(mask.r0)))
+            .filter(|&(x, y)| inside(x, y))
+            .collect();
+        for y in 0..h {
+            for x in 0..w {
+                let i = (y * w + x) as usize;
+                if !inside(x, y) {
+                    prop_assert!(dp[i].is_infinite() && df[i].is_infinite());
+                    continue;
+                }
+                let near = srcs.iter().map(|&(sx, sy)| (sx - x).pow(2) + (sy - y).pow(2)).min();
+                let want = near.map_or(f32::INFINITY, |d2| (d2 as f64).sqrt() as f32);
+                prop_assert_eq!(dp[i], want, "dp at ({}, {})", x, y);
+                // The nearest outside cell lies within the box and a one-cell border around it.
+                let mut edge = i64::MAX;
+                for oy in -1..=h {
+                    for ox in -1..=w {
+                        if !inside(ox, oy) {
+                            edge = edge.min((ox - x).pow(2) + (oy - y).pow(2));
+                        }
+                    }
+                }
+                prop_assert_eq!(df[i], ((edge as f64).sqrt() - 1.0) as f32, "df at ({}, {})", x, y);
+            }
+        }
     }
 
     /// Every weight is in [0, 1], and so is eq. 2's share of the relief, for any slope.
@@ -102,7 +141,8 @@ proptest! {
 
     /// With the breadth-first maps or the seed's sweeps, the terrain is the same to the bit.
     #[test]
-    fn generation_equals_seed_method(doc in nested_document()) {
+    fn generation_equals_seed_method(mut doc in nested_document()) {
+        doc.terrain.metric = Metric::Taxicab;
         prop_assert_eq!(generate(&doc).unwrap(), baseline::generate(&doc).unwrap());
     }
 
@@ -112,15 +152,18 @@ proptest! {
     /// height the parent gives the closed figure's cells. The step to a parent cell p beside it is
     /// then the parent's own slope toward its figure: with the closed figure alone in the parent
     /// (p has dp = 1), |h(p) − H| = |H|·(1 − shape(df/(df + 1), s0)) ≤ |H|·max(1, 1 − s0)/(df(p) + 1).
+    /// In either metric, with that metric's `df`.
     #[test]
-    fn continuous_across_nested_edge(mut doc in nested_document()) {
+    fn continuous_across_nested_edge(mut doc in nested_document(), euclidean in any::<bool>()) {
+        let metric = if euclidean { Metric::Euclidean } else { Metric::Taxicab };
+        doc.terrain.metric = metric;
         // The closed figure alone in the parent, for the bound on the parent's side.
         doc.regions[0].figures.retain(|f| f.kind == FigureKind::Closed);
         let map = generate(&doc).unwrap();
         let k = &doc.regions[0].figures[0];
         let nested = cells::closed_mask(&doc.grid, &k.points);
         let region = cells::closed_mask(&doc.grid, &doc.regions[0].boundary);
-        let df = distance::edge_layers(&region);
+        let df = distance::edge_map(metric, &region);
         let on_inner: Vec<(u32, u32)> = k.figures.iter().flat_map(|f| cells::figure_cells(&doc.grid, f)).collect();
         let h_k = k.height as f32;
         let bound_factor = 1f64.max(1.0 - k.slope);
@@ -136,7 +179,7 @@ proptest! {
             prop_assert_eq!(map.get(c, r), h_k, "nested edge cell {:?}", q);
             for p in outside.into_iter().filter(|&p| region.contains(p)) {
                 let dfp = df[region.index(p).unwrap()];
-                prop_assert!(dfp != UNREACHABLE);
+                prop_assert!(dfp.is_finite());
                 let step = (f64::from(map.get(p.0, p.1)) - f64::from(h_k)).abs();
                 let bound = f64::from(h_k).abs() * bound_factor / (f64::from(dfp) + 1.0);
                 prop_assert!(step <= bound * (1.0 + 1e-6) + 1e-5, "step {} > bound {} between {:?} and {:?}", step, bound, p, q);

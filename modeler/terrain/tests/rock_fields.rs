@@ -36,6 +36,7 @@ fn field(at: [f64; 2]) -> RockField {
 /// A 128 m square grid, one region over most of it with a peak, and a rock field on its flank.
 fn doc() -> Document {
     let region = Region {
+        metric: None,
         boundary: polygon([64.0, 64.0], 60.0, 24, 0.1),
         figures: vec![point([64.0, 64.0], 30.0, 0.0)],
     };
@@ -55,11 +56,14 @@ fn a_version_1_document_loads_as_the_current_version() {
     // Rock fields need version 2; a version 2 file with them loads.
     let mut v2 = doc.clone();
     v2.rocks.push(field([40.0, 30.0]));
+    // Written as an older version: without version 4's terrain settings (it loads as taxicab).
+    let mut older = v2.clone();
+    older.terrain = Default::default();
     let current = format!("\"version\": {VERSION}");
-    let with_rocks = v2.to_json().replace(&current, "\"version\": 1");
+    let with_rocks = older.to_json().replace(&current, "\"version\": 1");
     let e = Document::from_json(&with_rocks).expect_err("rocks in a version 1 file");
     assert_eq!(e.to_string(), "rocks: needs document version 2");
-    let as_v2 = Document::from_json(&v2.to_json().replace(&current, "\"version\": 2")).expect("version 2 loads");
+    let as_v2 = Document::from_json(&older.to_json().replace(&current, "\"version\": 2")).expect("version 2 loads");
     assert_eq!(as_v2, v2);
     let unknown = format!("\"version\": {}", VERSION + 1);
     let e = Document::from_json(&text.replace("\"version\": 1", &unknown)).expect_err("a future version");
@@ -290,10 +294,12 @@ fn an_edit_away_from_a_field_leaves_its_rocks_alone() {
         cell_size: 1.0,
     });
     d.regions.push(Region {
+        metric: None,
         boundary: square(5.0),
         figures: vec![point([50.0, 50.0], 30.0, 0.0)],
     });
     d.regions.push(Region {
+        metric: None,
         boundary: square(105.0),
         figures: vec![point([150.0, 50.0], 30.0, 0.0)],
     });

@@ -9,6 +9,7 @@ fn base() -> Document {
     document(
         40,
         vec![Region {
+            metric: None,
             boundary: polygon([20.0, 20.0], 15.0, 8, 0.1),
             figures: vec![
                 point([14.2, 18.3], 30.0, -1.0),
@@ -117,6 +118,7 @@ fn figures_outside_their_region() {
 fn overlapping_regions() {
     let mut d = base();
     d.regions.push(Region {
+        metric: None,
         boundary: polygon([36.0, 20.0], 3.5, 6, 0.0),
         figures: vec![],
     });
@@ -129,10 +131,12 @@ fn overlapping_regions() {
     // both fall in column 35.
     let mut d = document(40, vec![]);
     d.regions.push(Region {
+        metric: None,
         boundary: vec![[1.0, 1.0], [35.1, 1.0], [35.1, 20.0], [1.0, 20.0], [1.0, 1.0]],
         figures: vec![],
     });
     d.regions.push(Region {
+        metric: None,
         boundary: vec![[35.4, 1.0], [39.0, 1.0], [39.0, 20.0], [35.4, 20.0], [35.4, 1.0]],
         figures: vec![],
     });
@@ -240,10 +244,19 @@ fn json_errors_name_the_element() {
         }
         other => panic!("{other:?}"),
     }
-    let text = base().to_json().replacen("\"version\": 3", "\"version\": 4", 1);
+    let (current, next) = (
+        penmodel_terrain::document::VERSION,
+        penmodel_terrain::document::VERSION + 1,
+    );
+    let text = base()
+        .to_json()
+        .replacen(&format!("\"version\": {current}"), &format!("\"version\": {next}"), 1);
     match Document::from_json(&text) {
         Err(LoadError::Invalid(e)) => {
-            assert_eq!((e.path.as_str(), e.defect), ("version", Defect::Version("4".into())))
+            assert_eq!(
+                (e.path.as_str(), e.defect),
+                ("version", Defect::Version(next.to_string()))
+            )
         }
         other => panic!("{other:?}"),
     }

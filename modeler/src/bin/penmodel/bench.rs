@@ -76,6 +76,7 @@ fn memory_document(n: u32, k: u32) -> Document {
         cell_size: 1.0,
     });
     doc.regions.push(Region {
+        metric: None,
         boundary: vec![[lo, lo], [hi, lo], [hi, hi], [lo, hi], [lo, lo]],
         figures,
     });

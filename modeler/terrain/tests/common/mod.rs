@@ -189,6 +189,7 @@ pub fn nested_document() -> impl Strategy<Value = Document> {
                 document(
                     n,
                     vec![Region {
+                        metric: None,
                         boundary: boundary.clone(),
                         figures,
                     }],

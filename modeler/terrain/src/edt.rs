@@ -1,0 +1,187 @@
+//! Exact Euclidean distance transforms in linear time (Felzenszwalb & Huttenlocher, "Distance
+//! transforms of sampled functions", 2012), the distances of the `euclidean` metric.
+//!
+//! The squared distance to the nearest source cell is separable: a pass down each column gives
+//! every cell its vertical distance `g` to the nearest source in its column, then each row is
+//! the lower envelope of the parabolas `(x − q)² + g(q)²` over its columns q, built and read in
+//! one sweep. Both passes are linear, so a map costs O(cells of the box) whatever its distances.
+//! Intersections of parabolas are compared as exact fractions (128-bit cross products), not as
+//! floating-point numbers, so the squared distances are exact integers; the distance is their
+//! square root rounded once to `f32`.
+//!
+//! `df` is the distance to the nearest cell outside the region, less one (so that a cell with a
+//! 4-neighbour outside has `df = 0`, as in the taxicab metric, where `df` is the taxicab distance
+//! to the outside less one). It is geodesic — the length of the shortest path inside the region —
+//! for any region, convex or not: the disc of radius `d` around a cell holds no outside cell, so
+//! the straight segment to the nearest outside cell crosses only region cells. `dp`, the distance
+//! from a figure, is the straight-line distance to its nearest cell, which in a region with a
+//! bay may cross the bay (`docs/modeler.md` says what that does).
+
+use crate::cells::{Cell, Mask};
+
+/// No source in the column (or the row).
+const FAR: u32 = u32::MAX;
+
+/// Squared Euclidean distance from each cell of a `w × h` box (row-major) to the nearest cell
+/// where `source` is true, or `u64::MAX` when there is no source at all.
+pub fn squared(w: usize, h: usize, source: &[bool]) -> Vec<u64> {
+    debug_assert_eq!(source.len(), w * h);
+    // Column pass: vertical distance to the nearest source in the column, two sweeps over rows
+    // (row by row rather than column by column, for the cache).
+    let mut g: Vec<u32> = source.iter().map(|&s| if s { 0 } else { FAR }).collect();
+    for y in 1..h {
+        let (above, row) = g[(y - 1) * w..(y + 1) * w].split_at_mut(w);
+        for (d, &a) in row.iter_mut().zip(above.iter()) {
+            if *d != 0 && a != FAR {
+                *d = a + 1;
+            }
+        }
+    }
+    for y in (0..h.saturating_sub(1)).rev() {
+        let (row, below) = g[y * w..(y + 2) * w].split_at_mut(w);
+        for (d, &b) in row.iter_mut().zip(below.iter()) {
+            if b != FAR && b + 1 < *d {
+                *d = b + 1;
+            }
+        }
+    }
+    let mut out = vec![u64::MAX; w * h];
+    let mut env = Envelope::with_capacity(w);
+    for (row, dst) in g.chunks(w.max(1)).zip(out.chunks_mut(w.max(1))) {
+        env.row(row, dst);
+    }
+    out
+}
+
+/// The lower envelope of one row's parabolas: their vertices `v` (columns, increasing) and for
+/// each the fraction `z = num/den` where it starts to be the lowest.
+struct Envelope {
+    v: Vec<i64>,
+    f: Vec<i64>,
+    z: Vec<(i128, i128)>,
+}
+
+impl Envelope {
+    fn with_capacity(n: usize) -> Envelope {
+        Envelope {
+            v: Vec::with_capacity(n),
+            f: Vec::with_capacity(n),
+            z: Vec::with_capacity(n),
+        }
+    }
+
+    /// Where the parabola of column `q` (height `fq`) starts to lie below the one of the last
+    /// vertex `k`: `((fq + q²) − (fk + vk²)) / (2(q − vk))`, as a fraction with a positive
+    /// denominator.
+    fn meet(&self, k: usize, q: i64, fq: i64) -> (i128, i128) {
+        let (vk, fk) = (self.v[k], self.f[k]);
+        let num = i128::from(fq + q * q) - i128::from(fk + vk * vk);
+        (num, 2 * i128::from(q - vk))
+    }
+
+    /// `a ≤ b` for fractions with positive denominators.
+    fn at_most(a: (i128, i128), b: (i128, i128)) -> bool {
+        a.0 * b.1 <= b.0 * a.1
+    }
+
+    /// The squared distances of one row from its columns' vertical distances `g`.
+    fn row(&mut self, g: &[u32], out: &mut [u64]) {
+        self.v.clear();
+        self.f.clear();
+        self.z.clear();
+        for (q, &gq) in g.iter().enumerate() {
+            if gq == FAR {
+                continue;
+            }
+            let (q, fq) = (q as i64, i64::from(gq) * i64::from(gq));
+            // Drop the vertices the new parabola hides: those whose own stretch would start
+            // after the new one's.
+            while let Some(k) = self.v.len().checked_sub(1) {
+                let s = self.meet(k, q, fq);
+                if k > 0 && Self::at_most(s, self.z[k]) {
+                    self.v.pop();
+                    self.f.pop();
+                    self.z.pop();
+                } else {
+                    self.v.push(q);
+                    self.f.push(fq);
+                    self.z.push(s);
+                    break;
+                }
+            }
+            if self.v.is_empty() {
+                self.v.push(q);
+                self.f.push(fq);
+                // The first vertex's stretch starts at −∞.
+                self.z.push((-1, 0));
+            }
+        }
+        if self.v.is_empty() {
+            return;
+        }
+        let mut k = 0;
+        for (x, d) in out.iter_mut().enumerate() {
+            let x = x as i64;
+            // Move on while the next vertex's stretch starts at or before x (x·den ≥ num).
+            while k + 1 < self.v.len() && {
+                let (num, den) = self.z[k + 1];
+                i128::from(x) * den >= num
+            } {
+                k += 1;
+            }
+            let dx = x - self.v[k];
+            *d = (dx * dx + self.f[k]) as u64;
+        }
+    }
+}
+
+/// `dp` in the Euclidean metric: the distance of every region cell from the nearest of
+/// `sources` (straight-line), over the mask's box; cells outside the region are infinite, and
+/// so is every cell when no source lies in the region. Sources outside the region are ignored.
+pub fn from_sources(mask: &Mask, sources: &[Cell]) -> Vec<f32> {
+    let bits = mask.bits();
+    let mut src = vec![false; mask.box_len()];
+    for &s in sources {
+        if let Some(i) = mask.index(s).filter(|&i| bits[i]) {
+            src[i] = true;
+        }
+    }
+    let d2 = squared(mask.width as usize, mask.height as usize, &src);
+    bits.iter()
+        .zip(&d2)
+        .map(|(&inside, &d2)| {
+            if inside && d2 != u64::MAX {
+                (d2 as f64).sqrt() as f32
+            } else {
+                f32::INFINITY
+            }
+        })
+        .collect()
+}
+
+/// `df` in the Euclidean metric: for every region cell, the distance to the nearest cell outside
+/// the region (or the grid) less one, over the mask's box; cells outside the region are infinite.
+pub fn to_edge(mask: &Mask) -> Vec<f32> {
+    let (w, h) = (mask.width as usize, mask.height as usize);
+    let bits = mask.bits();
+    // The box with a one-cell border of outside cells: every cell beyond the box is outside the
+    // region, and the border is the nearest of them along rows and columns.
+    let (pw, ph) = (w + 2, h + 2);
+    let mut outside = vec![true; pw * ph];
+    for y in 0..h {
+        for (x, &inside) in bits[y * w..(y + 1) * w].iter().enumerate() {
+            outside[(y + 1) * pw + x + 1] = !inside;
+        }
+    }
+    let d2 = squared(pw, ph, &outside);
+    let mut out = vec![f32::INFINITY; w * h];
+    for y in 0..h {
+        for x in 0..w {
+            let i = y * w + x;
+            if bits[i] {
+                out[i] = ((d2[(y + 1) * pw + x + 1] as f64).sqrt() - 1.0) as f32;
+            }
+        }
+    }
+    out
+}
