@@ -14,4 +14,6 @@ mod ridges;
 mod rivers;
 mod rock_fields;
 mod rocks;
+mod tree_documents;
+mod trees;
 mod validation;

@@ -17,7 +17,7 @@ use crate::geometry::{self, Side};
 pub const JAMMING: f64 = 0.547;
 
 /// Pixels of the sampling image per spacing: finer places the trees more freely.
-pub const PIXELS_PER_SPACING: f64 = 4.0;
+pub const PIXELS_PER_SPACING: f64 = 8.0;
 
 /// The most pixels a grove's sampling image may have (the rock fields' limit).
 pub const MAX_PIXELS: u64 = crate::rocks::MAX_PIXELS;

@@ -2,7 +2,7 @@
 //! [`NodeTree`] that copies each node's precomputed geometry, or, where a node's extent is at
 //! most `Q·S_tree`, emits one simplified shape ([`Impostor`]) for it and skips its subtree.
 //!
-//! The data volume (nodes copied plus simplified shapes) follows the seed's law
+//! The data volume (nodes copied plus groups drawn as one shape) follows the seed's law
 //! [`law`]` = (M/(M−1))·Q^(ln M / ln λ)` exactly when all maps share the scale λ and `Q` is a
 //! power of it; with unequal scales its exponent is nearer `−D`, `D` the similarity dimension
 //! ([`super::species::Species::dimension`]).
@@ -41,12 +41,16 @@ pub struct Drawn {
     pub nodes: u64,
     /// Polygons copied (frustum quads and rhombus leaves).
     pub polygons: u64,
+    /// Rhombus leaves copied: the full model's own simplified shapes, each standing for a group
+    /// below 2 % of the tree.
+    pub leaves: u64,
 }
 
 impl Drawn {
-    /// The data volume: nodes copied plus simplified shapes.
+    /// The data volume: nodes copied plus the groups drawn as one shape (simplified shapes and
+    /// leaves). Every map of a copied node is one or the other, so this is `1 + M·nodes`.
     pub fn volume(&self) -> u64 {
-        self.nodes + self.impostors.len() as u64
+        self.nodes + self.impostors.len() as u64 + self.leaves
     }
 }
 
@@ -111,6 +115,7 @@ impl NodeTree {
             self.copy(i, &m, &mut out.mesh);
             out.nodes += 1;
             out.polygons += u64::from(n.polygons);
+            out.leaves += u64::from(n.polygons) - super::shapes::BRANCH_POLYGONS as u64;
             i += 1;
         }
     }
