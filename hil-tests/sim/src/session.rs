@@ -239,3 +239,12 @@ pub fn timeline(steps: &[ModelingStep], home: glam::DVec3) -> Timeline {
     s.move_to(home);
     s.build()
 }
+
+/// The seed's session watched by a seated viewer wearing the tracked glasses (issue 16): the
+/// head sways and leans in to look closely ([`crate::viewer::Viewer::seated`]), the glasses'
+/// emitter multiplexed with the pen's 5:2 and predicted 20 ms ahead, as the base station does
+/// after HeadOn. The modeler's demo plays it, so its frames, drawn from the tracked head, show
+/// the parallax of a person moving in front of the display.
+pub fn watched(scenario: crate::sim::Scenario) -> crate::sim::Scenario {
+    scenario.with_head(pen_core::HeadSettings::default())
+}

@@ -86,8 +86,10 @@ enum Command {
         #[command(subcommand)]
         action: ConfigAction,
     },
-    /// Start or stop tracking the viewer's head (the glasses' emitter, protocol 2.1; not saved).
-    #[command(after_help = "Examples:\n  penctl head on\n  penctl head off --source serial:/dev/ttyACM0")]
+    /// Start or stop tracking the viewer's head (the glasses' emitter, protocol 2.1; kept across a power cycle once `penctl config save` saves it).
+    #[command(
+        after_help = "Examples:\n  penctl head on && penctl config save\n  penctl head off --source serial:/dev/ttyACM0"
+    )]
     Head {
         /// `on` or `off`.
         #[arg(value_parser = ["on", "off"])]

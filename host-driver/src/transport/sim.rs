@@ -5,8 +5,8 @@
 //! back (a [`SimPlug`]) to exercise reattachment.
 
 use std::collections::VecDeque;
-use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 use pen_protocol::{MAX_PAYLOAD, Message, ReportId, Status};
@@ -15,25 +15,94 @@ use pen_sim::{Scenario, Simulation};
 
 use super::{Transport, TransportError};
 
-/// Plugs and unplugs a simulated device from another thread.
+/// Plugs and unplugs a simulated device from another thread, and reads its clock there.
 #[derive(Debug, Clone)]
-pub struct SimPlug(Arc<AtomicBool>);
+pub struct SimPlug {
+    plugged: Arc<AtomicBool>,
+    clock: DeviceClock,
+}
 
 impl Default for SimPlug {
     fn default() -> Self {
-        SimPlug(Arc::new(AtomicBool::new(true)))
+        SimPlug {
+            plugged: Arc::new(AtomicBool::new(true)),
+            clock: DeviceClock::default(),
+        }
     }
 }
 
 impl SimPlug {
     /// Whether the device is plugged in.
     pub fn is_plugged(&self) -> bool {
-        self.0.load(Ordering::SeqCst)
+        self.plugged.load(Ordering::SeqCst)
     }
 
     /// Plugs it in or pulls it out.
     pub fn set(&self, plugged: bool) {
-        self.0.store(plugged, Ordering::SeqCst)
+        self.plugged.store(plugged, Ordering::SeqCst)
+    }
+
+    /// The simulated device's clock, readable from any thread.
+    pub fn clock(&self) -> DeviceClock {
+        self.clock.clone()
+    }
+}
+
+/// The simulated device's clock (µs since it was last opened), for measuring on the device's
+/// time what a host does with its reports: a report with timestamp `t` is about something that
+/// happened `now_us() - t` ago. Paced (speed > 0) it is the wall clock since the device opened
+/// times the speed, as the transport releases each report at its device time; unpaced, the
+/// simulation runs only as far as it is read, so the device's "now" is the device time of the
+/// last report read.
+#[derive(Debug, Clone, Default)]
+pub struct DeviceClock(Arc<Mutex<ClockState>>);
+
+#[derive(Debug, Default)]
+struct ClockState {
+    /// When the device was opened, and its speed.
+    opened: Option<(Instant, f64)>,
+    /// The device time of the last report read, µs.
+    read_us: u64,
+}
+
+impl DeviceClock {
+    fn state(&self) -> std::sync::MutexGuard<'_, ClockState> {
+        self.0.lock().unwrap_or_else(|e| e.into_inner())
+    }
+
+    /// The device's time now, µs; `None` before it was opened.
+    pub fn now_us(&self) -> Option<u64> {
+        let s = self.state();
+        let (start, speed) = s.opened?;
+        Some(if speed > 0.0 {
+            (start.elapsed().as_secs_f64() * speed * 1e6) as u64
+        } else {
+            s.read_us
+        })
+    }
+
+    /// Whether the clock follows the wall clock (a paced device).
+    pub fn is_paced(&self) -> bool {
+        self.state().opened.is_some_and(|(_, speed)| speed > 0.0)
+    }
+
+    fn opened(&self, start: Instant, speed: f64) {
+        *self.state() = ClockState {
+            opened: Some((start, speed)),
+            read_us: 0,
+        };
+    }
+
+    fn read(&self, t_us: u64) {
+        let mut s = self.state();
+        s.read_us = s.read_us.max(t_us);
+    }
+}
+
+/// Two handles to the same clock are equal.
+impl PartialEq for DeviceClock {
+    fn eq(&self, other: &DeviceClock) -> bool {
+        Arc::ptr_eq(&self.0, &other.0)
     }
 }
 
@@ -53,7 +122,8 @@ pub struct SimOptions {
 /// The simulated pen as a transport.
 pub struct SimTransport {
     sim: Simulation,
-    queue: VecDeque<(Instant, Vec<u8>)>,
+    /// Reports waiting for their release: when, their device time, their bytes.
+    queue: VecDeque<(Instant, u64, Vec<u8>)>,
     start: Instant,
     speed: f64,
     plug: SimPlug,
@@ -67,10 +137,12 @@ impl SimTransport {
         if !options.plug.is_plugged() {
             return Err(TransportError::NotFound("the simulated pen is unplugged".into()));
         }
+        let start = Instant::now();
+        options.plug.clock.opened(start, options.speed);
         Ok(SimTransport {
             sim: Simulation::looping(&options.scenario, options.seed),
             queue: VecDeque::new(),
-            start: Instant::now(),
+            start,
             speed: options.speed,
             plug: options.plug.clone(),
             store: MemoryStore::default(),
@@ -110,7 +182,7 @@ impl Transport for SimTransport {
         self.check_plug()?;
         let deadline = Instant::now() + timeout;
         loop {
-            if let Some((release, _)) = self.queue.front() {
+            if let Some((release, _, _)) = self.queue.front() {
                 // Each report is released when the wall clock reaches its device time.
                 let now = Instant::now();
                 if *release > deadline {
@@ -118,9 +190,10 @@ impl Transport for SimTransport {
                     return Ok(None);
                 }
                 std::thread::sleep(release.saturating_duration_since(now));
-                let Some((_, bytes)) = self.queue.pop_front() else {
+                let Some((_, t_us, bytes)) = self.queue.pop_front() else {
                     continue;
                 };
+                self.plug.clock.read(t_us);
                 return Ok(Some(Message::decode(&bytes)?));
             }
             let record = self.sim.step();
@@ -130,7 +203,7 @@ impl Transport for SimTransport {
                 } else {
                     self.start
                 };
-                self.queue.push_back((release, sent.bytes));
+                self.queue.push_back((release, sent.t_us, sent.bytes));
             }
         }
     }
@@ -141,5 +214,54 @@ impl Transport for SimTransport {
 
     fn set_feature(&mut self, report: &Message) -> Result<Status, TransportError> {
         super::expect_status(self.request(report)?)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The device time a report is about (its burst), for the reports that carry one.
+    fn timestamp(m: &Message) -> Option<u64> {
+        match m {
+            Message::Pen(r) => Some(u64::from(r.timestamp_us)),
+            Message::Head(r) => Some(u64::from(r.timestamp_us)),
+            _ => None,
+        }
+    }
+
+    /// The clock is never behind a report read (a report is sent after its burst), restarts
+    /// when the device is opened again, and is readable from a clone of the plug.
+    #[test]
+    fn the_device_clock_is_never_behind_a_report_read() {
+        for speed in [0.0, 20.0] {
+            let plug = SimPlug::default();
+            let clock = plug.clone().clock();
+            assert_eq!(clock.now_us(), None, "before the device is opened");
+            let options = SimOptions {
+                scenario: pen_sim::scenarios::by_name("viewer").expect("scenario"),
+                seed: 1,
+                speed,
+                plug,
+            };
+            let mut t = SimTransport::open(&options).expect("open");
+            assert_eq!(clock.is_paced(), speed > 0.0);
+            let (mut reports, mut heads) = (0, 0);
+            while reports < 40 {
+                let Some(m) = t.read(Duration::from_secs(1)).expect("read") else {
+                    continue;
+                };
+                heads += usize::from(matches!(m, Message::Head(_)));
+                if let Some(ts) = timestamp(&m) {
+                    reports += 1;
+                    let now = clock.now_us().expect("opened");
+                    assert!(now >= ts, "speed {speed}: clock {now} µs behind a report of {ts} µs");
+                }
+            }
+            assert!(heads > 0, "the viewer's head reports are read too");
+            let before = clock.now_us().expect("opened");
+            let _again = SimTransport::open(&options).expect("reopen");
+            assert!(clock.now_us().expect("opened") < before, "reopened: the clock restarts");
+        }
     }
 }
