@@ -1,7 +1,7 @@
 //! Binary glTF 2.0 (`.glb`), written directly: a 12-byte header (`glTF`, version 2, total
-//! length), a JSON chunk (the scene: one node, one mesh, one triangle primitive with POSITION,
-//! NORMAL and 32-bit indices) padded with spaces to 4 bytes, and a BIN chunk (positions, normals,
-//! indices, each 4-byte aligned).
+//! length), a JSON chunk (the scene: one node per mesh, each one triangle primitive with POSITION,
+//! NORMAL, COLOR_0 when the mesh has colours, and 32-bit indices) padded with spaces to 4 bytes,
+//! and a BIN chunk (positions, normals, colours, indices, each 4-byte aligned).
 
 use std::io::Write;
 
@@ -55,6 +55,13 @@ pub fn write_glb_meshes(meshes: &[(&str, &Mesh)], mut out: impl Write) -> Result
         for n in &mesh.normals {
             n.iter().for_each(|v| bin.extend_from_slice(&v.to_le_bytes()));
         }
+        let colors = mesh.colors.len() == mesh.positions.len();
+        let colors_at = bin.len();
+        if colors {
+            for c in &mesh.colors {
+                c.iter().for_each(|v| bin.extend_from_slice(&v.to_le_bytes()));
+            }
+        }
         let indices_at = bin.len();
         for i in &mesh.indices {
             bin.extend_from_slice(&i.to_le_bytes());
@@ -68,18 +75,30 @@ pub fn write_glb_meshes(meshes: &[(&str, &Mesh)], mut out: impl Write) -> Result
             }
         }
         let n = mesh.positions.len();
-        let first = 3 * k;
-        nodes.push(json!({"mesh": k, "name": name}));
-        meshes.push(json!({"name": name, "primitives": [{
-            "attributes": {"POSITION": first, "NORMAL": first + 1}, "indices": first + 2, "mode": TRIANGLES}]}));
+        // One accessor per buffer view, numbered in the order they are pushed.
+        let first = accessors.len();
+        let mut attributes = json!({"POSITION": first, "NORMAL": first + 1});
         accessors.push(
             json!({"bufferView": first, "componentType": FLOAT, "count": n, "type": "VEC3", "min": min, "max": max}),
         );
-        accessors.push(json!({"bufferView": first + 1, "componentType": FLOAT, "count": n, "type": "VEC3"}));
-        accessors.push(json!({"bufferView": first + 2, "componentType": UNSIGNED_INT, "count": mesh.indices.len(), "type": "SCALAR"}));
         views.push(json!({"buffer": 0, "byteOffset": at, "byteLength": normals_at - at, "target": ARRAY_BUFFER}));
-        views.push(json!({"buffer": 0, "byteOffset": normals_at, "byteLength": indices_at - normals_at, "target": ARRAY_BUFFER}));
+        accessors.push(json!({"bufferView": first + 1, "componentType": FLOAT, "count": n, "type": "VEC3"}));
+        views.push(json!({"buffer": 0, "byteOffset": normals_at, "byteLength": colors_at - normals_at, "target": ARRAY_BUFFER}));
+        if colors {
+            // COLOR_0: linear RGB, as glTF specifies vertex colours.
+            let c = accessors.len();
+            attributes["COLOR_0"] = json!(c);
+            accessors.push(json!({"bufferView": c, "componentType": FLOAT, "count": n, "type": "VEC3"}));
+            views.push(json!({"buffer": 0, "byteOffset": colors_at, "byteLength": indices_at - colors_at, "target": ARRAY_BUFFER}));
+        }
+        let idx = accessors.len();
+        accessors.push(
+            json!({"bufferView": idx, "componentType": UNSIGNED_INT, "count": mesh.indices.len(), "type": "SCALAR"}),
+        );
         views.push(json!({"buffer": 0, "byteOffset": indices_at, "byteLength": end - indices_at, "target": ELEMENT_ARRAY_BUFFER}));
+        nodes.push(json!({"mesh": k, "name": name}));
+        meshes.push(json!({"name": name, "primitives": [{
+            "attributes": attributes, "indices": idx, "mode": TRIANGLES}]}));
     }
     let bin_len = bin.len();
     let doc = json!({

@@ -1,4 +1,4 @@
-//! Exports of a heightmap: 16-bit PNG, raw float32, and meshes (OBJ, binary glTF).
+//! Exports of a heightmap: 16-bit PNG, raw float32, and meshes (OBJ, binary glTF, PLY).
 //!
 //! Conventions shared by all formats:
 //! - grid row r, column c is image row r (top to bottom), column c (left to right), and raw
@@ -12,6 +12,7 @@
 mod glb;
 mod mesh;
 mod obj;
+mod ply;
 mod png;
 mod raw;
 
@@ -22,6 +23,7 @@ use thiserror::Error;
 pub use glb::{write_glb, write_glb_meshes, write_glb_with};
 pub use mesh::Mesh;
 pub use obj::{write_meshes, write_obj, write_obj_with};
+pub use ply::write_ply;
 pub use png::{HeightRange, KEY_CELL_SIZE, KEY_HEIGHT_MAX, KEY_HEIGHT_MIN, read_png_range, write_png};
 pub use raw::{read_raw, write_raw};
 

@@ -1,5 +1,6 @@
 //! Wavefront OBJ: `v` positions, `vn` normals, `f v//vn` triangles (1-based), one `o` object per
-//! mesh (the terrain, then each rock field's rocks).
+//! mesh (the terrain, then each rock field's rocks, then the trees). A mesh with colours writes
+//! them after each position, `v x y z r g b` (linear RGB, 0 to 1).
 
 use std::io::Write;
 
@@ -36,8 +37,15 @@ pub fn write_meshes<'a>(
     let mut base = 1u64;
     for (name, mesh) in meshes {
         writeln!(out, "o {name}")?;
-        for [x, y, z] in &mesh.positions {
-            writeln!(out, "v {x} {y} {z}")?;
+        if mesh.colors.len() == mesh.positions.len() {
+            // Vertex colours after the position (the extension Blender, MeshLab and others read).
+            for ([x, y, z], [r, g, b]) in mesh.positions.iter().zip(&mesh.colors) {
+                writeln!(out, "v {x} {y} {z} {r} {g} {b}")?;
+            }
+        } else {
+            for [x, y, z] in &mesh.positions {
+                writeln!(out, "v {x} {y} {z}")?;
+            }
         }
         for [x, y, z] in &mesh.normals {
             writeln!(out, "vn {x} {y} {z}")?;

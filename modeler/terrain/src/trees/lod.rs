@@ -54,6 +54,51 @@ impl Drawn {
     }
 }
 
+/// The simplified shapes as untextured crossed cards in the leaf colour, for exports: two
+/// quads per shape through the centre of the tree's box in the node's frame, one across Z and
+/// one across X, spanning the box (a group in its own frame is the tree cut sooner, inside the
+/// tree's box). The renderer draws them textured instead (`penmodel-render`'s `impostor`).
+pub fn cards(tree: &NodeTree, impostors: &[Impostor]) -> Mesh {
+    let (lo, hi) = tree.bounds();
+    let c = 0.5 * (lo + hi);
+    let mut mesh = Mesh::default();
+    for imp in impostors {
+        let t = &imp.transform;
+        for (corners, normal) in [
+            (
+                [
+                    [lo.x, lo.y, c.z],
+                    [hi.x, lo.y, c.z],
+                    [hi.x, hi.y, c.z],
+                    [lo.x, hi.y, c.z],
+                ],
+                DVec3::Z,
+            ),
+            (
+                [
+                    [c.x, lo.y, hi.z],
+                    [c.x, lo.y, lo.z],
+                    [c.x, hi.y, lo.z],
+                    [c.x, hi.y, hi.z],
+                ],
+                DVec3::X,
+            ),
+        ] {
+            let base = mesh.positions.len() as u32;
+            let n = t.transform_vector3(normal).normalize_or(DVec3::Z).as_vec3().to_array();
+            for p in corners {
+                mesh.positions
+                    .push(t.transform_point3(DVec3::from(p)).as_vec3().to_array());
+                mesh.normals.push(n);
+                mesh.colors.push(super::shapes::LEAF);
+            }
+            mesh.indices
+                .extend_from_slice(&[base, base + 1, base + 2, base, base + 2, base + 3]);
+        }
+    }
+    mesh
+}
+
 fn f32_affine(a: &DAffine3) -> Affine3A {
     Affine3A::from_cols_array(&a.to_cols_array().map(|v| v as f32))
 }

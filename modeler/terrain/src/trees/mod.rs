@@ -21,13 +21,18 @@
 //! - [`planted`]: [`Forest`] — a document's trees and groves standing on its terrain
 //!   (`Editor::trees`), each a [`Standing`] (`place()`: the tree's unit to the world in the
 //!   exports' frame; `draw(q, t, &mut Drawn)`).
+//! - [`silhouette`] and [`fit`]: orthographic coverage silhouettes (PNG in and out, framing,
+//!   normalised cross-correlation) and [`fit::fit`], the seed's reconstruction of a species from
+//!   a front and a side silhouette.
 
+pub mod fit;
 pub mod grove;
 pub mod lod;
 pub mod nodes;
 pub mod planted;
 pub mod roughness;
 pub mod shapes;
+pub mod silhouette;
 pub mod species;
 pub mod wind;
 

@@ -84,6 +84,7 @@ struct Build<'a> {
     r0: f64,
     r1: f64,
     leaf: f64,
+    stop: f64,
     tree: NodeTree,
     parts: Parts,
 }
@@ -96,7 +97,7 @@ impl Build<'_> {
         self.parts.branch(&w, self.trunk, self.r0, self.r1);
         let mut polygons = shapes::BRANCH_POLYGONS as u32;
         for (i, m) in self.species.maps.iter().enumerate() {
-            if scale * m.s.abs() < STOP {
+            if scale * m.s.abs() < self.stop {
                 self.parts.leaf(&(w * self.maps[i]), self.leaf);
                 polygons += shapes::LEAF_POLYGONS as u32;
             }
@@ -118,7 +119,7 @@ impl Build<'_> {
         });
         for (i, m) in self.species.maps.iter().enumerate() {
             let s = scale * m.s.abs();
-            if s >= STOP {
+            if s >= self.stop {
                 self.node(w * self.maps[i], s, depth + 1, i as u8);
             }
         }
@@ -131,6 +132,12 @@ impl NodeTree {
     /// nodes, which `crate::validate` checks). This is the seed's "fractal computation": every
     /// composition of maps down to [`STOP`].
     pub fn build(species: &Species) -> NodeTree {
+        NodeTree::build_to(species, STOP)
+    }
+
+    /// The tree with branches down to `stop` (a scale in (0, 1)) instead of [`STOP`]: coarser
+    /// trees, whose leaves stand for larger groups, for the silhouette fit.
+    pub fn build_to(species: &Species, stop: f64) -> NodeTree {
         let trunk = species.trunk().max(1e-6);
         let r0 = shapes::TRUNK_RADIUS * trunk;
         let s_max = species.maps.iter().map(|m| m.s.abs()).fold(0.0, f64::max);
@@ -144,6 +151,7 @@ impl NodeTree {
             // A leaf stands for a branch's whole cut-off subtree: its length is a fraction of
             // the tree's reach in the branch's frame.
             leaf: shapes::LEAF_LENGTH * species.reach(),
+            stop,
             tree: NodeTree {
                 species: species.clone(),
                 height: 0.0,
@@ -169,6 +177,17 @@ impl NodeTree {
         tree.colors = colors;
         tree.indices = indices;
         tree
+    }
+
+    /// The box of the full tree in its unit: `(min, max)` corners.
+    pub fn bounds(&self) -> (DVec3, DVec3) {
+        self.positions.iter().fold(
+            (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY)),
+            |(lo, hi), p| {
+                let p = DVec3::from(p.map(f64::from));
+                (lo.min(p), hi.max(p))
+            },
+        )
     }
 
     /// The polygons of the full tree.

@@ -1,0 +1,173 @@
+//! Reconstructing a tree from a front and a side silhouette (seed 004, §7): the maps' parameters
+//! (`y`, `s`, `θz`, `θy` of each map: 20 for five maps) that maximise the sum of the normalised
+//! cross-correlations between the candidate's silhouettes and the given ones.
+//!
+//! As in the seed: a template-matching start (the preset whose silhouettes correlate best), then
+//! gradient ascent with a line search. The gradient is by central differences, each parameter
+//! measured in its own step ([`STEPS`]), on silhouettes blurred twice (a rasterised outline is a
+//! step function of the parameters; blurred, small changes change the objective smoothly).
+
+use super::silhouette::{self, Image, View, ncc};
+use super::species::{Preset, Species};
+use crate::document::IfsMap;
+
+/// The difference step of each parameter: `y`, `s`, `θz` (degrees), `θy` (degrees).
+pub const STEPS: [f64; 4] = [0.02, 0.02, 4.0, 8.0];
+
+/// Canvas side, pixels.
+pub const SIZE: usize = 64;
+
+/// Branches stop at this scale in the fit's renders (coarser than the full tree's 2 %).
+pub const FIT_STOP: f64 = 0.05;
+
+/// The ranges each parameter is held in: `y` and `s` keep the tree contracting and its
+/// branches countable, the angles any lean and turn.
+pub const BOUNDS: [(f64, f64); 4] = [(0.02, 1.0), (0.1, 0.75), (-90.0, 90.0), (-360.0, 360.0)];
+
+/// Options of a fit.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Options {
+    /// Most gradient steps.
+    pub iterations: usize,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options { iterations: 30 }
+    }
+}
+
+/// A fit's result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Fit {
+    /// The preset the fit started from (the best template).
+    pub preset: Preset,
+    /// The fitted species.
+    pub species: Species,
+    /// Correlations of the start with the front and side silhouettes.
+    pub start: [f64; 2],
+    /// Correlations reached.
+    pub reached: [f64; 2],
+    /// Gradient steps taken.
+    pub iterations: usize,
+}
+
+/// Why a fit could not start.
+#[derive(Debug, thiserror::Error)]
+pub enum FitError {
+    /// A silhouette has nothing in it.
+    #[error("the {0} silhouette is blank")]
+    Blank(&'static str),
+}
+
+struct Target {
+    front: Image,
+    side: Image,
+}
+
+fn prepare(img: &Image) -> Option<Image> {
+    Some(img.framed(SIZE)?.blurred(2))
+}
+
+impl Target {
+    fn score(&self, s: &Species) -> [f64; 2] {
+        let f = silhouette::render(s, View::Front, SIZE, FIT_STOP).blurred(2);
+        let d = silhouette::render(s, View::Side, SIZE, FIT_STOP).blurred(2);
+        [ncc(&f, &self.front), ncc(&d, &self.side)]
+    }
+}
+
+fn params(s: &Species) -> Vec<f64> {
+    s.maps.iter().flat_map(|m| [m.y, m.s, m.theta_z, m.theta_y]).collect()
+}
+
+fn species(p: &[f64]) -> Species {
+    Species {
+        maps: p
+            .chunks_exact(4)
+            .map(|c| {
+                let b = |k: usize| c[k].clamp(BOUNDS[k].0, BOUNDS[k].1);
+                IfsMap {
+                    y: b(0),
+                    s: b(1),
+                    theta_z: b(2),
+                    theta_y: b(3),
+                }
+            })
+            .collect(),
+    }
+}
+
+/// Fits a species to a front and a side silhouette (coverage images of any size; each is
+/// framed on its own).
+pub fn fit(front: &Image, side: &Image, options: Options) -> Result<Fit, FitError> {
+    let target = Target {
+        front: prepare(front).ok_or(FitError::Blank("front"))?,
+        side: prepare(side).ok_or(FitError::Blank("side"))?,
+    };
+    let sum = |v: [f64; 2]| v[0] + v[1];
+    // Template matching: the best preset starts.
+    let (preset, start) = Preset::ALL
+        .iter()
+        .map(|&p| (p, target.score(&Species::preset(p))))
+        .fold(None, |best: Option<(Preset, [f64; 2])>, (p, v)| match best {
+            Some((_, b)) if sum(b) >= sum(v) => best,
+            _ => Some((p, v)),
+        })
+        .unwrap_or((Preset::Table31, [0.0; 2]));
+    let mut p = params(&Species::preset(preset));
+    let mut best = start;
+    let mut iterations = 0;
+    let mut stride = 1.0;
+    while iterations < options.iterations {
+        iterations += 1;
+        // The gradient in step units.
+        let grad: Vec<f64> = (0..p.len())
+            .map(|k| {
+                let h = STEPS[k % 4];
+                let mut up = p.clone();
+                up[k] += h;
+                let mut down = p.clone();
+                down[k] -= h;
+                0.5 * (sum(target.score(&species(&up))) - sum(target.score(&species(&down))))
+            })
+            .collect();
+        let norm = grad.iter().map(|g| g * g).sum::<f64>().sqrt();
+        if norm < 1e-9 {
+            break;
+        }
+        // Line search along the gradient: the best of a few strides, the last one first.
+        let mut moved = None;
+        for t in [2.0 * stride, stride, 0.5 * stride, 0.25 * stride] {
+            let q: Vec<f64> = p
+                .iter()
+                .enumerate()
+                .map(|(k, v)| v + t * grad[k] / norm * STEPS[k % 4])
+                .collect();
+            let v = target.score(&species(&q));
+            if sum(v) > sum(best) + 1e-6
+                && moved
+                    .as_ref()
+                    .is_none_or(|(_, b, _): &(Vec<f64>, [f64; 2], f64)| sum(v) > sum(*b))
+            {
+                moved = Some((q, v, t));
+            }
+        }
+        match moved {
+            Some((q, v, t)) => {
+                p = params(&species(&q));
+                best = v;
+                stride = t;
+            }
+            None if stride > 0.1 => stride *= 0.25,
+            None => break,
+        }
+    }
+    Ok(Fit {
+        preset,
+        species: species(&p),
+        start,
+        reached: best,
+        iterations,
+    })
+}
