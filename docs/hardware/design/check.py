@@ -96,9 +96,10 @@ def firmware_pins():
     """The Black Pill pins firmware/src/main.rs hands to each function."""
     text = (ROOT / "firmware/src/main.rs").read_text()
     burst = re.findall(r"burst_pin\(p\.(P[A-C]\d+)\)", text)
+    glasses = re.findall(r"glasses_pin\(p\.(P[A-C]\d+)\)", text)
     captures = re.findall(r"capture_pin\(p\.(P[A-C]\d+)\)", text)
     switches = re.findall(r"Input::new\(p\.(P[A-C]\d+),\s*Pull::Up\)", text)
-    return burst, captures, switches
+    return burst, glasses, captures, switches
 
 
 def doc_pins():
@@ -136,8 +137,9 @@ def check_rig():
 
 
 def check_pins(pill):
-    burst, captures, switches = firmware_pins()
+    burst, glasses, captures, switches = firmware_pins()
     check("firmware: burst pin is the schematic's", burst == [circuit.PIN_BURST], f"main.rs {burst}")
+    check("firmware: glasses' burst pin is the schematic's", glasses == [circuit.PIN_GLASSES], f"main.rs {glasses}")
     check("firmware: capture pins (receivers 0–7, in order) are the schematic's",
           captures == circuit.PINS_CAPTURE, f"main.rs {captures}")
     check("firmware: switch pins (SW1–SW3, in order) are the schematic's",
@@ -147,6 +149,8 @@ def check_pins(pill):
     parts = {p.ref: p for p in circuit.parts()}
     ok = net_of(pill, circuit.PIN_BURST) == net_of(parts["U3"], "INA") == net_of(parts["U2"], "A")
     check("schematic: the burst pin drives the TC4427 and the inverter", ok)
+    ok = net_of(pill, circuit.PIN_GLASSES) == net_of(parts["U5"], "INA") == net_of(parts["U4"], "A")
+    check("schematic: the glasses' burst pin drives their TC4427 and inverter", ok)
     bad = []
     for k, pin in enumerate(circuit.PINS_CAPTURE):
         net = net_of(pill, pin)
@@ -159,7 +163,7 @@ def check_pins(pill):
            if net_of(pill, pin) != net_of(parts[f"R{5 + 2 * i}"], "2")]
     check("schematic: each switch pin is behind its 1 k / 100 nF filter", not bad, ", ".join(bad))
     docs = doc_pins()
-    expected = {circuit.PIN_BURST: "burst"}
+    expected = {circuit.PIN_BURST: "burst", circuit.PIN_GLASSES: "glasses' burst"}
     expected.update({pin: f"receiver {k}" for k, pin in enumerate(circuit.PINS_CAPTURE)})
     expected.update({pin: f"SW{i + 1}" for i, pin in enumerate(circuit.PINS_SWITCH)})
     bad = [f"{pin} ({what}): docs say {docs.get(pin)!r}" for pin, what in expected.items()

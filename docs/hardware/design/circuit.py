@@ -152,6 +152,11 @@ CONN_PEN = connector(6, "Connector_JST:JST_XH_B6B-XH-A_1x06_P2.50mm_Vertical", "
 CONN_RX = connector(3, "Connector_JST:JST_XH_B3B-XH-A_1x03_P2.50mm_Vertical",
                     "receiver cable connector, 3 pins (3.3 V, signal, GND; shield to GND)",
                     "JST B3B-XH-A + XHP-3", "a 3.5 mm TRS jack (tip signal, ring 3.3 V, sleeve GND)", 0.20)
+# Not the receivers' XH: a receiver cable plugged in here would put ±12 V bursts on a module's
+# 3.3 V supply. PH (2.0 mm pitch) does not mate with XH.
+CONN_GLASSES = connector(3, "Connector_JST:JST_PH_B3B-PH-K_1x03_P2.00mm_Vertical",
+                         "glasses cable connector, 3 pins (TX_A, TX_B, GND; shield to GND)",
+                         "JST B3B-PH-K + PHR-3", "a 2.5 mm TRS jack (tip TX_A, ring TX_B, sleeve GND)", 0.20)
 CONN_PILL = connector(20, "Connector_PinSocket_2.54mm:PinSocket_1x20_P2.54mm_Vertical",
                       "socket strip for the Black Pill, 20 pins", "Samtec SSW-120-01-T-S", "any 2.54 mm 1×20 socket", 0.60)
 
@@ -175,6 +180,7 @@ def cc(ref, value, tmpl=CAP):
 
 # Black Pill pins as the firmware (firmware/src/main.rs) uses them; check.py compares.
 PIN_BURST = "PA8"
+PIN_GLASSES = "PA9"
 PINS_CAPTURE = ["PA15", "PB3", "PB10", "PA3", "PA6", "PA7", "PB0", "PB1"]
 PINS_SWITCH = ["PB12", "PB14", "PB15"]
 RECEIVERS_BUILT = 4
@@ -306,6 +312,28 @@ def build():
     cc("C5", 1e-6, CAP_BULK)[1, 2] += v12, gnd
     cc("C6", 100e-9)[1, 2] += v12, gnd
 
+    # The glasses' transmitter (head tracking, issue 16): PA9 (TIM1 channel 2) drives a second
+    # TC4427 in bridge exactly as PA8 drives the pen's. The firmware fires one emitter per slot,
+    # so the two never draw from the 12 V reservoir at once.
+    gburst, gburst_n = Net("GLASSES_BURST"), Net("GLASSES_BURST_N")
+    pill[PIN_GLASSES] += gburst
+    rc("R11", v.R_BURST_PULLDOWN)[1, 2] += gburst, gnd
+    ginv = add(INVERTER, "U4")
+    ginv["A", "Y", "VCC", "GND"] += gburst, gburst_n, v33, gnd
+    cc("C11", 100e-9)[1, 2] += v33, gnd
+    gdrv = add(TC4427, "U5")
+    gtx_a, gtx_b, gout_b = Net("GLASSES_TX_A"), Net("GLASSES_TX_B"), Net("GLASSES_TX_B_DRV")
+    gdrv["INA", "INB", "OUTA", "OUTB", "VDD", "GND"] += gburst, gburst_n, gtx_a, gout_b, v12, gnd
+    add(CAP_TX, "C12", v.fmt_c(v.C_TX_DC))[1, 2] += gout_b, gtx_b
+    rc("R12", v.R_TX_BLEED)[1, 2] += gtx_a, gtx_b
+    cc("C13", 1e-6, CAP_BULK)[1, 2] += v12, gnd
+    cc("C14", 100e-9)[1, 2] += v12, gnd
+    # The glasses' cable (1 TX_A, 2 TX_B, 3 GND and the shield), and the glasses: their half of
+    # it and the transducer on the bridge (docs/hardware.md, "The glasses").
+    add(CONN_GLASSES, "J4")[1, 2, 3] += gtx_a, gtx_b, gnd
+    add(CONN_GLASSES, "J601")[1, 2, 3] += gtx_a, gtx_b, gnd
+    add(TRANSDUCER_TX, "LS601")[1, 2] += gtx_a, gtx_b
+
     # The pen's cable: 1 TX_A, 2 TX_B, 3 SW1, 4 SW2, 5 SW3, 6 GND (and the shield).
     jpen = add(CONN_PEN, "J3")
     jpen[1, 2, 6] += tx_a, tx_b, gnd
@@ -426,6 +454,10 @@ OTHER_ITEMS = [
      "any 6-core shielded control cable; a USB 2.0 cable's 4 cores + shield for a 5-core variant", 4.00),
     (4, "receiver cables", "3-core shielded cable, 0.14 mm², 1.5 m each", "Lapp Unitronic LiYCY 3×0.14",
      "a 3.5 mm TRS audio cable", 2.50),
+    (1, "glasses cable", "2-core shielded cable, 0.14 mm², 2 m (TX pair twisted), along a temple",
+     "Lapp Unitronic LiYCY 2×0.14", "a thin 3.5 mm TRS audio cable", 2.00),
+    (1, "glasses emitter clip", "printed clip holding the MA40S4S on the shutter glasses' bridge, facing forward",
+     "docs/hardware.md, \"The glasses\"", "a hot-glued printed cup", 0.50),
     (1, "pen body", "3D-printed pen body, nib holder and reflector cone (PETG)", "docs/hardware.md drawings",
      "a 12 mm aluminium tube with a printed tip", 2.00),
     (2, "receiver posts", "300 mm post on a clamp base, printed receiver cup", "aluminium tube 12 mm, 300 mm",
