@@ -60,8 +60,9 @@ fn bench(c: &mut Criterion) {
     totals.sort_by(f64::total_cmp);
     let median = totals.get(totals.len() / 2).copied().unwrap_or(f64::NAN);
     eprintln!(
-        "fig1/512: {} rocks; fastest of {} runs per stage (ms): seeds+diagrams {:.2} (seeds {:.2}, labels {:.2} CPU), selection {:.2}, polygons {:.2}, meshes {:.2}, total {:.2} (median {:.2})",
+        "fig1/512: {} rocks, digest {:016x}; fastest of {} runs per stage (ms): seeds+diagrams {:.2} (seeds {:.2}, labels {:.2} CPU), selection {:.2}, polygons {:.2}, meshes {:.2}, total {:.2} (median {:.2})",
         once.rocks.len(),
+        digest(&once),
         runs.len(),
         least(|t| t.seeds_and_diagrams),
         least(|t| t.seeds),
@@ -199,6 +200,27 @@ fn bench(c: &mut Criterion) {
         })
     });
     g.finish();
+}
+
+/// FNV-1a over every rock's diagram, cell, polygon, added points, vertices and triangles (the
+/// bits of the coordinates): equal digests before and after a change of the code mean the same
+/// rocks bit for bit.
+fn digest(s: &rocks::Scatter) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |v: u64| {
+        for b in v.to_le_bytes() {
+            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    for r in s.rocks.iter() {
+        eat(r.diagram as u64);
+        eat(u64::from(r.cell));
+        r.polygon.iter().flatten().for_each(|c| eat(c.to_bits()));
+        r.mesh.added.iter().flatten().for_each(|c| eat(c.to_bits()));
+        r.mesh.vertices.iter().flatten().for_each(|c| eat(c.to_bits()));
+        r.mesh.triangles.iter().flatten().for_each(|&i| eat(u64::from(i)));
+    }
+    h
 }
 
 /// This thread's CPU time in nanoseconds, from `/proc/thread-self/schedstat` (None elsewhere).

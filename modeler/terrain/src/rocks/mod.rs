@@ -315,8 +315,9 @@ fn make_block(recipe: &Recipe, made: &Made, i: usize, part: &[(u32, usize)]) -> 
     block.vertices.reserve(2 * corners);
     block.triangles.reserve(3 * corners);
     let layer = &recipe.layers[i];
+    let seeded = ChaCha8Rng::seed_from_u64(recipe.seed);
     for (k, &(cell, _)) in part.iter().enumerate() {
-        let mut rng = stream(recipe.seed, SHAPE, i, u64::from(cell));
+        let mut rng = stream_of(&seeded, SHAPE, i, u64::from(cell));
         let list::Block {
             polygons,
             polygon_starts,
@@ -347,7 +348,14 @@ fn ms(since: Instant) -> f64 {
 
 /// A random stream for `purpose` of `layer` (and `cell`) of a field with `seed`.
 fn stream(seed: u64, purpose: u64, layer: usize, cell: u64) -> ChaCha8Rng {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    stream_of(&ChaCha8Rng::seed_from_u64(seed), purpose, layer, cell)
+}
+
+/// [`stream`] from the field's generator freshly seeded (`seeded`, nothing drawn from it): a
+/// copy with the stream set is the same generator, without expanding the seed again for each
+/// of tens of thousands of rocks.
+fn stream_of(seeded: &ChaCha8Rng, purpose: u64, layer: usize, cell: u64) -> ChaCha8Rng {
+    let mut rng = seeded.clone();
     rng.set_stream(purpose << 56 | (layer as u64) << 40 | cell);
     rng
 }
@@ -363,11 +371,15 @@ pub fn scatter(recipe: &Recipe, inside: Option<&[bool]>) -> Result<Scatter, Reci
     let start = Instant::now();
     let (width, height) = (recipe.width, recipe.height);
     let pixels = width as usize * height as usize;
-    let made: Vec<Made> = recipe
-        .layers
+    // The diagrams' seeds are sequential each; the smallest radius (the most seeds, and a
+    // pixel order drawn to the end: see `poisson::saturate`) is started first, so that the
+    // others run beside it rather than before it.
+    let mut by_cost: Vec<usize> = (0..recipe.layers.len()).collect();
+    by_cost.sort_by(|&a, &b| recipe.layers[a].radius.total_cmp(&recipe.layers[b].radius));
+    let mut made: Vec<(usize, Made)> = by_cost
         .par_iter()
-        .enumerate()
-        .map(|(i, layer)| {
+        .map(|&i| {
+            let layer = &recipe.layers[i];
             let t = Instant::now();
             let mut rng = stream(recipe.seed, SEEDS, i, 0);
             let mut seeds = match recipe.sampler {
@@ -390,15 +402,20 @@ pub fn scatter(recipe: &Recipe, inside: Option<&[bool]>) -> Result<Scatter, Reci
             let centres: Vec<[f64; 2]> = seeds.iter().map(|&p| voronoi::centre(p, width)).collect();
             // Seeds are more than r apart: a bucket of side r holds a few.
             let buckets = voronoi::Buckets::new(&centres, width, height, layer.radius.max(1.0));
-            Made {
-                centres,
-                cells,
-                buckets,
-                seeds_ms,
-                diagram_ms: ms(t),
-            }
+            (
+                i,
+                Made {
+                    centres,
+                    cells,
+                    buckets,
+                    seeds_ms,
+                    diagram_ms: ms(t),
+                },
+            )
         })
         .collect();
+    made.sort_by_key(|m| m.0);
+    let made: Vec<Made> = made.into_iter().map(|m| m.1).collect();
     let mut timing = Timing {
         seeds_and_diagrams: ms(start),
         seeds: made.iter().map(|m| m.seeds_ms).sum(),
