@@ -45,7 +45,8 @@ pub struct Document {
     /// Groves of trees (seed 004) scattered in a region; version 4 on.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub groves: Vec<Grove>,
-    /// How the regions' terrain is made from the figures: the distance metric; version 4 on. Left out, the defaults ([`TerrainSettings::default`]).
+    /// How the regions' terrain is made from the figures: the distance metric and the fractal
+    /// detail; version 4 on. Left out, the defaults ([`TerrainSettings::default`]).
     #[serde(default, skip_serializing_if = "TerrainSettings::is_default")]
     pub terrain: TerrainSettings,
 }
@@ -80,12 +81,58 @@ pub struct TerrainSettings {
     /// The distance metric of every region that does not choose its own ([`Region::metric`]).
     #[serde(default)]
     pub metric: Metric,
+    /// Fractal detail added to the regions' terrain; none when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub detail: Option<Detail>,
 }
 
 impl TerrainSettings {
     /// Whether these are the defaults (then the document leaves them out).
     pub fn is_default(&self) -> bool {
         *self == TerrainSettings::default()
+    }
+}
+
+/// Fractal detail (`crate::detail`): seeded gradient-noise fBm added to the regions' terrain,
+/// its amplitude following the ground — more on high and steep ground, none on the figures'
+/// cells and at the regions' edges.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Detail {
+    /// The amplitude as a fraction of the local relief (`docs/document.md`), 0 to 1.
+    #[serde(default = "default_detail_amount")]
+    pub amount: f64,
+    /// The longest wavelength of the noise, metres (> 0).
+    #[serde(default = "default_detail_scale")]
+    pub scale: f64,
+    /// Octaves of noise, each half the wavelength and half the amplitude of the last, 1 to 12.
+    #[serde(default = "default_detail_octaves")]
+    pub octaves: u32,
+    /// The noise's seed: the same seed, the same detail.
+    #[serde(default)]
+    pub seed: u64,
+}
+
+fn default_detail_amount() -> f64 {
+    0.12
+}
+
+fn default_detail_scale() -> f64 {
+    400.0
+}
+
+fn default_detail_octaves() -> u32 {
+    5
+}
+
+impl Default for Detail {
+    fn default() -> Detail {
+        Detail {
+            amount: default_detail_amount(),
+            scale: default_detail_scale(),
+            octaves: default_detail_octaves(),
+            seed: 0,
+        }
     }
 }
 

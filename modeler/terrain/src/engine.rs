@@ -7,15 +7,19 @@
 //! figure's *relief* is its height minus its region's base. For a cell `x` of a region with
 //! figures `k`:
 //!
-//! - `dp_k(x)`: 4-neighbour distance from figure k's cells, through the region's cells
-//!   ([`distance::from_sources`]); `df(x)`: layer count from the region's edge
-//!   ([`distance::edge_layers`]).
+//! - `dp_k(x)`: distance from figure k's cells; `df(x)`: distance from the region's edge, in the
+//!   region's metric ([`distance::figure_map`], [`distance::edge_map`]): `taxicab`, seed 000's
+//!   4-neighbour path through the region's cells and layer count, or `euclidean`, the exact
+//!   Euclidean transforms of [`crate::edt`].
 //! - eq. 1 `w_k = df/(df + dp_k)`, 1 on the figure; eq. 2 `shape(w_k, s_k)`
 //!   ([`profile::shape`]), with `s_k` the figure's slope, or for a nested figure eq. 4
 //!   `(s_k + s0)·w_k − s0` where `s0` is the enclosing figure's slope.
 //! - eq. 3: on one or more figures, the mean of their reliefs; elsewhere the inverse-distance
 //!   blend `Σ(relief_k·shape_k/dp_k) / Σ(1/dp_k)`.
 //! - height(x) = base + that blend, for the innermost region containing x; 0 outside every region.
+//! - with the document's fractal detail, [`crate::detail`] adds its noise to that terrain (the
+//!   regions paint the terrain before it and their gates; the detail follows the rectangle that
+//!   changed, grown by a cell).
 //!
 //! Distances move through every cell of the region, including cells a nested region covers. A
 //! cell that no figure can reach (`dp` infinite for all) stays at the base height: an unreachable
@@ -56,6 +60,7 @@
 
 use crate::cells::{self, Cell, Mask};
 use crate::change::{FigureList, ListChange, Scope};
+use crate::detail;
 use crate::distance;
 use crate::document::{Document, Figure, FigureKind, Grid, Metric, Point, Region};
 use crate::heightmap::Heightmap;
@@ -373,11 +378,30 @@ impl RegionNode {
         }
     }
 
-    fn clear(&self, map: &mut Heightmap) {
+    fn clear(&self, map: &mut Heightmap, gate: Option<&mut [f32]>) {
         let cols = map.cols() as usize;
         let out = map.heights_mut();
         for (c, r) in self.mask.cells() {
             out[r as usize * cols + c as usize] = 0.0;
+        }
+        if let Some(gate) = gate {
+            for (c, r) in self.mask.cells() {
+                gate[r as usize * cols + c as usize] = 0.0;
+            }
+        }
+    }
+
+    /// Paints the detail's gates ([`detail::gate`]) of the owned cells and every nested region's:
+    /// they follow the distances, so only a change of shape repaints them.
+    fn paint_gates(&self, gate: &mut [f32], cols: u32) {
+        for (b, g) in self.spans(cols) {
+            for (i, out) in b.zip(&mut gate[g..]) {
+                let near = self.figures.iter().map(|f| f.dp[i]).fold(f32::INFINITY, f32::min);
+                *out = detail::gate(self.df[i], near);
+            }
+        }
+        for child in self.figures.iter().filter_map(|f| f.child.as_deref()) {
+            child.paint_gates(gate, cols);
         }
     }
 }
@@ -387,8 +411,11 @@ impl RegionNode {
 /// touches.
 pub struct TerrainEngine {
     regions: Vec<RegionNode>,
-    /// The regions' terrain, before the ridges join it and the rivers carve it.
+    /// The regions' terrain, before the ridges join it and the rivers carve it (with the
+    /// detail, if the document has it).
     map: Heightmap,
+    /// The fractal detail and the regions' terrain before it, if the document has detail.
+    detail: Option<detail::Layer>,
     /// The ridgelines (seed 002) and the ground they make with `map`.
     ridges: crate::ridge::layer::Layer,
     rivers: Layer,
@@ -410,6 +437,16 @@ fn locate<'a, 'd>(
             }
             Some((node, &f.figures, f.height, Some(f.slope)))
         }
+    }
+}
+
+/// Every cell of the grid.
+fn whole(grid: &Grid) -> Rect {
+    Rect {
+        c0: 0,
+        r0: 0,
+        width: grid.cols,
+        height: grid.rows,
     }
 }
 
@@ -435,8 +472,18 @@ impl TerrainEngine {
         let grid = doc.grid;
         let regions: Vec<RegionNode> = doc.regions.iter().map(|r| region_node(doc, r)).collect();
         let mut map = Heightmap::new(&grid);
+        let mut detail = doc.terrain.detail.map(|d| detail::Layer::new(&grid, d));
         for (node, r) in regions.iter().zip(&doc.regions) {
-            node.paint_all(&r.figures, 0.0, &mut map);
+            match &mut detail {
+                Some(layer) => {
+                    node.paint_all(&r.figures, 0.0, &mut layer.smooth);
+                    node.paint_gates(&mut layer.gate, grid.cols);
+                }
+                None => node.paint_all(&r.figures, 0.0, &mut map),
+            }
+        }
+        if let Some(layer) = &detail {
+            layer.apply(whole(&grid), &mut map);
         }
         let ridges = crate::ridge::layer::Layer::new(doc, &map);
         let mut rivers = Layer::default();
@@ -444,6 +491,7 @@ impl TerrainEngine {
         TerrainEngine {
             regions,
             map,
+            detail,
             ridges,
             rivers,
         }
@@ -492,6 +540,11 @@ impl TerrainEngine {
     pub fn update(&mut self, doc: &Document, scope: &Scope) -> Rect {
         match self.regenerate(doc, scope) {
             Some(rect) => {
+                // The detail follows the regions' terrain that changed (and the cells beside it).
+                let rect = match &self.detail {
+                    Some(layer) => layer.apply(rect, &mut self.map),
+                    None => rect,
+                };
                 // The ridges follow their entry and join the regions' terrain that changed; the
                 // rivers follow their entries and the ground that changed under them.
                 let rect = rect.union(self.ridges.sync(doc, &self.map, rect));
@@ -502,12 +555,7 @@ impl TerrainEngine {
             }
             None => {
                 *self = TerrainEngine::build(doc);
-                Rect {
-                    c0: 0,
-                    r0: 0,
-                    width: doc.grid.cols,
-                    height: doc.grid.rows,
-                }
+                whole(&doc.grid)
             }
         }
     }
@@ -515,7 +563,24 @@ impl TerrainEngine {
     /// The part of [`TerrainEngine::update`] that regenerates by scope; `None` when the scope
     /// does not fit.
     fn regenerate(&mut self, doc: &Document, scope: &Scope) -> Option<Rect> {
-        let TerrainEngine { regions, map, .. } = self;
+        let TerrainEngine {
+            regions, map, detail, ..
+        } = self;
+        // Settings are not edits with a scope: a change of them regenerates everything.
+        if detail.as_ref().map(|l| *l.settings()) != doc.terrain.detail
+            || (regions.len() == doc.regions.len()
+                && regions
+                    .iter()
+                    .zip(&doc.regions)
+                    .any(|(n, r)| n.metric != doc.metric_of(r)))
+        {
+            return None;
+        }
+        // With detail the regions paint the terrain before it, and the shapes' gates.
+        let (map, mut gate) = match detail {
+            Some(detail::Layer { smooth, gate, .. }) => (smooth, Some(gate.as_mut_slice())),
+            None => (map, None),
+        };
         let grid = doc.grid;
         let before = match scope {
             Scope::RegionAdded(_) => doc.regions.len().checked_sub(1)?,
@@ -594,12 +659,18 @@ impl TerrainEngine {
                 }
                 node.settle(figs, outer);
                 node.paint_all(figs, base, map);
+                if let Some(g) = gate.as_deref_mut() {
+                    node.paint_gates(g, grid.cols);
+                }
                 Rect::of(&node.mask)
             }
             Scope::RegionAdded(i) => {
                 let r = doc.regions.get(*i)?;
                 let node = region_node(doc, r);
                 node.paint_all(&r.figures, 0.0, map);
+                if let Some(g) = gate.as_deref_mut() {
+                    node.paint_gates(g, grid.cols);
+                }
                 let rect = Rect::of(&node.mask);
                 regions.insert(*i, node);
                 rect
@@ -609,14 +680,17 @@ impl TerrainEngine {
                     return None;
                 }
                 let node = regions.remove(*i);
-                node.clear(map);
+                node.clear(map, gate.as_deref_mut());
                 Rect::of(&node.mask)
             }
             Scope::RegionReplaced(i) => {
                 let r = doc.regions.get(*i)?;
                 let old = std::mem::replace(regions.get_mut(*i)?, region_node(doc, r));
-                old.clear(map);
+                old.clear(map, gate.as_deref_mut());
                 regions[*i].paint_all(&r.figures, 0.0, map);
+                if let Some(g) = gate.as_deref_mut() {
+                    regions[*i].paint_gates(g, grid.cols);
+                }
                 Rect::of(&old.mask).union(Rect::of(&regions[*i].mask))
             }
             Scope::RegionOutline(i) => {
@@ -625,10 +699,13 @@ impl TerrainEngine {
                 if node.figures.len() != r.figures.len() {
                     return None;
                 }
-                node.clear(map);
+                node.clear(map, gate.as_deref_mut());
                 let old = Rect::of(&node.mask);
                 node.reshape(&grid, cells::closed_mask(&grid, &r.boundary), &r.figures, None);
                 node.paint_all(&r.figures, 0.0, map);
+                if let Some(g) = gate {
+                    node.paint_gates(g, grid.cols);
+                }
                 old.union(Rect::of(&node.mask))
             }
         };

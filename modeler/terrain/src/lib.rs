@@ -19,6 +19,7 @@
 pub mod address;
 pub mod cells;
 pub mod change;
+pub mod detail;
 pub mod distance;
 pub mod document;
 pub mod edit;
@@ -43,7 +44,7 @@ pub mod trees;
 pub mod validate;
 
 pub use address::{CurvePath, FigurePath};
-pub use document::{Document, Figure, FigureKind, Grid, Metric, Point, Region, River, TerrainSettings};
+pub use document::{Detail, Document, Figure, FigureKind, Grid, Metric, Point, Region, River, TerrainSettings};
 pub use edit::{Edit, EditError};
 pub use editor::{Editor, Outcome};
 pub use engine::{Rect, TerrainEngine, generate};

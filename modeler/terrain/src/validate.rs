@@ -306,6 +306,13 @@ pub enum Defect {
         "the grove's sampling image would be {width} × {height} pixels, more than {max}: use a smaller region or a lower density"
     )]
     GroveTooLarge { width: u32, height: u32, max: u64 },
+    /// A fractal detail setting (`terrain.detail`) out of its range.
+    #[error("{what} must be {range}, got {}", Num(*value))]
+    DetailRange {
+        what: &'static str,
+        range: String,
+        value: f64,
+    },
 }
 
 /// Checks the whole document.
@@ -333,7 +340,46 @@ pub fn document(doc: &Document) -> Result<(), ValidationError> {
     ridges(doc)?;
     trees(doc)?;
     groves(doc)?;
+    terrain(doc)?;
     memory(doc)
+}
+
+/// The most octaves of fractal detail: the twelfth's wavelength is 1/2048 of the first's.
+pub const MAX_DETAIL_OCTAVES: u32 = 12;
+
+/// Checks the terrain settings' fractal detail (`docs/document.md`): an amount from 0 to 1, a
+/// scale (the longest wavelength) of at least two cells — a shorter one would alias on the grid
+/// — and at most 10 000 km, and 1 to [`MAX_DETAIL_OCTAVES`] octaves. (The metric's names are
+/// checked when the text is read.)
+pub fn terrain(doc: &Document) -> Result<(), ValidationError> {
+    let Some(d) = &doc.terrain.detail else { return Ok(()) };
+    let range = |what: &'static str, range: String, value: f64| {
+        Err(ValidationError::new(
+            format!("terrain.detail.{}", what.rsplit(' ').next().unwrap_or(what)),
+            Defect::DetailRange { what, range, value },
+        ))
+    };
+    finite(d.amount, || "terrain.detail.amount".into())?;
+    finite(d.scale, || "terrain.detail.scale".into())?;
+    if !(0.0..=1.0).contains(&d.amount) {
+        return range("the detail's amount", "from 0 to 1".into(), d.amount);
+    }
+    let min_scale = 2.0 * doc.grid.cell_size;
+    if !(min_scale..=1e7).contains(&d.scale) {
+        return range(
+            "the detail's scale",
+            format!("from {} m (two cells) to 10 000 km", Num(min_scale)),
+            d.scale,
+        );
+    }
+    if !(1..=MAX_DETAIL_OCTAVES).contains(&d.octaves) {
+        return range(
+            "the detail's octaves",
+            format!("from 1 to {MAX_DETAIL_OCTAVES}"),
+            f64::from(d.octaves),
+        );
+    }
+    Ok(())
 }
 
 /// Checks every rock field: its outline (a closed curve on the grid, relative to `at`), its cell
@@ -468,7 +514,9 @@ pub fn engine_bytes(doc: &Document) -> (u64, u64, u64) {
             region(grid, &f.points, &f.figures, acc);
         }
     }
-    let mut acc = (4 * doc.grid.cells() as u64, 0, 0);
+    // The heightmap, and with detail its noise, gates and the terrain before it.
+    let per_cell = if doc.terrain.detail.is_some() { 16 } else { 4 };
+    let mut acc = (per_cell * doc.grid.cells() as u64, 0, 0);
     for r in &doc.regions {
         region(&doc.grid, &r.boundary, &r.figures, &mut acc);
     }

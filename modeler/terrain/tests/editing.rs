@@ -9,7 +9,7 @@ use common::*;
 use penmodel_terrain::change::Scope;
 use penmodel_terrain::editor::{Editor, EditorError, OpenReport};
 use penmodel_terrain::{
-    CurvePath, Defect, Document, Edit, EditError, Figure, FigurePath, Metric, TerrainEngine, generate, journal,
+    CurvePath, Defect, Detail, Document, Edit, EditError, Figure, FigurePath, Metric, TerrainEngine, generate, journal,
 };
 use proptest::prelude::*;
 
@@ -142,6 +142,19 @@ fn metric() -> impl Strategy<Value = Metric> {
     prop_oneof![Just(Metric::Taxicab), Just(Metric::Euclidean)]
 }
 
+/// No detail, or detail of a random amount, scale (2 to 40 cells of the 40-cell grid), octaves
+/// and seed.
+fn detail() -> impl Strategy<Value = Option<Detail>> {
+    prop::option::of(
+        (0.0..=1.0f64, 2.0..40.0f64, 1u32..=6, any::<u64>()).prop_map(|(amount, scale, octaves, seed)| Detail {
+            amount,
+            scale,
+            octaves,
+            seed,
+        }),
+    )
+}
+
 #[track_caller]
 fn assert_matches_full(editor: &Editor, context: &str) {
     let full = generate(editor.document()).unwrap();
@@ -158,8 +171,9 @@ proptest! {
     /// equals a full regeneration of the document within the summation-order tolerance, and a
     /// refused edit leaves the document and terrain exactly as they were; in either metric.
     #[test]
-    fn incremental_equals_full(mut doc in nested_document(), ops in prop::collection::vec(op(), 1..14), metric in metric()) {
+    fn incremental_equals_full(mut doc in nested_document(), ops in prop::collection::vec(op(), 1..14), metric in metric(), detail in detail()) {
         doc.terrain.metric = metric;
+        doc.terrain.detail = detail;
         let mut editor = Editor::new(doc).unwrap();
         for (n, op) in ops.iter().enumerate() {
             let Some(edit) = edit_for(editor.document(), op) else { continue };

@@ -1,6 +1,7 @@
 //! The integration tests of penmodel-terrain, in one binary: a module per area.
 mod baseline;
 mod common;
+mod detail;
 mod docs;
 mod editing;
 mod equations;

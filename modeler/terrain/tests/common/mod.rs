@@ -99,7 +99,18 @@ pub fn max_figures(doc: &Document) -> usize {
 /// the `terrain` module docs); two of them differ by at most twice that.
 pub fn tolerance(doc: &Document) -> f32 {
     let k = max_figures(doc) as f64;
-    ((6.0 * k + 16.0) * f64::from(f32::EPSILON) / 2.0 * max_height(doc)) as f32
+    let smooth = (6.0 * k + 16.0) * f64::from(f32::EPSILON) / 2.0 * max_height(doc);
+    match &doc.terrain.detail {
+        None => smooth as f32,
+        // Detail reads a cell's height e and its neighbours' slope: an error e in the terrain
+        // before detail moves it by at most amount·(e + (scale/4)·√2·e/cell); the sum is rounded
+        // to f32 once more (the height with detail stays within 3·max_height).
+        Some(d) => {
+            let reach = d.scale / 4.0 * 2f64.sqrt() / doc.grid.cell_size;
+            let with = smooth * (1.0 + d.amount * (1.0 + reach)) + f64::from(f32::EPSILON) * 3.0 * max_height(doc);
+            with as f32
+        }
+    }
 }
 
 /// The first cell where two heightmaps differ by more than `tol`.
