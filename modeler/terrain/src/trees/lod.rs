@@ -111,7 +111,10 @@ impl NodeTree {
         let pose = pose.filter(|p| !p.is_still());
         // The sway's axis in the tree's unit (the placement turns and scales the tree).
         let axis = pose.map(|p| place.matrix3.inverse().mul_vec3(p.axis).normalize_or(DVec3::Z));
-        let maps: Vec<DAffine3> = self.species.maps.iter().map(|m| m.affine()).collect();
+        let maps: Vec<DAffine3> = match pose {
+            Some(_) => self.species.maps.iter().map(|m| m.affine()).collect(),
+            None => Vec::new(),
+        };
         let still = f32_affine(place);
         let mut swayed: Vec<DAffine3> = Vec::new();
         let mut i = 0;

@@ -94,6 +94,16 @@ pub struct Forest {
     trees: Vec<Standing>,
 }
 
+/// The node tree of `species` from `built`, building and keeping it the first time.
+fn nodes_of(built: &mut Vec<(Vec<IfsMap>, Arc<NodeTree>)>, species: &Species) -> Arc<NodeTree> {
+    if let Some((_, n)) = built.iter().find(|(m, _)| *m == species.maps) {
+        return Arc::clone(n);
+    }
+    let n = Arc::new(NodeTree::build(species));
+    built.push((species.maps.clone(), Arc::clone(&n)));
+    n
+}
+
 impl Forest {
     /// The trees of `doc` (valid) on `map`.
     pub fn of(doc: &Document, map: &Heightmap) -> Forest {
@@ -104,12 +114,7 @@ impl Forest {
 
     /// The node tree of `species`, built once.
     pub fn nodes(&mut self, species: &Species) -> Arc<NodeTree> {
-        if let Some((_, n)) = self.species.iter().find(|(m, _)| *m == species.maps) {
-            return Arc::clone(n);
-        }
-        let n = Arc::new(NodeTree::build(species));
-        self.species.push((species.maps.clone(), Arc::clone(&n)));
-        n
+        nodes_of(&mut self.species, species)
     }
 
     /// Brings the trees up to date with `doc` and its terrain `map`: groves that changed are
@@ -138,10 +143,9 @@ impl Forest {
                 wind: t.wind.clone(),
             });
         }
-        let groves = self.groves.clone();
-        for (i, (g, list)) in groves.iter().enumerate() {
+        for (i, (g, list)) in self.groves.iter().enumerate() {
             for (k, t) in list.iter().enumerate() {
-                let nodes = self.nodes(&Species::preset(t.preset));
+                let nodes = nodes_of(&mut self.species, &Species::preset(t.preset));
                 trees.push(Standing {
                     source: Source::Grove(i, k),
                     at: t.at,
