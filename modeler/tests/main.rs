@@ -8,4 +8,5 @@ mod kill_loop;
 mod ridges_cli;
 mod river_cli;
 mod rocks_cli;
+mod trees_cli;
 mod waiting_cli;

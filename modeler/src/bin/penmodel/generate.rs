@@ -86,6 +86,11 @@ pub fn run(args: &Args) -> Result<()> {
     {
         placed.push(("water".to_string(), water.mesh(map.cell_size())));
     }
+    // The trees and groves standing on the terrain, full geometry at rest: one mesh "trees".
+    if !editor.trees().trees().is_empty() && (args.obj.is_some() || args.glb.is_some()) {
+        let drawn = editor.trees().draw(|_| penmodel_terrain::trees::nodes::STOP, 0.0);
+        placed.push(("trees".to_string(), drawn.mesh));
+    }
     export(map, &args.obj, |m, out| export::write_obj_with(m, &placed, out))?;
     export(map, &args.glb, |m, out| export::write_glb_with(m, &placed, out))?;
     let (lo, hi) = map.range();

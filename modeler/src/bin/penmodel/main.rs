@@ -14,6 +14,7 @@ mod render;
 mod ridges;
 mod river;
 mod rocks;
+mod trees;
 
 use std::process::ExitCode;
 
@@ -73,6 +74,8 @@ enum Command {
     Ridges(ridges::Args),
     /// Shape one river of a document by erosion and deposition (seed 003) and write its masks.
     River(river::Args),
+    /// Fractal trees (seed 004): counts per roughness Q, a tree or grove as a mesh, a fit to silhouettes.
+    Trees(trees::Args),
 }
 
 fn main() -> ExitCode {
@@ -87,6 +90,7 @@ fn main() -> ExitCode {
         Some(Command::Analyze(args)) => analyze::run(&args),
         Some(Command::Ridges(args)) => ridges::run(&args),
         Some(Command::River(args)) => river::run(&args),
+        Some(Command::Trees(args)) => trees::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
