@@ -147,33 +147,53 @@ impl Line {
     }
 }
 
+/// The upper hull of the samples passed so far, nearest vertex last.
+///
+/// The nearest vertex is kept in registers and the others in two `f32` stacks. Why: the pop
+/// test reads the vertex pushed one sample earlier; stored as a `(f32, f32)` pair it was written
+/// as two 4-byte stores and read back as one 8- or 16-byte load, which the CPU cannot forward
+/// from the store buffer, a stall of a dozen cycles on every sample (`perf` put most of the
+/// sweep there). Same-width stores and loads forward.
+#[derive(Default)]
+struct Hull {
+    s: Vec<f32>,
+    h: Vec<f32>,
+}
+
 /// The upper-hull pass over a line's samples in the order `order`, the first ones the farthest
 /// ahead: calls `sink(line, k, tangent)` for each sample (`None` when nothing is ahead).
 /// `sign` is 1 when ahead is increasing u, −1 when decreasing, so that positions grow ahead.
 #[inline]
 fn hull_pass(
     line: &Line,
-    hull: &mut Vec<(f32, f32)>,
+    hull: &mut Hull,
     sign: f32,
     order: impl Iterator<Item = usize>,
     sink: &mut impl FnMut(&Line, usize, Option<f32>),
 ) {
-    hull.clear();
+    hull.s.clear();
+    hull.h.clear();
+    // The nearest hull vertex, once there is one.
+    let mut near: Option<(f32, f32)> = None;
     for k in order {
         let (s, h) = (sign * (line.u0 + k as f32) * line.spacing, line.h[k]);
-        // Pop the nearest hull point while it lies on or under the line to the next one.
-        while hull.len() >= 2 {
-            let (s1, h1) = hull[hull.len() - 1];
-            let (s2, h2) = hull[hull.len() - 2];
-            if (h1 - h) * (s2 - s) <= (h2 - h) * (s1 - s) {
-                hull.pop();
-            } else {
-                break;
+        let t = near.map(|(mut s1, mut h1)| {
+            // Pop the nearest vertex while it lies on or under the line to the next one.
+            while let (Some(&s2), Some(&h2)) = (hull.s.last(), hull.h.last()) {
+                if (h1 - h) * (s2 - s) <= (h2 - h) * (s1 - s) {
+                    (s1, h1) = (s2, h2);
+                    hull.s.pop();
+                    hull.h.pop();
+                } else {
+                    break;
+                }
             }
-        }
-        let t = hull.last().map(|&(s1, h1)| (h1 - h) / (s1 - s));
+            hull.s.push(s1);
+            hull.h.push(h1);
+            (h1 - h) / (s1 - s)
+        });
         sink(line, k, t);
-        hull.push((s, h));
+        near = Some((s, h));
     }
 }
 
@@ -226,7 +246,10 @@ fn sweep(
     let w = cols as usize;
     let (lo, hi) = (f64::from(nu - 1) * slope.min(0.0), f64::from(nu - 1) * slope.max(0.0));
     let ahead_up = du > 0.0;
-    let mut hull: Vec<(f32, f32)> = Vec::with_capacity(nu as usize);
+    let mut hull = Hull {
+        s: Vec::with_capacity(nu as usize),
+        h: Vec::with_capacity(nu as usize),
+    };
     let mut line = Line {
         stride: w,
         spacing,
@@ -316,6 +339,17 @@ fn lambert(field: Field<'_>, c: u32, r: u32, s: [f64; 3]) -> f64 {
     let [gx, gy] = sobel(field.z, field.cols, field.rows, field.cell, c, r);
     let n = 1.0 / (gx * gx + gy * gy + 1.0).sqrt();
     ((-gx * s[0] - gy * s[1] + s[2]) * n).max(0.0)
+}
+
+/// A hillshade: Lambert's `max(0, n·s)` per cell with no shadows, the map that shows a
+/// heightfield's shape (its creases, steps and cones) most plainly.
+pub fn hillshade(field: Field<'_>, sun: Sun) -> Vec<f32> {
+    let (ce, se) = (sun.elevation.cos(), sun.elevation.sin());
+    let s = [ce * sun.azimuth.cos(), ce * sun.azimuth.sin(), se];
+    let cols = field.cols as usize;
+    (0..field.z.len())
+        .map(|i| lambert(field, (i % cols) as u32, (i / cols) as u32, s) as f32)
+        .collect()
 }
 
 /// Direct sunlight per cell: Lambert where the sun is above the cell's horizon, exactly 0 in
