@@ -10,6 +10,11 @@
 //! - `grove/r50/200ha`: a grove's trees (Poisson-disk positions, presets, heights) in a circle
 //!   of 50 m at 200 trees per hectare (about 157 trees).
 //!
+//! - `fit/render/table-3.1`: one candidate silhouette of the fit (the tree to scale 0.05,
+//!   rasterised on 64 × 64, blurred), the unit of its cost. Printed before the runs: the fit on
+//!   silhouettes (128 px) of each preset nudged by 1.5 fit steps per parameter with 2 % of the
+//!   pixels flipped — the correlations it starts from and reaches in 30 steps, and its time.
+//!
 //! Run: `cargo bench -p penmodel-terrain --bench trees` (filter with e.g. `-- draw`).
 
 use std::hint::black_box;
@@ -17,7 +22,9 @@ use std::hint::black_box;
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::DAffine3;
 use penmodel_terrain::document::{Grove, GroveSpecies, Sway, Wind};
-use penmodel_terrain::trees::{Drawn, NodeTree, Preset, Species, grove, wind};
+use penmodel_terrain::trees::nodes::STOP;
+use penmodel_terrain::trees::silhouette::{self, View};
+use penmodel_terrain::trees::{Drawn, NodeTree, Preset, Species, fit, grove, wind};
 
 fn clear(d: &mut Drawn) {
     d.mesh.positions.clear();
@@ -30,8 +37,38 @@ fn clear(d: &mut Drawn) {
     d.leaves = 0;
 }
 
+/// The fit's experiment: printed, not timed by criterion (a fit takes seconds).
+fn fit_experiment() {
+    for (k, p) in Preset::ALL.into_iter().enumerate() {
+        let seed = 11 + k as u64;
+        let truth = fit::nudged(&Species::preset(p), 1.5, seed);
+        let front = fit::speckled(&silhouette::render(&truth, View::Front, 128, STOP), 0.02, seed);
+        let side = fit::speckled(&silhouette::render(&truth, View::Side, 128, STOP), 0.02, seed + 1);
+        let t = std::time::Instant::now();
+        match fit::fit(&front, &side, fit::Options { iterations: 30 }) {
+            Ok(f) => println!(
+                "fit {}: from {} {:.3}/{:.3} to {:.3}/{:.3} (front/side) in {} steps, {:.1} s",
+                p.name(),
+                f.preset.name(),
+                f.start[0],
+                f.start[1],
+                f.reached[0],
+                f.reached[1],
+                f.iterations,
+                t.elapsed().as_secs_f64()
+            ),
+            Err(e) => println!("fit {}: {e}", p.name()),
+        }
+    }
+}
+
 fn trees(c: &mut Criterion) {
+    fit_experiment();
     let mut g = c.benchmark_group("trees");
+    let table = Species::preset(Preset::Table31);
+    g.bench_function("fit/render/table-3.1", |b| {
+        b.iter(|| black_box(silhouette::render(&table, View::Front, fit::SIZE, fit::FIT_STOP).blurred(2)))
+    });
     for p in [Preset::Table31, Preset::Fir] {
         let s = Species::preset(p);
         g.bench_function(format!("build/{}", p.name()), |b| {

@@ -171,3 +171,41 @@ pub fn fit(front: &Image, side: &Image, options: Options) -> Result<Fit, FitErro
         iterations,
     })
 }
+
+/// A few deterministic numbers in [−1, 1] from `seed` (xorshift64), for experiments.
+fn offsets(seed: u64) -> impl FnMut() -> f64 {
+    let mut x = seed | 1;
+    move || {
+        x ^= x << 13;
+        x ^= x >> 7;
+        x ^= x << 17;
+        (x % 2001) as f64 / 1000.0 - 1.0
+    }
+}
+
+/// `species` with every parameter nudged by up to `amount` fit steps ([`STEPS`]; y and s held
+/// in [0.05, 0.9] and [0.15, 0.7]): the unknown tree of the fit's experiments.
+pub fn nudged(species: &Species, amount: f64, seed: u64) -> Species {
+    let mut next = offsets(seed);
+    let mut s = species.clone();
+    for m in &mut s.maps {
+        m.y = (m.y + amount * STEPS[0] * next()).clamp(0.05, 0.9);
+        m.s = (m.s + amount * STEPS[1] * next()).clamp(0.15, 0.7);
+        m.theta_z += amount * STEPS[2] * next();
+        m.theta_y += amount * STEPS[3] * next();
+    }
+    s
+}
+
+/// `img` with a `fraction` of its pixels flipped (`c → 1 − c`) at seeded places: noise for the
+/// fit's experiments.
+pub fn speckled(img: &Image, fraction: f64, seed: u64) -> Image {
+    let mut next = offsets(seed);
+    let mut out = img.clone();
+    for v in &mut out.data {
+        if 0.5 * (next() + 1.0) < fraction {
+            *v = 1.0 - *v;
+        }
+    }
+    out
+}
