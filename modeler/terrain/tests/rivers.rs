@@ -6,7 +6,7 @@
 
 use glam::DVec2;
 use penmodel_terrain::river::course::{self, Sample};
-use penmodel_terrain::river::{self, Constants, Shape, carve, level, morph};
+use penmodel_terrain::river::{self, Constants, Shape, carve, edt, level, morph};
 use penmodel_terrain::{Grid, Heightmap, River};
 
 /// A deterministic pseudo-random 0/1 image with about `fill` of its cells set.
@@ -66,6 +66,35 @@ fn diamonds_equal_the_iterated_cross() {
             }
             assert_eq!(morph::dilate(&img, w, h, level), d, "dilation, level {level}, {w}x{h}");
             assert_eq!(morph::erode(&img, w, h, level), e, "erosion, level {level}, {w}x{h}");
+        }
+    }
+}
+
+#[test]
+fn the_euclidean_distance_is_the_nearest_set_cell() {
+    // Brute force: the least √(dx² + dy²) to a set cell; none: infinite.
+    for (w, h, fill, seed) in [
+        (31, 19, 0.02, 15),
+        (40, 40, 0.3, 16),
+        (23, 29, 0.9, 17),
+        (1, 12, 0.3, 18),
+        (9, 1, 0.3, 19),
+    ] {
+        for img in [noise(w, h, seed, fill), vec![0; w * h], vec![1; w * h]] {
+            let d = edt::euclidean(&img, w, h);
+            for i in 0..w * h {
+                let (c, r) = ((i % w) as f64, (i / w) as f64);
+                let want = (0..w * h)
+                    .filter(|&j| img[j] != 0)
+                    .map(|j| ((j % w) as f64 - c).hypot((j / w) as f64 - r))
+                    .fold(f64::INFINITY, f64::min);
+                assert!(
+                    (f64::from(d[i]) - want).abs() <= 1e-5 * want.max(1.0)
+                        || (want.is_infinite() && d[i].is_infinite()),
+                    "{w}x{h} fill {fill}, cell ({c}, {r}): {} against {want}",
+                    d[i]
+                );
+            }
         }
     }
 }

@@ -11,12 +11,12 @@
 //! - **Lakes**: their surface is the river's at the neck that cut them off, their bed
 //!   [`LAKE_DEPTH`] × depth below it.
 //! - **Banks**: land cells within a width (at least 2 cells) of water are lowered towards the
-//!   water's edge linearly with their city-block distance to it; nothing is raised.
+//!   water's edge linearly with their Euclidean distance to it ([`edt`]); nothing is raised.
 //!
 //! The result is a target height per cell; the terrain is the lower of the ground and every
 //! river's target, so rivers over the same ground combine in any order.
 
-use super::morph;
+use super::edt;
 use super::near::NONE;
 use super::{Shape, Window};
 use crate::heightmap::Heightmap;
@@ -81,7 +81,8 @@ pub fn carve(shape: &Shape, width: f64, depth: f64, ground: &Heightmap) -> Carve
     let wet: Vec<u8> = (0..n)
         .map(|i| u8::from(shape.mask[i] != 0 || shape.lakes[i] != 0))
         .collect();
-    let to_water = morph::distance(&wet, win.width, win.height, true, false);
+    // Euclidean, so the banks' contours are round rather than the diamonds' stairs.
+    let to_water = edt::euclidean(&wet, win.width, win.height);
     let bank = (width / shape.cell_size).round().max(2.0);
     for i in 0..n {
         let o = shape.near.owner[i];
