@@ -3,4 +3,5 @@ mod common;
 mod outputs;
 mod render;
 mod rocks;
+mod trees;
 mod water;
