@@ -8,7 +8,8 @@
 //!    screen bounds, near to far.
 //! 3. [`clip`]: triangles and lines crossing the near plane or the guard band, cut.
 //! 4. [`rasterise`]: triangles into a depth buffer, fixed point, top-left rule.
-//! 5. [`shade`]: per-vertex light, the elevation ramp per pixel, the sky.
+//! 5. [`shade`]: per-vertex light, the elevation ramp per pixel, the sky; or the land look's
+//!    ground colours ([`land`]) and the sky, table and haze around them ([`atmosphere`]).
 //! 6. [`overlay`]: figures and boundaries draped on the surface, depth-tested with a bias.
 //! 7. [`ui`] and [`text`]: the slope bar and the mode line.
 //! 8. [`stereo`]: anaglyph and side-by-side.
@@ -23,19 +24,18 @@
 //! height leaves a hole (the triangles touching it are skipped, and [`RenderStats`] counts such
 //! vertices); a grid smaller than 2 × 2 has no triangles and shows only sky, overlays and UI.
 
+pub mod atmosphere;
 pub mod camera;
 pub mod clip;
-pub mod forest;
 pub mod frame;
-pub mod impostor;
-pub mod meshes;
+pub mod land;
 pub mod overlay;
 pub mod rasterise;
+pub mod meshes;
 pub mod scene;
 pub mod shade;
 pub mod stereo;
 pub mod text;
-pub mod textured;
 pub mod tiles;
 pub mod transform;
 pub mod ui;
@@ -44,7 +44,7 @@ pub mod output;
 
 pub use camera::{Camera, Eye, Orbit, Projection, Tracked, View, Viewport};
 pub use frame::{Frame, RenderError, Rgba};
-pub use scene::{Overlay, Scene, SlopeBar, Stereo, Style};
+pub use scene::{Look, Overlay, Scene, SlopeBar, Stereo, Style};
 
 use meshes::Paint;
 use rasterise::{Bounds, Capsule, Sample, Surface};
@@ -78,19 +78,19 @@ struct EyeBuffers {
     capsules: Vec<Capsule>,
     /// Rocks, water and trees, in that order.
     meshes: meshes::Projected,
-    /// The scene's textured polygons and the trees' simplified shapes.
-    textured: textured::Projected,
 }
 
 /// Renders scenes into frames, keeping its buffers from one frame to the next.
 pub struct Renderer {
     tile_rows: usize,
     light: Vec<f32>,
+    /// The land look's maps, kept while the terrain does not change.
+    land: land::Land,
+    /// The land look's background per eye (centre, left, right), kept while the camera stays.
+    backdrops: [atmosphere::Backdrop; 3],
     samples: Vec<Sample>,
     eye: EyeBuffers,
     left: Option<Frame>,
-    /// The trees drawn this frame and the simplified shapes' textures.
-    trees: forest::Trees,
 }
 
 impl Default for Renderer {
@@ -110,10 +110,11 @@ impl Renderer {
         Renderer {
             tile_rows: rows.max(1),
             light: Vec::new(),
+            land: land::Land::default(),
+            backdrops: Default::default(),
             samples: Vec::new(),
             eye: EyeBuffers::default(),
             left: None,
-            trees: forest::Trees::default(),
         }
     }
 
@@ -122,8 +123,6 @@ impl Renderer {
         scene.camera.check()?;
         let stats = self.prepare(scene);
         let full = whole(frame);
-        self.trees
-            .prepare(scene, f64::from(frame.width()) / f64::from(frame.height()));
         match scene.stereo {
             Stereo::None => {
                 self.eye(scene, Eye::Centre, full, frame);
@@ -162,8 +161,6 @@ impl Renderer {
         scene.camera.check()?;
         let stats = self.prepare(scene);
         let full = whole(frame);
-        self.trees
-            .prepare(scene, f64::from(frame.width()) / f64::from(frame.height()));
         self.eye(scene, eye, full, frame);
         self.ui(scene, full, frame);
         Ok(stats)
@@ -181,7 +178,7 @@ impl Renderer {
             y0: 0,
             y1: height as i32,
         };
-        let (affine, near) = self.project(scene, Eye::Centre, full, width, height);
+        let (affine, near, _) = self.project(scene, Eye::Centre, full, width, height);
         let pass = tiles::EyePass {
             map: scene.terrain,
             light: &self.light,
@@ -195,8 +192,21 @@ impl Renderer {
         Ok(counts)
     }
 
+    /// How many times the land look's maps were remade (they are kept while the terrain, the
+    /// vertical scale, the style and the water stay the same).
+    pub fn land_remakes(&self) -> u64 {
+        self.land.remakes()
+    }
+
     /// Per-frame work shared by both eyes: the light.
     fn prepare(&mut self, scene: &Scene) -> RenderStats {
+        if scene.style.look == scene::Look::Land {
+            return RenderStats {
+                skipped_vertices: self.land.prepare(scene, &mut self.light),
+            };
+        }
+        // The light buffer is about to hold the classic light.
+        self.land.forget();
         let skipped = shade::vertex_light(
             scene.terrain,
             scene.vertical_scale,
@@ -210,7 +220,14 @@ impl Renderer {
     }
 
     /// Projects the grid for `eye` drawn into `viewport` of a `width × height` frame.
-    fn project(&mut self, scene: &Scene, eye: Eye, viewport: Bounds, width: u32, height: u32) -> (Affine, f32) {
+    fn project(
+        &mut self,
+        scene: &Scene,
+        eye: Eye,
+        viewport: Bounds,
+        width: u32,
+        height: u32,
+    ) -> (Affine, f32, Projection) {
         let vp = scene.camera.viewpoint(eye, f64::from(width) / f64::from(height));
         let projection = Projection::new(
             &vp,
@@ -240,21 +257,29 @@ impl Renderer {
         meshes.add(rocks, Paint::Whole(Surface::Rock), &affine, cell, near, &scene.style);
         let water = scene.water.iter().map(|(_, m)| m);
         meshes.add(water, Paint::Whole(Surface::Water), &affine, cell, near, &scene.style);
-        let trees = std::iter::once(self.trees.mesh());
-        meshes.add(trees, Paint::Own, &affine, cell, near, &scene.style);
-        let textured = &mut self.eye.textured;
-        textured.clear((height as usize, self.tile_rows));
-        textured.add(scene.polygons, 0, &affine, cell, near);
-        let first = scene.textures.len() as u32;
-        textured.add(self.trees.quads(), first, &affine, cell, near);
-        (affine, near)
+        (affine, near, projection)
     }
 
     fn eye(&mut self, scene: &Scene, eye: Eye, viewport: Bounds, frame: &mut Frame) {
         let (width, height) = (frame.width(), frame.height());
-        let (affine, near) = self.project(scene, eye, viewport, width, height);
+        let (affine, near, projection) = self.project(scene, eye, viewport, width, height);
         self.samples.resize(width as usize * height as usize, Sample::default());
         let ramp = shade::Ramp::new(&scene.style);
+        let air = (scene.style.look == scene::Look::Land)
+            .then(|| atmosphere::Atmosphere::new(&projection, scene.terrain, scene.vertical_scale, &scene.style));
+        let columns = (viewport.x0 as usize, viewport.x1 as usize);
+        let slot = match eye {
+            Eye::Centre => 0,
+            Eye::Left => 1,
+            Eye::Right => 2,
+        };
+        let back = air
+            .as_ref()
+            .map(|a| self.backdrops[slot].of(a, width as usize, height as usize, columns));
+        let shading = shade::Shading {
+            ramp: &ramp,
+            land: air.as_ref().zip(back).map(|(a, b)| (&self.land, a, b)),
+        };
         let pass = tiles::EyePass {
             map: scene.terrain,
             light: &self.light,
@@ -263,25 +288,17 @@ impl Renderer {
             near,
             viewport,
         };
-        // The scene's textures, then the simplified shapes' (the order `project` offset them by).
-        let textures: Vec<&textured::Texture> = scene.textures.iter().chain(self.trees.cache().textures()).collect();
         tiles::render(
             &pass,
             &self.eye.meshes,
-            (&self.eye.textured, &textures),
             &self.eye.capsules,
-            &ramp,
+            &shading,
             &scene.style,
             frame.pixels_mut(),
             &mut self.samples,
             width as usize,
             self.tile_rows,
         );
-    }
-
-    /// What the last frame's trees cost: polygons copied, simplified shapes drawn.
-    pub fn tree_stats(&self) -> forest::TreeStats {
-        self.trees.stats()
     }
 
     fn ui(&self, scene: &Scene, viewport: Bounds, frame: &mut Frame) {

@@ -8,9 +8,6 @@ use super::frame::Rgba;
 use penmodel_terrain::Heightmap;
 use penmodel_terrain::Point;
 use penmodel_terrain::export::Mesh;
-use penmodel_terrain::trees::{Roughness, Standing};
-
-use super::textured::{Quad, Texture};
 
 /// How the two eyes' images are combined.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -65,9 +62,48 @@ impl SlopeBar {
     }
 }
 
+/// How the terrain is coloured and lit ([`Style::look`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Look {
+    /// The first renderer's look: one elevation ramp over `[−ramp_depth, ramp_top]`, Lambert plus
+    /// ambient light, a screen-space sky gradient.
+    #[default]
+    Classic,
+    /// Land (issue 20): colour by height in metres and by slope, cast shadows and sky light,
+    /// sky, table and haze beyond the terrain ([`crate::land`], [`crate::atmosphere`]).
+    Land,
+}
+
 /// Colours, widths and lighting: everything about the look that is not the scene's content.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Style {
+    /// Classic or land: [`Style::default`] is classic, [`Style::land`] the land look.
+    pub look: Look,
+    /// Land look: the snow line, metres of true height (not scaled by the vertical scale).
+    pub snow_line: f32,
+    /// Land look: the top of the beach band above sea level (height 0), metres, drawn when the
+    /// scene has water (a height below 0, or rivers and lakes).
+    pub beach_height: f32,
+    /// Land look: slopes (degrees) from which grass gives way to rock, and where it is all rock.
+    pub rock_slope: [f32; 2],
+    /// Land look: azimuths of the sky-view factor (issue 12's horizons).
+    pub sky_directions: u32,
+    /// Land look: the shadows and sky light are computed on a grid of at most this many cells
+    /// along its longer side (the heightmap averaged in blocks), and interpolated per vertex;
+    /// 0 for the heightmap's own grid.
+    pub light_cells: u32,
+    /// Land look: while the terrain changes every frame, how many frames the shadows, sky light and
+    /// colours may lag it (0: remade for every change); remade as soon as it stops.
+    pub light_lag: u32,
+    /// Land look: the distance over which the haze reaches 63 % of its strength, metres; 0 for
+    /// three times the terrain's diagonal.
+    pub haze_distance: f32,
+    /// Land look: the haze's strength far away, 0 to 1.
+    pub haze: f32,
+    /// Land look: the display's table around the terrain, before light.
+    pub table_colour: Rgba,
+    /// Land look: the table's width around the terrain, as a fraction of its longer side.
+    pub table_margin: f32,
     /// Heights at or above this many metres get the ramp's top colour (snow).
     pub ramp_top: f32,
     /// Heights at or below minus this many metres get the deepest water colour.
@@ -97,9 +133,36 @@ pub struct Style {
     pub water_colour: Rgba,
 }
 
+impl Style {
+    /// The land look (issue 20) with its defaults; the rest as [`Style::default`].
+    pub fn land() -> Style {
+        Style {
+            look: Look::Land,
+            // A clear sky's zenith and its paler horizon: the land look's sky is a gradient by the
+            // view ray's elevation, and the haze tends to the horizon's colour.
+            sky_top: [82, 128, 196, 255],
+            sky_bottom: [206, 220, 232, 255],
+            ..Style::default()
+        }
+    }
+}
+
 impl Default for Style {
     fn default() -> Style {
         Style {
+            look: Look::Classic,
+            // Alpine snow lines are 1,500 to 3,000 m; the seed's terrains are true metres.
+            snow_line: 1800.0,
+            beach_height: 1.5,
+            rock_slope: [32.0, 44.0],
+            sky_directions: 16,
+            light_cells: 160,
+            light_lag: 2,
+            haze_distance: 0.0,
+            haze: 0.3,
+            // Pale birch, the sand table's wooden frame.
+            table_colour: [196, 178, 146, 255],
+            table_margin: 0.06,
             ramp_top: 100.0,
             ramp_depth: 20.0,
             // From the south-west, 50° up: the default views look from the south, so the slopes
@@ -152,23 +215,6 @@ pub struct Scene<'a> {
     pub stereo: Stereo,
     /// Colours and lighting.
     pub style: Style,
-    /// Trees standing on the terrain (a document's: `Editor::trees().trees()`), drawn with
-    /// their own bark and leaf colours at the roughness [`Scene::tree_lod`] chooses
-    /// (`crate::forest`).
-    pub trees: &'a [Standing],
-    /// How trees choose their roughness `Q` by distance and gaze; `None` draws every tree in
-    /// full (level of detail off).
-    pub tree_lod: Option<Roughness>,
-    /// The tracked head's view direction, world `[X, Y up, Z]`, when known; otherwise the gaze
-    /// is the line from the centre eye through the screen's centre.
-    pub gaze: Option<[f64; 3]>,
-    /// Seconds, for the trees' sway in the wind.
-    pub time: f64,
-    /// Textured, alpha-tested quads (the exports' frame), each naming a texture of
-    /// [`Scene::textures`] (`crate::textured`).
-    pub polygons: &'a [Quad],
-    /// The textures [`Scene::polygons`] name.
-    pub textures: &'a [Texture],
 }
 
 impl<'a> Scene<'a> {
@@ -187,12 +233,6 @@ impl<'a> Scene<'a> {
             camera,
             stereo: Stereo::None,
             style: Style::default(),
-            trees: &[],
-            tree_lod: Some(Roughness::default()),
-            gaze: None,
-            time: 0.0,
-            polygons: &[],
-            textures: &[],
         }
     }
 }

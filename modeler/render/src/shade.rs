@@ -11,10 +11,16 @@
 //! - The ramp: water below sea level (height 0) from shallow to deep blue, so a depression is
 //!   never mistaken for land; then sand, grass, forest, rock and snow up to `ramp_top`.
 //! - Empty samples show the sky, a vertical gradient.
+//! - The land look ([`crate::scene::Look::Land`]) colours a terrain sample by the ground colour at
+//!   its world point ([`crate::land`]) instead of the ramp, hazes every surface by its distance
+//!   and shows the sky, the table and the land beyond where nothing was drawn
+//!   ([`crate::atmosphere`]).
 
 use rayon::prelude::*;
 
+use super::atmosphere::Atmosphere;
 use super::frame::Rgba;
+use super::land::Land;
 use super::rasterise::{Sample, Surface};
 use super::scene::Style;
 use penmodel_terrain::Heightmap;
@@ -36,7 +42,7 @@ pub const LAND: [(f32, [u8; 3]); 7] = [
 /// Water colours at fractions of `ramp_depth` below sea level.
 pub const WATER: [(f32, [u8; 3]); 2] = [(0.0, [78, 150, 212]), (1.0, [16, 40, 104])];
 
-fn interpolate(stops: &[(f32, [u8; 3])], t: f32) -> [u8; 3] {
+pub(crate) fn interpolate(stops: &[(f32, [u8; 3])], t: f32) -> [u8; 3] {
     let t = t.clamp(0.0, 1.0);
     for pair in stops.windows(2) {
         let ((t0, c0), (t1, c1)) = (pair[0], pair[1]);
@@ -166,6 +172,28 @@ fn mix(a: Rgba, b: Rgba, t: f32) -> Rgba {
     [0, 1, 2, 3].map(|i| (f32::from(a[i]) + t * (f32::from(b[i]) - f32::from(a[i]))).round() as u8)
 }
 
+/// How one eye's samples become colours: the classic ramp, or the land look's ground colours and
+/// atmosphere.
+pub struct Shading<'a> {
+    /// The classic look's colour table (unused by the land look).
+    pub ramp: &'a Ramp,
+    /// The land look's maps of the terrain, this eye's atmosphere and its background (row-major
+    /// over the frame: [`crate::atmosphere::Backdrop`]).
+    pub land: Option<(&'a Land, &'a Atmosphere, &'a [[u8; 3]])>,
+}
+
+/// A sample's colour before light, for surfaces other than the terrain.
+#[inline]
+fn surface_colour(surface: Surface, style: &Style) -> Option<[f32; 3]> {
+    let flat = |r: Rgba| [f32::from(r[0]), f32::from(r[1]), f32::from(r[2])];
+    match surface {
+        Surface::Rock => Some(flat(style.rock_colour)),
+        Surface::Water => Some(flat(style.water_colour)),
+        Surface::Colour([r, g, b]) => Some([f32::from(r), f32::from(g), f32::from(b)]),
+        Surface::Terrain => None,
+    }
+}
+
 /// Resolves a tile of samples into colours: terrain where covered, sky elsewhere. `y0` is the
 /// tile's first row in a frame of `frame_height` rows; only columns `x0..x1` are written.
 #[allow(clippy::too_many_arguments)]
@@ -176,27 +204,71 @@ pub fn resolve(
     (x0, x1): (usize, usize),
     y0: usize,
     frame_height: usize,
-    ramp: &Ramp,
+    shading: &Shading,
     style: &Style,
 ) {
+    if let Some((land, air, back)) = shading.land {
+        let back = &back[(y0 * width).min(back.len())..];
+        resolve_land(samples, pixels, width, (x0, x1), y0, (land, air, back), style);
+        return;
+    }
+    let ramp = shading.ramp;
     for (row, (srow, prow)) in samples.chunks(width).zip(pixels.chunks_mut(width)).enumerate() {
         let t = (y0 + row) as f32 / frame_height.max(1) as f32;
         let sky = mix(style.sky_top, style.sky_bottom, t);
         for (s, p) in srow[x0..x1].iter().zip(&mut prow[x0..x1]) {
             if s.invw > 0.0 {
                 let w = 1.0 / s.invw;
-                let flat = |r: Rgba| [f32::from(r[0]), f32::from(r[1]), f32::from(r[2])];
-                let c = match s.surface {
-                    Surface::Rock => flat(style.rock_colour),
-                    Surface::Water => flat(style.water_colour),
-                    Surface::Colour([r, g, b]) => [f32::from(r), f32::from(g), f32::from(b)],
-                    Surface::Terrain => ramp.get(s.hw * w),
-                };
+                let c = surface_colour(s.surface, style).unwrap_or_else(|| ramp.get(s.hw * w));
                 let l = (s.lw * w).clamp(0.0, 1.0);
                 *p = [(c[0] * l) as u8, (c[1] * l) as u8, (c[2] * l) as u8, 255];
             } else {
                 *p = sky;
             }
+        }
+    }
+}
+
+/// [`resolve`] in the land look: a terrain sample's ground colour where its world point lies
+/// ([`Land::albedo_at`]), every surface hazed by its distance, the atmosphere behind.
+#[allow(clippy::too_many_arguments)]
+fn resolve_land(
+    samples: &[Sample],
+    pixels: &mut [Rgba],
+    width: usize,
+    (x0, x1): (usize, usize),
+    y0: usize,
+    (land, air, back): (&Land, &Atmosphere, &[[u8; 3]]),
+    style: &Style,
+) {
+    let step = air.step();
+    // Where a cell spans less than a pixel (1/w below this), the nearest cell's colour.
+    let fine = 1.0 / air.pixels(land.cell, 1.0).max(f32::MIN_POSITIVE);
+    let rows = samples
+        .chunks(width)
+        .zip(pixels.chunks_mut(width))
+        .zip(back.chunks(width));
+    for (row, ((srow, prow), brow)) in rows.enumerate() {
+        let mut ray = air.ray(x0 as f32 + 0.5, (y0 + row) as f32 + 0.5);
+        for ((s, p), b) in srow[x0..x1].iter().zip(&mut prow[x0..x1]).zip(&brow[x0..x1]) {
+            let c = if s.invw > 0.0 {
+                let w = 1.0 / s.invw;
+                let (at, d) = air.point(ray, w);
+                let c = surface_colour(s.surface, style).unwrap_or_else(|| {
+                    if s.invw < fine {
+                        land.nearest_at(at[0], at[1])
+                    } else {
+                        land.albedo_at(at[0], at[1])
+                    }
+                });
+                let l = (s.lw * w).clamp(0.0, 1.0);
+                let c = air.hazed([c[0] * l, c[1] * l, c[2] * l], d);
+                [c[0] as u8, c[1] as u8, c[2] as u8]
+            } else {
+                *b
+            };
+            *p = [c[0], c[1], c[2], 255];
+            ray = [ray[0] + step[0], ray[1] + step[1], ray[2] + step[2]];
         }
     }
 }

@@ -16,7 +16,7 @@ use super::clip;
 use super::frame::Rgba;
 use super::rasterise::{self, Bounds, Capsule, Sample, Sink, Vtx};
 use super::scene::Style;
-use super::shade::{self, Ramp};
+use super::shade::{self, Shading};
 use super::transform::{self, Affine, ChunkState, Projected};
 use penmodel_terrain::Heightmap;
 
@@ -112,9 +112,8 @@ impl EyePass<'_> {
 pub fn render(
     pass: &EyePass,
     meshes: &super::meshes::Projected,
-    (textured, textures): (&super::textured::Projected, &[&super::textured::Texture]),
     capsules: &[Capsule],
-    ramp: &Ramp,
+    shading: &Shading,
     style: &Style,
     pixels: &mut [Rgba],
     samples: &mut [Sample],
@@ -149,8 +148,7 @@ pub fn render(
             };
             pass.terrain(&bounds, &mut sink);
             meshes.draw(&bounds, smp, width, pass.near);
-            textured.draw(&bounds, smp, width, pass.near, textures);
-            shade::resolve(smp, pix, width, (x0, x1), y0, frame_height, ramp, style);
+            shade::resolve(smp, pix, width, (x0, x1), y0, frame_height, shading, style);
             let (top, bottom) = (bounds.y0 as f32, bounds.y1 as f32);
             for cap in capsules {
                 let (lo, hi) = cap.rows();

@@ -1,0 +1,311 @@
+//! The land look's world around the terrain (issue 20), per eye and pixel: the sky, the display's
+//! table, the land beyond it, and the haze (aerial perspective).
+//!
+//! - **View rays**: with the projection's rows `r₀`, `r₁`, `r₂` (their world parts: `X`, `Y`, `w`
+//!   as linear functions of the world point), the ray through pixel `(x, y)` lies in the planes
+//!   `(r₀ − x·r₂)·q = 0` and `(r₁ − y·r₂)·q = 0` through the eye, so its direction is their
+//!   normals' cross product, `r₀×r₁ + x·(r₁×r₂) + y·(r₂×r₀)`: affine in the pixel, a step per
+//!   pixel. Along it `w` grows by `r₂·(r₀×r₁)` (the determinant) per unit, so a sample of depth `w`
+//!   is at `eye + dir·w/det` — the world point a terrain pixel shows, whose ground colour
+//!   [`crate::land::Land::albedo_at`] gives, and its distance from the eye.
+//! - **Sky**: a gradient by the ray's elevation, from [`Style::sky_bottom`] at the horizon to
+//!   [`Style::sky_top`] at the zenith (`√sin` of the elevation: the pale band stays near the
+//!   horizon), instead of a gradient down the screen.
+//! - **Table**: rays below the horizon meet a level plane at the lowest height of the terrain's
+//!   edge. Within [`Style::table_margin`] of the terrain it is the display's table
+//!   ([`Style::table_colour`]); under the terrain's own footprint (seen between the terrain's edge
+//!   and the table, where the edge stands higher than the plane) it is the model's side, dark
+//!   earth; beyond the table it is distant land, a muted green fading into the horizon's colour.
+//!   So the flat plane is only the display's table around the model, and the world's edge is a
+//!   horizon.
+//! - **Haze**: `f = 1 − exp(−d/L)` at distance `d` metres from the eye along the view's axis, `L` =
+//!   [`Style::haze_distance`] (by default three times the terrain's diagonal: at true scale a 320 m
+//!   model would show no aerial perspective at all, so the haze is scaled to the model, a look and
+//!   not physics); surfaces tend to the horizon's colour by `haze·f`, the land beyond the table by
+//!   `f` at three times the distance, so it is mostly haze and meets the sky at the horizon.
+
+use rayon::prelude::*;
+
+use super::camera::Projection;
+use super::frame::Rgba;
+use super::scene::Style;
+use penmodel_terrain::Heightmap;
+
+/// Distant land beyond the table, before light and haze.
+pub const FAR_LAND: [u8; 3] = [118, 136, 96];
+/// The model's side (its cut-away earth), before light.
+pub const SIDE: [u8; 3] = [104, 86, 66];
+
+/// Entries of the haze table over `d/L` in `[0, HAZE_SPAN]`.
+const HAZE_ENTRIES: usize = 512;
+const HAZE_SPAN: f32 = 8.0;
+
+fn rgb(c: Rgba) -> [f32; 3] {
+    [f32::from(c[0]), f32::from(c[1]), f32::from(c[2])]
+}
+
+fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
+
+/// One eye's view of the world around the terrain.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Atmosphere {
+    /// The ray through pixel `(x, y)` (pixel coordinates, centres at `+½`) is `a + x·b + y·c`.
+    a: [f32; 3],
+    b: [f32; 3],
+    c: [f32; 3],
+    /// `1/|det|`: a sample of depth `w` is at `eye + dir·w/|det|` (the rays' sign chosen so).
+    inv_det: f32,
+    eye: [f32; 3],
+    /// World metres along the view's axis per unit of `w`: `1/|r₂|`.
+    metres_per_w: f32,
+    /// At most the pixels a metre across the view spans at `w = 1`: `max(|r₀|, |r₁|)`.
+    pixels_per_metre: f32,
+    /// The table's plane, world Y.
+    table_y: f32,
+    /// The terrain's footprint, metres, and the table's outer edge.
+    extent: [f32; 2],
+    margin: f32,
+    /// `1/L`.
+    inv_haze: f32,
+    haze: f32,
+    /// `1 − exp(−d/L)` over `d/L ∈ [0, HAZE_SPAN]`.
+    table: Vec<f32>,
+    horizon: [f32; 3],
+    zenith: [f32; 3],
+    /// Lit colours of the table, the model's side and the far land.
+    lit_table: [f32; 3],
+    lit_side: [f32; 3],
+    lit_far: [f32; 3],
+}
+
+impl Atmosphere {
+    /// The atmosphere of `projection` (one eye) around `map` drawn × `vertical_scale`.
+    pub fn new(projection: &Projection, map: &Heightmap, vertical_scale: f32, style: &Style) -> Atmosphere {
+        let r = projection.rows.map(|row| [row[0], row[1], row[2]]);
+        let a = cross(r[0], r[1]);
+        let b = cross(r[1], r[2]);
+        let c = cross(r[2], r[0]);
+        let det = dot(r[2], a);
+        // Rays point ahead (w grows along them) whatever the determinant's sign.
+        let sign = if det < 0.0 { -1.0 } else { 1.0 };
+        let (a, b, c) = (a.map(|v| v * sign), b.map(|v| v * sign), c.map(|v| v * sign));
+        // The eye: where X, Y and w all vanish.
+        let m = glam::DMat3::from_cols(
+            glam::DVec3::new(r[0][0], r[1][0], r[2][0]),
+            glam::DVec3::new(r[0][1], r[1][1], r[2][1]),
+            glam::DVec3::new(r[0][2], r[1][2], r[2][2]),
+        );
+        let t = glam::DVec3::new(projection.rows[0][3], projection.rows[1][3], projection.rows[2][3]);
+        let eye = if m.determinant().abs() > 0.0 {
+            -(m.inverse() * t)
+        } else {
+            projection.eye
+        };
+        let (cols, rows) = (map.cols() as usize, map.rows() as usize);
+        let s = map.cell_size() as f32;
+        let extent = [cols as f32 * s, rows as f32 * s];
+        let table_y = edge_low(map) * vertical_scale;
+        let diagonal = extent[0].hypot(extent[1]).max(f32::MIN_POSITIVE);
+        let l = if style.haze_distance > 0.0 {
+            style.haze_distance
+        } else {
+            3.0 * diagonal
+        };
+        let table = (0..HAZE_ENTRIES)
+            .map(|i| 1.0 - (-(i as f32) * HAZE_SPAN / (HAZE_ENTRIES - 1) as f32).exp())
+            .collect();
+        let [lx, ly, lup] = style.light;
+        let len = (lx * lx + ly * ly + lup * lup).sqrt();
+        let up = if len > 0.0 && len.is_finite() {
+            (lup / len).max(0.0)
+        } else {
+            1.0
+        };
+        let ambient = style.ambient.clamp(0.0, 1.0);
+        let flat = ambient + (1.0 - ambient) * up;
+        let lit = |c: [f32; 3], k: f32| c.map(|v| v * k);
+        let f3 = |c: [u8; 3]| c.map(f32::from);
+        Atmosphere {
+            a: a.map(|v| v as f32),
+            b: b.map(|v| v as f32),
+            c: c.map(|v| v as f32),
+            inv_det: (1.0 / det.abs()) as f32,
+            metres_per_w: (1.0 / dot(r[2], r[2]).sqrt()) as f32,
+            pixels_per_metre: dot(r[0], r[0]).sqrt().max(dot(r[1], r[1]).sqrt()) as f32,
+            eye: [eye.x as f32, eye.y as f32, eye.z as f32],
+            table_y,
+            extent,
+            margin: style.table_margin.max(0.0) * extent[0].max(extent[1]),
+            inv_haze: 1.0 / l.max(f32::MIN_POSITIVE),
+            haze: style.haze.clamp(0.0, 1.0),
+            table,
+            horizon: rgb(style.sky_bottom),
+            zenith: rgb(style.sky_top),
+            lit_table: lit(rgb(style.table_colour), flat),
+            // The side faces the viewer, away from the sun's plane: ambient light.
+            lit_side: lit(f3(SIDE), ambient + 0.3 * (1.0 - ambient)),
+            lit_far: lit(f3(FAR_LAND), flat),
+        }
+    }
+
+    /// The ray through pixel `(x, y)` (a pixel's centre is at `+½`), not unit length.
+    #[inline]
+    pub fn ray(&self, x: f32, y: f32) -> [f32; 3] {
+        let (a, b, c) = (self.a, self.b, self.c);
+        [
+            a[0] + x * b[0] + y * c[0],
+            a[1] + x * b[1] + y * c[1],
+            a[2] + x * b[2] + y * c[2],
+        ]
+    }
+
+    /// The step of [`Atmosphere::ray`] per pixel along a row.
+    #[inline]
+    pub fn step(&self) -> [f32; 3] {
+        self.b
+    }
+
+    /// The ground position `(x, z)` of the point of depth `w` along `ray`, and its distance from
+    /// the eye along the view's axis (the haze's distance: within the 45° of a view it is at most
+    /// 8 % short of the distance along the ray, and it costs no square root per pixel).
+    #[inline]
+    pub fn point(&self, ray: [f32; 3], w: f32) -> ([f32; 2], f32) {
+        let k = w * self.inv_det;
+        (
+            [self.eye[0] + ray[0] * k, self.eye[2] + ray[2] * k],
+            w * self.metres_per_w,
+        )
+    }
+
+    /// At most how many pixels `metres` span across the view at depth `1/invw`.
+    #[inline]
+    pub fn pixels(&self, metres: f32, invw: f32) -> f32 {
+        metres * self.pixels_per_metre * invw
+    }
+
+    /// `1 − exp(−d/L)`.
+    #[inline]
+    fn fog(&self, d: f32) -> f32 {
+        let x = d * self.inv_haze * ((HAZE_ENTRIES - 1) as f32 / HAZE_SPAN);
+        if x.is_finite() {
+            self.table[(x as usize).min(HAZE_ENTRIES - 1)]
+        } else {
+            1.0
+        }
+    }
+
+    /// `colour` (lit) seen from `d` metres away.
+    #[inline]
+    pub fn hazed(&self, colour: [f32; 3], d: f32) -> [f32; 3] {
+        lerp(colour, self.horizon, self.haze * self.fog(d))
+    }
+
+    /// What a pixel that shows no surface sees along `ray`: the table, the model's side, the
+    /// land beyond, or the sky.
+    #[inline]
+    pub fn background(&self, ray: [f32; 3]) -> [f32; 3] {
+        let len = (ray[0] * ray[0] + ray[1] * ray[1] + ray[2] * ray[2]).sqrt();
+        if len.is_nan() || len <= 0.0 {
+            return self.horizon;
+        }
+        let sin = ray[1] / len;
+        if sin < 0.0 {
+            if self.eye[1] <= self.table_y {
+                return self.horizon;
+            }
+            let t = (self.table_y - self.eye[1]) / ray[1];
+            let (x, z) = (self.eye[0] + t * ray[0], self.eye[2] + t * ray[2]);
+            let d = t * len;
+            let [w, h] = self.extent;
+            let m = self.margin;
+            let inside = |m: f32| x >= -m && x <= w + m && z >= -m && z <= h + m;
+            return if inside(0.0) {
+                self.hazed(self.lit_side, d)
+            } else if inside(m) {
+                self.hazed(self.lit_table, d)
+            } else {
+                // The far land fades three times faster than the model: it is the atmosphere
+                // beyond the table more than land.
+                let f = self.fog(3.0 * d);
+                lerp(self.lit_far, self.horizon, f)
+            };
+        }
+        let t = sin.sqrt();
+        lerp(self.horizon, self.zenith, t)
+    }
+}
+
+/// `a + t·(b − a)`, spelled out (an array `map` here costs a tenth of the frame).
+#[inline]
+pub fn lerp(a: [f32; 3], b: [f32; 3], t: f32) -> [f32; 3] {
+    [
+        a[0] + t * (b[0] - a[0]),
+        a[1] + t * (b[1] - a[1]),
+        a[2] + t * (b[2] - a[2]),
+    ]
+}
+
+/// The lowest finite height on the terrain's edge (0 for a terrain without any).
+fn edge_low(map: &Heightmap) -> f32 {
+    let (cols, rows) = (map.cols() as usize, map.rows() as usize);
+    let h = map.heights();
+    if cols == 0 || rows == 0 {
+        return 0.0;
+    }
+    let top = &h[..cols];
+    let bottom = &h[(rows - 1) * cols..];
+    let sides = (0..rows).flat_map(|r| [h[r * cols], h[r * cols + cols - 1]]);
+    let low = top
+        .iter()
+        .chain(bottom)
+        .copied()
+        .chain(sides)
+        .filter(|v| v.is_finite())
+        .fold(f32::INFINITY, f32::min);
+    if low.is_finite() { low } else { 0.0 }
+}
+
+/// An eye's background (what pixels that show no surface see), kept between frames while the
+/// eye's atmosphere and the frame stay the same: it depends on the camera, the style and the
+/// terrain's extent and edge only, and costs about a square root and a division per pixel.
+#[derive(Debug, Default)]
+pub struct Backdrop {
+    key: Option<(Atmosphere, [usize; 4])>,
+    pixels: Vec<[u8; 3]>,
+}
+
+impl Backdrop {
+    /// The background of `air` over the columns `x0..x1` of a `width × height` frame, row-major
+    /// over the whole frame (other columns unset).
+    pub fn of(&mut self, air: &Atmosphere, width: usize, height: usize, (x0, x1): (usize, usize)) -> &[[u8; 3]] {
+        let key = [width, height, x0, x1];
+        if self.key.as_ref().is_some_and(|(a, k)| a == air && *k == key) {
+            return &self.pixels;
+        }
+        self.pixels.resize(width * height, [0; 3]);
+        let step = air.step();
+        self.pixels
+            .par_chunks_mut(width.max(1))
+            .enumerate()
+            .for_each(|(y, row)| {
+                let mut ray = air.ray(x0 as f32 + 0.5, y as f32 + 0.5);
+                for p in &mut row[x0..x1] {
+                    let c = air.background(ray);
+                    *p = [c[0] as u8, c[1] as u8, c[2] as u8];
+                    ray = [ray[0] + step[0], ray[1] + step[1], ray[2] + step[2]];
+                }
+            });
+        self.key = Some((air.clone(), key));
+        &self.pixels
+    }
+}
