@@ -27,7 +27,7 @@ use pen_host::device::Device;
 use pen_host::events::PenEvent;
 use pen_host::pipeline::Pipeline;
 use pen_host::source::{Source, SourceError};
-use pen_host::transport::sim::SimOptions;
+use pen_host::transport::sim::{DeviceClock, SimOptions, SimPlug};
 use pen_sim::Scenario;
 use pen_sim::acoustics::Acoustics;
 use pen_sim::rig::Rig;
@@ -39,6 +39,9 @@ pub enum Feed {
     Display([f64; 2]),
     /// Something to tell the user: attaching, calibrating.
     Status(String),
+    /// The simulated device's clock (the demo, `sim:SCENARIO`): frames are timed on it against
+    /// the head reports' timestamps ([`crate::latency`]).
+    Clock(DeviceClock),
     /// The calibration procedure as it goes: the targets and the pen, for a picture of it.
     Calibrating(Calibrating),
     /// A pen event in the display frame.
@@ -188,7 +191,8 @@ pub fn demo_scenario() -> (Scenario, Vec<DVec2>) {
     let calibration = pen_sim::scenarios::calibration(&targets, rig.clone());
     let session = pen_sim::session::timeline(&pen_sim::session::steps(), pen_sim::scenarios::home());
     let timeline = calibration.timeline.then(&session);
-    (Scenario::new("demo", rig, Acoustics::clean(), timeline), targets)
+    let scenario = pen_sim::session::watched(Scenario::new("demo", rig, Acoustics::clean(), timeline));
+    (scenario, targets)
 }
 
 /// Starts the pen thread; `capacity` bounds the messages waiting to be read.
@@ -235,11 +239,13 @@ fn send(tx: &SyncSender<Feed>, feed: Feed) -> Result<(), Stop> {
 fn run_demo(tx: &SyncSender<Feed>, speed: f64, seed: u64) -> Result<(), Stop> {
     let (scenario, targets) = demo_scenario();
     let end_us = (scenario.timeline.duration_s() * 1e6) as u64;
+    let plug = SimPlug::default();
+    send(tx, Feed::Clock(plug.clock()))?;
     let mut device = Device::new(Source::Sim(SimOptions {
         scenario,
         seed,
         speed,
-        plug: Default::default(),
+        plug,
     }));
     attach(&mut device, Duration::from_secs(5)).map_err(failed("the simulated pen"))?;
     prepare(&mut device).map_err(failed("calibration"))?;
@@ -372,6 +378,9 @@ fn run_device(tx: &SyncSender<Feed>, source: Source, calibration: Option<PathBuf
     };
     send(tx, Feed::Display(display_mm(&calibration)))?;
     send(tx, Feed::Status(format!("pen: {source}")))?;
+    if let Source::Sim(o) = &source {
+        send(tx, Feed::Clock(o.plug.clock()))?;
+    }
     let mut pipeline = Pipeline::new(source, calibration);
     let mut events = Vec::new();
     loop {

@@ -14,5 +14,6 @@
 pub mod feed;
 pub mod interaction;
 pub mod keys;
+pub mod latency;
 pub mod picture;
 pub mod session;

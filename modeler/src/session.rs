@@ -1,9 +1,11 @@
 //! A modeling session: a document being edited by the pen, fed from a [`feed`](crate::feed).
 
 use pen_host::events::{EventKind, PenEvent};
+use pen_host::transport::sim::DeviceClock;
 
 use crate::feed::{Calibrating, Feed};
 use crate::interaction::{Interaction, Tuning, View};
+use crate::latency::{HeadLatency, LatencySummary};
 use penmodel_terrain::document::{Document, Grid};
 use penmodel_terrain::editor::Editor;
 
@@ -41,6 +43,14 @@ pub struct Session {
     last_event_us: Option<u64>,
     /// The tracked head's last pose, display-centred metres (issue 16).
     head_m: Option<[f64; 3]>,
+    /// The device time of that pose's burst, and how far past it the pose was predicted, ms.
+    head_burst: Option<(u64, u8)>,
+    /// The simulated device's clock, when the feed has one.
+    clock: Option<DeviceClock>,
+    /// Emission to frame of the frames drawn with a tracked pose.
+    latency: HeadLatency,
+    /// When the frame being drawn was started, device µs.
+    frame_started_us: Option<u64>,
 }
 
 impl Session {
@@ -56,6 +66,10 @@ impl Session {
             events: 0,
             last_event_us: None,
             head_m: None,
+            head_burst: None,
+            clock: None,
+            latency: HeadLatency::default(),
+            frame_started_us: None,
         }
     }
 
@@ -95,6 +109,10 @@ impl Session {
                 self.status = s.clone();
                 vec![s]
             }
+            Feed::Clock(clock) => {
+                self.clock = Some(clock);
+                Vec::new()
+            }
             Feed::Event(e) => {
                 self.calibrating = None;
                 self.event(&e);
@@ -125,6 +143,13 @@ impl Session {
             // centre); the emitter on the bridge stands for the point between the eyes.
             let [w, hgt] = self.interaction.view().display_mm;
             self.head_m = Some([(at.u_mm - 0.5 * w) * 1e-3, (at.v_mm - 0.5 * hgt) * 1e-3, at.h_mm * 1e-3]);
+            // A held or refused pose is an older burst's: its age is measured from this report
+            // only when the report brought it.
+            if h.status == pen_host::events::HeadStatus::Tracked
+                && let Some((_, device_us)) = e.seq
+            {
+                self.head_burst = Some((device_us, h.prediction_ms));
+            }
         }
         self.interaction.handle(&mut self.editor, e);
     }
@@ -134,6 +159,38 @@ impl Session {
     /// viewer), as the camera takes it.
     pub fn head_m(&self) -> Option<[f64; 3]> {
         self.head_m
+    }
+
+    /// A frame showing the session is about to be drawn: the device time it starts at.
+    pub fn frame_started(&mut self) {
+        self.frame_started_us = self.paced_now_us();
+    }
+
+    /// A frame showing the session was just produced: with a tracked pose and the clock of a
+    /// simulated device paced to the wall clock, how old the pose's burst is (when the frame
+    /// was started, and now) goes into [`head_latency`](Self::head_latency). An unpaced
+    /// simulation runs ahead of what is drawn by as much as the feed holds and takes no device
+    /// time to draw: nothing is measured.
+    pub fn frame_produced(&mut self) {
+        let started = self.frame_started_us.take();
+        if let (Some(done_us), Some((burst_us, prediction_ms))) = (self.paced_now_us(), self.head_burst) {
+            self.latency
+                .frame(started.unwrap_or(done_us), done_us, burst_us, prediction_ms);
+        }
+    }
+
+    /// The paced simulated device's time now, µs.
+    fn paced_now_us(&self) -> Option<u64> {
+        self.clock
+            .as_ref()
+            .filter(|c| c.is_paced())
+            .and_then(DeviceClock::now_us)
+    }
+
+    /// The tracked head's latency from emission to frame on the device's clock, once frames
+    /// were produced with a tracked pose from a paced simulated device ([`crate::latency`]).
+    pub fn head_latency(&self) -> Option<LatencySummary> {
+        self.latency.summary()
     }
 
     /// Whether the feed is still running.

@@ -116,19 +116,18 @@ impl Projected {
                 self.clip.push(v);
             }
             let coloured = paint == Paint::Own && mesh.colors.len() == mesh.positions.len();
-            self.triangles
-                .extend(mesh.indices.chunks_exact(3).map(|t| {
-                    let surface = match paint {
-                        Paint::Whole(s) => s,
-                        Paint::Own if coloured => {
-                            let [a, b, c] = [0, 1, 2].map(|k| mesh.colors[t[k] as usize]);
-                            let third = 1.0 / 3.0;
-                            Surface::Colour(srgb([0, 1, 2].map(|i| (a[i] + b[i] + c[i]) * third)))
-                        }
-                        Paint::Own => Surface::Rock,
-                    };
-                    ([t[0] + base, t[1] + base, t[2] + base], surface)
-                }));
+            self.triangles.extend(mesh.indices.chunks_exact(3).map(|t| {
+                let surface = match paint {
+                    Paint::Whole(s) => s,
+                    Paint::Own if coloured => {
+                        let [a, b, c] = [0, 1, 2].map(|k| mesh.colors[t[k] as usize]);
+                        let third = 1.0 / 3.0;
+                        Surface::Colour(srgb([0, 1, 2].map(|i| (a[i] + b[i] + c[i]) * third)))
+                    }
+                    Paint::Own => Surface::Rock,
+                };
+                ([t[0] + base, t[1] + base, t[2] + base], surface)
+            }));
         }
         self.bin(first);
     }

@@ -397,6 +397,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
                 "missed": stats.missed, "rock_fields": stats.rock_fields, "rivers": stats.rivers,
                 "ridgelines": stats.ridgelines, "valley_rounds": stats.grown,
             },
+            "head_latency": head_latency_json(&session),
         });
         pen_host::outln!("{summary}");
     } else {
@@ -428,6 +429,9 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
             ),
             (false, None) => "wrote".to_string(),
         };
+        if let Some(line) = head_latency_line(&session) {
+            pen_host::outln!("{line}");
+        }
         let meshes = if args.meshes { ", its meshes" } else { "" };
         pen_host::outln!(
             "{what} the terrain{meshes}, its render and the document to {}/ (document: {})",
@@ -439,6 +443,40 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
         bail!("the pen failed: {why}");
     }
     Ok(())
+}
+
+/// The tracked head's emission-to-frame latency for the JSON summary (issue 16), or null
+/// without a tracked head on a paced simulated device's clock (`--source sim --speed 1`).
+fn head_latency_json(session: &Session) -> serde_json::Value {
+    match session.head_latency() {
+        None => serde_json::Value::Null,
+        Some(l) => json!({
+            "frames": l.frames, "p50_ms": l.p50_ms, "p95_ms": l.p95_ms, "max_ms": l.max_ms,
+            "prediction_ms": l.prediction_ms, "uncovered_p95_ms": l.uncovered_p95_ms(),
+            "draw_start_p50_ms": l.start_p50_ms, "draw_start_p95_ms": l.start_p95_ms,
+            "target_ms": penmodel::latency::TARGET_MS, "meets_target": l.meets_target(),
+        }),
+    }
+}
+
+/// The same for a person: emission to frame against the 20 ms target, and what prediction
+/// leaves uncovered.
+fn head_latency_line(session: &Session) -> Option<String> {
+    let l = session.head_latency()?;
+    Some(format!(
+        "head: emission to frame on the device's clock p50 {:.1} ms, p95 {:.1} ms, max {:.1} ms over {} \
+         (to the start of drawing p50 {:.1}, p95 {:.1}); target {} ms {}; predicted {} ms ahead, p95 uncovered {:.1} ms",
+        l.p50_ms,
+        l.p95_ms,
+        l.max_ms,
+        count(l.frames as u64, "frame"),
+        l.start_p50_ms,
+        l.start_p95_ms,
+        penmodel::latency::TARGET_MS,
+        if l.meets_target() { "met" } else { "missed" },
+        l.prediction_ms,
+        l.uncovered_p95_ms(),
+    ))
 }
 
 fn say(messages: Vec<String>, progress: Option<&ProgressBar>) {
@@ -606,7 +644,11 @@ fn run_headless(
             }
             let due = *next_us.get_or_insert(t);
             if let Some(frames) = frames.as_mut().filter(|_| t >= due) {
-                frames.push(painter.session(session, look)?)?;
+                // Its head pose's age on the device's clock, drawn and produced (issue 16).
+                session.frame_started();
+                let frame = painter.session(session, look)?;
+                session.frame_produced();
+                frames.push(frame)?;
                 next_us = Some(due + step_us);
                 progress.set_message(format!("{} frames", frames.frames().len()));
             }
@@ -745,6 +787,7 @@ fn run_window(
             if let Some(t) = session.last_event_us() {
                 session.interaction.advance(t);
             }
+            session.frame_started();
             let mut frame = painter.session(session, look)?.clone();
             let (w, h) = (painter.view.width() as i32, painter.view.height() as i32);
             let viewport = penmodel_render::rasterise::Bounds {
@@ -767,6 +810,7 @@ fn run_window(
             if viewer.show(frame).is_err() {
                 break;
             }
+            session.frame_produced();
             frames += 1;
             last = Instant::now();
             dirty = session.interaction.pulling() || session.interaction.view().tilt > 1e-3;

@@ -1,0 +1,144 @@
+//! Trees in the scene (seed 004): each frame, every standing tree is drawn at the roughness `Q`
+//! its distance and its angle from the gaze call for, once for both eyes; the copied branches
+//! go to the meshes, the simplified shapes to the textured polygons.
+//!
+//! - **Distance** `D`: from the centre eye to the middle of the tree's height; `L0` is the
+//!   tree's height. **Angle** `θ`: between the gaze and the line to that point. `Q` is
+//!   [`Roughness::choose`]`(D, L0, θ)`.
+//! - **The gaze** is [`Scene::gaze`] when the tracked head's view direction is known, else the
+//!   line from the centre eye through the screen's centre (an orbit camera's view axis).
+//! - **LOD off** ([`Scene::tree_lod`] `None`) draws every tree at [`STOP`], the full model.
+//! - Both eyes see the same `Q` per tree, so a stereo pair never shows a group as geometry in one
+//!   eye and as a shape in the other.
+
+use glam::{DMat3, DVec3};
+use penmodel_terrain::trees::nodes::STOP;
+use penmodel_terrain::trees::{Drawn, Roughness};
+
+use super::camera::Eye;
+use super::impostor::Cache;
+use super::scene::Scene;
+use super::textured::Quad;
+
+/// What the trees of the last frame cost.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct TreeStats {
+    /// Trees drawn.
+    pub trees: usize,
+    /// Polygons of copied geometry (frustum quads and rhombus leaves).
+    pub polygons: u64,
+    /// Simplified shapes drawn (one polygon each).
+    pub impostors: usize,
+    /// Groups baked into textures so far.
+    pub baked: usize,
+}
+
+impl TreeStats {
+    /// Polygons drawn in all: the copied ones and one per simplified shape.
+    pub fn total_polygons(&self) -> u64 {
+        self.polygons + self.impostors as u64
+    }
+}
+
+/// The trees' per-frame buffers and the simplified shapes' textures.
+#[derive(Debug, Default)]
+pub struct Trees {
+    drawn: Drawn,
+    quads: Vec<Quad>,
+    cache: Cache,
+    stats: TreeStats,
+}
+
+/// The centre eye and the gaze of `scene` in the terrain's frame (the tilt undone), for a frame
+/// of `aspect` = width / height.
+pub fn eye_and_gaze(scene: &Scene, aspect: f64) -> (DVec3, DVec3) {
+    let vp = scene.camera.viewpoint(Eye::Centre, aspect);
+    // The terrain turns by −tilt about the axis through the pivot; the eye, seen from the
+    // terrain, turns the other way.
+    let back = DMat3::from_axis_angle(vp.axis, -scene.camera.tilt).transpose();
+    let eye = back * (vp.eye - vp.pivot) + vp.pivot;
+    let centre = 0.5 * (vp.lower_right + vp.upper_left);
+    let axis = back * (centre - vp.eye);
+    let gaze = scene
+        .gaze
+        .map(DVec3::from_array)
+        .filter(|g| g.is_finite() && g.length() > 0.0)
+        .unwrap_or(axis);
+    (eye, gaze.normalize_or(DVec3::NEG_Y))
+}
+
+/// The roughness for a tree whose middle is at `middle`, `height` tall, seen from `eye` with
+/// `gaze` (unit).
+pub fn roughness(lod: &Roughness, eye: DVec3, gaze: DVec3, middle: DVec3, height: f64) -> f64 {
+    let to = middle - eye;
+    let d = to.length();
+    let theta = if d > 0.0 {
+        (to.dot(gaze) / d).clamp(-1.0, 1.0).acos().to_degrees()
+    } else {
+        0.0
+    };
+    lod.choose(d, height, theta)
+}
+
+impl Trees {
+    /// Draws `scene`'s trees for this frame (both eyes), seen from a frame of `aspect`.
+    pub fn prepare(&mut self, scene: &Scene, aspect: f64) {
+        let d = &mut self.drawn;
+        d.mesh.positions.clear();
+        d.mesh.normals.clear();
+        d.mesh.colors.clear();
+        d.mesh.indices.clear();
+        d.impostors.clear();
+        (d.nodes, d.polygons, d.leaves) = (0, 0, 0);
+        self.quads.clear();
+        if scene.trees.is_empty() {
+            self.stats = TreeStats {
+                baked: self.cache.groups(),
+                ..TreeStats::default()
+            };
+            return;
+        }
+        let (eye, gaze) = eye_and_gaze(scene, aspect);
+        for tree in scene.trees {
+            let q = match &scene.tree_lod {
+                None => STOP,
+                Some(lod) => {
+                    let middle = DVec3::new(tree.at[0], tree.base + 0.5 * tree.height, tree.at[1]);
+                    roughness(lod, eye, gaze, middle, tree.height)
+                }
+            };
+            let first = self.drawn.impostors.len();
+            tree.draw(q, scene.time, &mut self.drawn);
+            for imp in &self.drawn.impostors[first..] {
+                let group = self.cache.group(&tree.nodes, imp.node, &scene.style);
+                self.quads.push(self.cache.quad(group, imp, eye));
+            }
+        }
+        self.stats = TreeStats {
+            trees: scene.trees.len(),
+            polygons: self.drawn.polygons,
+            impostors: self.drawn.impostors.len(),
+            baked: self.cache.groups(),
+        };
+    }
+
+    /// The copied branches and leaves, coloured.
+    pub fn mesh(&self) -> &penmodel_terrain::export::Mesh {
+        &self.drawn.mesh
+    }
+
+    /// The simplified shapes' polygons.
+    pub fn quads(&self) -> &[Quad] {
+        &self.quads
+    }
+
+    /// The simplified shapes' textures.
+    pub fn cache(&self) -> &Cache {
+        &self.cache
+    }
+
+    /// What the last frame's trees cost.
+    pub fn stats(&self) -> TreeStats {
+        self.stats
+    }
+}

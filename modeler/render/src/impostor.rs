@@ -1,0 +1,264 @@
+//! Simplified shapes of trees (seed 004, §5.2.3): a branch group drawn as crossed polygons with
+//! images of the group's full geometry.
+//!
+//! - **Baking** ([`bake`]): the group's full sub-model ([`NodeTree::subtree`], in the node's own
+//!   frame) is rendered by this crate's rasteriser, in parallel projection, into four RGBA
+//!   textures, one per side — front (seen from +Z), back (−Z), right (+X), left (−X) — lit
+//!   like the meshes (two-sided Lambert with the style's light taken in the node's frame: one
+//!   image serves every instance, whatever its turn) and transparent where nothing was drawn.
+//!   The seed's "texture elements": the detailed shape projected in parallel onto the polygon.
+//! - **Which polygon** ([`facing`]): of the two crossed polygons (through the group's box
+//!   centre, one across Z, one across X), the one whose normal makes the smaller angle with the
+//!   line to the eye, with the texture of the side the eye is on.
+//! - **Cache** ([`Cache`]): a node's sub-model in its own frame depends only on its scale (the
+//!   product of its maps' scales decides where its branches stop), so textures are kept per
+//!   species and scale and baked the first time a group of that scale is drawn.
+
+use std::collections::HashMap;
+use std::sync::Arc;
+
+use glam::{DAffine3, DVec3, Vec3};
+use penmodel_terrain::export::Mesh;
+use penmodel_terrain::trees::{Impostor, NodeTree};
+
+use super::meshes::srgb;
+use super::rasterise::{self, Bounds, DepthSink, Sample, Surface, Vtx};
+use super::scene::Style;
+use super::textured::{Quad, Texture};
+
+/// Texels across a side of a simplified shape's texture. A group drawn as one shape is at most
+/// `Q·S_tree` across, tens of pixels at the distances where it replaces geometry.
+pub const TEXELS: u32 = 64;
+
+/// The side a simplified shape is seen from, in the node's frame (+Y up).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Side {
+    /// The eye on +Z.
+    Front = 0,
+    /// The eye on −Z.
+    Back = 1,
+    /// The eye on +X.
+    Right = 2,
+    /// The eye on −X.
+    Left = 3,
+}
+
+impl Side {
+    /// All four, in texture order.
+    pub const ALL: [Side; 4] = [Side::Front, Side::Back, Side::Right, Side::Left];
+
+    /// The image's right-hand direction and the direction towards the eye, node frame.
+    fn basis(self) -> (Vec3, Vec3) {
+        match self {
+            Side::Front => (Vec3::X, Vec3::Z),
+            Side::Back => (-Vec3::X, -Vec3::Z),
+            Side::Right => (-Vec3::Z, Vec3::X),
+            Side::Left => (Vec3::Z, -Vec3::X),
+        }
+    }
+}
+
+/// A group's four images and the box they span, node frame.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Baked {
+    /// The box's lower and upper corners.
+    pub bounds: [Vec3; 2],
+    /// The images, in [`Side`] order.
+    pub textures: [Texture; 4],
+}
+
+/// The range of `axis·c` over the corners of `bounds`.
+fn span(bounds: &[Vec3; 2], axis: Vec3) -> (f32, f32) {
+    let [lo, hi] = bounds;
+    let a = axis.x * lo.x + axis.y * lo.y + axis.z * lo.z;
+    let b = axis.x * hi.x + axis.y * hi.y + axis.z * hi.z;
+    (a.min(b), a.max(b))
+}
+
+/// Renders `mesh` (node frame) into the four side images of `size × size` texels.
+pub fn bake(mesh: &Mesh, style: &Style, size: u32) -> Baked {
+    let size = size.max(1);
+    let mut lo = Vec3::splat(f32::INFINITY);
+    let mut hi = Vec3::splat(f32::NEG_INFINITY);
+    for p in &mesh.positions {
+        lo = lo.min(Vec3::from_array(*p));
+        hi = hi.max(Vec3::from_array(*p));
+    }
+    if !(lo.is_finite() && hi.is_finite()) {
+        (lo, hi) = (Vec3::ZERO, Vec3::ZERO);
+    }
+    // A flat group still gets a box with some depth, so every image has an extent.
+    let pad = (hi - lo).max_element().max(1e-6) * 1e-3;
+    let bounds = [lo - pad, hi + pad];
+    let light = Vec3::from_array(super::shade::world_light(style));
+    let ambient = style.ambient.clamp(0.0, 1.0);
+    let lit: Vec<f32> = mesh
+        .normals
+        .iter()
+        .map(|n| ambient + (1.0 - ambient) * Vec3::from_array(*n).dot(light).abs())
+        .collect();
+    let colours: Vec<[u8; 3]> = mesh
+        .indices
+        .chunks_exact(3)
+        .map(|t| {
+            if mesh.colors.len() != mesh.positions.len() {
+                return [style.rock_colour[0], style.rock_colour[1], style.rock_colour[2]];
+            }
+            let c = [0, 1, 2].map(|i| t.iter().map(|&k| mesh.colors[k as usize][i]).sum::<f32>() / 3.0);
+            srgb(c)
+        })
+        .collect();
+    let textures = Side::ALL.map(|side| image(mesh, &lit, &colours, &bounds, side, size));
+    Baked { bounds, textures }
+}
+
+/// One side's image.
+fn image(mesh: &Mesh, lit: &[f32], colours: &[[u8; 3]], bounds: &[Vec3; 2], side: Side, size: u32) -> Texture {
+    let (right, toward) = side.basis();
+    let (r0, r1) = span(bounds, right);
+    let (t0, t1) = span(bounds, toward);
+    let (y0, y1) = (bounds[0].y, bounds[1].y);
+    let n = size as usize;
+    let px = size as f32;
+    let screen: Vec<Vtx> = mesh
+        .positions
+        .iter()
+        .zip(lit)
+        .map(|(p, &l)| {
+            let p = Vec3::from_array(*p);
+            // Parallel projection: depth is affine, so 1/w is any positive affine depth
+            // (1 to 2, larger nearer the eye) and the light needs no division.
+            let x = (p.dot(right) - r0) / (r1 - r0) * px;
+            let y = (y1 - p.y) / (y1 - y0) * px;
+            Vtx {
+                x: rasterise::snap(x),
+                y: rasterise::snap(y),
+                invw: 1.0 + (p.dot(toward) - t0) / (t1 - t0),
+                hw: 0.0,
+                lw: l,
+            }
+        })
+        .collect();
+    let mut samples = vec![Sample::default(); n * n];
+    let whole = Bounds {
+        x0: 0,
+        x1: size as i32,
+        y0: 0,
+        y1: size as i32,
+    };
+    let mut sink = DepthSink {
+        samples: &mut samples,
+        width: n,
+        y0: 0,
+        surface: Surface::Terrain,
+    };
+    for (t, c) in mesh.indices.chunks_exact(3).zip(colours) {
+        let [a, b, cc] = [0, 1, 2].map(|k| &screen[t[k] as usize]);
+        sink.surface = Surface::Colour(*c);
+        rasterise::triangle(a, b, cc, &whole, &mut sink);
+        rasterise::triangle(a, cc, b, &whole, &mut sink);
+    }
+    let texels = samples
+        .iter()
+        .map(|s| match s.surface {
+            Surface::Colour([r, g, b]) if s.invw > 0.0 => {
+                let l = s.lw.clamp(0.0, 1.0);
+                [
+                    (f32::from(r) * l) as u8,
+                    (f32::from(g) * l) as u8,
+                    (f32::from(b) * l) as u8,
+                    255,
+                ]
+            }
+            _ => [0, 0, 0, 0],
+        })
+        .collect();
+    Texture::new(size, size, texels).unwrap_or_default()
+}
+
+/// The side of a group's box an eye at `eye` (world) sees best, given the node's frame → world
+/// `transform`: the crossed polygon whose normal is nearest the line from the box's centre to the
+/// eye, and which of its faces.
+pub fn facing(transform: &DAffine3, bounds: &[Vec3; 2], eye: DVec3) -> Side {
+    let centre = (bounds[0] + bounds[1]).as_dvec3() * 0.5;
+    let v = transform.inverse().transform_point3(eye) - centre;
+    if v.z.abs() >= v.x.abs() {
+        if v.z >= 0.0 { Side::Front } else { Side::Back }
+    } else if v.x >= 0.0 {
+        Side::Right
+    } else {
+        Side::Left
+    }
+}
+
+/// The polygon of `side` through the box's centre, corners in the world (by `transform`) with
+/// their texture coordinates, drawn with texture `texture`.
+pub fn quad(transform: &DAffine3, bounds: &[Vec3; 2], side: Side, texture: u32) -> Quad {
+    let (right, toward) = side.basis();
+    let (r0, r1) = span(bounds, right);
+    let (y0, y1) = (bounds[0].y, bounds[1].y);
+    let axis = toward.abs();
+    let middle = axis * axis.dot((bounds[0] + bounds[1]) * 0.5);
+    let at = |s: f32, y: f32| {
+        let p = right * s + middle + Vec3::Y * y;
+        transform.transform_point3(p.as_dvec3()).as_vec3().to_array()
+    };
+    Quad {
+        corners: [at(r0, y1), at(r1, y1), at(r1, y0), at(r0, y0)],
+        uv: [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+        texture,
+    }
+}
+
+/// Baked groups, per species and scale; their textures in one table, four per group.
+#[derive(Debug, Default)]
+pub struct Cache {
+    /// `(node tree's address, scale's bits)` → group index. The trees are kept in `held`, so an
+    /// address is not reused while it is a key.
+    groups: HashMap<(usize, u64), u32>,
+    held: Vec<Arc<NodeTree>>,
+    bounds: Vec<[Vec3; 2]>,
+    textures: Vec<Texture>,
+}
+
+impl Cache {
+    /// The group index of `impostor`'s node of `tree`, baked now if it is the first of its scale.
+    pub fn group(&mut self, tree: &Arc<NodeTree>, node: u32, style: &Style) -> u32 {
+        let scale = tree.nodes.get(node as usize).map_or(1.0, |n| n.scale);
+        let key = (Arc::as_ptr(tree) as usize, scale.to_bits());
+        if let Some(&g) = self.groups.get(&key) {
+            return g;
+        }
+        let mesh = if (node as usize) < tree.nodes.len() {
+            tree.subtree(node as usize)
+        } else {
+            Mesh::default()
+        };
+        let baked = bake(&mesh, style, TEXELS);
+        let g = self.bounds.len() as u32;
+        self.bounds.push(baked.bounds);
+        self.textures.extend(baked.textures);
+        if !self.held.iter().any(|t| Arc::ptr_eq(t, tree)) {
+            self.held.push(Arc::clone(tree));
+        }
+        self.groups.insert(key, g);
+        g
+    }
+
+    /// The quad facing `eye` for `impostor`, a group of [`Cache::group`].
+    pub fn quad(&self, group: u32, impostor: &Impostor, eye: DVec3) -> Quad {
+        let bounds = &self.bounds[group as usize];
+        let side = facing(&impostor.transform, bounds, eye);
+        quad(&impostor.transform, bounds, side, group * 4 + side as u32)
+    }
+
+    /// Every baked texture, four per group in [`Side`] order.
+    pub fn textures(&self) -> &[Texture] {
+        &self.textures
+    }
+
+    /// How many groups were baked.
+    pub fn groups(&self) -> usize {
+        self.bounds.len()
+    }
+}
