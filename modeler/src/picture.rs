@@ -10,6 +10,7 @@ use penmodel_terrain::Heightmap;
 use penmodel_terrain::address::{CurvePath, FigurePath};
 use penmodel_terrain::document::{Document, Figure, FigureKind, Point};
 use penmodel_terrain::export::Mesh;
+use penmodel_terrain::trees::Standing;
 
 use crate::feed::Calibrating;
 use crate::interaction::rocks::{self, Tool};
@@ -106,6 +107,10 @@ pub struct Picture {
     rocks: Arc<Vec<(String, Mesh)>>,
     /// The rivers' and lakes' water surface.
     water: Arc<Vec<(String, Mesh)>>,
+    /// The trees and groves' trees standing on the terrain.
+    trees: Arc<Vec<Standing>>,
+    /// Seconds, for the trees' sway.
+    time: f64,
 }
 
 /// A tool button's outline: bright and thick while its tool is on.
@@ -162,6 +167,20 @@ impl Picture {
         Picture::from_parts(ui, doc, mode, look)
             .with_rocks(session.editor.rocks().shared())
             .with_water(Arc::new(water))
+            .with_trees(Arc::new(session.editor.trees().trees().to_vec()))
+    }
+
+    /// The picture with the trees `trees` (an editor's, `Editor::trees().trees()`), drawn with
+    /// level of detail.
+    pub fn with_trees(mut self, trees: Arc<Vec<Standing>>) -> Picture {
+        self.trees = trees;
+        self
+    }
+
+    /// The picture at `seconds`, for the trees' sway in the wind.
+    pub fn with_time(mut self, seconds: f64) -> Picture {
+        self.time = seconds;
+        self
     }
 
     /// The picture with the water surface `water` (from [`penmodel_terrain::Editor::water`]).
@@ -238,6 +257,8 @@ impl Picture {
             look: look.clone(),
             rocks: Arc::default(),
             water: Arc::default(),
+            trees: Arc::default(),
+            time: 0.0,
         }
     }
 
@@ -376,6 +397,8 @@ impl Picture {
             look: look.clone(),
             rocks: Arc::default(),
             water: Arc::default(),
+            trees: Arc::default(),
+            time: 0.0,
         }
     }
 
@@ -435,6 +458,9 @@ impl Picture {
             camera: self.camera,
             stereo: self.look.stereo,
             style: self.look.style.clone(),
+            trees: &self.trees,
+            time: self.time,
+            ..Scene::new(terrain, self.camera)
         }
     }
 }

@@ -27,15 +27,18 @@
 pub mod atmosphere;
 pub mod camera;
 pub mod clip;
+pub mod forest;
 pub mod frame;
+pub mod impostor;
 pub mod land;
+pub mod meshes;
 pub mod overlay;
 pub mod rasterise;
-pub mod meshes;
 pub mod scene;
 pub mod shade;
 pub mod stereo;
 pub mod text;
+pub mod textured;
 pub mod tiles;
 pub mod transform;
 pub mod ui;
@@ -78,6 +81,8 @@ struct EyeBuffers {
     capsules: Vec<Capsule>,
     /// Rocks, water and trees, in that order.
     meshes: meshes::Projected,
+    /// The trees' simplified shapes.
+    textured: textured::Projected,
 }
 
 /// Renders scenes into frames, keeping its buffers from one frame to the next.
@@ -91,6 +96,8 @@ pub struct Renderer {
     samples: Vec<Sample>,
     eye: EyeBuffers,
     left: Option<Frame>,
+    /// The trees drawn this frame and the simplified shapes' textures.
+    trees: forest::Trees,
 }
 
 impl Default for Renderer {
@@ -115,6 +122,7 @@ impl Renderer {
             samples: Vec::new(),
             eye: EyeBuffers::default(),
             left: None,
+            trees: forest::Trees::default(),
         }
     }
 
@@ -123,6 +131,8 @@ impl Renderer {
         scene.camera.check()?;
         let stats = self.prepare(scene);
         let full = whole(frame);
+        self.trees
+            .prepare(scene, f64::from(frame.width()) / f64::from(frame.height()));
         match scene.stereo {
             Stereo::None => {
                 self.eye(scene, Eye::Centre, full, frame);
@@ -161,6 +171,8 @@ impl Renderer {
         scene.camera.check()?;
         let stats = self.prepare(scene);
         let full = whole(frame);
+        self.trees
+            .prepare(scene, f64::from(frame.width()) / f64::from(frame.height()));
         self.eye(scene, eye, full, frame);
         self.ui(scene, full, frame);
         Ok(stats)
@@ -257,6 +269,13 @@ impl Renderer {
         meshes.add(rocks, Paint::Whole(Surface::Rock), &affine, cell, near, &scene.style);
         let water = scene.water.iter().map(|(_, m)| m);
         meshes.add(water, Paint::Whole(Surface::Water), &affine, cell, near, &scene.style);
+        let trees = std::iter::once(self.trees.mesh());
+        meshes.add(trees, Paint::Own, &affine, cell, near, &scene.style);
+        let textured = &mut self.eye.textured;
+        textured.clear((height as usize, self.tile_rows));
+        textured.add(scene.polygons, 0, &affine, cell, near);
+        let first = scene.textures.len() as u32;
+        textured.add(self.trees.quads(), first, &affine, cell, near);
         (affine, near, projection)
     }
 
@@ -288,9 +307,12 @@ impl Renderer {
             near,
             viewport,
         };
+        // The scene's textures, then the simplified shapes' (the order `project` offset them by).
+        let textures: Vec<&textured::Texture> = scene.textures.iter().chain(self.trees.cache().textures()).collect();
         tiles::render(
             &pass,
             &self.eye.meshes,
+            (&self.eye.textured, &textures),
             &self.eye.capsules,
             &shading,
             &scene.style,
@@ -299,6 +321,11 @@ impl Renderer {
             width as usize,
             self.tile_rows,
         );
+    }
+
+    /// What the last frame's trees cost: polygons copied, simplified shapes drawn.
+    pub fn tree_stats(&self) -> forest::TreeStats {
+        self.trees.stats()
     }
 
     fn ui(&self, scene: &Scene, viewport: Bounds, frame: &mut Frame) {

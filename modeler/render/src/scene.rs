@@ -8,6 +8,9 @@ use super::frame::Rgba;
 use penmodel_terrain::Heightmap;
 use penmodel_terrain::Point;
 use penmodel_terrain::export::Mesh;
+use penmodel_terrain::trees::{Roughness, Standing};
+
+use super::textured::{Quad, Texture};
 
 /// How the two eyes' images are combined.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -215,6 +218,23 @@ pub struct Scene<'a> {
     pub stereo: Stereo,
     /// Colours and lighting.
     pub style: Style,
+    /// Trees standing on the terrain (a document's: `Editor::trees().trees()`), drawn with
+    /// their own bark and leaf colours at the roughness [`Scene::tree_lod`] chooses
+    /// (`crate::forest`).
+    pub trees: &'a [Standing],
+    /// How trees choose their roughness `Q` by distance and gaze; `None` draws every tree in
+    /// full (level of detail off).
+    pub tree_lod: Option<Roughness>,
+    /// The tracked head's view direction, world `[X, Y up, Z]`, when known; otherwise the gaze
+    /// is the line from the centre eye through the screen's centre.
+    pub gaze: Option<[f64; 3]>,
+    /// Seconds, for the trees' sway in the wind.
+    pub time: f64,
+    /// Textured, alpha-tested quads (the exports' frame), each naming a texture of
+    /// [`Scene::textures`] (`crate::textured`).
+    pub polygons: &'a [Quad],
+    /// The textures [`Scene::polygons`] name.
+    pub textures: &'a [Texture],
 }
 
 impl<'a> Scene<'a> {
@@ -233,6 +253,12 @@ impl<'a> Scene<'a> {
             camera,
             stereo: Stereo::None,
             style: Style::default(),
+            trees: &[],
+            tree_lod: Some(Roughness::default()),
+            gaze: None,
+            time: 0.0,
+            polygons: &[],
+            textures: &[],
         }
     }
 }

@@ -112,6 +112,7 @@ impl EyePass<'_> {
 pub fn render(
     pass: &EyePass,
     meshes: &super::meshes::Projected,
+    (textured, textures): (&super::textured::Projected, &[&super::textured::Texture]),
     capsules: &[Capsule],
     shading: &Shading,
     style: &Style,
@@ -148,6 +149,7 @@ pub fn render(
             };
             pass.terrain(&bounds, &mut sink);
             meshes.draw(&bounds, smp, width, pass.near);
+            textured.draw(&bounds, smp, width, pass.near, textures);
             shade::resolve(smp, pix, width, (x0, x1), y0, frame_height, shading, style);
             let (top, bottom) = (bounds.y0 as f32, bounds.y1 as f32);
             for cap in capsules {

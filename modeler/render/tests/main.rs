@@ -4,4 +4,5 @@ mod land;
 mod outputs;
 mod render;
 mod rocks;
+mod trees;
 mod water;

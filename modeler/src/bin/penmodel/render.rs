@@ -220,6 +220,8 @@ pub fn run(args: &Args) -> Result<()> {
     scene.overlays = &overlays;
     scene.rocks = editor.rocks().meshes();
     scene.water = &water;
+    // The document's trees, with level of detail from this camera (crate::forest).
+    scene.trees = editor.trees().trees();
     scene.mode = &args.mode;
     scene.vertical_scale = args.vertical_scale as f32;
     scene.style.ramp_top = ramp_top(hi);
