@@ -185,6 +185,8 @@ fn fit_returns_a_preset_and_names_bad_files() {
             "side.png",
             "--iterations",
             "2",
+            "--starts",
+            "1",
             "--json",
             "-",
         ],

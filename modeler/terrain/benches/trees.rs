@@ -45,7 +45,7 @@ fn fit_experiment() {
         let front = fit::speckled(&silhouette::render(&truth, View::Front, 128, STOP), 0.02, seed);
         let side = fit::speckled(&silhouette::render(&truth, View::Side, 128, STOP), 0.02, seed + 1);
         let t = std::time::Instant::now();
-        match fit::fit(&front, &side, fit::Options { iterations: 30 }) {
+        match fit::fit(&front, &side, fit::Options::default()) {
             Ok(f) => println!(
                 "fit {}: from {} {:.3}/{:.3} to {:.3}/{:.3} (front/side) in {} steps, {:.1} s",
                 p.name(),

@@ -135,9 +135,12 @@ struct FitArgs {
     /// The side silhouette (looking along +X).
     #[arg(value_name = "SIDE.png")]
     side: PathBuf,
-    /// Most gradient steps.
+    /// Most gradient steps of each ascent.
     #[arg(long, default_value_t = 30)]
     iterations: usize,
+    /// How many of the best-matching presets an ascent starts from (the best result is kept).
+    #[arg(long, default_value_t = fit::STARTS as u32, value_parser = clap::value_parser!(u32).range(1..=4))]
+    starts: u32,
     /// The result as JSON (the maps usable as --maps or a document tree's "maps"); `-` for stdout.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
@@ -483,6 +486,7 @@ fn fit_run(args: &FitArgs) -> Result<()> {
         &side,
         Options {
             iterations: args.iterations,
+            starts: args.starts as usize,
         },
     )?;
     if let Some(path) = &args.json {

@@ -2,10 +2,13 @@
 //! (`y`, `s`, `θz`, `θy` of each map: 20 for five maps) that maximise the sum of the normalised
 //! cross-correlations between the candidate's silhouettes and the given ones.
 //!
-//! As in the seed: a template-matching start (the preset whose silhouettes correlate best), then
-//! gradient ascent with a line search. The gradient is by central differences, each parameter
+//! As in the seed: a template-matching start (the presets whose silhouettes correlate best;
+//! the ascent runs from the best [`STARTS`] and keeps the higher result), then gradient ascent
+//! with a line search. The gradient is by central differences, each parameter
 //! measured in its own step ([`STEPS`]), on silhouettes blurred twice (a rasterised outline is a
 //! step function of the parameters; blurred, small changes change the objective smoothly).
+
+use rayon::prelude::*;
 
 use super::silhouette::{self, Image, View, ncc};
 use super::species::{Preset, Species};
@@ -27,20 +30,25 @@ pub const BOUNDS: [(f64, f64); 4] = [(0.02, 1.0), (0.1, 0.75), (-90.0, 90.0), (-
 /// Options of a fit.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Options {
-    /// Most gradient steps.
+    /// Most gradient steps of each ascent.
     pub iterations: usize,
+    /// How many of the best templates an ascent starts from ([`STARTS`] by default).
+    pub starts: usize,
 }
 
 impl Default for Options {
     fn default() -> Options {
-        Options { iterations: 30 }
+        Options {
+            iterations: 30,
+            starts: STARTS,
+        }
     }
 }
 
 /// A fit's result.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Fit {
-    /// The preset the fit started from (the best template).
+    /// The preset the kept ascent started from.
     pub preset: Preset,
     /// The fitted species.
     pub species: Species,
@@ -48,7 +56,7 @@ pub struct Fit {
     pub start: [f64; 2],
     /// Correlations reached.
     pub reached: [f64; 2],
-    /// Gradient steps taken.
+    /// Gradient steps the kept ascent took.
     pub iterations: usize,
 }
 
@@ -58,6 +66,9 @@ pub enum FitError {
     /// A silhouette has nothing in it.
     #[error("the {0} silhouette is blank")]
     Blank(&'static str),
+    /// No preset to start from.
+    #[error("no template to start from")]
+    NoTemplate,
 }
 
 struct Target {
@@ -98,31 +109,24 @@ fn species(p: &[f64]) -> Species {
     }
 }
 
-/// Fits a species to a front and a side silhouette (coverage images of any size; each is
-/// framed on its own).
-pub fn fit(front: &Image, side: &Image, options: Options) -> Result<Fit, FitError> {
-    let target = Target {
-        front: prepare(front).ok_or(FitError::Blank("front"))?,
-        side: prepare(side).ok_or(FitError::Blank("side"))?,
-    };
-    let sum = |v: [f64; 2]| v[0] + v[1];
-    // Template matching: the best preset starts.
-    let (preset, start) = Preset::ALL
-        .iter()
-        .map(|&p| (p, target.score(&Species::preset(p))))
-        .fold(None, |best: Option<(Preset, [f64; 2])>, (p, v)| match best {
-            Some((_, b)) if sum(b) >= sum(v) => best,
-            _ => Some((p, v)),
-        })
-        .unwrap_or((Preset::Table31, [0.0; 2]));
-    let mut p = params(&Species::preset(preset));
-    let mut best = start;
-    let mut iterations = 0;
+/// How many of the best templates an ascent starts from by default (the best result is kept):
+/// one template's basin may hold a lower maximum than the next one's.
+pub const STARTS: usize = 2;
+
+fn sum(v: [f64; 2]) -> f64 {
+    v[0] + v[1]
+}
+
+/// Gradient ascent from `p` (scoring `score`), at most `iterations` steps: the parameters, their
+/// correlations and the steps taken.
+fn ascend(target: &Target, mut p: Vec<f64>, mut best: [f64; 2], iterations: usize) -> (Vec<f64>, [f64; 2], usize) {
+    let mut steps = 0;
     let mut stride = 1.0;
-    while iterations < options.iterations {
-        iterations += 1;
-        // The gradient in step units.
+    while steps < iterations {
+        steps += 1;
+        // The gradient in step units, its 2·4M renders on all cores.
         let grad: Vec<f64> = (0..p.len())
+            .into_par_iter()
             .map(|k| {
                 let h = STEPS[k % 4];
                 let mut up = p.clone();
@@ -136,23 +140,23 @@ pub fn fit(front: &Image, side: &Image, options: Options) -> Result<Fit, FitErro
         if norm < 1e-9 {
             break;
         }
-        // Line search along the gradient: the best of a few strides, the last one first.
-        let mut moved = None;
-        for t in [2.0 * stride, stride, 0.5 * stride, 0.25 * stride] {
-            let q: Vec<f64> = p
-                .iter()
-                .enumerate()
-                .map(|(k, v)| v + t * grad[k] / norm * STEPS[k % 4])
-                .collect();
-            let v = target.score(&species(&q));
-            if sum(v) > sum(best) + 1e-6
-                && moved
-                    .as_ref()
-                    .is_none_or(|(_, b, _): &(Vec<f64>, [f64; 2], f64)| sum(v) > sum(*b))
-            {
-                moved = Some((q, v, t));
-            }
-        }
+        // Line search along the gradient: the best of four strides around the last one.
+        let tried: Vec<(Vec<f64>, [f64; 2], f64)> = [2.0 * stride, stride, 0.5 * stride, 0.25 * stride]
+            .into_par_iter()
+            .map(|t| {
+                let q: Vec<f64> = p
+                    .iter()
+                    .enumerate()
+                    .map(|(k, v)| v + t * grad[k] / norm * STEPS[k % 4])
+                    .collect();
+                let v = target.score(&species(&q));
+                (q, v, t)
+            })
+            .collect();
+        let moved = tried
+            .into_iter()
+            .filter(|(_, v, _)| sum(*v) > sum(best) + 1e-6)
+            .max_by(|a, b| sum(a.1).total_cmp(&sum(b.1)));
         match moved {
             Some((q, v, t)) => {
                 p = params(&species(&q));
@@ -163,13 +167,36 @@ pub fn fit(front: &Image, side: &Image, options: Options) -> Result<Fit, FitErro
             None => break,
         }
     }
-    Ok(Fit {
-        preset,
-        species: species(&p),
-        start,
-        reached: best,
-        iterations,
-    })
+    (p, best, steps)
+}
+
+/// Fits a species to a front and a side silhouette (coverage images of any size; each is
+/// framed on its own).
+pub fn fit(front: &Image, side: &Image, options: Options) -> Result<Fit, FitError> {
+    let target = Target {
+        front: prepare(front).ok_or(FitError::Blank("front"))?,
+        side: prepare(side).ok_or(FitError::Blank("side"))?,
+    };
+    // Template matching: the presets ranked by their correlations; the best few start.
+    let mut templates: Vec<(Preset, [f64; 2])> = Preset::ALL
+        .into_par_iter()
+        .map(|p| (p, target.score(&Species::preset(p))))
+        .collect();
+    templates.sort_by(|a, b| sum(b.1).total_cmp(&sum(a.1)));
+    let mut result: Option<Fit> = None;
+    for &(preset, start) in templates.iter().take(options.starts.max(1)) {
+        let (p, reached, iterations) = ascend(&target, params(&Species::preset(preset)), start, options.iterations);
+        if result.as_ref().is_none_or(|r| sum(reached) > sum(r.reached)) {
+            result = Some(Fit {
+                preset,
+                species: species(&p),
+                start,
+                reached,
+                iterations,
+            });
+        }
+    }
+    result.ok_or(FitError::NoTemplate)
 }
 
 /// A few deterministic numbers in [−1, 1] from `seed` (xorshift64), for experiments.
