@@ -68,6 +68,8 @@ fn write_replay_seeds() {
         ("echoes", 2),
         ("draw-figures", 3),
         ("dead-receiver", 4),
+        // Replay format 3: the glasses' slots among the pen's, the head's own filter.
+        ("viewer", 5),
     ] {
         let s = scenarios::by_name(name).expect("scenario");
         let records = Simulation::new(&s, seed).run_for(0.5);

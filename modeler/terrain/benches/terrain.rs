@@ -12,6 +12,8 @@
 //! a rippled circle of N vertices (10k, 40k, 100k) with a closed figure of N vertices inside;
 //! checking every pair of segments took 0.61 s at 10k and 9.5 s at 40k.
 //!
+//! Each figure also with Euclidean distances (issue 20): `full_euclidean/512`, `move_point_euclidean/512`, ….
+//!
 //! Run: `cargo bench -p penmodel-terrain --bench terrain` (filter with e.g. `-- pull/512`).
 
 use std::hint::black_box;
@@ -19,8 +21,8 @@ use std::time::Duration;
 
 use criterion::{BenchmarkId, Criterion, criterion_group, criterion_main};
 use penmodel_terrain::{
-    CurvePath, Document, Edit, Figure, FigureKind, FigurePath, Grid, Point, Rect, Region, TerrainEngine, generate,
-    validate,
+    CurvePath, Document, Edit, Figure, FigureKind, FigurePath, Grid, Metric, Point, Rect, Region, TerrainEngine,
+    generate, validate,
 };
 
 #[path = "../tests/baseline.rs"]
@@ -58,67 +60,73 @@ fn terrain(c: &mut Criterion) {
         .measurement_time(Duration::from_secs(3));
     let peak = FigurePath::new(0, 0);
     let other = FigurePath::new(0, 1);
-    for n in SIZES {
-        let doc = document(n);
-        g.bench_with_input(BenchmarkId::new("full", n), &doc, |b, doc| {
-            b.iter(|| generate(black_box(doc)))
-        });
+    // Seed 000's taxicab distances (the example is a version 1 file) under the old names, and the
+    // Euclidean ones (issue 20) with `_euclidean` after the name.
+    for (suffix, metric) in [("", Metric::Taxicab), ("_euclidean", Metric::Euclidean)] {
+        for n in SIZES {
+            let mut doc = document(n);
+            doc.terrain.metric = metric;
+            let id = |name: &str| BenchmarkId::new(format!("{name}{suffix}"), n);
+            g.bench_with_input(id("full"), &doc, |b, doc| b.iter(|| generate(black_box(doc))));
 
-        let mut model = Model {
-            terrain: TerrainEngine::new(&doc).expect("valid"),
-            doc: doc.clone(),
-        };
-        let mut h = 60.0;
-        g.bench_function(BenchmarkId::new("pull", n), |b| {
-            b.iter(|| {
-                h = if h == 60.0 { 61.0 } else { 60.0 };
-                model.edit(Edit::SetHeight {
-                    at: black_box(peak.clone()),
-                    height: h,
+            let mut model = Model {
+                terrain: TerrainEngine::new(&doc).expect("valid"),
+                doc: doc.clone(),
+            };
+            let mut h = 60.0;
+            g.bench_function(id("pull"), |b| {
+                b.iter(|| {
+                    h = if h == 60.0 { 61.0 } else { 60.0 };
+                    model.edit(Edit::SetHeight {
+                        at: black_box(peak.clone()),
+                        height: h,
+                    })
                 })
-            })
-        });
+            });
 
-        let mut flip = false;
-        g.bench_function(BenchmarkId::new("pull_start", n), |b| {
-            b.iter(|| {
-                // Alternating figures: each height change starts a new pull (rebuilds rest_k).
-                flip = !flip;
-                let (at, h) = if flip { (&peak, 60.5) } else { (&other, 45.5) };
-                model.edit(Edit::SetHeight {
-                    at: black_box(at.clone()),
-                    height: h,
+            let mut flip = false;
+            g.bench_function(id("pull_start"), |b| {
+                b.iter(|| {
+                    // Alternating figures: each height change starts a new pull (rebuilds rest_k).
+                    flip = !flip;
+                    let (at, h) = if flip { (&peak, 60.5) } else { (&other, 45.5) };
+                    model.edit(Edit::SetHeight {
+                        at: black_box(at.clone()),
+                        height: h,
+                    })
                 })
-            })
-        });
+            });
 
-        let mut s = -1.5;
-        g.bench_function(BenchmarkId::new("slope", n), |b| {
-            b.iter(|| {
-                s = if s == -1.5 { -1.4 } else { -1.5 };
-                model.edit(Edit::SetSlope {
-                    at: black_box(peak.clone()),
-                    slope: s,
+            let mut s = -1.5;
+            g.bench_function(id("slope"), |b| {
+                b.iter(|| {
+                    s = if s == -1.5 { -1.4 } else { -1.5 };
+                    model.edit(Edit::SetSlope {
+                        at: black_box(peak.clone()),
+                        slope: s,
+                    })
                 })
-            })
-        });
+            });
 
-        let curve = CurvePath::Figure(FigurePath::new(0, 3));
-        let mut x = 110.0;
-        g.bench_function(BenchmarkId::new("move_point", n), |b| {
-            b.iter(|| {
-                x = if x == 110.0 { 112.0 } else { 110.0 };
-                model.edit(Edit::MovePoint {
-                    curve: curve.clone(),
-                    index: 1,
-                    to: [x, 170.0],
+            let curve = CurvePath::Figure(FigurePath::new(0, 3));
+            let mut x = 110.0;
+            g.bench_function(id("move_point"), |b| {
+                b.iter(|| {
+                    x = if x == 110.0 { 112.0 } else { 110.0 };
+                    model.edit(Edit::MovePoint {
+                        curve: curve.clone(),
+                        index: 1,
+                        to: [x, 170.0],
+                    })
                 })
-            })
-        });
+            });
 
-        g.bench_with_input(BenchmarkId::new("seed_full", n), &doc, |b, doc| {
-            b.iter(|| baseline::generate(black_box(doc)))
-        });
+            if metric == Metric::Taxicab {
+                g.bench_with_input(BenchmarkId::new("seed_full", n), &doc, |b, doc| {
+                    b.iter(|| baseline::generate(black_box(doc)))
+                });
+            }
+        }
     }
     g.finish();
 }

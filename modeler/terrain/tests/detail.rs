@@ -113,6 +113,24 @@ fn the_same_seed_the_same_detail() {
         spread = (spread.0.min(v), spread.1.max(v));
     }
     assert!(spread.0 < -0.3 && spread.1 > 0.3, "fbm spread {spread:?}");
+    // The row-wise evaluation the layer uses is fbm itself, to the bit.
+    for (cell, seed) in [(12.5, 0u64), (1.0, 99), (0.37, 5)] {
+        let d = Detail {
+            scale: 40.0 * cell,
+            seed,
+            ..Detail::default()
+        };
+        let y = 17.5 * cell;
+        let mut row = vec![0.0; 300];
+        penmodel_terrain::detail::fbm_row(&d, cell, y, &mut row);
+        for (k, v) in row.iter().enumerate() {
+            assert_eq!(
+                v.to_bits(),
+                fbm(&d, (k as f64 + 0.5) * cell, y).to_bits(),
+                "cell {cell}, k {k}"
+            );
+        }
+    }
 }
 
 /// Loads `text`, expecting a refusal whose message reads `says`.
@@ -186,4 +204,46 @@ fn a_region_may_choose_its_own_metric() {
     doc.terrain.metric = Metric::Taxicab;
     assert_eq!(own, generate(&doc).unwrap());
     assert_ne!(own, euclidean);
+}
+
+/// The hillshade of a plane `z = a·x` is `(−a·cos el·cos az + sin el)/√(1 + a²)`, worked out
+/// from the plane's normal, on every inner cell (the border's slope is one-sided).
+#[test]
+fn hillshade_of_planes() {
+    use penmodel_terrain::Heightmap;
+    use penmodel_terrain::ridge::sun::{Field, Sun, hillshade};
+    for a in [0.0f64, 0.3, -0.8] {
+        let (cols, rows, cell) = (12u32, 9u32, 2.0);
+        let z: Vec<f32> = (0..rows * cols)
+            .map(|i| (a * f64::from(i % cols) * cell) as f32)
+            .collect();
+        let map = Heightmap::from_heights(cols, rows, cell, z).unwrap();
+        let sun = Sun::degrees(200.0, 35.0, "test").unwrap();
+        let shade = hillshade(Field::of(&map), sun);
+        let (az, el) = (200f64.to_radians(), 35f64.to_radians());
+        let want = ((-a * el.cos() * az.cos() + el.sin()) / (1.0 + a * a).sqrt()).max(0.0);
+        for r in 1..rows - 1 {
+            for c in 1..cols - 1 {
+                let got = f64::from(shade[(r * cols + c) as usize]);
+                assert!((got - want).abs() < 1e-5, "a {a}: {got} vs {want} at ({c}, {r})");
+            }
+        }
+    }
+}
+
+/// The version 4 example of `docs/document.md` with terrain settings loads as it says.
+#[test]
+fn the_settings_example_in_the_docs_loads() {
+    let text = include_str!("../../../docs/document.md");
+    let start = text
+        .find("A version 4 file with terrain settings:")
+        .expect("the example's heading");
+    let block = &text[start..];
+    let open = block.find("```json\n").expect("a json block") + "```json\n".len();
+    let close = open + block[open..].find("```").expect("its end");
+    let doc = Document::from_json(&block[open..close]).unwrap();
+    assert_eq!(doc.terrain.metric, Metric::Euclidean);
+    assert_eq!(doc.terrain.detail.map(|d| (d.amount, d.seed)), Some((0.12, 3)));
+    assert_eq!(doc.metric_of(&doc.regions[0]), Metric::Taxicab);
+    generate(&doc).unwrap();
 }

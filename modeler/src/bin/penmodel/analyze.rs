@@ -16,11 +16,12 @@ use penmodel_terrain::{Heightmap, ridge::RidgeError};
 /// Arguments of `penmodel analyze`: at least one map.
 #[derive(clap::Args)]
 #[command(
-    group(clap::ArgGroup::new("maps").args(["flow", "ridges", "valleys", "direct", "sky", "insolation"]).required(true).multiple(true)),
+    group(clap::ArgGroup::new("maps").args(["flow", "ridges", "valleys", "direct", "sky", "insolation", "hillshade"]).required(true).multiple(true)),
     after_help = "Give at least one map. A FILE ending in .png is a 16-bit PNG, any other raw float32 (rows × cols).\n\
     Examples (from the repository's folder):\n  \
     penmodel analyze modeler/examples/ridges/ridgelines.json --flow flow.png --valleys valleys.f32\n  \
-    penmodel analyze modeler/examples/ridges/ridgelines.json --sun 135,25 --direct sun.png --sky sky.png --insolation ins.f32"
+    penmodel analyze modeler/examples/ridges/ridgelines.json --sun 135,25 --direct sun.png --sky sky.png --insolation ins.f32\n  \
+    penmodel analyze modeler/examples/04-volcano.json --hillshade volcano-shade.png"
 )]
 pub struct Args {
     /// The document (JSON). A pending journal beside it is replayed, read-only.
@@ -53,6 +54,9 @@ pub struct Args {
     /// Insolation (needs --sun): 0.8·direct + 0.2·sky.
     #[arg(long, value_name = "FILE")]
     insolation: Option<PathBuf>,
+    /// Hillshade: Lambert's cos of the angle to the sun (--sun, default 225,45: from the map's upper left) with no shadows, 0..1; the terrain's shape at a glance.
+    #[arg(long, value_name = "FILE")]
+    hillshade: Option<PathBuf>,
     /// Azimuths of the sky view's horizon sweeps.
     #[arg(long, value_name = "K", default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=4096))]
     sky_directions: u32,
@@ -151,6 +155,13 @@ pub fn run(args: &Args) -> Result<()> {
     }
     if let (Some(d), Some(s)) = (&direct, &sky) {
         write(map, &args.insolation, &sun::insolation(d, s), |v| v)?;
+    }
+    if args.hillshade.is_some() {
+        let light = match sun {
+            Some(s) => s,
+            None => Sun::degrees(225.0, 45.0, "the hillshade's light").map_err(|e: RidgeError| anyhow::anyhow!(e))?,
+        };
+        write(map, &args.hillshade, &sun::hillshade(field, light), |v| v)?;
     }
     Ok(())
 }
