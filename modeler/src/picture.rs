@@ -70,10 +70,11 @@ impl Default for Look {
             head_m: [0.0, -0.35, 0.7],
             eye_separation_m: 0.063,
             stereo: Stereo::None,
+            // The land look (issue 20); the classic ramp's top kept for `Look::Classic`: terrain
+            // of hundreds of metres, snow from 900 m.
             style: Style {
-                // Terrain of hundreds of metres: snow from 900 m.
                 ramp_top: 900.0,
-                ..Style::default()
+                ..Style::land()
             },
         }
     }

@@ -227,7 +227,13 @@ fn bench_json_has_the_documented_shape() {
     let pull = v["pull_update"].as_array().unwrap();
     for (i, n) in [16, 24].into_iter().enumerate() {
         let r = render[i].as_object().unwrap();
-        assert_eq!(r.keys().collect::<Vec<_>>(), ["grid", "width", "height", "frame_ms"]);
+        assert_eq!(
+            r.keys().collect::<Vec<_>>(),
+            ["grid", "width", "height", "look", "frame_ms", "frame_mean_ms"]
+        );
+        // The land look unless --look classic (issue 20).
+        assert_eq!(r["look"].as_str(), Some("land"));
+        assert!(r["frame_mean_ms"].as_f64().unwrap() > 0.0);
         assert_eq!(
             (r["grid"].as_u64(), r["width"].as_u64(), r["height"].as_u64()),
             (Some(n), Some(1280), Some(720))

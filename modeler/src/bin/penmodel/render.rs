@@ -20,6 +20,15 @@ pub enum StereoArg {
     SideBySide,
 }
 
+/// Looks on the command line.
+#[derive(Clone, Copy, ValueEnum)]
+pub enum LookArg {
+    /// Colour by height in metres and slope, shadows and sky light, sky, table and haze.
+    Land,
+    /// The first renderer's look: one elevation ramp whose top tenth is snow, Lambert light.
+    Classic,
+}
+
 /// `W×H` or `WxH`, positive integers.
 pub fn size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
@@ -70,6 +79,14 @@ pub fn head_mm(s: &str) -> Result<[f64; 3], String> {
     Ok([x / 1000.0, y / 1000.0, z / 1000.0])
 }
 
+/// A snow line: finite metres.
+fn snow_line(s: &str) -> Result<f64, String> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() && v.abs() < 1e6 => Ok(v),
+        _ => Err(format!("{s:?} is not a snow line: metres, e.g. 1800")),
+    }
+}
+
 /// A vertical scale: a positive, finite factor.
 pub fn vertical_scale(s: &str) -> Result<f64, String> {
     match s.trim().parse::<f64>() {
@@ -103,6 +120,12 @@ pub struct Args {
     /// Stereo mode.
     #[arg(long, value_enum, default_value = "none")]
     stereo: StereoArg,
+    /// How the terrain is coloured and lit (docs/renderer.md, "The land look").
+    #[arg(long, value_enum, default_value = "land")]
+    look: LookArg,
+    /// Land look: the snow line, metres.
+    #[arg(long, value_name = "M", value_parser = snow_line)]
+    snow_line: Option<f64>,
     /// Orbit camera: angle around the terrain's centre, degrees (0 = from the south, 90 = east).
     #[arg(long, default_value_t = 30.0, allow_negative_numbers = true)]
     azimuth: f64,
@@ -224,7 +247,18 @@ pub fn run(args: &Args) -> Result<()> {
     scene.trees = editor.trees().trees();
     scene.mode = &args.mode;
     scene.vertical_scale = args.vertical_scale as f32;
-    scene.style.ramp_top = ramp_top(hi);
+    match args.look {
+        LookArg::Classic => scene.style.ramp_top = ramp_top(hi),
+        LookArg::Land => {
+            scene.style = render::Style::land();
+            // One frame: the light on the heightmap's own grid.
+            scene.style.light_cells = 0;
+            scene.style.sky_directions = 32;
+            if let Some(m) = args.snow_line {
+                scene.style.snow_line = m as f32;
+            }
+        }
+    }
     scene.stereo = match args.stereo {
         StereoArg::None => Stereo::None,
         StereoArg::Anaglyph => Stereo::Anaglyph,
