@@ -185,7 +185,7 @@ fn demo(seed: u64) {
     println!("rock field within {field_mm:.2} mm, {rocks} rocks");
 
     // The river (issue 13): drawn with the river tool along the session's course, two years old,
-    // carved into the flat ground left of the region with water over it.
+    // carved into the terrain with water over it.
     let river = pen_sim::session::river_step();
     assert_eq!(got.rivers.len(), 1, "one river");
     let r = &got.rivers[0];
@@ -196,6 +196,16 @@ fn demo(seed: u64) {
         .iter()
         .map(|s| [s.p.x, s.p.y])
         .collect();
+    // It runs through the terrain, not beside it: the ground the figures made (the document
+    // generated anew, without the river) stands above the table under every drawn point.
+    let cell = b.cell_size();
+    for p in &course {
+        let (c, r) = ((p[0] / cell) as u32, (p[1] / cell) as u32);
+        assert!(
+            c < b.cols() && r < b.rows() && b.get(c, r) > 0.0,
+            "the river's course at {p:?} is off the terrain"
+        );
+    }
     let course_mm = shape_error(&fitted, &course) * view.scale;
     // The fit rounds the stroke's corners: within 4 mm of the polyline through its corners.
     assert!(course_mm <= 5.0, "the river's course is off by {course_mm:.2} mm");

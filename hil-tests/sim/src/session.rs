@@ -119,7 +119,8 @@ pub fn rock_step() -> RockStep {
 }
 
 /// The session's river (issue 13): the river button tapped (the river tool), a meandering course
-/// drawn down the flat strip left of the region, two SW3 clicks over it (two years: its bends
+/// drawn through the terrain — from the ridge's southern foot down the valley between the second
+/// peak and the plateau to the region's lower edge — two SW3 clicks over it (two years: its bends
 /// migrate), and the button tapped again (back to figures).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RiverStep {
@@ -137,12 +138,12 @@ pub struct RiverStep {
 /// The river of the demo's session, after the rock field.
 pub fn river_step() -> RiverStep {
     let course = vec![
-        v(30.0, 70.0),
-        v(44.0, 110.0),
-        v(14.0, 160.0),
-        v(44.0, 210.0),
-        v(14.0, 260.0),
-        v(30.0, 330.0),
+        v(320.0, 145.0),
+        v(342.0, 180.0),
+        v(310.0, 215.0),
+        v(342.0, 250.0),
+        v(310.0, 282.0),
+        v(326.0, 312.0),
     ];
     RiverStep {
         button: v(18.0, 42.0),
