@@ -241,3 +241,53 @@ fn generate_exports_the_documents_trees() {
         .fold(f64::INFINITY, f64::min);
     assert!((lowest - 10.0).abs() < 0.5, "{lowest}");
 }
+
+#[test]
+fn scene_bench_reports_both_levels_of_detail() {
+    let dir = tempfile::tempdir().expect("dir");
+    let n = 4u64;
+    let out = penmodel(
+        dir.path(),
+        &[
+            "trees", "scene", "--trees", "4", "--bench", "--frames", "1", "--width", "160", "--height", "90", "--json",
+        ],
+    );
+    ok(&out);
+    let v: Value = serde_json::from_slice(&out.stdout).expect("one JSON document on stdout");
+    for key in [
+        "frame_ms_full",
+        "frame_ms_lod",
+        "frame_ms_lod_stereo",
+        "polygons_full",
+        "polygons_lod",
+        "image_difference",
+        "image_metric",
+    ] {
+        assert!(v.get(key).is_some(), "{key} missing: {v}");
+    }
+    for key in ["frame_ms_full", "frame_ms_lod", "frame_ms_lod_stereo"] {
+        assert!(v[key].as_f64().expect(key) > 0.0, "{key}: {v}");
+    }
+    // Every tree in full is the Table 3.1 tree's whole node tree.
+    let tree = penmodel_terrain::trees::NodeTree::build(&Species::preset(Preset::Table31));
+    let full = v["polygons_full"].as_u64().expect("polygons_full");
+    assert_eq!(full, n * tree.polygons());
+    let lod = v["polygons_lod"].as_u64().expect("polygons_lod");
+    assert!(lod > 0 && lod < full, "{lod} of {full}");
+    let mad = v["image_difference"]["mean_abs"].as_f64().expect("mean_abs");
+    assert!((0.0..=255.0).contains(&mad), "{mad}");
+    assert!(v["image_difference"]["psnr_db"].as_f64().expect("psnr") > 0.0);
+    assert!(v["image_metric"].as_str().expect("metric").contains("PSNR"));
+    // Without --bench: untimed, and the summary is readable text.
+    let out = penmodel(
+        dir.path(),
+        &["trees", "scene", "--trees", "2", "--width", "64", "--height", "36"],
+    );
+    ok(&out);
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("2 Table 3.1 trees") && text.contains("untimed"), "{text}");
+    // Bad input names the flag.
+    let out = penmodel(dir.path(), &["trees", "scene", "--trees", "0"]);
+    assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("--trees"));
+}

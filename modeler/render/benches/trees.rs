@@ -69,20 +69,6 @@ fn grove_trees(map: &Heightmap) -> Vec<Standing> {
         .collect()
 }
 
-fn difference(a: &Frame, b: &Frame) -> (f64, f64) {
-    let (mut sum, mut sq, mut n) = (0.0, 0.0, 0.0);
-    for (p, q) in a.pixels().iter().zip(b.pixels()) {
-        for c in 0..3 {
-            let d = f64::from(p[c]) - f64::from(q[c]);
-            sum += d.abs();
-            sq += d * d;
-            n += 1.0;
-        }
-    }
-    let mse = sq / n;
-    (sum / n, 10.0 * (255.0 * 255.0 / mse).log10())
-}
-
 fn bench(c: &mut Criterion) {
     let map = terrain();
     let trees = grove_trees(&map);
@@ -104,7 +90,7 @@ fn bench(c: &mut Criterion) {
     scene.tree_lod = lod_q;
     renderer.render(&scene, &mut lod).expect("render");
     let sl = renderer.tree_stats();
-    let (mad, psnr) = difference(&full, &lod);
+    let (mad, psnr) = full.difference(&lod).expect("frames of one size");
     println!(
         "trees {}: polygons full {} lod {} (copied {} + shapes {}), groups baked {}; image difference full vs lod: mean abs {mad:.3}/255 per channel, PSNR {psnr:.1} dB",
         sf.trees,

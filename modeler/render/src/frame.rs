@@ -92,4 +92,23 @@ impl Frame {
     pub fn as_bytes(&self) -> &[u8] {
         self.pixels.as_flattened()
     }
+
+    /// How far `other` is from this frame over R, G and B (alpha ignored): the mean absolute
+    /// difference per channel (0–255) and the PSNR in dB (infinite for equal frames); `None`
+    /// when the sizes differ.
+    pub fn difference(&self, other: &Frame) -> Option<(f64, f64)> {
+        if (self.width, self.height) != (other.width, other.height) {
+            return None;
+        }
+        let (mut sum, mut sq) = (0.0, 0.0);
+        for (p, q) in self.pixels.iter().zip(&other.pixels) {
+            for c in 0..3 {
+                let d = f64::from(p[c]) - f64::from(q[c]);
+                sum += d.abs();
+                sq += d * d;
+            }
+        }
+        let n = 3.0 * self.pixels.len() as f64;
+        Some((sum / n, 10.0 * (255.0 * 255.0 / (sq / n)).log10()))
+    }
 }

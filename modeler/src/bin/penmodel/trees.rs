@@ -1,6 +1,9 @@
 //! `penmodel trees`: the fractal trees of seed 004 on their own — node and polygon counts per
 //! roughness Q against the seed's law (`stats`, the default), a tree or grove as a mesh (`mesh`),
-//! and a species fitted to a front and a side silhouette (`fit`). docs/trees.md.
+//! a species fitted to a front and a side silhouette (`fit`), and the seed's 30-tree scene rendered
+//! with level of detail off and on (`scene`). docs/trees.md.
+
+mod scene;
 
 use std::path::{Path, PathBuf};
 
@@ -25,7 +28,8 @@ use serde_json::{Value, json};
     penmodel trees --preset table-3.1 --q 0.02,0.05,0.1,0.2 --json -\n  \
     penmodel trees mesh --preset oak --height 12 --q 0.05 --glb oak.glb\n  \
     penmodel trees mesh --grove 30 --density 200 --mix oak:2,fir:1 --obj grove.obj\n  \
-    penmodel trees fit front.png side.png --json fit.json"
+    penmodel trees fit front.png side.png --json fit.json\n  \
+    penmodel trees scene --trees 30 --bench --json"
 )]
 pub struct Args {
     #[command(subcommand)]
@@ -58,6 +62,12 @@ enum Sub {
         penmodel trees fit front.png side.png --iterations 50 --json -"
     )]
     Fit(FitArgs),
+    /// The seed's scene: Table 3.1 trees on example 1's terrain, rendered with level of detail
+    /// off and on; polygons, frame times (--bench) and the image difference.
+    #[command(after_help = "Examples:\n  \
+        penmodel trees scene --trees 30 --bench --json\n  \
+        penmodel trees scene --png scene/                   # scene/full.png and scene/lod.png")]
+    Scene(scene::SceneArgs),
 }
 
 /// Which species.
@@ -204,6 +214,7 @@ pub fn run(args: &Args) -> Result<()> {
         Some(Sub::Stats(a)) => stats(a),
         Some(Sub::Mesh(a)) => mesh(a),
         Some(Sub::Fit(a)) => fit_run(a),
+        Some(Sub::Scene(a)) => scene::run(a),
     }
 }
 
