@@ -5,8 +5,8 @@
 
 For each of the five examples: the render in the classic look (`--look classic`, "before") and
 in the land look ("after"), 640 x 360 at `penmodel render`'s default camera, and a hillshade of
-its heightmap (`penmodel generate --raw`; Lambert only, light from the north-west 45 degrees up,
-no shadows: it shows the heightmap's own creases). Then the demo (`--show headless --seed 1`):
+its heightmap (`penmodel analyze --hillshade`: Lambert only, no shadows: it shows the heightmap's
+own creases). Then the demo (`--show headless --seed 1`):
 its orbit render and its display view with PENMODEL ("after") and, when given, OLD_PENMODEL (a
 build from before the land look, "before"), and the hillshade of its final terrain. Pictures are
 quantised to 256 colours so that each stays under about 200 KB.
@@ -16,7 +16,6 @@ import subprocess
 import sys
 import tempfile
 
-import numpy as np
 from PIL import Image
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -34,26 +33,16 @@ def save(img, name):
     print(name, os.path.getsize(os.path.join(OUT, name)) // 1024, "KB")
 
 
-def hillshade(z, cell):
-    """Lambert of the surface normal against light from the north-west (row 0 is north), 45 deg up."""
-    gy, gx = np.gradient(z.astype(np.float64), cell)
-    n = np.stack([-gx, -gy, np.ones_like(gx)])
-    n /= np.linalg.norm(n, axis=0)
-    light = np.array([-0.5, -0.5, np.sqrt(0.5)])
-    shade = np.clip(np.tensordot(light, n, axes=1), 0.0, 1.0)
-    img = Image.fromarray((shade * 255).astype(np.uint8), "L")
-    scale = max(1, 320 // max(z.shape))
-    return img.resize((z.shape[1] * scale, z.shape[0] * scale), Image.NEAREST)
-
-
-def heights(penmodel, doc, tmp):
-    import json
-
-    raw = os.path.join(tmp, "h.f32")
-    subprocess.run([penmodel, "generate", doc, "--raw", raw], check=True, capture_output=True)
-    grid = json.load(open(doc))["grid"]
-    z = np.fromfile(raw, dtype="<f4").reshape(grid["rows"], grid["cols"])
-    return z, grid["cell_size"]
+def hillshade(penmodel, doc, tmp):
+    """`penmodel analyze --hillshade` (Lambert from the map's upper left, 45 deg up, no shadows),
+    enlarged to about 320 pixels."""
+    png = os.path.join(tmp, "shade.png")
+    subprocess.run([penmodel, "analyze", doc, "--hillshade", png], check=True, capture_output=True)
+    img = Image.open(png)
+    # A 16-bit grey PNG (0..65535 for 0..1): to 8 bits.
+    img = img.point(lambda v: v / 257.0).convert("L") if img.mode.startswith("I") else img.convert("L")
+    scale = max(1, 320 // max(img.size))
+    return img.resize((img.width * scale, img.height * scale), Image.NEAREST)
 
 
 def main():
@@ -71,7 +60,7 @@ def main():
                     capture_output=True,
                 )
                 save(Image.open(png), f"{name}-{tag}.png")
-            save(hillshade(*heights(penmodel, doc, tmp)), f"{name}-hillshade.png")
+            save(hillshade(penmodel, doc, tmp), f"{name}-hillshade.png")
         for binary, tag in [(penmodel, "after"), (old, "before")]:
             if binary is None:
                 continue
@@ -84,11 +73,7 @@ def main():
             save(Image.open(os.path.join(out, "render.png")), f"demo-render-{tag}.png")
             save(Image.open(os.path.join(out, "display.png")), f"demo-display-{tag}.png")
             if tag == "after":
-                import json
-
-                grid = json.load(open(os.path.join(out, "document.json")))["grid"]
-                z = np.fromfile(os.path.join(out, "terrain.f32"), dtype="<f4").reshape(grid["rows"], grid["cols"])
-                save(hillshade(z, grid["cell_size"]), "demo-hillshade.png")
+                save(hillshade(penmodel, os.path.join(out, "document.json"), tmp), "demo-hillshade.png")
 
 
 if __name__ == "__main__":
