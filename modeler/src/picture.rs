@@ -169,6 +169,8 @@ impl Picture {
             .with_rocks(session.editor.rocks().shared())
             .with_water(Arc::new(water))
             .with_trees(Arc::new(session.editor.trees().trees().to_vec()))
+            // The pen's clock drives the sway, so a replayed session sways the same.
+            .with_time(session.last_event_us().map_or(0.0, |us| us as f64 * 1e-6))
     }
 
     /// The picture with the trees `trees` (an editor's, `Editor::trees().trees()`), drawn with

@@ -185,6 +185,13 @@ pub struct Args {
     /// The folder for --turntable.
     #[arg(long, value_name = "DIR", requires = "turntable")]
     frames: Option<PathBuf>,
+    /// Draw every tree in full (level of detail off; seed 004).
+    #[arg(long)]
+    full_trees: bool,
+    /// Render the frame N times more and print the median time and the trees' polygons
+    /// (`render: M ms median of N, trees: T, polygons: P`), for comparing renderers.
+    #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1000))]
+    repeat: Option<u32>,
 }
 
 /// Runs the command.
@@ -245,6 +252,9 @@ pub fn run(args: &Args) -> Result<()> {
     scene.water = &water;
     // The document's trees, with level of detail from this camera (crate::forest).
     scene.trees = editor.trees().trees();
+    if args.full_trees {
+        scene.tree_lod = None;
+    }
     scene.mode = &args.mode;
     scene.vertical_scale = args.vertical_scale as f32;
     match args.look {
@@ -266,9 +276,29 @@ pub fn run(args: &Args) -> Result<()> {
     };
     let (w, h) = args.size;
     let mut frame = Frame::new(w, h)?;
-    let stats = Renderer::new().render(&scene, &mut frame)?;
+    let mut renderer = Renderer::new();
+    let stats = renderer.render(&scene, &mut frame)?;
     if stats.skipped_vertices > 0 {
         bail!("{} heights are not finite", stats.skipped_vertices);
+    }
+    if let Some(n) = args.repeat {
+        // The first frame above baked the simplified shapes' textures; these are steady frames.
+        let mut ms: Vec<f64> = (0..n)
+            .map(|_| {
+                let t = std::time::Instant::now();
+                renderer
+                    .render(&scene, &mut frame)
+                    .map(|_| t.elapsed().as_secs_f64() * 1e3)
+            })
+            .collect::<Result<_, _>>()?;
+        ms.sort_by(f64::total_cmp);
+        let t = renderer.tree_stats();
+        pen_host::outln!(
+            "render: {:.2} ms median of {n}, trees: {}, polygons: {}",
+            ms[ms.len() / 2],
+            t.trees,
+            t.total_polygons()
+        );
     }
     output::write_png(&frame, &args.png)?;
     pen_host::outln!(
