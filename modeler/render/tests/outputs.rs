@@ -186,3 +186,20 @@ fn the_viewer_says_so_without_a_display() {
         assert_eq!(Viewer::open("test", 64, 48).err(), Some(WindowError::NoDisplay));
     }
 }
+
+#[test]
+fn difference_is_the_mean_absolute_channel_error_and_psnr() {
+    let mut a = frame(4, 2, 0);
+    a.pixels_mut()[5] = [40, 90, 188, 255];
+    let mut b = a.clone();
+    assert_eq!(a.difference(&b).map(|d| d.0), Some(0.0));
+    assert!(a.difference(&b).unwrap().1.is_infinite());
+    // One pixel off by 30 in red and 12 in blue; alpha does not count.
+    b.pixels_mut()[5] = [10, 90, 200, 0];
+    let n = 8.0 * 3.0;
+    let (mad, psnr) = a.difference(&b).unwrap();
+    assert!((mad - 42.0 / n).abs() < 1e-12, "{mad}");
+    let mse = (900.0 + 144.0) / n;
+    assert!((psnr - 10.0 * (65025.0 / mse).log10()).abs() < 1e-9, "{psnr}");
+    assert_eq!(a.difference(&frame(2, 4, 0)), None);
+}
