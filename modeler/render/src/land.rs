@@ -514,21 +514,8 @@ fn colours(
                     *o = [0.0; 3];
                     continue;
                 }
-                let at = |cc: usize, rr: usize| {
-                    let v = h[rr * cols + cc];
-                    if v.is_finite() { v } else { centre }
-                };
-                let (c0, c1) = (c.saturating_sub(1), (c + 1).min(cols - 1));
-                let dx = if c1 > c0 {
-                    (at(c1, r) - at(c0, r)) / ((c1 - c0) as f64 * s) as f32
-                } else {
-                    0.0
-                };
-                let dz = if r1 > r0 {
-                    (at(c, r1) - at(c, r0)) / ((r1 - r0) as f64 * s) as f32
-                } else {
-                    0.0
-                };
+                // The true slope: heights unscaled.
+                let [dx, dz] = shade::gradient(h, (cols, rows), (c, r), (r0, r1), (1.0, s as f32));
                 let slope = atan_degrees((dx * dx + dz * dz).sqrt());
                 let [broad, fine] = noise[r * cols + c];
                 let near = shore.get(r * cols + c).copied().unwrap_or(Shore::NONE);
@@ -625,21 +612,7 @@ fn lights(map: &penmodel_terrain::Heightmap, vertical_scale: f32, style: &Style,
                     bad += 1;
                     continue;
                 }
-                let at = |cc: usize, rr: usize| {
-                    let v = h[rr * cols + cc];
-                    if v.is_finite() { v } else { centre }
-                };
-                let (c0, c1) = (c.saturating_sub(1), (c + 1).min(cols - 1));
-                let dx = if c1 > c0 {
-                    (at(c1, r) - at(c0, r)) * vertical_scale / ((c1 - c0) as f32 * s)
-                } else {
-                    0.0
-                };
-                let dz = if r1 > r0 {
-                    (at(c, r1) - at(c, r0)) * vertical_scale / ((r1 - r0) as f32 * s)
-                } else {
-                    0.0
-                };
+                let [dx, dz] = shade::gradient(h, (cols, rows), (c, r), (r0, r1), (vertical_scale, s));
                 let inv = 1.0 / (dx * dx + 1.0 + dz * dz).sqrt();
                 let lambert = ((-dx * light[0] + light[1] - dz * light[2]) * inv).max(0.0);
                 let seen = bilinear(&sun_seen, c, r);

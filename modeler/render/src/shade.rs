@@ -104,6 +104,38 @@ impl Ramp {
     }
 }
 
+/// The drawn surface's gradient `[∂y/∂x, ∂y/∂z]` at vertex `(c, r)` of the `cols × rows`
+/// heights `h` (finite at the vertex), by central differences (one-sided at the edges); rows
+/// `r0`, `r1` are the vertex's neighbours above and below (clamped); heights are drawn times
+/// `vertical_scale` on cells `cell` wide. A non-finite neighbour counts as level with the vertex.
+#[inline]
+pub(crate) fn gradient(
+    h: &[f32],
+    (cols, rows): (usize, usize),
+    (c, r): (usize, usize),
+    (r0, r1): (usize, usize),
+    (vertical_scale, cell): (f32, f32),
+) -> [f32; 2] {
+    debug_assert!(r1 < rows);
+    let centre = h[r * cols + c];
+    let at = |cc: usize, rr: usize| {
+        let v = h[rr * cols + cc];
+        if v.is_finite() { v } else { centre }
+    };
+    let (c0, c1) = (c.saturating_sub(1), (c + 1).min(cols - 1));
+    let dx = if c1 > c0 {
+        (at(c1, r) - at(c0, r)) * vertical_scale / ((c1 - c0) as f32 * cell)
+    } else {
+        0.0
+    };
+    let dz = if r1 > r0 {
+        (at(c, r1) - at(c, r0)) * vertical_scale / ((r1 - r0) as f32 * cell)
+    } else {
+        0.0
+    };
+    [dx, dz]
+}
+
 /// Per-vertex light, row-major like the heights; `NaN` where the height is not finite. Returns
 /// how many heights are not finite. With `given` (one value per cell, 0 to 1: see
 /// [`Scene::light_map`](super::scene::Scene::light_map)) the light is `ambient + (1 − ambient)·given`
@@ -137,22 +169,7 @@ pub fn vertex_light(
                     bad += 1;
                     continue;
                 }
-                // A non-finite neighbour counts as level with the centre.
-                let at = |cc: usize, rr: usize| {
-                    let v = h[rr * cols + cc];
-                    if v.is_finite() { v } else { centre }
-                };
-                let (c0, c1) = (c.saturating_sub(1), (c + 1).min(cols - 1));
-                let dx = if c1 > c0 {
-                    (at(c1, r) - at(c0, r)) * vertical_scale / ((c1 - c0) as f32 * s)
-                } else {
-                    0.0
-                };
-                let dz = if r1 > r0 {
-                    (at(c, r1) - at(c, r0)) * vertical_scale / ((r1 - r0) as f32 * s)
-                } else {
-                    0.0
-                };
+                let [dx, dz] = gradient(h, (cols, rows), (c, r), (r0, r1), (vertical_scale, s));
                 if let Some(g) = given.filter(|g| g.len() == cols * rows) {
                     let v = g[r * cols + c];
                     *o = ambient + (1.0 - ambient) * if v.is_finite() { v.clamp(0.0, 1.0) } else { 0.0 };
