@@ -1,11 +1,13 @@
 //! `penmodel generate`: document in, heightmap and meshes out.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use penmodel_terrain::editor::Editor;
 use penmodel_terrain::rocks::cache::Rocks;
 use penmodel_terrain::{Heightmap, export, journal};
+
+use crate::out::write;
 
 /// Arguments of `penmodel generate`: at least one output.
 #[derive(clap::Args)]
@@ -32,10 +34,6 @@ pub struct Args {
     /// The terrain mesh as binary glTF.
     #[arg(long, value_name = "OUT.glb")]
     glb: Option<PathBuf>,
-}
-
-fn write(path: &Path, bytes: &[u8]) -> Result<()> {
-    std::fs::write(path, bytes).with_context(|| format!("cannot write {}", path.display()))
 }
 
 fn export(

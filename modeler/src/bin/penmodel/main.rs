@@ -10,6 +10,7 @@ mod analyze;
 mod bench;
 mod generate;
 mod live;
+mod out;
 mod render;
 mod ridges;
 mod river;

@@ -11,6 +11,8 @@ use penmodel_terrain::Document;
 use penmodel_terrain::river::{Constants, Shape, morph};
 use serde_json::json;
 
+use crate::out::write;
+
 /// Arguments of `penmodel river`.
 #[derive(clap::Args)]
 #[command(after_help = "Examples (from the repository's folder):\n  \
@@ -38,10 +40,6 @@ pub struct Args {
     /// best of 5, and with --masks write morph-mask.png, morph-dilate.png, morph-erode.png.
     #[arg(long, value_name = "LEVEL", value_parser = clap::value_parser!(u8).range(1..=6))]
     morph: Option<u8>,
-}
-
-fn write(path: &Path, bytes: &[u8]) -> Result<()> {
-    std::fs::write(path, bytes).with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// An 8-bit PNG of `channels` (1 gray, 3 RGB) per pixel.

@@ -10,6 +10,8 @@ use penmodel_terrain::rocks::place::{self, Placement};
 use penmodel_terrain::rocks::{Amount, Layer, Recipe, RecipeError, Sampler, Scatter, Shape, scatter, top_view};
 use serde_json::{Value, json};
 
+use crate::out::write;
+
 /// The seed's shape presets (its table 1 and figs. 9–11).
 #[derive(Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 pub enum Preset {
@@ -336,16 +338,6 @@ fn to_json(recipe: &Recipe, s: &Scatter) -> Value {
             "total": t.total,
         },
     })
-}
-
-fn write(path: &Path, bytes: &[u8]) -> Result<()> {
-    if path == Path::new("-") {
-        use std::io::Write;
-        let mut out = std::io::stdout().lock();
-        out.write_all(bytes)?;
-        return out.flush().context("cannot write to stdout");
-    }
-    std::fs::write(path, bytes).with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Runs the command.

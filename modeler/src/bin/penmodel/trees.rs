@@ -19,6 +19,8 @@ use penmodel_terrain::trees::{Drawn, NodeTree, Preset, Species, planted, wind};
 use penmodel_terrain::validate;
 use serde_json::{Value, json};
 
+use crate::out::write;
+
 /// Arguments of `penmodel trees`.
 #[derive(clap::Args)]
 #[command(
@@ -154,16 +156,6 @@ struct FitArgs {
     /// The result as JSON (the maps usable as --maps or a document tree's "maps"); `-` for stdout.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
-}
-
-fn write(path: &Path, bytes: &[u8]) -> Result<()> {
-    if path == Path::new("-") {
-        use std::io::Write;
-        let mut out = std::io::stdout().lock();
-        out.write_all(bytes)?;
-        return out.flush().context("cannot write to stdout");
-    }
-    std::fs::write(path, bytes).with_context(|| format!("cannot write {}", path.display()))
 }
 
 /// Prints a summary line, on stderr when `json` goes to stdout.
