@@ -28,6 +28,8 @@ pub const EROSION_COLOUR: Rgba = [230, 40, 30, 255];
 pub const DEPOSITION_COLOUR: Rgba = [160, 215, 255, 255];
 /// Colour of ridgelines and ridgeline trees.
 pub const RIDGE_COLOUR: Rgba = [150, 110, 60, 255];
+/// Colour of a grove's outline and a single tree's trunk, with the tree tool.
+pub const GROVE_COLOUR: Rgba = [60, 150, 70, 255];
 /// Colour of the palette button while the rock tool is on.
 pub const PALETTE_ON_COLOUR: Rgba = [255, 200, 90, 255];
 /// Colour of the palette button while figures are drawn.
@@ -368,6 +370,42 @@ impl Picture {
             }));
         }
         overlays.push(button(ridge::palette_outline(view), ridges_on));
+        // With the tree tool: the groves' outlines and the single trees' trunks (the held one where
+        // the pen takes it, the one under the pen selected); the tree button.
+        let trees_on = ui.tool() == Tool::Trees;
+        if trees_on {
+            use crate::interaction::trees::Held;
+            let moving = ui.tree_moving();
+            let shift = |held: Held, p: Point| match moving {
+                Some((h, by)) if h == held => [p[0] + by[0], p[1] + by[1]],
+                _ => p,
+            };
+            let colour = |held: Held| match moving {
+                Some((h, _)) if h == held => MOVING_COLOUR,
+                _ => GROVE_COLOUR,
+            };
+            for (i, g) in doc.groves.iter().enumerate() {
+                let held = Held::Grove(i);
+                if ui.tree_hover() == Some(held) && selection.is_none() {
+                    selection = Some(overlays.len());
+                }
+                overlays.push(Overlay {
+                    points: g.region.iter().map(|&p| shift(held, p)).collect(),
+                    closed: true,
+                    colour: colour(held),
+                    width: 2.0,
+                    height: None,
+                });
+            }
+            for (i, t) in doc.trees.iter().enumerate() {
+                let held = Held::Tree(i);
+                if ui.tree_hover() == Some(held) && selection.is_none() {
+                    selection = Some(overlays.len());
+                }
+                overlays.push(dot(shift(held, t.at), None, colour(held), 4.0));
+            }
+        }
+        overlays.push(button(crate::interaction::trees::palette_outline(view), trees_on));
         if let Some(drawn) = ui.drawing() {
             overlays.push(Overlay {
                 points: drawn.to_vec(),

@@ -463,6 +463,144 @@ fn a_rock_field_dropped_outside_every_region_goes() {
     assert_eq!(pen.doc().rocks.len(), 1);
 }
 
+/// The tree tool (issue 14): the tree button picks it (and, tapped again, the next preset); an
+/// SW1 tap plants a tree, an outline back to its start a grove; SW2 grabs and slides either; a
+/// pull sets a tree's height, SW3 sideways its height or a grove's density; each one undoable edit.
+#[test]
+fn the_tree_tool_plants_moves_and_sizes_trees_and_groves() {
+    use penmodel::interaction::rocks::Tool;
+    // The reference display shows the 6000 m grid on 600 mm: 10 m per mm, across and up.
+    const M_PER_MM: f64 = 10.0;
+    let mut pen = Pen::new(blank());
+    // The tree button is the square 8 to 28 mm across and 56 to 76 mm down.
+    pen.hover(18.0, 66.0).touch().lift(HOVER);
+    assert_eq!(pen.ui.tool(), Tool::Trees);
+
+    // A tap plants one table-3.1 tree where it touched, 8 mm tall on the display, swaying.
+    pen.hover(200.0, 150.0).touch().lift(HOVER);
+    assert_eq!(pen.doc().trees.len(), 1, "{:?}", pen.ui.take_messages());
+    let tree = pen.doc().trees[0].clone();
+    assert!(near(tree.at, pen.ground(200.0, 150.0), 1.0), "{:?}", tree.at);
+    assert_eq!(tree.preset.as_deref(), Some("table-3.1"));
+    assert!((tree.height - 8.0 * M_PER_MM).abs() < 1e-6, "{}", tree.height);
+    assert!(tree.wind.is_some(), "a planted tree sways");
+    // The button again: the next preset.
+    pen.hover(18.0, 66.0).touch().lift(HOVER);
+    assert_eq!(pen.ui.tool(), Tool::Trees);
+    pen.hover(250.0, 150.0).touch().lift(HOVER);
+    assert_eq!(pen.doc().trees.len(), 2);
+    assert_eq!(pen.doc().trees[1].preset.as_deref(), Some("cypress"));
+    assert_eq!(pen.ui.stats().trees, 2);
+
+    // An outline back to its start plants a grove; lifting the tip ends it (no SW3).
+    let outline = [
+        (300.0, 100.0),
+        (420.0, 100.0),
+        (420.0, 200.0),
+        (300.0, 200.0),
+        (300.0, 100.0),
+    ];
+    pen.hover(outline[0].0, outline[0].1).touch();
+    for &(u, v) in &outline[1..] {
+        pen.drag_to(u, v);
+    }
+    pen.lift(HOVER);
+    assert_eq!(pen.doc().groves.len(), 1, "{:?}", pen.ui.take_messages());
+    assert_eq!(pen.doc().trees.len(), 2, "the outline planted no single tree");
+    let grove = pen.doc().groves[0].clone();
+    for &(u, v) in &outline[..4] {
+        let g = pen.ground(u, v);
+        let d = grove
+            .region
+            .iter()
+            .map(|p| (p[0] - g[0]).hypot(p[1] - g[1]))
+            .fold(f64::INFINITY, f64::min);
+        assert!(d < 2.0 * M_PER_MM, "corner {:?} is {d} m from the region", (u, v));
+    }
+    // Trees 4 mm (40 m) apart: saturated random disks of diameter 40 m cover 0.547 of the plane.
+    let per_m2 = 4.0 * 0.547 / (std::f64::consts::PI * 40.0 * 40.0);
+    let expected = per_m2 * (120.0 * M_PER_MM) * (100.0 * M_PER_MM);
+    let n = penmodel_terrain::trees::grove::trees(&grove).len() as f64;
+    assert!((n / expected - 1.0).abs() < 0.2, "{n} trees, expected about {expected}");
+    assert_eq!(pen.ui.stats().groves, 1);
+
+    // SW2 + touch on the first tree and a slide moves it by the slide.
+    let cypress_at = pen.doc().trees[1].at;
+    pen.grab(200.0, 150.0).drag_to(230.0, 160.0).lift(HOVER).let_go();
+    let moved = pen.doc().trees[0].clone();
+    assert!(
+        near(moved.at, pen.ground(230.0, 160.0), 0.5 * M_PER_MM),
+        "{:?}",
+        moved.at
+    );
+    assert_eq!(moved.height, tree.height);
+    assert_eq!(pen.doc().trees[1].at, cypress_at, "the other tree stays");
+
+    // Held and lifted: the pull; the top follows the pen, 20 mm up is 200 m.
+    pen.grab(230.0, 160.0).pull_to(20.0).hold(0.2).let_go();
+    let pulled = pen.doc().trees[0].height;
+    assert!(
+        (pulled - 20.0 * M_PER_MM).abs() < 0.2 * M_PER_MM,
+        "pulled to {pulled} m"
+    );
+    assert_eq!(pen.doc().trees[0].at, moved.at, "a pull moves nothing");
+
+    // Held, SW3 and 35 mm right: the height × e^(0.02 × 35).
+    pen.grab(230.0, 160.0);
+    pen.set(2, true).set(0, false);
+    let to = pen.at + DVec3::new(35.0, 0.0, 0.0);
+    pen.move_to(to).set(2, false).let_go();
+    let taller = pen.doc().trees[0].height;
+    assert!(
+        (taller / pulled - (0.02f64 * 35.0).exp()).abs() < 0.01,
+        "{taller} m from {pulled} m"
+    );
+
+    // The grove held, SW3 and 35 mm left: sparser by e^(−0.7).
+    pen.grab(360.0, 150.0);
+    pen.set(2, true).set(0, false);
+    let to = pen.at + DVec3::new(-35.0, 0.0, 0.0);
+    pen.move_to(to).set(2, false).let_go();
+    let sparser = pen.doc().groves[0].density;
+    assert!(
+        (sparser / grove.density - (-0.7f64).exp()).abs() < 0.01,
+        "{sparser} from {}",
+        grove.density
+    );
+    // And slid: its region moves by the slide.
+    pen.grab(360.0, 150.0).drag_to(380.0, 170.0).lift(HOVER).let_go();
+    let shifted = &pen.doc().groves[0];
+    let (a, b) = (pen.ground(360.0, 150.0), pen.ground(380.0, 170.0));
+    let by = [
+        shifted.region[0][0] - grove.region[0][0],
+        shifted.region[0][1] - grove.region[0][1],
+    ];
+    assert!(near(by, [b[0] - a[0], b[1] - a[1]], 0.5 * M_PER_MM), "moved by {by:?}");
+
+    // Each was one edit: undo the grove's move and density, the tree's height twice and its move.
+    for _ in 0..2 {
+        pen.editor.undo().expect("undo");
+    }
+    assert_eq!(pen.doc().groves[0], grove);
+    for _ in 0..3 {
+        pen.editor.undo().expect("undo");
+    }
+    assert_eq!(pen.doc().trees[0], tree);
+
+    // An open stroke is refused with a message; three more taps on the button: oak, fir, figures.
+    pen.hover(100.0, 250.0).touch().drag_to(200.0, 260.0).lift(HOVER);
+    assert_eq!(pen.doc().groves.len(), 1);
+    let messages = pen.ui.take_messages();
+    assert!(
+        messages.iter().any(|m| m.contains("grove needs an outline")),
+        "{messages:?}"
+    );
+    for _ in 0..3 {
+        pen.hover(18.0, 66.0).touch().lift(HOVER);
+    }
+    assert_eq!(pen.ui.tool(), Tool::Figures);
+}
+
 /// The river tool (issue 13): the river button picks it; a stroke becomes a river fitted to
 /// Bézier segments; an SW3 click over it adds a year; SW2 on a control point reshapes it, with
 /// the next year's erosion and deposition previewed; SW2 + SW3 sideways widens it.

@@ -22,6 +22,12 @@
 //! | ridge tool: SW2 + touch a node, slide or lift | carries or pulls the node, the terrain following; release SW2 sets it |
 //! | ridge tool: node held, SW3 held, move left/right | the flank slope α: left steeper, right gentler |
 //! | ridge tool: SW3 click over a ridgeline | grows one round of valleys (Alg. 2.5) |
+//! | tree button ([`trees`]): SW1 taps | the tree tool with the first preset, the next preset, back to figures |
+//! | tree tool: SW1 tap | plants one tree of the current preset |
+//! | tree tool: SW1 outline back to its start, lift | plants a grove inside it |
+//! | tree tool: SW2 + touch a tree or grove, slide | moves it |
+//! | tree tool: held, lift | pulls: the height follows the pen's; release SW2 sets it |
+//! | tree tool: held, SW3 held, move left/right | a tree's height, a grove's density (right more) |
 //!
 //! [`KeyCommand`]s give the same edits to a keyboard or a script. Times come from the device clock
 //! that reports carry (a click is timed the same at any replay speed); events that are not from
@@ -34,6 +40,7 @@ pub mod ridge;
 pub mod river;
 pub mod rocks;
 pub mod stroke;
+pub mod trees;
 pub mod view;
 
 use pen_host::events::{DisplayPoint, EventKind, PenEvent};
@@ -141,6 +148,10 @@ pub struct Stats {
     pub ridgelines: u32,
     /// Rounds of valleys grown from the ridgelines.
     pub grown: u32,
+    /// Single trees planted.
+    pub trees: u32,
+    /// Groves planted.
+    pub groves: u32,
     /// Grabs committed with a height change.
     pub pulls: u32,
     /// Grabs committed with a slope change.
@@ -200,6 +211,8 @@ enum State {
     Field(rocks::FieldGrab),
     /// A river (or one of its control points) held with SW2.
     River(river::RiverGrab),
+    /// A tree or grove held with SW2 (tree tool).
+    Tree(trees::TreeGrab),
     /// A ridge stroke being drawn (ridge tool): the pen's positions since the first touch.
     RidgeStroke(Vec<ridge::Sample>),
     /// A ridgeline's or tree's node held with SW2, with the ridges from before the grab.
@@ -249,6 +262,10 @@ pub struct Interaction {
     river_preview: Option<(Vec<Point>, Vec<Point>)>,
     /// The ridgeline or tree under the pen, with the ridge tool.
     ridge_hover: Option<ridge::Part>,
+    /// The preset a tap plants, with the tree tool.
+    tree_preset: penmodel_terrain::trees::Preset,
+    /// The tree or grove under the pen, with the tree tool.
+    tree_hover: Option<trees::Held>,
 }
 
 /// The event's time on the device's clock, µs; `None` for events not from a report (device
@@ -293,6 +310,29 @@ impl Interaction {
             river_hover: None,
             river_preview: None,
             ridge_hover: None,
+            tree_preset: penmodel_terrain::trees::Preset::Table31,
+            tree_hover: None,
+        }
+    }
+
+    /// The preset an SW1 tap plants with the tree tool.
+    pub fn tree_preset(&self) -> penmodel_terrain::trees::Preset {
+        self.tree_preset
+    }
+
+    /// The tree or grove under the pen (tree tool), or held.
+    pub fn tree_hover(&self) -> Option<trees::Held> {
+        match &self.state {
+            State::Tree(g) => Some(g.held),
+            _ => self.tree_hover,
+        }
+    }
+
+    /// The held tree or grove and how far the pen has slid it, ground metres.
+    pub fn tree_moving(&self) -> Option<(trees::Held, Point)> {
+        match &self.state {
+            State::Tree(g) if g.moving => Some((g.held, g.by)),
+            _ => None,
         }
     }
 
@@ -505,7 +545,32 @@ impl Interaction {
                 (None, true) => format!("moving {} node {} | lift to set", g.node.0.name(), g.node.1),
                 (None, false) => format!("{} node {}: slide to move, lift to pull", g.node.0.name(), g.node.1),
             },
+            State::Idle if self.tool == rocks::Tool::Trees => match self.tree_hover {
+                Some(h) => format!("trees: {}: SW2 + touch grabs it | tap: plant a tree", h.name()),
+                None => format!(
+                    "trees ({}): tap plants a tree, an outline back to its start a grove | tap the tree button: next preset",
+                    self.tree_preset.name()
+                ),
+            },
+            State::Armed if self.tool == rocks::Tool::Trees => {
+                "trees: SW2: touch a tree or grove to grab it | SW3: redo".to_string()
+            }
+            State::Tree(g) => match (g.tuning, g.pull) {
+                (Some((_, k)), _) => format!(
+                    "{}: {} ×{k:.2} | sideways: more or less",
+                    g.held.name(),
+                    if matches!(g.held, trees::Held::Tree(_)) {
+                        "height"
+                    } else {
+                        "density"
+                    }
+                ),
+                (None, Some(h)) => format!("{}: {h:.0} m high | release SW2 to set", g.held.name()),
+                (None, None) if g.moving => format!("moving {} | lift to drop", g.held.name()),
+                (None, None) => format!("{}: slide to move, lift to pull | SW3 + sideways", g.held.name()),
+            },
             State::Palette => match self.tool {
+                rocks::Tool::Trees => format!("tree tool: {}", self.tree_preset.name()),
                 rocks::Tool::Ridges => "ridge tool".to_string(),
                 rocks::Tool::Rocks => "rock tool".to_string(),
                 rocks::Tool::Rivers => "river tool".to_string(),
@@ -649,6 +714,20 @@ impl Interaction {
                     self.river_hover = None;
                 }
             }
+            KeyCommand::Delete if self.tool == rocks::Tool::Trees => {
+                let Some(held) = self.tree_hover() else {
+                    self.say("no tree or grove highlighted to delete".into());
+                    return;
+                };
+                let edit = match held {
+                    trees::Held::Tree(index) => Edit::DeleteTree { index },
+                    trees::Held::Grove(index) => Edit::DeleteGrove { index },
+                };
+                if self.commit(editor, edit, "delete") {
+                    self.stats.deletes += 1;
+                    self.tree_hover = None;
+                }
+            }
             KeyCommand::Delete if self.tool == rocks::Tool::Rocks => {
                 let Some(index) = self.field_hover() else {
                     self.say("no rock field highlighted to delete".into());
@@ -732,6 +811,21 @@ impl Interaction {
             State::Idle | State::Armed if self.tool == rocks::Tool::Rocks => {
                 self.hover = None;
                 self.field_hover = rocks::field_at(editor.document(), g);
+            }
+            State::Idle | State::Armed if self.tool == rocks::Tool::Trees => {
+                self.hover = None;
+                self.tree_hover = trees::held_at(editor.document(), g, self.view.metres(s.pick_mm));
+            }
+            State::Tree(grab) => {
+                let slid = (p.u_mm - grab.at_mm[0]).hypot(p.v_mm - grab.at_mm[1]);
+                if let Some((u0, _)) = grab.tuning {
+                    grab.tuning = Some((u0, ((p.u_mm - u0) * trees::GAIN_PER_MM).exp()));
+                } else if grab.pull.is_some() {
+                    grab.pull = Some(trees::clamp_height(self.view.height_at(p.h_mm.max(0.0))));
+                } else if self.sw[0] && !grab.tuned && (grab.moving || slid > s.move_mm) {
+                    grab.moving = true;
+                    grab.by = minus(g, self.view.to_ground(grab.at_mm[0], grab.at_mm[1]));
+                }
             }
             State::Idle | State::Armed => {
                 self.hover = pick::pick(editor.document(), g, self.view.metres(s.pick_mm));
@@ -897,6 +991,33 @@ impl Interaction {
                     _ => "figures: draw with the tip".into(),
                 });
             }
+            State::Idle if trees::on_palette(p.u_mm, p.v_mm) => {
+                // Each tap picks the next preset; after the last, back to figures.
+                let next = match self.tool {
+                    rocks::Tool::Trees => trees::next_preset(self.tree_preset),
+                    _ => Some(penmodel_terrain::trees::Preset::Table31),
+                };
+                match next {
+                    Some(preset) => {
+                        self.tool = rocks::Tool::Trees;
+                        self.tree_preset = preset;
+                    }
+                    None => self.tool = rocks::Tool::Figures,
+                }
+                self.hover = None;
+                self.field_hover = None;
+                self.river_hover = None;
+                self.ridge_hover = None;
+                self.tree_hover = None;
+                self.state = State::Palette;
+                self.say(match self.tool {
+                    rocks::Tool::Trees => format!(
+                        "tree tool ({}): tap to plant a tree, draw an outline for a grove",
+                        self.tree_preset.name()
+                    ),
+                    _ => "figures: draw with the tip".into(),
+                });
+            }
             State::Idle if rocks::on_palette(p.u_mm, p.v_mm) => {
                 self.tool = match self.tool {
                     rocks::Tool::Rocks => rocks::Tool::Figures,
@@ -939,6 +1060,12 @@ impl Interaction {
                     None => self.say("no river here to grab".into()),
                 }
             }
+            State::Armed if self.tool == rocks::Tool::Trees => {
+                match trees::held_at(editor.document(), g, self.view.metres(self.tuning.pick_mm)) {
+                    Some(held) => self.state = State::Tree(trees::TreeGrab::new(held, [p.u_mm, p.v_mm])),
+                    None => self.say("no tree or grove here to grab".into()),
+                }
+            }
             State::Armed if self.tool == rocks::Tool::Rocks => match rocks::field_at(editor.document(), g) {
                 Some(index) => {
                     self.state = State::Field(rocks::FieldGrab {
@@ -978,6 +1105,7 @@ impl Interaction {
             | State::Palette
             | State::Field(_)
             | State::River(_)
+            | State::Tree(_)
             | State::Node(..) => {}
         }
     }
@@ -985,6 +1113,25 @@ impl Interaction {
     fn on_tip_up(&mut self, editor: &mut Editor) {
         let g = self.ground().map(|(g, _)| g);
         match &mut self.state {
+            // A tree-tool stroke is one touch: lifting the tip ends it.
+            State::Drawing { positions, .. } if self.tool == rocks::Tool::Trees => {
+                let mut positions = std::mem::take(positions);
+                if let Some(g) = g
+                    && positions.last() != Some(&g)
+                {
+                    positions.push(g);
+                }
+                self.state = State::Idle;
+                self.finish_trees(editor, &positions);
+            }
+            State::Tree(grab) if grab.moving => {
+                self.drop_tree(editor);
+                self.state = State::Armed;
+            }
+            State::Tree(grab) if !grab.tuned && grab.tuning.is_none() => {
+                let h = self.pen.map_or(0.0, |p| p.h_mm.max(0.0));
+                grab.pull = Some(trees::clamp_height(self.view.height_at(h)));
+            }
             State::Drawing { positions, touching } => {
                 *touching = false;
                 if let Some(g) = g
@@ -1086,6 +1233,11 @@ impl Interaction {
             self.state = State::Idle;
             return;
         }
+        if let State::Tree(_) = &self.state {
+            self.drop_tree(editor);
+            self.state = State::Idle;
+            return;
+        }
         let State::Grabbed(grab) = &self.state else {
             if self.state == State::Armed {
                 self.state = State::Idle;
@@ -1150,6 +1302,15 @@ impl Interaction {
                     grab.tuning = Some(([p.u_mm, p.h_mm], 1.0, 1.0));
                 }
             }
+            State::Tree(grab) => {
+                if let Some(p) = self.pen
+                    && !grab.moving
+                    && grab.pull.is_none()
+                {
+                    grab.tuning = Some((p.u_mm, 1.0));
+                    grab.tuned = true;
+                }
+            }
             State::Node(grab, base) => {
                 if let Some(p) = self.pen {
                     grab.slope_from = Some((p.u_mm, grab.slope.unwrap_or(base.slope)));
@@ -1182,6 +1343,30 @@ impl Interaction {
                     "the rock field's density and size",
                 ) {
                     self.say(format!("rock field {index}: density ×{density:.2}, size ×{size:.2}"));
+                }
+            }
+            State::Tree(grab) => {
+                let Some((_, k)) = grab.tuning.take() else { return };
+                let held = grab.held;
+                let doc = editor.document();
+                let edit = match held {
+                    trees::Held::Tree(index) => doc.trees.get(index).map(|t| Edit::ReplaceTree {
+                        index,
+                        tree: trees::with_height(t, t.height * k),
+                    }),
+                    trees::Held::Grove(index) => doc.groves.get(index).map(|g| Edit::ReplaceGrove {
+                        index,
+                        grove: trees::denser(g, k),
+                    }),
+                };
+                let Some(edit) = edit else { return };
+                let what = if matches!(held, trees::Held::Tree(_)) {
+                    "height"
+                } else {
+                    "density"
+                };
+                if self.commit(editor, edit, &format!("the {what} of {}", held.name())) {
+                    self.say(format!("{}: {what} ×{k:.2}", held.name()));
                 }
             }
             State::River(grab) => {
@@ -1236,6 +1421,11 @@ impl Interaction {
             }
             State::River(_) => {
                 self.say(format!("pen lost ({reason}): the river stays as it was"));
+                self.state = State::Idle;
+            }
+            State::Tree(g) => {
+                let name = g.held.name();
+                self.say(format!("pen lost ({reason}): {name} stays as it was"));
                 self.state = State::Idle;
             }
             State::Node(..) => {
@@ -1401,6 +1591,9 @@ impl Interaction {
         if self.tool == rocks::Tool::Rivers {
             return self.finish_river(editor, positions);
         }
+        if self.tool == rocks::Tool::Trees {
+            return self.finish_trees(editor, positions);
+        }
         let v = self.view;
         let tol = Tolerances {
             point: v.metres(self.tuning.point_mm),
@@ -1476,6 +1669,81 @@ impl Interaction {
             self.stats.rock_fields += 1;
             let n = editor.rocks().fields().get(index).map_or(0, |f| f.scatter.rocks.len());
             self.say(format!("added rock field {index}: {n} rocks"));
+        }
+    }
+}
+
+impl Interaction {
+    /// Ends a tree-tool stroke: a tap plants a tree, a closed outline a grove.
+    fn finish_trees(&mut self, editor: &mut Editor, positions: &[Point]) {
+        let v = self.view;
+        let doc = editor.document();
+        if trees::is_tap(positions, v.metres(self.tuning.point_mm)) {
+            let index = doc.trees.len();
+            let tree = trees::new_tree(positions[0], &v, self.tree_preset, index as u64 + 1);
+            let name = format!("{} tree {index}", self.tree_preset.name());
+            if self.commit(editor, Edit::AddTree { index, tree }, &name) {
+                self.stats.trees += 1;
+                self.say(format!("planted {name}"));
+            }
+            return;
+        }
+        let tol = Tolerances {
+            point: v.metres(self.tuning.point_mm),
+            close: v.metres(self.tuning.close_mm),
+            simplify: v.metres(self.tuning.simplify_mm),
+        };
+        let Some(shape) = stroke::classify(positions, &tol).filter(|s| s.kind == FigureKind::Closed) else {
+            self.stats.refused += 1;
+            self.say("a grove needs an outline back to its start (a tap plants one tree)".into());
+            return;
+        };
+        let index = doc.groves.len();
+        let grove = trees::new_grove(&shape.points, &v, index as u64 + 1);
+        if self.commit(editor, Edit::AddGrove { index, grove }, &format!("grove {index}")) {
+            self.stats.groves += 1;
+            let n = editor
+                .document()
+                .groves
+                .get(index)
+                .map_or(0, |g| penmodel_terrain::trees::grove::trees(g).len());
+            self.say(format!("planted grove {index}: {n} trees"));
+        }
+    }
+
+    /// Sets the held tree or grove: where the pen slid it, or the height it pulled to.
+    fn drop_tree(&mut self, editor: &mut Editor) {
+        let State::Tree(grab) = &self.state else { return };
+        let (held, by) = (grab.held, grab.by);
+        let doc = editor.document();
+        let edit = match (grab.moving, grab.pull, held) {
+            (true, _, _) if by == [0.0, 0.0] => return,
+            (true, _, trees::Held::Tree(index)) => Edit::MoveTree { index, by },
+            (true, _, trees::Held::Grove(index)) => Edit::MoveGrove { index, by },
+            (false, Some(h), trees::Held::Tree(index)) => {
+                let Some(t) = doc.trees.get(index) else { return };
+                Edit::ReplaceTree {
+                    index,
+                    tree: trees::with_height(t, h),
+                }
+            }
+            (false, Some(h), trees::Held::Grove(index)) => {
+                let Some(g) = doc.groves.get(index) else { return };
+                Edit::ReplaceGrove {
+                    index,
+                    grove: trees::grove_with_height(g, h),
+                }
+            }
+            (false, None, _) => return,
+        };
+        let moved = matches!(edit, Edit::MoveTree { .. } | Edit::MoveGrove { .. });
+        let what = if moved { "moving" } else { "the height of" };
+        if self.commit(editor, edit, &format!("{what} {}", held.name())) {
+            if moved {
+                self.stats.moves += 1;
+            } else {
+                self.stats.pulls += 1;
+            }
         }
     }
 }

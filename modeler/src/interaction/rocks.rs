@@ -44,6 +44,8 @@ pub enum Tool {
     Rivers,
     /// Ridgelines (seed 002; [`super::ridge`]).
     Ridges,
+    /// Trees and groves (seed 004; [`super::trees`]).
+    Trees,
 }
 
 /// Whether display point `(u, v)` mm is on the palette button.
