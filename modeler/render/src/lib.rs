@@ -25,6 +25,7 @@
 //! vertices); a grid smaller than 2 × 2 has no triangles and shows only sky, overlays and UI.
 
 pub mod atmosphere;
+pub mod binned;
 pub mod camera;
 pub mod clip;
 pub mod forest;

@@ -16,10 +16,10 @@
 
 use penmodel_terrain::export::Mesh;
 
-use super::clip::{self, ClipVertex};
-use super::rasterise::{self, Bounds, DepthSink, Sample, Surface, Vtx};
+use super::binned::Binned;
+use super::rasterise::{Bounds, DepthSink, Sample, Surface};
 use super::scene::Style;
-use super::transform::{self, Affine};
+use super::transform::Affine;
 
 /// How a mesh is coloured.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -62,32 +62,13 @@ pub fn srgb(linear: [f32; 3]) -> [u8; 3] {
 
 /// One eye's projected meshes.
 #[derive(Debug, Default)]
-pub struct Projected {
-    clip: Vec<ClipVertex>,
-    screen: Vec<Vtx>,
-    /// Whether each vertex is in front of the near plane.
-    direct: Vec<bool>,
-    /// Triangles (indices into `clip`) and what they show, all meshes together.
-    triangles: Vec<([u32; 3], Surface)>,
-    /// Triangle indices per band of `band_rows` rows.
-    bins: Vec<Vec<u32>>,
-    band_rows: usize,
-    frame_height: usize,
-}
+pub struct Projected(Binned<Surface>);
 
 impl Projected {
     /// Forgets the last frame's meshes, for a frame `frame_height` rows tall drawn in bands of
     /// `band_rows` rows; then [`Projected::add`] the meshes.
-    pub fn clear(&mut self, (frame_height, band_rows): (usize, usize)) {
-        self.clip.clear();
-        self.screen.clear();
-        self.direct.clear();
-        self.triangles.clear();
-        self.band_rows = band_rows.max(1);
-        self.frame_height = frame_height;
-        let bands = frame_height.div_ceil(self.band_rows);
-        self.bins.resize_with(bands, Vec::new);
-        self.bins.iter_mut().for_each(Vec::clear);
+    pub fn clear(&mut self, bands: (usize, usize)) {
+        self.0.clear(bands);
     }
 
     /// Projects `meshes` (the exports' frame: X, Y up, Z, metres) for one eye, painted `paint`,
@@ -104,19 +85,17 @@ impl Projected {
         let light = super::shade::world_light(style);
         let ambient = style.ambient.clamp(0.0, 1.0);
         let s = cell_size as f32;
-        let first = self.triangles.len();
+        let first = self.0.triangles();
         for mesh in meshes {
-            let base = self.clip.len() as u32;
+            let base = self.0.vertices();
             for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
                 let lambert = (n[0] * light[0] + n[1] * light[1] + n[2] * light[2]).abs();
                 let l = ambient + (1.0 - ambient) * lambert;
-                let v = affine.clip_point(p[0] / s - 0.5, p[2] / s - 0.5, p[1], l);
-                self.direct.push(v.inside(near));
-                self.screen.push(transform::project(&v));
-                self.clip.push(v);
+                self.0
+                    .vertex(affine.clip_point(p[0] / s - 0.5, p[2] / s - 0.5, p[1], l), near);
             }
             let coloured = paint == Paint::Own && mesh.colors.len() == mesh.positions.len();
-            self.triangles.extend(mesh.indices.chunks_exact(3).map(|t| {
+            self.0.extend(mesh.indices.chunks_exact(3).map(|t| {
                 let surface = match paint {
                     Paint::Whole(s) => s,
                     Paint::Own if coloured => {
@@ -129,67 +108,26 @@ impl Projected {
                 ([t[0] + base, t[1] + base, t[2] + base], surface)
             }));
         }
-        self.bin(first);
-    }
-
-    /// Bins the triangles from `first` on.
-    fn bin(&mut self, first: usize) {
-        let bands = self.bins.len();
-        let one = (1 << rasterise::SUBPIXEL) as f32;
-        for (i, (t, _)) in self.triangles.iter().enumerate().skip(first) {
-            let (lo, hi) = if t.iter().all(|&k| self.direct[k as usize]) {
-                let ys = t.map(|k| self.screen[k as usize].y as f32 / one);
-                (ys[0].min(ys[1]).min(ys[2]), ys[0].max(ys[1]).max(ys[2]))
-            } else if t.iter().any(|&k| self.direct[k as usize]) {
-                // Crosses the near plane: every band may see it.
-                (0.0, self.frame_height as f32)
-            } else {
-                continue;
-            };
-            let first = (lo.max(0.0) as usize) / self.band_rows;
-            let last = ((hi.max(0.0) as usize) / self.band_rows).min(bands.saturating_sub(1));
-            for bin in self.bins.iter_mut().take(last + 1).skip(first) {
-                bin.push(i as u32);
-            }
-        }
+        self.0.bin(first);
     }
 
     /// How many triangles were added this frame.
     pub fn triangles(&self) -> usize {
-        self.triangles.len()
+        self.0.triangles()
     }
 
     /// Draws the triangles that reach the tile `bounds` (its first row starts a band) into its
     /// samples.
     pub fn draw(&self, bounds: &Bounds, samples: &mut [Sample], width: usize, near: f32) {
-        let Some(bin) = self.bins.get(bounds.y0.max(0) as usize / self.band_rows.max(1)) else {
-            return;
-        };
         let mut sink = DepthSink {
             samples,
             width,
             y0: bounds.y0,
             surface: Surface::Rock,
         };
-        for &i in bin {
-            let (t, surface) = self.triangles[i as usize];
+        self.0.draw(bounds, near, &mut sink, |sink, surface| {
             sink.surface = surface;
-            if t.iter().all(|&k| self.direct[k as usize]) {
-                let [a, b, c] = t.map(|k| &self.screen[k as usize]);
-                // Both windings: the rasteriser fills one.
-                rasterise::triangle(a, b, c, bounds, &mut sink);
-                rasterise::triangle(a, c, b, bounds, &mut sink);
-            } else {
-                let poly = clip::triangle(t.map(|k| self.clip[k as usize]), near);
-                if poly.len < 3 {
-                    continue;
-                }
-                let v: Vec<Vtx> = poly.vertices[..poly.len].iter().map(transform::project).collect();
-                for k in 1..poly.len - 1 {
-                    rasterise::triangle(&v[0], &v[k], &v[k + 1], bounds, &mut sink);
-                    rasterise::triangle(&v[0], &v[k + 1], &v[k], bounds, &mut sink);
-                }
-            }
-        }
+            true
+        });
     }
 }

@@ -17,10 +17,11 @@
 //! - Quads are drawn from both windings, like the meshes; triangles are binned by bands of rows
 //!   as the meshes are.
 
-use super::clip::{self, ClipVertex};
+use super::binned::Binned;
+use super::clip::ClipVertex;
 use super::frame::Rgba;
-use super::rasterise::{self, Bounds, Sample, Sink, Surface, Vtx};
-use super::transform::{self, Affine};
+use super::rasterise::{Bounds, Sample, Sink, Surface};
+use super::transform::Affine;
 
 /// An RGBA image, row 0 at the top.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
@@ -78,41 +79,24 @@ pub struct Quad {
     pub texture: u32,
 }
 
-/// One eye's projected quads.
+/// One eye's projected quads: two triangles each, tagged with their texture's index.
 #[derive(Debug, Default)]
-pub struct Projected {
-    clip: Vec<ClipVertex>,
-    screen: Vec<Vtx>,
-    direct: Vec<bool>,
-    /// Triangles (indices into `clip`) and their texture.
-    triangles: Vec<([u32; 3], u32)>,
-    bins: Vec<Vec<u32>>,
-    band_rows: usize,
-    frame_height: usize,
-}
+pub struct Projected(Binned<u32>);
 
 impl Projected {
     /// Forgets the last frame's quads, for a frame `frame_height` rows tall drawn in bands of
     /// `band_rows` rows; then [`Projected::add`] the quads.
-    pub fn clear(&mut self, (frame_height, band_rows): (usize, usize)) {
-        self.clip.clear();
-        self.screen.clear();
-        self.direct.clear();
-        self.triangles.clear();
-        self.band_rows = band_rows.max(1);
-        self.frame_height = frame_height;
-        let bands = frame_height.div_ceil(self.band_rows);
-        self.bins.resize_with(bands, Vec::new);
-        self.bins.iter_mut().for_each(Vec::clear);
+    pub fn clear(&mut self, bands: (usize, usize)) {
+        self.0.clear(bands);
     }
 
     /// Projects `quads` for one eye (with the terrain's `affine` map and `cell_size`) and bins
     /// their triangles; their texture indices are offset by `first_texture`.
     pub fn add(&mut self, quads: &[Quad], first_texture: u32, affine: &Affine, cell_size: f64, near: f32) {
-        let first = self.triangles.len();
+        let first = self.0.triangles();
         let s = cell_size as f32;
         for q in quads {
-            let base = self.clip.len() as u32;
+            let base = self.0.vertices();
             for (p, uv) in q.corners.iter().zip(&q.uv) {
                 // u and v ride in the height and light slots: interpolated as u/w, v/w.
                 let v = affine.clip_point(p[0] / s - 0.5, p[2] / s - 0.5, p[1], 0.0);
@@ -121,71 +105,42 @@ impl Projected {
                     l: uv[1],
                     ..v
                 };
-                self.direct.push(v.inside(near));
-                self.screen.push(transform::project(&v));
-                self.clip.push(v);
+                self.0.vertex(v, near);
             }
             let texture = q.texture.saturating_add(first_texture);
-            self.triangles.push(([base, base + 1, base + 2], texture));
-            self.triangles.push(([base, base + 2, base + 3], texture));
+            self.0.extend([
+                ([base, base + 1, base + 2], texture),
+                ([base, base + 2, base + 3], texture),
+            ]);
         }
-        let (bands, frame_height) = (self.bins.len(), self.frame_height);
-        let one = (1 << rasterise::SUBPIXEL) as f32;
-        for (i, (t, _)) in self.triangles.iter().enumerate().skip(first) {
-            let (lo, hi) = if t.iter().all(|&k| self.direct[k as usize]) {
-                let ys = t.map(|k| self.screen[k as usize].y as f32 / one);
-                (ys[0].min(ys[1]).min(ys[2]), ys[0].max(ys[1]).max(ys[2]))
-            } else if t.iter().any(|&k| self.direct[k as usize]) {
-                (0.0, frame_height as f32)
-            } else {
-                continue;
-            };
-            let first = (lo.max(0.0) as usize) / self.band_rows;
-            let last = ((hi.max(0.0) as usize) / self.band_rows).min(bands.saturating_sub(1));
-            for bin in self.bins.iter_mut().take(last + 1).skip(first) {
-                bin.push(i as u32);
-            }
-        }
+        self.0.bin(first);
     }
 
     /// How many quads were projected.
     pub fn quads(&self) -> usize {
-        self.triangles.len() / 2
+        self.0.triangles() / 2
     }
 
     /// Draws the triangles that reach the tile `bounds` (its first row starts a band) into its
     /// samples, each with its texture from `textures` (a quad naming none is skipped).
     pub fn draw(&self, bounds: &Bounds, samples: &mut [Sample], width: usize, near: f32, textures: &[&Texture]) {
-        let Some(bin) = self.bins.get(bounds.y0.max(0) as usize / self.band_rows.max(1)) else {
+        let Some(&first) = textures.first() else {
             return;
         };
-        for &i in bin {
-            let (t, k) = self.triangles[i as usize];
-            let Some(&texture) = textures.get(k as usize) else {
-                continue;
-            };
-            let mut sink = TexelSink {
-                samples: &mut *samples,
-                width,
-                y0: bounds.y0,
-                texture,
-            };
-            if t.iter().all(|&k| self.direct[k as usize]) {
-                let [a, b, c] = t.map(|k| &self.screen[k as usize]);
-                rasterise::triangle(a, b, c, bounds, &mut sink);
-                rasterise::triangle(a, c, b, bounds, &mut sink);
-            } else {
-                let poly = clip::triangle(t.map(|k| self.clip[k as usize]), near);
-                if poly.len < 3 {
-                    continue;
+        let mut sink = TexelSink {
+            samples,
+            width,
+            y0: bounds.y0,
+            texture: first,
+        };
+        self.0
+            .draw(bounds, near, &mut sink, |sink, k| match textures.get(k as usize) {
+                Some(&texture) => {
+                    sink.texture = texture;
+                    true
                 }
-                let v: Vec<Vtx> = poly.vertices[..poly.len].iter().map(transform::project).collect();
-                for k in 1..poly.len - 1 {
-                    rasterise::triangle(&v[0], &v[k], &v[k + 1], bounds, &mut sink);
-                    rasterise::triangle(&v[0], &v[k + 1], &v[k], bounds, &mut sink);
-                }
-            }
-        }
+                None => false,
+            });
     }
 }
 

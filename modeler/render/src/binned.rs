@@ -1,0 +1,133 @@
+//! Projected triangles binned by bands of rows, shared by the meshes ([`crate::meshes`]) and the
+//! textured quads ([`crate::textured`]): vertices projected once per eye, each triangle listed
+//! in the bands of rows its screen extent reaches (every band when it crosses the near plane),
+//! and drawn per tile — straight when it lies wholly in front of the near plane, clipped
+//! otherwise — from both windings (the rasteriser fills one; rocks are open underneath and
+//! leaves and quads are single-sided surfaces).
+
+use super::clip::{self, ClipVertex};
+use super::rasterise::{self, Bounds, Sink, Vtx};
+use super::transform;
+
+/// One eye's projected triangles, each tagged with a `T` (what it shows).
+#[derive(Debug)]
+pub struct Binned<T> {
+    clip: Vec<ClipVertex>,
+    screen: Vec<Vtx>,
+    /// Whether each vertex is in front of the near plane.
+    direct: Vec<bool>,
+    /// Triangles (indices into `clip`) and their tags.
+    triangles: Vec<([u32; 3], T)>,
+    /// Triangle indices per band of `band_rows` rows.
+    bins: Vec<Vec<u32>>,
+    band_rows: usize,
+    frame_height: usize,
+}
+
+impl<T> Default for Binned<T> {
+    fn default() -> Self {
+        Binned {
+            clip: Vec::new(),
+            screen: Vec::new(),
+            direct: Vec::new(),
+            triangles: Vec::new(),
+            bins: Vec::new(),
+            band_rows: 1,
+            frame_height: 0,
+        }
+    }
+}
+
+impl<T: Copy> Binned<T> {
+    /// Forgets the last frame's triangles, for a frame `frame_height` rows tall drawn in bands
+    /// of `band_rows` rows.
+    pub fn clear(&mut self, (frame_height, band_rows): (usize, usize)) {
+        self.clip.clear();
+        self.screen.clear();
+        self.direct.clear();
+        self.triangles.clear();
+        self.band_rows = band_rows.max(1);
+        self.frame_height = frame_height;
+        let bands = frame_height.div_ceil(self.band_rows);
+        self.bins.resize_with(bands, Vec::new);
+        self.bins.iter_mut().for_each(Vec::clear);
+    }
+
+    /// Adds a vertex; returns its index.
+    #[inline]
+    pub fn vertex(&mut self, v: ClipVertex, near: f32) -> u32 {
+        let i = self.clip.len() as u32;
+        self.direct.push(v.inside(near));
+        self.screen.push(transform::project(&v));
+        self.clip.push(v);
+        i
+    }
+
+    /// How many vertices were added this frame.
+    pub fn vertices(&self) -> u32 {
+        self.clip.len() as u32
+    }
+
+    /// Adds triangles (indices of added vertices) with their tags; bin them with
+    /// [`Binned::bin`].
+    pub fn extend(&mut self, triangles: impl IntoIterator<Item = ([u32; 3], T)>) {
+        self.triangles.extend(triangles);
+    }
+
+    /// How many triangles were added this frame.
+    pub fn triangles(&self) -> usize {
+        self.triangles.len()
+    }
+
+    /// Bins the triangles from index `first` on.
+    pub fn bin(&mut self, first: usize) {
+        let bands = self.bins.len();
+        let one = (1 << rasterise::SUBPIXEL) as f32;
+        for (i, (t, _)) in self.triangles.iter().enumerate().skip(first) {
+            let (lo, hi) = if t.iter().all(|&k| self.direct[k as usize]) {
+                let ys = t.map(|k| self.screen[k as usize].y as f32 / one);
+                (ys[0].min(ys[1]).min(ys[2]), ys[0].max(ys[1]).max(ys[2]))
+            } else if t.iter().any(|&k| self.direct[k as usize]) {
+                // Crosses the near plane: every band may see it.
+                (0.0, self.frame_height as f32)
+            } else {
+                continue;
+            };
+            let first = (lo.max(0.0) as usize) / self.band_rows;
+            let last = ((hi.max(0.0) as usize) / self.band_rows).min(bands.saturating_sub(1));
+            for bin in self.bins.iter_mut().take(last + 1).skip(first) {
+                bin.push(i as u32);
+            }
+        }
+    }
+
+    /// Draws the triangles that reach the tile `bounds` (its first row starts a band) into
+    /// `sink`, after `prepare(sink, tag)` set it up for each; a triangle whose `prepare` returns
+    /// false is skipped.
+    pub fn draw<S: Sink>(&self, bounds: &Bounds, near: f32, sink: &mut S, mut prepare: impl FnMut(&mut S, T) -> bool) {
+        let Some(bin) = self.bins.get(bounds.y0.max(0) as usize / self.band_rows.max(1)) else {
+            return;
+        };
+        for &i in bin {
+            let (t, tag) = self.triangles[i as usize];
+            if !prepare(sink, tag) {
+                continue;
+            }
+            if t.iter().all(|&k| self.direct[k as usize]) {
+                let [a, b, c] = t.map(|k| &self.screen[k as usize]);
+                rasterise::triangle(a, b, c, bounds, sink);
+                rasterise::triangle(a, c, b, bounds, sink);
+            } else {
+                let poly = clip::triangle(t.map(|k| self.clip[k as usize]), near);
+                if poly.len < 3 {
+                    continue;
+                }
+                let v: Vec<Vtx> = poly.vertices[..poly.len].iter().map(transform::project).collect();
+                for k in 1..poly.len - 1 {
+                    rasterise::triangle(&v[0], &v[k], &v[k + 1], bounds, sink);
+                    rasterise::triangle(&v[0], &v[k + 1], &v[k], bounds, sink);
+                }
+            }
+        }
+    }
+}
