@@ -1674,40 +1674,49 @@ impl Interaction {
 }
 
 impl Interaction {
-    /// Ends a tree-tool stroke: a tap plants a tree, a closed outline a grove.
+    /// Ends a tree-tool stroke: a tap (a point figure's stroke) plants a tree, a closed outline a
+    /// grove.
     fn finish_trees(&mut self, editor: &mut Editor, positions: &[Point]) {
         let v = self.view;
-        let doc = editor.document();
-        if trees::is_tap(positions, v.metres(self.tuning.point_mm)) {
-            let index = doc.trees.len();
-            let tree = trees::new_tree(positions[0], &v, self.tree_preset, index as u64 + 1);
-            let name = format!("{} tree {index}", self.tree_preset.name());
-            if self.commit(editor, Edit::AddTree { index, tree }, &name) {
-                self.stats.trees += 1;
-                self.say(format!("planted {name}"));
-            }
-            return;
-        }
         let tol = Tolerances {
             point: v.metres(self.tuning.point_mm),
             close: v.metres(self.tuning.close_mm),
             simplify: v.metres(self.tuning.simplify_mm),
         };
-        let Some(shape) = stroke::classify(positions, &tol).filter(|s| s.kind == FigureKind::Closed) else {
-            self.stats.refused += 1;
-            self.say("a grove needs an outline back to its start (a tap plants one tree)".into());
-            return;
-        };
-        let index = doc.groves.len();
-        let grove = trees::new_grove(&shape.points, &v, index as u64 + 1);
-        if self.commit(editor, Edit::AddGrove { index, grove }, &format!("grove {index}")) {
-            self.stats.groves += 1;
-            let n = editor
-                .document()
-                .groves
-                .get(index)
-                .map_or(0, |g| penmodel_terrain::trees::grove::trees(g).len());
-            self.say(format!("planted grove {index}: {n} trees"));
+        let doc = editor.document();
+        match stroke::classify(positions, &tol) {
+            Some(Shape {
+                kind: FigureKind::Point,
+                points,
+            }) => {
+                let index = doc.trees.len();
+                let tree = trees::new_tree(points[0], &v, self.tree_preset, index as u64 + 1);
+                let name = format!("{} tree {index}", self.tree_preset.name());
+                if self.commit(editor, Edit::AddTree { index, tree }, &name) {
+                    self.stats.trees += 1;
+                    self.say(format!("planted {name}"));
+                }
+            }
+            Some(Shape {
+                kind: FigureKind::Closed,
+                points,
+            }) => {
+                let index = doc.groves.len();
+                let grove = trees::new_grove(&points, &v, index as u64 + 1);
+                if self.commit(editor, Edit::AddGrove { index, grove }, &format!("grove {index}")) {
+                    self.stats.groves += 1;
+                    let n = editor
+                        .document()
+                        .groves
+                        .get(index)
+                        .map_or(0, |g| penmodel_terrain::trees::grove::trees(g).len());
+                    self.say(format!("planted grove {index}: {n} trees"));
+                }
+            }
+            _ => {
+                self.stats.refused += 1;
+                self.say("a grove needs an outline back to its start (a tap plants one tree)".into());
+            }
         }
     }
 

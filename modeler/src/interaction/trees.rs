@@ -6,8 +6,9 @@
 //! - **Pick the tool and a preset**: tap the tree button (the display's left edge, below the
 //!   river button) with the tip: the tree tool with `table-3.1`; each further tap picks the next
 //!   preset (cypress, oak, fir), and a tap after the last goes back to figures.
-//! - **Plant a tree**: an SW1 tap (the tip down and up, travelling less than the tuning's
-//!   `point_mm`) plants one tree of the current preset there, [`TREE_MM`] tall on the display.
+//! - **Plant a tree**: an SW1 tap (the tip down and up, staying within the tuning's `point_mm`
+//!   of where it touched, as a point figure's stroke) plants one tree of the current preset at
+//!   the touch's mean position, [`TREE_MM`] tall on the display.
 //! - **Plant a grove**: an SW1 outline that comes back to its start (within `close_mm`) plants a
 //!   grove there: trees [`SPACING_MM`] apart on the display, [`TREE_MM`] tall, every preset in
 //!   equal shares. Lifting the tip (or SW3) ends the stroke; a stroke that is neither is refused.
@@ -110,16 +111,6 @@ pub fn new_grove(outline: &[Point], view: &View, seed: u64) -> Grove {
         seed,
         wind: Some(breeze()),
     }
-}
-
-/// Whether a stroke (ground metres) is a tap: every position within `tolerance` of the first.
-pub fn is_tap(positions: &[Point], tolerance: f64) -> bool {
-    let Some(first) = positions.first() else {
-        return false;
-    };
-    positions
-        .iter()
-        .all(|p| (p[0] - first[0]).hypot(p[1] - first[1]) <= tolerance)
 }
 
 /// What the tree tool holds.
