@@ -223,6 +223,66 @@ fn demo(seed: u64) {
         "river within {course_mm:.2} mm, {} wet cells, {moved} cells moved in two years",
         wet.len()
     );
+    assert_eq!((stats.trees, stats.groves), (2, 1), "{log:#?}");
+    check_trees(&session, &view);
+}
+
+/// The trees (issue 14): two single trees where the hand tapped (within the figures' 2 mm), a
+/// table-3.1 then a cypress, and a grove inside the outline the hand drew; all standing on the
+/// terrain and swaying: the branches drawn a second apart are not where they were.
+fn check_trees(session: &Session, view: &View) {
+    let step = pen_sim::session::tree_step();
+    let got = session.editor.document();
+    assert_eq!(got.trees.len(), 2, "two single trees");
+    let mut taps_mm = 0.0f64;
+    for (t, (tap, preset)) in got.trees.iter().zip(step.taps.iter().zip(["table-3.1", "cypress"])) {
+        let off_mm = glam::DVec2::from(t.at).distance(glam::DVec2::from(to_ground(view, *tap))) * view.scale;
+        assert!(off_mm <= 2.0, "a tree {off_mm:.2} mm from the tap");
+        taps_mm = taps_mm.max(off_mm);
+        assert_eq!(t.preset.as_deref(), Some(preset));
+    }
+    assert_eq!(got.groves.len(), 1, "one grove");
+    let mut outline: Vec<Point> = step.outline.iter().map(|p| to_ground(view, *p)).collect();
+    outline.push(outline[0]);
+    let grove_mm = shape_error(&got.groves[0].region, &outline) * view.scale;
+    assert!(grove_mm <= 2.5, "the grove's outline is off by {grove_mm:.2} mm");
+    let forest = session.editor.trees().trees();
+    assert!(forest.len() > 20, "{} trees standing", forest.len());
+    let heights = session.editor.heightmap();
+    let cell = heights.cell_size();
+    // On the ground: between the lowest and highest of the 3 × 3 cells around its trunk (any
+    // interpolation of the heightmap is).
+    for t in forest {
+        let (c, r) = ((t.at[0] / cell) as i64, (t.at[1] / cell) as i64);
+        let around: Vec<f64> = (-1..=1)
+            .flat_map(|dr| (-1..=1).map(move |dc| (c + dc, r + dr)))
+            .filter(|&(c, r)| c >= 0 && r >= 0 && c < i64::from(heights.cols()) && r < i64::from(heights.rows()))
+            .map(|(c, r)| f64::from(heights.get(c as u32, r as u32)))
+            .collect();
+        let (lo, hi) = around.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &h| {
+            (lo.min(h), hi.max(h))
+        });
+        assert!(
+            (lo - 0.01..=hi + 0.01).contains(&t.base),
+            "a tree at {:?} stands at {} m, the ground around is {lo}..{hi} m",
+            t.at,
+            t.base
+        );
+    }
+    let drawn = |t: f64| session.editor.trees().draw(|_| 0.2, t).mesh.positions;
+    let (a, b) = (drawn(0.0), drawn(1.0));
+    assert_eq!(a.len(), b.len());
+    let swayed = a.iter().zip(&b).filter(|(p, q)| p != q).count();
+    assert!(
+        swayed * 2 > a.len(),
+        "{swayed} of {} vertices moved in a second",
+        a.len()
+    );
+    println!(
+        "trees within {taps_mm:.2} mm of the taps, grove within {grove_mm:.2} mm, {} trees standing, {swayed} of {} vertices swaying",
+        forest.len(),
+        a.len()
+    );
 }
 
 fn to_ground(view: &View, p: glam::DVec2) -> Point {

@@ -60,6 +60,12 @@ fn the_demo_runs_headless_and_writes_its_results() {
         ),
         "{summary}"
     );
+    // The tree tool's step (pen_sim::session::tree_step): two taps, one outline.
+    assert_eq!(
+        (&stats["trees"], &stats["groves"]),
+        (&Value::from(2), &Value::from(1)),
+        "{summary}"
+    );
 
     let out_dir = dir.path().join("out");
     // Frames of the display's view with the overview column beside it, and their animation.

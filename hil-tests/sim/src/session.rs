@@ -183,6 +183,31 @@ pub fn ridge_step() -> RidgeStep {
     }
 }
 
+/// The session's trees (issue 14): the tree button tapped (the tree tool, `table-3.1`), a tap
+/// planting a tree, the button again (cypress), a tap planting a second; an outline drawn back to
+/// its start and the tip lifted plants a grove; three more taps on the button (oak, fir, back to
+/// figures). Every planted tree sways in the tool's breeze, so the demo's frames move.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TreeStep {
+    /// The tree button's centre, display mm (the modeler's button is the square from 8 to 28 mm
+    /// across and 56 to 76 mm down).
+    pub button: DVec2,
+    /// Where the two single trees are tapped, display mm: a table-3.1, then a cypress.
+    pub taps: [DVec2; 2],
+    /// The grove's outline, display mm (closed back to the first point).
+    pub outline: Vec<DVec2>,
+}
+
+/// The trees of the demo's session, after the ridgeline: two on the saddle between the second
+/// peak and the ridge's start, a grove on the slope right of the ridge's end.
+pub fn tree_step() -> TreeStep {
+    TreeStep {
+        button: v(18.0, 66.0),
+        taps: [v(255.0, 175.0), v(275.0, 195.0)],
+        outline: vec![v(460.0, 135.0), v(515.0, 130.0), v(520.0, 170.0), v(465.0, 175.0)],
+    }
+}
+
 /// The hand's timeline for `steps`, from and back to `home`.
 pub fn timeline(steps: &[ModelingStep], home: glam::DVec3) -> Timeline {
     let mut s = Script::new(home);
@@ -237,6 +262,23 @@ pub fn timeline(steps: &[ModelingStep], home: glam::DVec3) -> Timeline {
     }
     s.hover(ridge.over).click(SW3).hold(0.3);
     s.hover(ridge.button).touch().lift(8.0);
+    let trees = tree_step();
+    // The tree tool: its button, a tap (a tree), the button (next preset), a tap; a grove's
+    // outline ended by lifting the tip; the button three times more (back to figures).
+    s.hover(trees.button).touch().lift(8.0);
+    s.hover(trees.taps[0]).touch().lift(8.0);
+    s.hover(trees.button).touch().lift(8.0);
+    s.hover(trees.taps[1]).touch().lift(8.0);
+    if let Some(first) = trees.outline.first() {
+        s.hover(*first).touch();
+        for p in trees.outline.iter().skip(1).chain(Some(first)) {
+            s.drag_to(*p);
+        }
+        s.lift(8.0);
+    }
+    for _ in 0..3 {
+        s.hover(trees.button).touch().lift(8.0);
+    }
     s.move_to(home);
     s.build()
 }

@@ -396,13 +396,14 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
                 "undos": stats.undos, "redos": stats.redos, "refused": stats.refused,
                 "missed": stats.missed, "rock_fields": stats.rock_fields, "rivers": stats.rivers,
                 "ridgelines": stats.ridgelines, "valley_rounds": stats.grown,
+                "trees": stats.trees, "groves": stats.groves,
             },
             "head_latency": head_latency_json(&session),
         });
         pen_host::outln!("{summary}");
     } else {
         pen_host::outln!(
-            "{state}: {}; {}, {}, {}, {}, {}, {}, {}, {}; terrain {lo:.0} to {hi:.0} m",
+            "{state}: {}; {}, {}, {}, {}, {}, {}, {}, {}, {}, {}; terrain {lo:.0} to {hi:.0} m",
             count(session.events(), "pen event"),
             count(stats.regions as u64, "region"),
             count(stats.figures as u64, "figure"),
@@ -412,6 +413,8 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
             count(stats.rock_fields as u64, "rock field"),
             count(stats.rivers as u64, "river"),
             count(stats.ridgelines as u64, "ridgeline"),
+            count(stats.trees as u64, "tree"),
+            count(stats.groves as u64, "grove"),
         );
         let what = match (written.shown, &written.animation) {
             (true, _) => format!("showed {}; wrote", count(written.frames as u64, "frame")),
