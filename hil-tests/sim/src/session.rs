@@ -184,9 +184,10 @@ pub fn ridge_step() -> RidgeStep {
 }
 
 /// The session's trees (issue 14): the tree button tapped (the tree tool, `table-3.1`), a tap
-/// planting a tree, the button again (cypress), a tap planting a second; an outline drawn back to
-/// its start and the tip lifted plants a grove; three more taps on the button (oak, fir, back to
-/// figures). Every planted tree sways in the tool's breeze, so the demo's frames move.
+/// planting a tree, the button again (cypress), a tap planting a second; the first grabbed (SW2)
+/// and pulled up, taller; an outline drawn back to its start and the tip lifted plants a grove;
+/// three more taps on the button (oak, fir, back to figures). Every planted tree sways in the
+/// tool's breeze, so the demo's frames move.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TreeStep {
     /// The tree button's centre, display mm (the modeler's button is the square from 8 to 28 mm
@@ -194,6 +195,8 @@ pub struct TreeStep {
     pub button: DVec2,
     /// Where the two single trees are tapped, display mm: a table-3.1, then a cypress.
     pub taps: [DVec2; 2],
+    /// The pen's height when it lets go of the first tree, pulled: its top, mm.
+    pub pull_mm: f64,
     /// The grove's outline, display mm (closed back to the first point).
     pub outline: Vec<DVec2>,
 }
@@ -204,6 +207,7 @@ pub fn tree_step() -> TreeStep {
     TreeStep {
         button: v(18.0, 66.0),
         taps: [v(255.0, 175.0), v(275.0, 195.0)],
+        pull_mm: 25.0,
         outline: vec![v(460.0, 135.0), v(515.0, 130.0), v(520.0, 170.0), v(465.0, 175.0)],
     }
 }
@@ -263,12 +267,14 @@ pub fn timeline(steps: &[ModelingStep], home: glam::DVec3) -> Timeline {
     s.hover(ridge.over).click(SW3).hold(0.3);
     s.hover(ridge.button).touch().lift(8.0);
     let trees = tree_step();
-    // The tree tool: its button, a tap (a tree), the button (next preset), a tap; a grove's
-    // outline ended by lifting the tip; the button three times more (back to figures).
+    // The tree tool: its button, a tap (a tree), the button (next preset), a tap; the first tree
+    // pulled taller; a grove's outline ended by lifting the tip; the button three times more
+    // (back to figures).
     s.hover(trees.button).touch().lift(8.0);
     s.hover(trees.taps[0]).touch().lift(8.0);
     s.hover(trees.button).touch().lift(8.0);
     s.hover(trees.taps[1]).touch().lift(8.0);
+    s.grab(trees.taps[0]).pull_to(trees.pull_mm).hold(0.3).let_go();
     if let Some(first) = trees.outline.first() {
         s.hover(*first).touch();
         for p in trees.outline.iter().skip(1).chain(Some(first)) {
