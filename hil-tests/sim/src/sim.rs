@@ -55,6 +55,9 @@ pub struct Scenario {
     /// A viewer wears the tracked glasses and the device schedules their emitter with these
     /// settings; `None`: the pen alone.
     pub head: Option<HeadSettings>,
+    /// Device time at which the glasses are switched on (as a HeadOn from the host would),
+    /// s; 0: tracked from the start.
+    pub head_from_s: f64,
 }
 
 impl Scenario {
@@ -69,6 +72,7 @@ impl Scenario {
             config,
             unique_id: SIM_UNIQUE_ID,
             head: None,
+            head_from_s: 0.0,
         }
     }
 
@@ -77,6 +81,16 @@ impl Scenario {
     pub fn with_head(self, head: HeadSettings) -> Scenario {
         Scenario {
             head: Some(head),
+            ..self
+        }
+    }
+
+    /// The same session with the glasses switched on only at `from_s` seconds of device time:
+    /// until then the device tracks the pen alone.
+    pub fn with_head_from(self, head: HeadSettings, from_s: f64) -> Scenario {
+        Scenario {
+            head: Some(head),
+            head_from_s: from_s.max(0.0),
             ..self
         }
     }
@@ -266,6 +280,8 @@ pub struct Simulation {
     engine: SimEngine,
     station: Station<NoopRawMutex, SimEngine, SimRanging, SimSwitches, SimClock, SimSink>,
     scenario: Scenario,
+    /// The glasses' settings until they are switched on ([`Scenario::head_from_s`]).
+    head_pending: Option<HeadSettings>,
 }
 
 impl Simulation {
@@ -316,9 +332,10 @@ impl Simulation {
             pacer: None,
         }));
         let mut device = Engine::new(Some(scenario.config), SIM_FIRMWARE, scenario.unique_id);
-        // A viewer wears the glasses: their emitter is fitted, and tracked from the start.
+        // A viewer wears the glasses: their emitter is fitted, and tracked from the start unless
+        // they are switched on later (see `step`).
         device.set_head_emitter_fitted(scenario.head.is_some());
-        device.set_head(scenario.head);
+        device.set_head(scenario.head.filter(|_| scenario.head_from_s <= 0.0));
         let engine: SimEngine = Rc::new(Mutex::new(RefCell::new(device)));
         let station = Station::new(
             engine.clone(),
@@ -332,6 +349,7 @@ impl Simulation {
             engine,
             station,
             scenario: scenario.clone(),
+            head_pending: scenario.head.filter(|_| scenario.head_from_s > 0.0),
         }
     }
 
@@ -359,6 +377,13 @@ impl Simulation {
     /// Runs one measurement cycle.
     pub fn step(&mut self) -> CycleRecord {
         let t0_us = self.now_us();
+        if let Some(head) = self.head_pending
+            && t0_us as f64 >= self.scenario.head_from_s * 1e6
+        {
+            // The glasses switched on: from this cycle the device multiplexes their emitter.
+            self.head_pending = None;
+            self.engine.lock(|e| e.borrow_mut().set_head(Some(head)));
+        }
         // The world hears within the slot's listening window, which the engine knows (it is
         // the pen-only cycle's unless the head is tracked).
         let listen = self.engine.lock(|e| {
