@@ -90,7 +90,7 @@ pub fn bake(mesh: &Mesh, style: &Style, size: u32) -> Baked {
     // A flat group still gets a box with some depth, so every image has an extent.
     let pad = (hi - lo).max_element().max(1e-6) * 1e-3;
     let bounds = [lo - pad, hi + pad];
-    let light = Vec3::from_array(super::shade::world_light(style));
+    let light = Vec3::from_array(super::light::world_light(style));
     let ambient = style.ambient.clamp(0.0, 1.0);
     let lit: Vec<f32> = mesh
         .normals

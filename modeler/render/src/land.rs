@@ -33,8 +33,9 @@
 
 use rayon::prelude::*;
 
+use super::light;
+use super::ramp::{self, WATER};
 use super::scene::{Scene, Style};
-use super::shade::{self, WATER};
 use penmodel_terrain::ridge::sun::{self, Field};
 
 /// Grass, lush.
@@ -155,7 +156,7 @@ impl Land {
         self.last_print = print;
         let Some(mut rect) = rect else {
             if let Some(given) = scene.light_map {
-                self.bad = shade::vertex_light(map, scene.vertical_scale, &scene.style, Some(given), light);
+                self.bad = light::vertex_light(map, scene.vertical_scale, &scene.style, Some(given), light);
             }
             return self.bad;
         };
@@ -198,7 +199,7 @@ impl Land {
         self.albedo.resize(cols * rows, [0.0; 3]);
         colours(map, &scene.style, &self.shore, grown, &self.noise, &mut self.albedo);
         self.bad = match scene.light_map {
-            Some(given) => shade::vertex_light(map, scene.vertical_scale, &scene.style, Some(given), light),
+            Some(given) => light::vertex_light(map, scene.vertical_scale, &scene.style, Some(given), light),
             None => lights(map, scene.vertical_scale, &scene.style, light),
         };
         self.key = Some(key);
@@ -354,7 +355,7 @@ pub const SHORE_CELLS: f32 = 3.0;
 pub fn material(style: &Style, h: f32, slope: f32, broad: f32, fine: f32, shore: Shore) -> [f32; 3] {
     if h < 0.0 {
         let depth = style.ramp_depth.max(f32::MIN_POSITIVE);
-        return rgb(shade::interpolate(&WATER, -h / depth));
+        return rgb(ramp::interpolate(&WATER, -h / depth));
     }
     let snow_line = style.snow_line.max(f32::MIN_POSITIVE);
     let jitter = broad - 0.5;
@@ -515,7 +516,7 @@ fn colours(
                     continue;
                 }
                 // The true slope: heights unscaled.
-                let [dx, dz] = shade::gradient(h, (cols, rows), (c, r), (r0, r1), (1.0, s as f32));
+                let [dx, dz] = light::gradient(h, (cols, rows), (c, r), (r0, r1), (1.0, s as f32));
                 let slope = atan_degrees((dx * dx + dz * dz).sqrt());
                 let [broad, fine] = noise[r * cols + c];
                 let near = shore.get(r * cols + c).copied().unwrap_or(Shore::NONE);
@@ -585,7 +586,7 @@ fn lights(map: &penmodel_terrain::Heightmap, vertical_scale: f32, style: &Style,
     let sky = sun::sky_view(field, style.sky_directions.max(1));
     let h = map.heights();
     let s = map.cell_size() as f32;
-    let light = shade::world_light(style);
+    let light = light::world_light(style);
     let ambient = style.ambient.clamp(0.0, 1.0);
     // A vertex's place on the coarse grid: block centres at (i + ½)f − ½ cells.
     let half = (f as f32 - 1.0) * 0.5;
@@ -612,7 +613,7 @@ fn lights(map: &penmodel_terrain::Heightmap, vertical_scale: f32, style: &Style,
                     bad += 1;
                     continue;
                 }
-                let [dx, dz] = shade::gradient(h, (cols, rows), (c, r), (r0, r1), (vertical_scale, s));
+                let [dx, dz] = light::gradient(h, (cols, rows), (c, r), (r0, r1), (vertical_scale, s));
                 let inv = 1.0 / (dx * dx + 1.0 + dz * dz).sqrt();
                 let lambert = ((-dx * light[0] + light[1] - dz * light[2]) * inv).max(0.0);
                 let seen = bilinear(&sun_seen, c, r);

@@ -8,8 +8,9 @@
 //!    screen bounds, near to far.
 //! 3. [`clip`]: triangles and lines crossing the near plane or the guard band, cut.
 //! 4. [`rasterise`]: triangles into a depth buffer, fixed point, top-left rule.
-//! 5. [`shade`]: per-vertex light, the elevation ramp per pixel, the sky; or the land look's
-//!    ground colours ([`land`]) and the sky, table and haze around them ([`atmosphere`]).
+//! 5. [`shade`]: per-vertex light ([`light`]), the elevation ramp per pixel ([`ramp`]), the sky;
+//!    or the land look's ground colours ([`land`]) and the sky, table and haze around them
+//!    ([`atmosphere`]).
 //! 6. [`overlay`]: figures and boundaries draped on the surface, depth-tested with a bias.
 //! 7. [`ui`] and [`text`]: the slope bar and the mode line.
 //! 8. [`stereo`]: anaglyph and side-by-side.
@@ -32,8 +33,10 @@ pub mod forest;
 pub mod frame;
 pub mod impostor;
 pub mod land;
+pub mod light;
 pub mod meshes;
 pub mod overlay;
+pub mod ramp;
 pub mod rasterise;
 pub mod scene;
 pub mod shade;
@@ -220,7 +223,7 @@ impl Renderer {
         }
         // The light buffer is about to hold the classic light.
         self.land.forget();
-        let skipped = shade::vertex_light(
+        let skipped = light::vertex_light(
             scene.terrain,
             scene.vertical_scale,
             &scene.style,
@@ -284,7 +287,7 @@ impl Renderer {
         let (width, height) = (frame.width(), frame.height());
         let (affine, near, projection) = self.project(scene, eye, viewport, width, height);
         self.samples.resize(width as usize * height as usize, Sample::default());
-        let ramp = shade::Ramp::new(&scene.style);
+        let ramp = ramp::Ramp::new(&scene.style);
         let air = (scene.style.look == scene::Look::Land)
             .then(|| atmosphere::Atmosphere::new(&projection, scene.terrain, scene.vertical_scale, &scene.style));
         let columns = (viewport.x0 as usize, viewport.x1 as usize);

@@ -82,7 +82,7 @@ impl Projected {
         near: f32,
         style: &Style,
     ) {
-        let light = super::shade::world_light(style);
+        let light = super::light::world_light(style);
         let ambient = style.ambient.clamp(0.0, 1.0);
         let s = cell_size as f32;
         let first = self.0.triangles();

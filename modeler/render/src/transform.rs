@@ -141,7 +141,7 @@ pub struct Projected {
 }
 
 /// Projects every vertex of `map` and sorts its chunks; `light` is per vertex
-/// ([`super::shade::vertex_light`]), `viewport` the pixels this eye may draw.
+/// ([`super::light::vertex_light`]), `viewport` the pixels this eye may draw.
 pub fn project_grid(map: &Heightmap, light: &[f32], affine: &Affine, near: f32, viewport: Bounds, out: &mut Projected) {
     let (cols, rows) = (map.cols() as usize, map.rows() as usize);
     let n = cols * rows;
