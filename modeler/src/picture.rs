@@ -170,7 +170,7 @@ impl Picture {
         Picture::from_parts(ui, doc, mode, look)
             .with_rocks(session.editor.rocks().shared())
             .with_water(Arc::new(water))
-            .with_trees(Arc::new(session.editor.trees().trees().to_vec()))
+            .with_trees(session.editor.trees().shared())
             // The pen's clock drives the sway, so a replayed session sways the same.
             .with_time(session.last_event_us().map_or(0.0, |us| us as f64 * 1e-6))
     }

@@ -868,7 +868,7 @@ fn write_results(
     // The trees at the last event's time, as the last frame drew them.
     let picture = Picture::document(session.editor.document(), &view, mode, look)
         .with_rocks(session.editor.rocks().shared())
-        .with_trees(std::sync::Arc::new(session.editor.trees().trees().to_vec()))
+        .with_trees(session.editor.trees().shared())
         .with_time(session.last_event_us().map_or(0.0, |us| us as f64 * 1e-6));
     bytes.clear();
     output::encode_png(painter.plain(&picture, map)?, &mut bytes)?;

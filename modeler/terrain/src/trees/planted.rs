@@ -91,7 +91,8 @@ impl Species {
 pub struct Forest {
     species: Vec<(Vec<IfsMap>, Arc<NodeTree>)>,
     groves: Vec<(Grove, Arc<Vec<GroveTree>>)>,
-    trees: Vec<Standing>,
+    /// Shared with the pictures drawn from it, so that a frame takes them without a copy.
+    trees: Arc<Vec<Standing>>,
 }
 
 /// The node tree of `species` from `built`, building and keeping it the first time.
@@ -157,7 +158,7 @@ impl Forest {
                 });
             }
         }
-        self.trees = trees;
+        self.trees = Arc::new(trees);
     }
 
     /// Every standing tree: the document's trees in order, then each grove's.
@@ -165,10 +166,15 @@ impl Forest {
         &self.trees
     }
 
+    /// The same trees, shared: what a picture keeps for its frame.
+    pub fn shared(&self) -> Arc<Vec<Standing>> {
+        Arc::clone(&self.trees)
+    }
+
     /// Draws every tree at the roughness `q(tree)` gives and time `t` seconds.
     pub fn draw(&self, q: impl Fn(&Standing) -> f64, t: f64) -> Drawn {
         let mut out = Drawn::default();
-        for tree in &self.trees {
+        for tree in self.trees.iter() {
             tree.draw(q(tree), t, &mut out);
         }
         out
