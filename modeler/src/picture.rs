@@ -114,6 +114,9 @@ pub struct Picture {
     trees: Arc<Vec<Standing>>,
     /// Seconds, for the trees' sway.
     time: f64,
+    /// The pen's tip while it is over the display: its ground point and, in the air, its height
+    /// (metres); on the surface, the terrain's. The trees' gaze turns to it (seed 004).
+    pen_tip: Option<(Point, Option<f64>)>,
 }
 
 /// A tool button's outline: bright and thick while its tool is on.
@@ -264,6 +267,7 @@ impl Picture {
             water: Arc::default(),
             trees: Arc::default(),
             time: 0.0,
+            pen_tip: None,
         }
     }
 
@@ -415,6 +419,12 @@ impl Picture {
                 height: None,
             });
         }
+        let pen_tip = ui.pen().map(|p| {
+            (
+                view.to_ground(p.u_mm, p.v_mm),
+                (p.h_mm > 1.0).then(|| view.height_at(p.h_mm)),
+            )
+        });
         if let Some(p) = ui.pen() {
             let ground = view.to_ground(p.u_mm, p.v_mm);
             overlays.push(dot(ground, None, PEN_COLOUR, 4.0));
@@ -440,6 +450,7 @@ impl Picture {
             water: Arc::default(),
             trees: Arc::default(),
             time: 0.0,
+            pen_tip,
         }
     }
 
@@ -464,6 +475,8 @@ impl Picture {
                 stereo: Stereo::None,
                 ..self.look.clone()
             },
+            // Nobody's eyes are at an orbit camera: its trees are chosen along its view axis.
+            pen_tip: None,
             ..self.clone()
         }
     }
@@ -501,6 +514,10 @@ impl Picture {
             style: self.look.style.clone(),
             trees: &self.trees,
             time: self.time,
+            looking_at: self.pen_tip.and_then(|(g, h)| {
+                let h = h.or_else(|| penmodel_render::overlay::surface_height(terrain, g[0], g[1]))?;
+                Some([g[0], h * f64::from(self.vertical_scale), g[1]])
+            }),
             ..Scene::new(terrain, self.camera)
         }
     }

@@ -5,8 +5,11 @@
 //! - **Distance** `D`: from the centre eye to the middle of the tree's height; `L0` is the
 //!   tree's height. **Angle** `θ`: between the gaze and the line to that point. `Q` is
 //!   [`Roughness::choose`]`(D, L0, θ)`.
-//! - **The gaze** is [`Scene::gaze`] when the tracked head's view direction is known, else the
-//!   line from the centre eye through the screen's centre (an orbit camera's view axis).
+//! - **The gaze** is [`Scene::gaze`] when a view direction is given; else the line from the
+//!   centre eye to [`Scene::looking_at`], the pen's tip while modeling (the seed: "the pen tip's
+//!   direction from the head"); else the line from the centre eye through the screen's centre.
+//!   The tracker gives the head's position, not where it faces, so with the tracked head and no
+//!   pen the gaze is the line from the real eyes through the display's centre.
 //! - **LOD off** ([`Scene::tree_lod`] `None`) draws every tree at [`STOP`], the full model.
 //! - Both eyes see the same `Q` per tree, so a stereo pair never shows a group as geometry in one
 //!   eye and as a shape in the other.
@@ -59,10 +62,12 @@ pub fn eye_and_gaze(scene: &Scene, aspect: f64) -> (DVec3, DVec3) {
     let eye = back * (vp.eye - vp.pivot) + vp.pivot;
     let centre = 0.5 * (vp.lower_right + vp.upper_left);
     let axis = back * (centre - vp.eye);
+    let usable = |g: &DVec3| g.is_finite() && g.length() > 0.0;
     let gaze = scene
         .gaze
         .map(DVec3::from_array)
-        .filter(|g| g.is_finite() && g.length() > 0.0)
+        .filter(usable)
+        .or_else(|| scene.looking_at.map(|p| DVec3::from_array(p) - eye).filter(usable))
         .unwrap_or(axis);
     (eye, gaze.normalize_or(DVec3::NEG_Y))
 }

@@ -228,6 +228,10 @@ pub struct Scene<'a> {
     /// The tracked head's view direction, world `[X, Y up, Z]`, when known; otherwise the gaze
     /// is the line from the centre eye through the screen's centre.
     pub gaze: Option<[f64; 3]>,
+    /// The point the viewer looks at, world `[X, Y up, Z]`, when known (the pen's tip while
+    /// modeling: seed 004's gaze is "the pen tip's direction from the head"); the gaze then runs
+    /// from the centre eye to it. [`Scene::gaze`] takes precedence.
+    pub looking_at: Option<[f64; 3]>,
     /// Seconds, for the trees' sway in the wind.
     pub time: f64,
     /// Textured, alpha-tested quads (the exports' frame), each naming a texture of
@@ -256,6 +260,7 @@ impl<'a> Scene<'a> {
             trees: &[],
             tree_lod: Some(Roughness::default()),
             gaze: None,
+            looking_at: None,
             time: 0.0,
             polygons: &[],
             textures: &[],

@@ -256,4 +256,17 @@ fn near_the_gaze_a_tree_is_full_and_far_in_the_periphery_it_is_simplified() {
         "{lod:?} of {}",
         nodes.polygons()
     );
+    // The pen's tip on that tree while modeling: the gaze turns to it, so only its distance
+    // simplifies it, and it keeps several times the polygons it had in the periphery.
+    let middle = [far[0].at[0], 10.0, far[0].at[1]];
+    scene.looking_at = Some(middle);
+    render(&scene, &mut renderer, 160, 120);
+    let looked = renderer.tree_stats();
+    assert!(
+        looked.total_polygons() > 3 * lod.total_polygons(),
+        "looked at {looked:?}, in the periphery {lod:?}"
+    );
+    let (eye, gaze) = penmodel_render::forest::eye_and_gaze(&scene, 160.0 / 120.0);
+    let to = (glam::DVec3::from_array(middle) - eye).normalize();
+    assert!(gaze.dot(to) > 0.999_999, "gaze {gaze} towards {to}");
 }
