@@ -130,6 +130,42 @@ def receiver():
     return _svg(d)
 
 
+def _bridge_driver(d, base, pin, names, load):
+    """A burst pin's driver: the burst to A, inverted to B, the transducer between the outputs
+    (through the DC block, its bleed resistor across it). `names` are the inverter's, the
+    driver's, the block's and the bleed's references; `load` labels the transducer."""
+    inverter, driver, block, bleed = names
+    elm.Line().left(3.0).at(base).color("white")  # room for the label
+    elm.Dot(open=True).at(base).label(pin, loc="left")
+    elm.Line().right(1.0).at(base)
+    pin_dot = elm.Dot()
+    d.push()
+    elm.Resistor().down().label(f"{R(v.R_BURST_PULLDOWN)}", loc="bottom")
+    elm.Ground()
+    d.pop()
+    elm.Line().right(6.0)
+    drv = elm.Ic(pins=[elm.IcPin(name="INA", side="left", slot="1/2"), elm.IcPin(name="INB", side="left", slot="2/2"),
+                       elm.IcPin(name="OUTA", side="right", slot="1/2"), elm.IcPin(name="OUTB", side="right", slot="2/2"),
+                       elm.IcPin(name="VDD", side="top"), elm.IcPin(name="GND", side="bottom")],
+                 size=(2.6, 2.6), label=f"{driver} TC4427", lblloc="center", pinspacing=1.2).right().anchor("INA")
+    elm.Line().up(0.8).at(drv.VDD)
+    elm.Vdd().label("+12 V")
+    elm.Ground().at(drv.GND)
+    elm.Wire("|-").at(pin_dot.center).to((pin_dot.center[0] + 1.5, drv.INB[1]))
+    logic.Not().right().at((pin_dot.center[0] + 1.5, drv.INB[1])).label(f"{inverter} 74LVC1G04", loc="bottom")
+    elm.Line().right().tox(drv.INB)
+    # OUTB (on top) through the DC block; the transducer and its bleed resistor on the cable.
+    elm.Capacitor().right(3.0).at(drv.OUTB).label(f"{block} {C(v.C_TX_DC)}")
+    b = elm.Dot()
+    elm.Line().right(1.5)
+    elm.Crystal().down().toy(drv.OUTA).label(load, loc="bottom")
+    a = elm.Dot()
+    elm.Line().left().tox(drv.OUTA)
+    elm.Resistor().down().at(b.center).toy(a.center).label(f"{bleed}\n{R(v.R_TX_BLEED)}", loc="bottom")
+    # Room for the transducer's label, clear of its text: schemdraw's bounds leave labels out.
+    elm.Line().right(3.5).at((a.center[0], a.center[1] - 1.5)).color("white")
+
+
 def transmitter():
     with schemdraw.Drawing(show=False) as d:
         d.config(fontsize=10, unit=2.2, bgcolor="white")
@@ -172,35 +208,12 @@ def transmitter():
         elm.Tag().left().label("+5 V")
         elm.Line().left(1.0).at(ic.EN)
         elm.Tag().left().label("+5 V")
-        # Driver: PA8's burst to A, inverted to B; the transducer between the outputs.
+        # The pen's driver, and below it the glasses' (issue 16): the same bridge on PA9.
         base = (sw.center[0] - 6.0, sw.center[1] - 10.0)
-        elm.Line().left(3.0).at(base).color("white")  # room for the label
-        elm.Dot(open=True).at(base).label("PA8 (TIM1 CH1)", loc="left")
-        elm.Line().right(1.0).at(base)
-        pa8 = elm.Dot()
-        d.push()
-        elm.Resistor().down().label(f"{R(v.R_BURST_PULLDOWN)}", loc="bottom")
-        elm.Ground()
-        d.pop()
-        elm.Line().right(6.0)
-        drv = elm.Ic(pins=[elm.IcPin(name="INA", side="left", slot="1/2"), elm.IcPin(name="INB", side="left", slot="2/2"),
-                           elm.IcPin(name="OUTA", side="right", slot="1/2"), elm.IcPin(name="OUTB", side="right", slot="2/2"),
-                           elm.IcPin(name="VDD", side="top"), elm.IcPin(name="GND", side="bottom")],
-                     size=(2.6, 2.6), label="U3 TC4427", lblloc="center", pinspacing=1.2).right().anchor("INA")
-        elm.Line().up(0.8).at(drv.VDD)
-        elm.Vdd().label("+12 V")
-        elm.Ground().at(drv.GND)
-        elm.Wire("|-").at(pa8.center).to((pa8.center[0] + 1.5, drv.INB[1]))
-        logic.Not().right().at((pa8.center[0] + 1.5, drv.INB[1])).label("U2 74LVC1G04", loc="bottom")
-        elm.Line().right().tox(drv.INB)
-        # OUTB (on top) through the DC block; the transducer and its bleed resistor in the pen's cable.
-        elm.Capacitor().right(3.0).at(drv.OUTB).label(f"C10 {C(v.C_TX_DC)}")
-        b = elm.Dot()
-        elm.Line().right(1.5)
-        elm.Crystal().down().toy(drv.OUTA).label(f"LS501 MA40S4S\nin the pen\n{v.tx_swing():.1f} V p-p", loc="bottom")
-        a = elm.Dot()
-        elm.Line().left().tox(drv.OUTA)
-        elm.Resistor().down().at(b.center).toy(a.center).label(f"R10\n{R(v.R_TX_BLEED)}", loc="bottom")
+        _bridge_driver(d, base, "PA8 (TIM1 CH1)", ("U2", "U3", "C10", "R10"),
+                       f"LS501 MA40S4S\nin the pen\n{v.tx_swing():.1f} V p-p")
+        _bridge_driver(d, (base[0], base[1] - 7.0), "PA9 (TIM1 CH2)", ("U4", "U5", "C12", "R12"),
+                       f"J4: glasses cable\nLS601 MA40S4S\non the glasses\n{v.tx_swing():.1f} V p-p")
     return _svg(d)
 
 
