@@ -222,7 +222,26 @@ fn bench_json_has_the_documented_shape() {
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let obj = v.as_object().unwrap();
-    assert_eq!(obj.keys().collect::<Vec<_>>(), ["render", "pull_update", "memory"]);
+    assert_eq!(
+        obj.keys().collect::<Vec<_>>(),
+        ["render", "pull_update", "memory", "terrain"]
+    );
+    // The terrain engine's figures (issue 18): each grid in both metrics.
+    let terrain = v["terrain"].as_array().unwrap();
+    assert_eq!(terrain.len(), 4);
+    for (t, (n, metric)) in terrain
+        .iter()
+        .zip([(16, "taxicab"), (16, "euclidean"), (24, "taxicab"), (24, "euclidean")])
+    {
+        assert_eq!(
+            t.as_object().unwrap().keys().collect::<Vec<_>>(),
+            ["grid", "metric", "full_ms", "move_point_ms", "slope_ms"]
+        );
+        assert_eq!((t["grid"].as_u64(), t["metric"].as_str()), (Some(n), Some(metric)));
+        for key in ["full_ms", "move_point_ms", "slope_ms"] {
+            assert!(t[key].as_f64().unwrap() >= 0.0, "{key}");
+        }
+    }
     let render = v["render"].as_array().unwrap();
     let pull = v["pull_update"].as_array().unwrap();
     for (i, n) in [16, 24].into_iter().enumerate() {

@@ -13,6 +13,11 @@
 //! - Pull update: [`Editor::preview`] of the first figure's height, alternating between two
 //!   values after a first (untimed) step that starts the pull.
 //! - Medians over repeated runs after warm-up.
+//! - Terrain engine (issue 18), for each grid and both metrics (`taxicab`, `euclidean`): a full
+//!   regeneration ([`TerrainEngine::new`]), a moved vertex (the fourth figure's second point
+//!   moved 2 m and back, as the criterion bench's `move_point`) and a slope change of the first
+//!   figure (−1.5 ↔ −1.4), each an edit applied to the document and the engine brought up to date
+//!   with its scope; medians. `--terrain-only` measures only these.
 //! - Memory, measured first: the peak resident set (`VmHWM` of /proc/self/status, Linux) after
 //!   building the terrain of a document with K point figures in one region over most of an
 //!   N × N grid (default 100 figures on 1024², cell size 1 m), beside the bound validation
@@ -24,7 +29,9 @@ use std::time::Instant;
 use anyhow::{Context, Result};
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use penmodel_render::{Camera, Frame, Renderer, Scene, SlopeBar, Style};
-use penmodel_terrain::{Document, Edit, Editor, Figure, FigureKind, FigurePath, Grid, Region, TerrainEngine, validate};
+use penmodel_terrain::{
+    CurvePath, Document, Edit, Editor, Figure, FigureKind, FigurePath, Grid, Metric, Region, TerrainEngine, validate,
+};
 
 /// Grid sizes measured.
 const GRIDS: [u32; 3] = [256, 512, 1024];
@@ -36,14 +43,22 @@ const FRAMES: usize = 25;
 const PULLS: usize = 60;
 /// Untimed frames first.
 const WARM_UP: usize = 3;
+/// Timed full regenerations per grid and metric.
+const FULLS: usize = 7;
+/// Timed vertex moves and slope changes per grid and metric.
+const EDITS: usize = 30;
 
 /// Arguments of `penmodel bench`.
 #[derive(clap::Args)]
 #[command(after_help = "Examples:\n  penmodel bench\n  penmodel bench --json > bench.json")]
 pub struct Args {
-    /// Print `{"render": [...], "pull_update": [...]}` on stdout instead of a table.
+    /// Print `{"render": [...], "pull_update": [...], "memory": {...}, "terrain": [...]}` on stdout
+    /// instead of a table.
     #[arg(long)]
     json: bool,
+    /// Measure only the terrain engine (full regeneration, moved vertex, slope change).
+    #[arg(long)]
+    terrain_only: bool,
     /// Grid sizes to measure (repeatable; default 256, 512 and 1024).
     #[arg(long = "grid", value_name = "N", value_parser = clap::value_parser!(u32).range(2..=4096))]
     grids: Vec<u32>,
@@ -238,6 +253,65 @@ fn measure(n: u32, look: crate::render::LookArg, bar: &ProgressBar) -> Result<Fi
     })
 }
 
+/// The terrain engine's figures for one grid and metric.
+struct Engine {
+    grid: u32,
+    metric: Metric,
+    full_ms: f64,
+    move_point_ms: f64,
+    slope_ms: f64,
+}
+
+fn measure_engine(n: u32, metric: Metric, bar: &ProgressBar) -> Result<Engine> {
+    let mut doc = document(n)?;
+    doc.terrain.metric = metric;
+    let mut fulls = Vec::with_capacity(FULLS);
+    for _ in 0..FULLS {
+        let t = Instant::now();
+        let engine = TerrainEngine::new(&doc)?;
+        fulls.push(ms(t));
+        drop(engine);
+        bar.inc(1);
+    }
+    let mut terrain = TerrainEngine::new(&doc)?;
+    let mut edit = |doc: &mut Document, edit: Edit| -> Result<f64> {
+        let t = Instant::now();
+        let applied = edit.apply_to(doc)?;
+        terrain.update(doc, &applied.scope);
+        Ok(ms(t))
+    };
+    let curve = CurvePath::Figure(FigurePath::new(0, 3));
+    let mut moves = Vec::with_capacity(EDITS);
+    let mut slopes = Vec::with_capacity(EDITS);
+    for i in 0..EDITS {
+        let x = if i % 2 == 0 { 112.0 } else { 110.0 };
+        moves.push(edit(
+            &mut doc,
+            Edit::MovePoint {
+                curve: curve.clone(),
+                index: 1,
+                to: [x, 170.0],
+            },
+        )?);
+        let slope = if i % 2 == 0 { -1.4 } else { -1.5 };
+        slopes.push(edit(
+            &mut doc,
+            Edit::SetSlope {
+                at: FigurePath::new(0, 0),
+                slope,
+            },
+        )?);
+        bar.inc(1);
+    }
+    Ok(Engine {
+        grid: n,
+        metric,
+        full_ms: median(fulls),
+        move_point_ms: median(moves),
+        slope_ms: median(slopes),
+    })
+}
+
 /// Runs the command.
 pub fn run(args: &Args) -> Result<()> {
     let grids = if args.grids.is_empty() {
@@ -245,7 +319,9 @@ pub fn run(args: &Args) -> Result<()> {
     } else {
         args.grids.clone()
     };
-    let total = grids.len() * (WARM_UP + FRAMES + PULLS);
+    let metrics = [Metric::Taxicab, Metric::Euclidean];
+    let render_steps = if args.terrain_only { 0 } else { WARM_UP + FRAMES + PULLS };
+    let total = grids.len() * (render_steps + metrics.len() * (FULLS + EDITS));
     let bar = if std::io::stderr().is_terminal() {
         let bar = ProgressBar::with_draw_target(Some(total as u64), ProgressDrawTarget::stderr());
         if let Ok(style) = ProgressStyle::with_template("{msg:>12} [{bar:30}] {pos}/{len}") {
@@ -258,9 +334,15 @@ pub fn run(args: &Args) -> Result<()> {
     // First, while the process is small, so the peak is the engine's.
     let memory = measure_memory(args.memory_grid, args.memory_figures)?;
     let mut results = Vec::new();
+    let mut engines = Vec::new();
     for &n in &grids {
         bar.set_message(format!("{n}×{n}"));
-        results.push(measure(n, args.look, &bar)?);
+        if !args.terrain_only {
+            results.push(measure(n, args.look, &bar)?);
+        }
+        for metric in metrics {
+            engines.push(measure_engine(n, metric, &bar)?);
+        }
     }
     bar.finish_and_clear();
     let (w, h) = FRAME;
@@ -287,12 +369,21 @@ pub fn run(args: &Args) -> Result<()> {
             "peak_rss_mb": memory.peak.map(mb),
             "rss_before_mb": memory.before.map(mb),
         });
+        let terrain: Vec<_> = engines
+            .iter()
+            .map(|e| {
+                serde_json::json!({"grid": e.grid, "metric": e.metric.name(), "full_ms": round3(e.full_ms),
+                    "move_point_ms": round3(e.move_point_ms), "slope_ms": round3(e.slope_ms)})
+            })
+            .collect();
         pen_host::outln!(
             "{}",
-            serde_json::json!({"render": render, "pull_update": pull, "memory": memory})
+            serde_json::json!({"render": render, "pull_update": pull, "memory": memory, "terrain": terrain})
         );
     } else {
-        pen_host::outln!("grid        frame {w}×{h}   (mean)      frames/s   terrain on screen   pull update");
+        if !results.is_empty() {
+            pen_host::outln!("grid        frame {w}×{h}   (mean)      frames/s   terrain on screen   pull update");
+        }
         for r in &results {
             pen_host::outln!(
                 "{:>4}×{:<4}   {:>8.2} ms   ({:>6.2} ms)   {:>9.1}   {:>16.0} %   {:>8.3} ms",
@@ -305,8 +396,25 @@ pub fn run(args: &Args) -> Result<()> {
                 r.pull_ms
             );
         }
+        if !results.is_empty() {
+            pen_host::outln!(
+                "{look} look; medians of {FRAMES} frames and {PULLS} pull updates per grid; targets at 512×512: ≤ 16.7 ms, ≤ 2 ms"
+            );
+        }
+        pen_host::outln!("grid        metric       full regeneration   move one vertex   slope change");
+        for e in &engines {
+            pen_host::outln!(
+                "{:>4}×{:<4}   {:<9}   {:>14.3} ms   {:>12.3} ms   {:>9.3} ms",
+                e.grid,
+                e.grid,
+                e.metric.name(),
+                e.full_ms,
+                e.move_point_ms,
+                e.slope_ms
+            );
+        }
         pen_host::outln!(
-            "{look} look; medians of {FRAMES} frames and {PULLS} pull updates per grid; targets at 512×512: ≤ 16.7 ms, ≤ 2 ms"
+            "terrain engine: medians of {FULLS} regenerations, {EDITS} moves and {EDITS} slope changes; targets at 512×512: ≤ 10 ms, ≤ 4 ms, ≤ 1 ms"
         );
         let show = |v: Option<u64>| v.map_or("unknown".to_owned(), |b| format!("{} MB", mb(b)));
         pen_host::outln!(
