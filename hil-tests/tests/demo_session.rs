@@ -229,14 +229,19 @@ fn demo(seed: u64) {
 }
 
 /// The trees (issue 14): two single trees where the hand tapped (within the figures' 2 mm), a
-/// table-3.1 then a cypress, and a grove inside the outline the hand drew; all standing on the
+/// table-3.1 then a sample-3.2 (the seed's two species), and a grove inside the outline the hand drew; all standing on the
 /// terrain and swaying: the branches drawn a second apart are not where they were.
 fn check_trees(session: &Session, view: &View) {
     let step = pen_sim::session::tree_step();
+    assert_eq!(
+        pen_sim::session::TREE_TAPS_TO_FIGURES,
+        penmodel_terrain::trees::Preset::ALL.len() - 1,
+        "the session's taps past the modeler's presets"
+    );
     let got = session.editor.document();
     assert_eq!(got.trees.len(), 2, "two single trees");
     let mut taps_mm = 0.0f64;
-    for (t, (tap, preset)) in got.trees.iter().zip(step.taps.iter().zip(["table-3.1", "cypress"])) {
+    for (t, (tap, preset)) in got.trees.iter().zip(step.taps.iter().zip(["table-3.1", "sample-3.2"])) {
         let off_mm = glam::DVec2::from(t.at).distance(glam::DVec2::from(to_ground(view, *tap))) * view.scale;
         assert!(off_mm <= 2.0, "a tree {off_mm:.2} mm from the tap");
         taps_mm = taps_mm.max(off_mm);

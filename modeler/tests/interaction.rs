@@ -489,7 +489,7 @@ fn the_tree_tool_plants_moves_and_sizes_trees_and_groves() {
     assert_eq!(pen.ui.tool(), Tool::Trees);
     pen.hover(250.0, 150.0).touch().lift(HOVER);
     assert_eq!(pen.doc().trees.len(), 2);
-    assert_eq!(pen.doc().trees[1].preset.as_deref(), Some("cypress"));
+    assert_eq!(pen.doc().trees[1].preset.as_deref(), Some("sample-3.2"));
     assert_eq!(pen.ui.stats().trees, 2);
 
     // An outline back to its start plants a grove; lifting the tip ends it (no SW3).
@@ -525,7 +525,7 @@ fn the_tree_tool_plants_moves_and_sizes_trees_and_groves() {
     assert_eq!(pen.ui.stats().groves, 1);
 
     // SW2 + touch on the first tree and a slide moves it by the slide.
-    let cypress_at = pen.doc().trees[1].at;
+    let second_at = pen.doc().trees[1].at;
     pen.grab(200.0, 150.0).drag_to(230.0, 160.0).lift(HOVER).let_go();
     let moved = pen.doc().trees[0].clone();
     assert!(
@@ -534,7 +534,7 @@ fn the_tree_tool_plants_moves_and_sizes_trees_and_groves() {
         moved.at
     );
     assert_eq!(moved.height, tree.height);
-    assert_eq!(pen.doc().trees[1].at, cypress_at, "the other tree stays");
+    assert_eq!(pen.doc().trees[1].at, second_at, "the other tree stays");
 
     // Held and lifted: the pull; the top follows the pen, 20 mm up is 200 m.
     pen.grab(230.0, 160.0).pull_to(20.0).hold(0.2).let_go();
@@ -587,7 +587,8 @@ fn the_tree_tool_plants_moves_and_sizes_trees_and_groves() {
     }
     assert_eq!(pen.doc().trees[0], tree);
 
-    // An open stroke is refused with a message; three more taps on the button: oak, fir, figures.
+    // An open stroke is refused with a message; a tap on the button for each remaining preset,
+    // and one more: figures.
     pen.hover(100.0, 250.0).touch().drag_to(200.0, 260.0).lift(HOVER);
     assert_eq!(pen.doc().groves.len(), 1);
     let messages = pen.ui.take_messages();
@@ -595,7 +596,7 @@ fn the_tree_tool_plants_moves_and_sizes_trees_and_groves() {
         messages.iter().any(|m| m.contains("grove needs an outline")),
         "{messages:?}"
     );
-    for _ in 0..3 {
+    for _ in 1..penmodel_terrain::trees::Preset::ALL.len() {
         pen.hover(18.0, 66.0).touch().lift(HOVER);
     }
     assert_eq!(pen.ui.tool(), Tool::Figures);

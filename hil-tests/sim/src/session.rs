@@ -183,17 +183,22 @@ pub fn ridge_step() -> RidgeStep {
     }
 }
 
+/// Taps on the tree button that take the tool from the second preset back to figures: one per
+/// remaining preset of the modeler's `Preset::ALL` (cypress, oak, fir) and one more. The demo's
+/// test checks it against the modeler's list.
+pub const TREE_TAPS_TO_FIGURES: usize = 4;
+
 /// The session's trees (issue 14): the tree button tapped (the tree tool, `table-3.1`), a tap
-/// planting a tree, the button again (cypress), a tap planting a second; the first grabbed (SW2)
+/// planting a tree, the button again (sample-3.2: the seed's two species), a tap planting a second; the first grabbed (SW2)
 /// and pulled up, taller; an outline drawn back to its start and the tip lifted plants a grove;
-/// three more taps on the button (oak, fir, back to figures). Every planted tree sways in the
+/// a tap on the button for each remaining preset (cypress, oak, fir) and one more, back to figures. Every planted tree sways in the
 /// tool's breeze, so the demo's frames move.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TreeStep {
     /// The tree button's centre, display mm (the modeler's button is the square from 8 to 28 mm
     /// across and 56 to 76 mm down).
     pub button: DVec2,
-    /// Where the two single trees are tapped, display mm: a table-3.1, then a cypress.
+    /// Where the two single trees are tapped, display mm: a table-3.1, then a sample-3.2.
     pub taps: [DVec2; 2],
     /// The pen's height when it lets go of the first tree, pulled: its top, mm.
     pub pull_mm: f64,
@@ -268,8 +273,8 @@ pub fn timeline(steps: &[ModelingStep], home: glam::DVec3) -> Timeline {
     s.hover(ridge.button).touch().lift(8.0);
     let trees = tree_step();
     // The tree tool: its button, a tap (a tree), the button (next preset), a tap; the first tree
-    // pulled taller; a grove's outline ended by lifting the tip; the button three times more
-    // (back to figures).
+    // pulled taller; a grove's outline ended by lifting the tip; the button once per remaining
+    // preset and once more (back to figures).
     s.hover(trees.button).touch().lift(8.0);
     s.hover(trees.taps[0]).touch().lift(8.0);
     s.hover(trees.button).touch().lift(8.0);
@@ -282,7 +287,7 @@ pub fn timeline(steps: &[ModelingStep], home: glam::DVec3) -> Timeline {
         }
         s.lift(8.0);
     }
-    for _ in 0..3 {
+    for _ in 0..TREE_TAPS_TO_FIGURES {
         s.hover(trees.button).touch().lift(8.0);
     }
     s.move_to(home);

@@ -120,7 +120,7 @@ fn bad_trees_and_groves_are_named() {
     d.trees[0].preset = Some("baobab".into());
     assert_eq!(
         refused(&d),
-        "trees[0].preset: unknown preset \"baobab\"; the presets are table-3.1, cypress, oak, fir"
+        "trees[0].preset: unknown preset \"baobab\"; the presets are table-3.1, sample-3.2, cypress, oak, fir"
     );
     d.trees[0].preset = None;
     let mut maps = Preset::Table31.maps();

@@ -182,6 +182,41 @@ fn fitted_exponent(points: &[(f64, f64)]) -> f64 {
 }
 
 #[test]
+fn sample_3_2_is_the_seeds_and_its_volume_follows_its_dimension() {
+    let s = Species::preset(Preset::Sample32);
+    let got: Vec<[f64; 4]> = s.maps.iter().map(|m| [m.y, m.s, m.theta_z, m.theta_y]).collect();
+    // Table 3.1, the block of Sample 3.2 (λ 0.45, OS 0.52, M 6).
+    let seed = [
+        [0.52, 0.52, -32.6, 40.2],
+        [0.44, 0.52, 33.9, 40.5],
+        [0.44, 0.38, 7.3, 45.0],
+        [0.40, 0.47, 56.4, 45.2],
+        [0.52, 0.28, 62.8, 180.0],
+        [0.36, 0.55, -59.3, 134.8],
+    ];
+    assert_eq!(got, seed);
+    assert!((s.lambda() - 0.45).abs() < 0.005, "λ {}", s.lambda());
+    assert!((s.trunk() - 0.52).abs() < 1e-12, "OS {}", s.trunk());
+    let tree = NodeTree::build(&s);
+    let points: Vec<(f64, f64)> = [0.02, 0.03, 0.05, 0.07, 0.1, 0.14, 0.2]
+        .into_iter()
+        .map(|q| (q, drawn(&tree, q).volume() as f64))
+        .collect();
+    let slope = fitted_exponent(&points);
+    eprintln!(
+        "sample-3.2: fitted exponent {slope:.3}, law {:.3}, −D {:.3} (the seed fitted −2.39)",
+        s.law_exponent(),
+        -s.dimension()
+    );
+    // As for Sample 3.1, the count follows the similarity dimension of the unequal scales.
+    assert!(
+        (slope + s.dimension()).abs() < 0.05,
+        "fitted {slope:.3}, −D = {:.3}",
+        -s.dimension()
+    );
+}
+
+#[test]
 fn table_3_1_volume_against_the_law() {
     let s = Species::preset(Preset::Table31);
     let tree = NodeTree::build(&s);

@@ -75,7 +75,7 @@ enum Sub {
 /// Which species.
 #[derive(clap::Args)]
 struct SpeciesArgs {
-    /// A preset: table-3.1, cypress, oak or fir.
+    /// A preset: table-3.1, sample-3.2, cypress, oak or fir.
     #[arg(long, default_value = "table-3.1", conflicts_with = "maps")]
     preset: String,
     /// The maps as a JSON list of {"y", "s", "theta_z", "theta_y"} (degrees), instead of a preset.

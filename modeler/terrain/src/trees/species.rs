@@ -1,5 +1,5 @@
 //! IFS tree species: the maps `ω_i = Trans(0, y_i, 0)·Rot_y(θy_i)·Rot_z(−θz_i)·Scale(s_i)` and
-//! the seed's Table 3.1 with three other presets.
+//! the seed's Table 3.1 (its two species, Sample 3.1 and Sample 3.2) with three other presets.
 //!
 //! A tree's own unit: the trunk grows from the origin up +Y to the highest branching point
 //! (`max y_i`); every map places a scaled copy of the whole tree on the trunk, so the tree is
@@ -17,8 +17,11 @@ pub const MAX_MAPS: usize = 8;
 /// A named preset.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
 pub enum Preset {
-    /// The seed's Table 3.1 (M = 5, λ = 0.46): a broadleaf with a leaning leader.
+    /// The seed's Table 3.1, Sample 3.1 (M = 5, λ = 0.46): a broadleaf with a leaning leader.
     Table31,
+    /// The seed's Table 3.1, Sample 3.2 (M = 6, λ = 0.45): a denser crown of six limbs, every one
+    /// turned off the trunk's axis.
+    Sample32,
     /// A columnar conifer (Italian cypress): a strong vertical leader, steep short side shoots.
     Cypress,
     /// A broad deciduous crown (oak): four wide-spreading limbs from a short trunk, no leader.
@@ -29,12 +32,19 @@ pub enum Preset {
 
 impl Preset {
     /// Every preset, in the order the documentation lists them.
-    pub const ALL: [Preset; 4] = [Preset::Table31, Preset::Cypress, Preset::Oak, Preset::Fir];
+    pub const ALL: [Preset; 5] = [
+        Preset::Table31,
+        Preset::Sample32,
+        Preset::Cypress,
+        Preset::Oak,
+        Preset::Fir,
+    ];
 
     /// The name documents and the command line use.
     pub fn name(self) -> &'static str {
         match self {
             Preset::Table31 => "table-3.1",
+            Preset::Sample32 => "sample-3.2",
             Preset::Cypress => "cypress",
             Preset::Oak => "oak",
             Preset::Fir => "fir",
@@ -46,7 +56,7 @@ impl Preset {
         Preset::ALL.into_iter().find(|p| p.name() == name)
     }
 
-    /// The names of every preset, for messages (`table-3.1, cypress, oak, fir`).
+    /// The names of every preset, for messages (`table-3.1, sample-3.2, cypress, oak, fir`).
     pub fn names() -> String {
         Preset::ALL.map(Preset::name).join(", ")
     }
@@ -61,6 +71,15 @@ impl Preset {
                 (0.16, 0.45, -40.0, 120.0),
                 (0.08, 0.40, 50.0, 180.0),
                 (0.08, 0.30, -60.0, 50.0),
+            ],
+            // Table 3.1's second block; its trunk (OS = 0.52) is its largest y, as for Sample 3.1.
+            Preset::Sample32 => &[
+                (0.52, 0.52, -32.6, 40.2),
+                (0.44, 0.52, 33.9, 40.5),
+                (0.44, 0.38, 7.3, 45.0),
+                (0.40, 0.47, 56.4, 45.2),
+                (0.52, 0.28, 62.8, 180.0),
+                (0.36, 0.55, -59.3, 134.8),
             ],
             Preset::Cypress => &[
                 (0.40, 0.72, 0.0, 0.0),
