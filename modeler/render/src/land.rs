@@ -25,17 +25,32 @@
 //!   the style or the water change. While the terrain changes frame after frame (a pull), they may
 //!   lag it by up to [`Style::light_lag`] frames (2: remade every third frame of a pull, about 50 ms
 //!   at 60 frames a second), and when it stops they are remade for its final shape: a pull's frame
-//!   would otherwise cost half as much again as a classic one. The renderer compares the heights with the ones it made the
-//!   maps from (a copy): the colours are remade only in the changed rectangle (and a cell around
-//!   it, for the slopes; all of them when there is water, whose beach a change can move); the
-//!   light everywhere, since a change anywhere casts shadows and hides
-//!   sky across the grid.
+//!   would otherwise cost half as much again as a classic one.
+//! - **What changed**: a scene from an editor carries the terrain's revisions
+//!   ([`Scene::revisions`], `penmodel_terrain::revision`): the maps remember the revision they
+//!   were made for and ask for the rectangle changed since, so a frame of an unchanged terrain
+//!   does no work per cell. Without revisions the heights are compared with a copy (and
+//!   fingerprinted, to tell a moving terrain), as before. Then, in the changed rectangle:
+//!   - the colours, grown by a cell for the slopes (all of them when there is water, whose beach
+//!     a change can move anywhere);
+//!   - the light's blocks of the coarse grid it touches; if one of them changed, the sun and sky
+//!     sweeps over the whole coarse grid (at most `light_cells`² blocks, whatever the terrain's
+//!     size: a shadow reaches as far as the sun's tangent lets the height difference carry it, a
+//!     hidden sky as far as the hill is seen, so they are not bounded by the change), and the
+//!     vertices where the heights changed (grown by a cell, for the normals) or where a block's
+//!     sun or sky changed (the vertices that interpolate it). A hill's sky light reaches most of
+//!     the grid, so most vertices are relit when a hill changes; a change the blocks' averages do
+//!     not see relights the rectangle alone.
+//!
+//!   Each cell's colour and each vertex's light is a function of its neighbourhood and the coarse
+//!   maps alone, so the maps after any sequence of changes equal fresh ones to the bit.
 
 use rayon::prelude::*;
 
 use super::light;
 use super::ramp::{self, WATER};
 use super::scene::{Scene, Style};
+use penmodel_terrain::revision::Mark;
 use penmodel_terrain::ridge::sun::{self, Field};
 
 /// Grass, lush.
@@ -98,8 +113,43 @@ pub struct Land {
     remakes: u64,
     /// Changed frames since the maps were last remade.
     lagging: u32,
-    /// The fingerprint of the last frame's heights.
+    /// The fingerprint of the last frame's heights (scenes without revisions).
     last_print: u64,
+    /// The terrain's revision the maps were made for, when the scene gave its revisions.
+    made: Option<Mark>,
+    /// The last frame's revision.
+    last_mark: Option<Mark>,
+    /// The shadows and sky light on their coarse grid, kept for the next change.
+    sky_light: SkyLight,
+    /// Non-finite heights per row.
+    bad_rows: Vec<u32>,
+    /// What the last remake recomputed (a test reads it).
+    remade: Remade,
+}
+
+/// What a remake of the maps recomputed.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct Remade {
+    /// Cells whose ground colour was recomputed.
+    pub coloured: u64,
+    /// Vertices whose light was recomputed.
+    pub relit: u64,
+}
+
+/// The shadows and sky light on the coarse grid ([`Style::light_cells`]), kept between remakes:
+/// a change recomputes the blocks it touches, sweeps the coarse grid again, and relights the
+/// vertices where the heights or these maps changed.
+#[derive(Debug, Default)]
+struct SkyLight {
+    /// Block size in cells, columns and rows of blocks.
+    f: usize,
+    cc: usize,
+    rr: usize,
+    /// The drawn heights averaged in blocks.
+    z: Vec<f32>,
+    /// Per block: the sun seen (1 lit, 0 in shadow) and the sky-view factor.
+    sun: Vec<f32>,
+    sky: Vec<f32>,
 }
 
 /// A rectangle of cells, columns `c0..c1`, rows `r0..r1`.
@@ -111,6 +161,43 @@ struct Rect {
     r1: usize,
 }
 
+impl Rect {
+    /// The cells of the terrain's rectangle `r` on a `cols × rows` grid; `None` when empty.
+    fn within(r: penmodel_terrain::rect::Rect, cols: usize, rows: usize) -> Option<Rect> {
+        let (c0, r0) = ((r.c0 as usize).min(cols), (r.r0 as usize).min(rows));
+        let rect = Rect {
+            c0,
+            c1: (c0 + r.width as usize).min(cols),
+            r0,
+            r1: (r0 + r.height as usize).min(rows),
+        };
+        (rect.c1 > rect.c0 && rect.r1 > rect.r0).then_some(rect)
+    }
+
+    /// Grown by `n` cells on every side, clamped to the grid.
+    fn grown(self, n: usize, cols: usize, rows: usize) -> Rect {
+        Rect {
+            c0: self.c0.saturating_sub(n),
+            c1: (self.c1 + n).min(cols),
+            r0: self.r0.saturating_sub(n),
+            r1: (self.r1 + n).min(rows),
+        }
+    }
+
+    /// The smallest rectangle holding both; `other` may be empty.
+    fn union(self, other: Rect) -> Rect {
+        if other.c1 <= other.c0 || other.r1 <= other.r0 {
+            return self;
+        }
+        Rect {
+            c0: self.c0.min(other.c0),
+            c1: self.c1.max(other.c1),
+            r0: self.r0.min(other.r0),
+            r1: self.r1.max(other.r1),
+        }
+    }
+}
+
 impl Land {
     /// Forgets the maps (the renderer drew a classic frame into the light buffer).
     pub fn forget(&mut self) {
@@ -120,6 +207,16 @@ impl Land {
     /// How many times the maps were remade.
     pub fn remakes(&self) -> u64 {
         self.remakes
+    }
+
+    /// The ground's colour per cell (sRGB 0–255, before light), row-major like the heights.
+    pub fn albedo(&self) -> &[[f32; 3]] {
+        &self.albedo
+    }
+
+    /// What the last remake recomputed (everything when the terrain was new).
+    pub fn remade(&self) -> Remade {
+        self.remade
     }
 
     /// Brings the maps up to date with `scene` and writes the light per vertex into `light` when
@@ -145,15 +242,34 @@ impl Land {
             r1: rows,
         };
         let same = self.key.as_ref() == Some(&key) && self.heights.len() == h.len() && light.len() == h.len();
-        let rect = if same {
-            changed(&self.heights, h, cols)
-        } else {
-            Some(full)
+        // What changed since the maps were made, and whether the terrain moved since the last
+        // frame: from the terrain's revisions when the scene has them (no work per cell), else by
+        // comparing the heights with the copy and a fingerprint of the last frame's.
+        let (rect, moving) = match scene.revisions {
+            Some(revisions) => {
+                let now = revisions.mark();
+                let moving = self.last_mark != Some(now);
+                self.last_mark = Some(now);
+                let since = self.made.filter(|_| same).and_then(|m| revisions.since(m));
+                let rect = match since {
+                    None => Some(full),
+                    Some(r) => Rect::within(r, cols, rows),
+                };
+                (rect, moving)
+            }
+            None => {
+                self.last_mark = None;
+                let rect = if same {
+                    changed(&self.heights, h, cols)
+                } else {
+                    Some(full)
+                };
+                let print = fingerprint(h);
+                let moving = print != self.last_print;
+                self.last_print = print;
+                (rect, moving)
+            }
         };
-        // A fingerprint of this frame's heights: whether the terrain is still moving.
-        let print = fingerprint(h);
-        let moving = print != self.last_print;
-        self.last_print = print;
         let Some(mut rect) = rect else {
             if let Some(given) = scene.light_map {
                 self.bad = light::vertex_light(map, scene.vertical_scale, &scene.style, Some(given), light);
@@ -168,16 +284,24 @@ impl Land {
         }
         self.lagging = 0;
         self.remakes += 1;
+        self.made = scene.revisions.map(|r| r.mark());
         self.cols = cols;
         self.rows = rows;
         self.cell = map.cell_size() as f32;
+        if !same {
+            rect = full;
+        }
         if self.heights.len() != h.len() {
             self.heights = h.to_vec();
         } else {
             let (a, b) = (rect.r0 * cols, rect.r1 * cols);
             self.heights[a..b].copy_from_slice(&h[a..b]);
         }
-        let sea = h.par_iter().any(|&v| v < 0.0);
+        // The sea can only have appeared in the changed rectangle, unless there was water.
+        let seen = if self.water || rect == full { full } else { rect };
+        let sea = h[seen.r0 * cols..seen.r1 * cols]
+            .par_chunks(cols.max(1))
+            .any(|line| line[seen.c0..seen.c1].iter().any(|&v| v < 0.0));
         let water = sea || key.rivers;
         if water || water != self.water {
             // The beach follows the water, which a change can move anywhere: all of it again.
@@ -186,21 +310,32 @@ impl Land {
         self.water = water;
         self.shore = if water { shore(scene) } else { Vec::new() };
         // The slopes read a cell's neighbours.
-        let grown = Rect {
-            c0: rect.c0.saturating_sub(1),
-            c1: (rect.c1 + 1).min(cols),
-            r0: rect.r0.saturating_sub(1),
-            r1: (rect.r1 + 1).min(rows),
-        };
+        let grown = rect.grown(1, cols, rows);
         if self.noise_grid != (cols, rows, map.cell_size()) || self.noise.len() != cols * rows {
             self.noise = noise(cols, rows, map.cell_size());
             self.noise_grid = (cols, rows, map.cell_size());
         }
         self.albedo.resize(cols * rows, [0.0; 3]);
         colours(map, &scene.style, &self.shore, grown, &self.noise, &mut self.albedo);
+        self.remade.coloured = ((grown.c1 - grown.c0) * (grown.r1 - grown.r0)) as u64;
+        // Non-finite heights, counted again in the changed rows.
+        self.bad_rows.resize(rows, 0);
+        for (r, n) in self.bad_rows.iter_mut().enumerate().take(rect.r1).skip(rect.r0) {
+            *n = h[r * cols..(r + 1) * cols].iter().filter(|v| !v.is_finite()).count() as u32;
+        }
         self.bad = match scene.light_map {
-            Some(given) => light::vertex_light(map, scene.vertical_scale, &scene.style, Some(given), light),
-            None => lights(map, scene.vertical_scale, &scene.style, light),
+            Some(given) => {
+                self.sky_light = SkyLight::default();
+                self.remade.relit = (cols * rows) as u64;
+                light::vertex_light(map, scene.vertical_scale, &scene.style, Some(given), light)
+            }
+            None => {
+                let whole = rect == full || light.len() != cols * rows;
+                self.remade.relit = self
+                    .sky_light
+                    .relight(map, scene.vertical_scale, &scene.style, rect, whole, light);
+                self.bad_rows.iter().map(|&n| n as usize).sum()
+            }
         };
         self.key = Some(key);
         self.bad
@@ -525,28 +660,20 @@ fn colours(
         });
 }
 
-/// The terrain's heights × `scale`, averaged in blocks of `f × f` cells (non-finite heights count
-/// as 0: their triangles are holes anyway): `(heights, cols, rows)`.
-fn coarse(map: &penmodel_terrain::Heightmap, scale: f32, f: usize) -> (Vec<f32>, usize, usize) {
-    let (cols, rows) = (map.cols() as usize, map.rows() as usize);
-    let (cc, rr) = (cols.div_ceil(f), rows.div_ceil(f));
-    let h = map.heights();
-    let mut out = vec![0.0f32; cc * rr];
-    out.par_chunks_mut(cc).enumerate().for_each(|(j, line)| {
-        for (i, o) in line.iter_mut().enumerate() {
-            let (mut sum, mut n) = (0.0f32, 0u32);
-            for r in j * f..((j + 1) * f).min(rows) {
-                for &v in &h[r * cols + i * f..r * cols + ((i + 1) * f).min(cols)] {
-                    if v.is_finite() {
-                        sum += v;
-                    }
-                    n += 1;
-                }
+/// Block `(i, j)` of `f × f` cells of the `cols × rows` heights `h`, averaged and × `scale`
+/// (non-finite heights count as 0: their triangles are holes anyway).
+#[inline]
+fn block(h: &[f32], (cols, rows): (usize, usize), f: usize, (i, j): (usize, usize), scale: f32) -> f32 {
+    let (mut sum, mut n) = (0.0f32, 0u32);
+    for r in j * f..((j + 1) * f).min(rows) {
+        for &v in &h[r * cols + i * f..r * cols + ((i + 1) * f).min(cols)] {
+            if v.is_finite() {
+                sum += v;
             }
-            *o = sum / n.max(1) as f32 * scale;
+            n += 1;
         }
-    });
-    (out, cc, rr)
+    }
+    sum / n.max(1) as f32 * scale
 }
 
 /// The sun's azimuth (from +x towards +y) and elevation, radians, of the style's light.
@@ -555,25 +682,155 @@ fn sun_angles(style: &Style) -> (f64, f64) {
     (y.atan2(x), up.atan2(x.hypot(y)))
 }
 
-/// The light per vertex (see the module's notes); returns how many heights are not finite.
-fn lights(map: &penmodel_terrain::Heightmap, vertical_scale: f32, style: &Style, out: &mut Vec<f32>) -> usize {
-    let (cols, rows) = (map.cols() as usize, map.rows() as usize);
-    out.resize(cols * rows, 0.0);
-    if cols == 0 || rows == 0 {
-        return 0;
+impl SkyLight {
+    /// Brings the coarse maps up to date after the heights changed in `rect` (all of them when
+    /// `whole`) and writes the light of every vertex it may have changed into `out` (see the
+    /// module's notes): the blocks `rect` touches are averaged again; if one changed, the sun and
+    /// sky sweeps run over the whole coarse grid again (a shadow or a hidden sky can reach any
+    /// distance) and the vertices are relit where the heights changed (grown by a cell, for the
+    /// normals) and where the sun or sky of a block changed (its bilinear footprint). Returns
+    /// how many vertices were relit. A vertex's light is a function of its 3 × 3 heights and
+    /// the coarse maps alone, so this equals relighting them all.
+    fn relight(
+        &mut self,
+        map: &penmodel_terrain::Heightmap,
+        vertical_scale: f32,
+        style: &Style,
+        rect: Rect,
+        whole: bool,
+        out: &mut Vec<f32>,
+    ) -> u64 {
+        let (cols, rows) = (map.cols() as usize, map.rows() as usize);
+        out.resize(cols * rows, 0.0);
+        if cols == 0 || rows == 0 {
+            return 0;
+        }
+        let side = cols.max(rows);
+        let f = if style.light_cells == 0 {
+            1
+        } else {
+            side.div_ceil(style.light_cells as usize).max(1)
+        };
+        let (cc, rr) = (cols.div_ceil(f), rows.div_ceil(f));
+        let whole = whole || (self.f, self.cc, self.rr) != (f, cc, rr) || self.z.len() != cc * rr;
+        let h = map.heights();
+        let everything = Rect {
+            c0: 0,
+            c1: cols,
+            r0: 0,
+            r1: rows,
+        };
+        let mut relit = rect.grown(1, cols, rows);
+        if whole {
+            self.f = f;
+            self.cc = cc;
+            self.rr = rr;
+            self.z = vec![0.0f32; cc * rr];
+            self.z.par_chunks_mut(cc).enumerate().for_each(|(j, line)| {
+                for (i, o) in line.iter_mut().enumerate() {
+                    *o = block(h, (cols, rows), f, (i, j), vertical_scale);
+                }
+            });
+            let (sun, sky) = sweeps(&self.z, (cc, rr), map.cell_size() * f as f64, style);
+            self.sun = sun;
+            self.sky = sky;
+            relit = everything;
+        } else {
+            // The blocks the change touches.
+            let mut moved = false;
+            for j in rect.r0 / f..rect.r1.div_ceil(f).min(rr) {
+                for i in rect.c0 / f..rect.c1.div_ceil(f).min(cc) {
+                    let v = block(h, (cols, rows), f, (i, j), vertical_scale);
+                    moved |= v.to_bits() != self.z[j * cc + i].to_bits();
+                    self.z[j * cc + i] = v;
+                }
+            }
+            if moved {
+                let (sun, sky) = sweeps(&self.z, (cc, rr), map.cell_size() * f as f64, style);
+                // The blocks whose sun or sky changed, and the vertices that read them.
+                let mut blocks: Option<Rect> = None;
+                for (k, ((a, b), (c, d))) in sun.iter().zip(&self.sun).zip(sky.iter().zip(&self.sky)).enumerate() {
+                    if a.to_bits() != b.to_bits() || c.to_bits() != d.to_bits() {
+                        let (i, j) = (k % cc, k / cc);
+                        let one = Rect {
+                            c0: i,
+                            c1: i + 1,
+                            r0: j,
+                            r1: j + 1,
+                        };
+                        blocks = Some(blocks.map_or(one, |b| b.union(one)));
+                    }
+                }
+                if let Some(b) = blocks {
+                    relit = relit.union(footprint(b, f, (cc, rr), (cols, rows)));
+                }
+                self.sun = sun;
+                self.sky = sky;
+            }
+        }
+        self.vertices(map, vertical_scale, style, relit, out);
+        ((relit.c1 - relit.c0) * (relit.r1 - relit.r0)) as u64
     }
-    let side = cols.max(rows);
-    let f = if style.light_cells == 0 {
-        1
-    } else {
-        side.div_ceil(style.light_cells as usize).max(1)
-    };
-    let (z, cc, rr) = coarse(map, vertical_scale, f);
+
+    /// The light of the vertices in `rect` (see the module's notes).
+    fn vertices(
+        &self,
+        map: &penmodel_terrain::Heightmap,
+        vertical_scale: f32,
+        style: &Style,
+        rect: Rect,
+        out: &mut [f32],
+    ) {
+        let (cols, rows) = (map.cols() as usize, map.rows() as usize);
+        let (f, cc, rr) = (self.f, self.cc, self.rr);
+        let h = map.heights();
+        let s = map.cell_size() as f32;
+        let light = light::world_light(style);
+        let ambient = style.ambient.clamp(0.0, 1.0);
+        // A vertex's place on the coarse grid: block centres at (i + ½)f − ½ cells.
+        let half = (f as f32 - 1.0) * 0.5;
+        let inv_f = 1.0 / f as f32;
+        let bilinear = |m: &[f32], c: usize, r: usize| {
+            let u = ((c as f32 - half) * inv_f).clamp(0.0, (cc - 1) as f32);
+            let v = ((r as f32 - half) * inv_f).clamp(0.0, (rr - 1) as f32);
+            let (i, j) = (u as usize, v as usize);
+            let (fu, fv) = (u - i as f32, v - j as f32);
+            let (i1, j1) = ((i + 1).min(cc - 1), (j + 1).min(rr - 1));
+            let top = m[j * cc + i] + fu * (m[j * cc + i1] - m[j * cc + i]);
+            let bottom = m[j1 * cc + i] + fu * (m[j1 * cc + i1] - m[j1 * cc + i]);
+            top + fv * (bottom - top)
+        };
+        out[rect.r0 * cols..rect.r1 * cols]
+            .par_chunks_mut(cols)
+            .enumerate()
+            .for_each(|(k, line)| {
+                let r = rect.r0 + k;
+                let (r0, r1) = (r.saturating_sub(1), (r + 1).min(rows - 1));
+                for (c, o) in line.iter_mut().enumerate().take(rect.c1).skip(rect.c0) {
+                    let centre = h[r * cols + c];
+                    if !centre.is_finite() {
+                        *o = f32::NAN;
+                        continue;
+                    }
+                    let [dx, dz] = light::gradient(h, (cols, rows), (c, r), (r0, r1), (vertical_scale, s));
+                    let inv = 1.0 / (dx * dx + 1.0 + dz * dz).sqrt();
+                    let lambert = ((-dx * light[0] + light[1] - dz * light[2]) * inv).max(0.0);
+                    let seen = bilinear(&self.sun, c, r);
+                    let open = bilinear(&self.sky, c, r);
+                    *o = ambient * open + (1.0 - ambient) * seen * lambert;
+                }
+            });
+    }
+}
+
+/// The sun seen and the sky-view factor per cell of the coarse heights `z` (`cc × rr` blocks
+/// `cell` metres wide), by issue 12's horizon sweeps.
+fn sweeps(z: &[f32], (cc, rr): (usize, usize), cell: f64, style: &Style) -> (Vec<f32>, Vec<f32>) {
     let field = Field {
-        z: &z,
+        z,
         cols: cc as u32,
         rows: rr as u32,
-        cell: map.cell_size() * f as f64,
+        cell,
     };
     let (azimuth, elevation) = sun_angles(style);
     let mut sun_seen = vec![0.0f32; z.len()];
@@ -583,44 +840,20 @@ fn lights(map: &penmodel_terrain::Heightmap, vertical_scale: f32, style: &Style,
             sun_seen[i] = (above / PENUMBRA + 0.5).clamp(0.0, 1.0) as f32;
         });
     }
-    let sky = sun::sky_view(field, style.sky_directions.max(1));
-    let h = map.heights();
-    let s = map.cell_size() as f32;
-    let light = light::world_light(style);
-    let ambient = style.ambient.clamp(0.0, 1.0);
-    // A vertex's place on the coarse grid: block centres at (i + ½)f − ½ cells.
-    let half = (f as f32 - 1.0) * 0.5;
-    let inv_f = 1.0 / f as f32;
-    let bilinear = |m: &[f32], c: usize, r: usize| {
-        let u = ((c as f32 - half) * inv_f).clamp(0.0, (cc - 1) as f32);
-        let v = ((r as f32 - half) * inv_f).clamp(0.0, (rr - 1) as f32);
-        let (i, j) = (u as usize, v as usize);
-        let (fu, fv) = (u - i as f32, v - j as f32);
-        let (i1, j1) = ((i + 1).min(cc - 1), (j + 1).min(rr - 1));
-        let top = m[j * cc + i] + fu * (m[j * cc + i1] - m[j * cc + i]);
-        let bottom = m[j1 * cc + i] + fu * (m[j1 * cc + i1] - m[j1 * cc + i]);
-        top + fv * (bottom - top)
-    };
-    out.par_chunks_mut(cols)
-        .enumerate()
-        .map(|(r, line)| {
-            let mut bad = 0;
-            let (r0, r1) = (r.saturating_sub(1), (r + 1).min(rows - 1));
-            for (c, o) in line.iter_mut().enumerate() {
-                let centre = h[r * cols + c];
-                if !centre.is_finite() {
-                    *o = f32::NAN;
-                    bad += 1;
-                    continue;
-                }
-                let [dx, dz] = light::gradient(h, (cols, rows), (c, r), (r0, r1), (vertical_scale, s));
-                let inv = 1.0 / (dx * dx + 1.0 + dz * dz).sqrt();
-                let lambert = ((-dx * light[0] + light[1] - dz * light[2]) * inv).max(0.0);
-                let seen = bilinear(&sun_seen, c, r);
-                let open = bilinear(&sky, c, r);
-                *o = ambient * open + (1.0 - ambient) * seen * lambert;
-            }
-            bad
-        })
-        .sum()
+    (sun_seen, sun::sky_view(field, style.sky_directions.max(1)))
+}
+
+/// The vertices that read blocks `b` (of `f × f` cells, `cc × rr` of them) when they interpolate
+/// the coarse maps: a vertex reads the block its place falls in and the next one, so a block's
+/// readers reach from the previous block's centre to the next one's; a cell more on each side for
+/// the rounding of that place.
+fn footprint(b: Rect, f: usize, (cc, rr): (usize, usize), (cols, rows): (usize, usize)) -> Rect {
+    let lo = |i: usize| if i == 0 { 0 } else { ((i - 1) * f).saturating_sub(1) };
+    let hi = |i: usize, n: usize, len: usize| if i + 1 >= n { len } else { ((i + 2) * f + 1).min(len) };
+    Rect {
+        c0: lo(b.c0),
+        c1: hi(b.c1 - 1, cc, cols),
+        r0: lo(b.r0),
+        r1: hi(b.r1 - 1, rr, rows),
+    }
 }

@@ -8,6 +8,7 @@ use super::frame::Rgba;
 use penmodel_terrain::Heightmap;
 use penmodel_terrain::Point;
 use penmodel_terrain::export::Mesh;
+use penmodel_terrain::revision::Revisions;
 use penmodel_terrain::trees::{Roughness, Standing};
 
 use super::textured::{Quad, Texture};
@@ -191,6 +192,10 @@ impl Default for Style {
 #[derive(Debug, Clone)]
 pub struct Scene<'a> {
     pub terrain: &'a Heightmap,
+    /// The terrain's history of changes (its editor's: `Editor::revisions`), when known: the
+    /// land look then learns what changed since its last frame from it and recomputes only
+    /// there; without it, it compares the heights with a copy ([`crate::land`]).
+    pub revisions: Option<&'a Revisions>,
     /// Vertical exaggeration: heights are drawn × this (1 = true scale).
     pub vertical_scale: f32,
     /// Lines on the terrain.
@@ -246,6 +251,7 @@ impl<'a> Scene<'a> {
     pub fn new(terrain: &'a Heightmap, camera: Camera) -> Scene<'a> {
         Scene {
             terrain,
+            revisions: None,
             vertical_scale: 1.0,
             overlays: &[],
             rocks: &[],

@@ -292,3 +292,121 @@ fn the_maps_are_kept_until_the_terrain_changes_and_then_match_a_fresh_render() {
         assert!((0..3).all(|c| p[c].abs_diff(q[c]) <= 2), "{p:?} {q:?}");
     }
 }
+
+/// A terrain edited locally: two regions, the second small, with point figures.
+fn edited_document() -> penmodel_terrain::Document {
+    use penmodel_terrain::{Document, Figure, FigureKind, Grid, Region};
+    let square = |x0: f64, y0: f64, x1: f64, y1: f64| vec![[x0, y0], [x1, y0], [x1, y1], [x0, y1], [x0, y0]];
+    let point = |x: f64, y: f64, height: f64| Figure {
+        kind: FigureKind::Point,
+        points: vec![[x, y]],
+        height,
+        slope: 0.0,
+        figures: Vec::new(),
+    };
+    let mut doc = Document::new(Grid {
+        cols: 120,
+        rows: 120,
+        cell_size: 2.0,
+    });
+    doc.regions.push(Region {
+        boundary: square(4.0, 4.0, 150.0, 150.0),
+        figures: vec![point(60.0, 70.0, 80.0), point(110.0, 40.0, 40.0)],
+        metric: None,
+    });
+    doc.regions.push(Region {
+        boundary: square(170.0, 20.0, 230.0, 90.0),
+        figures: vec![point(200.0, 50.0, 30.0)],
+        metric: None,
+    });
+    doc
+}
+
+#[test]
+fn the_maps_follow_the_editors_revisions_and_equal_fresh_ones_exactly() {
+    use penmodel_render::land::Land;
+    use penmodel_terrain::{Edit, Editor, FigurePath};
+    let camera = crate::common::above(240.0);
+    for light_cells in [40, 0] {
+        let mut editor = Editor::new(edited_document()).expect("valid");
+        let mut style = style();
+        style.light_cells = light_cells;
+        let mut land = Land::default();
+        let mut light = Vec::new();
+        let mut renderer = Renderer::new();
+        let mut frame = Frame::new(200, 160).expect("frame");
+        fn scene<'a>(editor: &'a Editor, camera: Camera, style: &Style) -> Scene<'a> {
+            let mut s = Scene::new(editor.heightmap(), camera);
+            s.style = style.clone();
+            s
+        }
+        fn tracked<'a>(editor: &'a Editor, camera: Camera, style: &Style) -> Scene<'a> {
+            let mut s = scene(editor, camera, style);
+            s.revisions = Some(editor.revisions());
+            s
+        }
+        land.prepare(&tracked(&editor, camera, &style), &mut light);
+        renderer
+            .render(&tracked(&editor, camera, &style), &mut frame)
+            .expect("render");
+        let cells = 120 * 120;
+        let everything = land.remade();
+        assert_eq!(
+            [everything.coloured, everything.relit],
+            [cells as u64; 2],
+            "the first frame makes everything"
+        );
+        let remakes = land.remakes();
+        land.prepare(&tracked(&editor, camera, &style), &mut light);
+        assert_eq!(land.remakes(), remakes, "an unchanged terrain: nothing remade");
+        // Local edits, a frame after each (some of them lag: Style::light_lag), then frames
+        // of the still terrain until the maps have caught up.
+        let small = FigurePath::new(1, 0);
+        let edits = [
+            Edit::SetHeight {
+                at: small.clone(),
+                height: 45.0,
+            },
+            Edit::MoveFigure {
+                at: small.clone(),
+                by: [6.0, -4.0],
+            },
+            Edit::SetHeight {
+                at: small.clone(),
+                height: 20.0,
+            },
+            Edit::SetHeight {
+                at: FigurePath::new(0, 1),
+                height: 55.0,
+            },
+        ];
+        let mut remade = Vec::new();
+        for edit in edits {
+            editor.apply(edit).expect("applies");
+            let before = land.remakes();
+            for _ in 0..=style.light_lag {
+                land.prepare(&tracked(&editor, camera, &style), &mut light);
+                renderer
+                    .render(&tracked(&editor, camera, &style), &mut frame)
+                    .expect("render");
+            }
+            assert_eq!(land.remakes(), before + 1, "remade once the terrain stood still");
+            remade.push(land.remade());
+        }
+        // The small region's edits recolour less than a fifth of the grid (the sky light may
+        // change across the grid: a hill changes the horizon of all that see it).
+        assert!(remade[..3].iter().all(|r| r.coloured * 5 < cells as u64), "{remade:?}");
+        let mut fresh = Land::default();
+        let mut fresh_light = Vec::new();
+        fresh.prepare(&scene(&editor, camera, &style), &mut fresh_light);
+        let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<u32>>();
+        assert_eq!(bits(&light), bits(&fresh_light), "light, {light_cells} light cells");
+        let albedo = |l: &Land| l.albedo().iter().flatten().map(|x| x.to_bits()).collect::<Vec<u32>>();
+        assert_eq!(albedo(&land), albedo(&fresh), "colours, {light_cells} light cells");
+        let mut other = Frame::new(200, 160).expect("frame");
+        Renderer::new()
+            .render(&scene(&editor, camera, &style), &mut other)
+            .expect("render");
+        assert_eq!(frame.pixels(), other.pixels(), "{light_cells} light cells");
+    }
+}

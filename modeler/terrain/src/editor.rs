@@ -27,6 +27,7 @@ use crate::engine::{Rect, TerrainEngine};
 use crate::heightmap::Heightmap;
 use crate::journal::{self, Entry, JournalError, Replay, UndoStep, Writer};
 use crate::persist::{self, LoadError, SaveError};
+use crate::revision::Revisions;
 use crate::rocks::cache::Seated;
 use crate::trees::Forest;
 use crate::validate::ValidationError;
@@ -146,6 +147,8 @@ pub struct Editor {
     rocks: Seated,
     /// The trees and groves standing on the terrain, following every change.
     trees: Forest,
+    /// The terrain's changes, for those who keep something made from its heights.
+    revisions: Revisions,
 }
 
 /// Moves a stale journal to `JOURNAL.stale`, or `.stale.2`, `.stale.3`, … when one set aside
@@ -205,6 +208,7 @@ impl Editor {
             store: None,
             preview: None,
             ridge_preview: None,
+            revisions: Revisions::new(),
         })
     }
 
@@ -319,6 +323,11 @@ impl Editor {
         &self.terrain
     }
 
+    /// The terrain's history of changes: what changed since a [`Mark`](crate::revision::Mark).
+    pub fn revisions(&self) -> &Revisions {
+        &self.revisions
+    }
+
     /// The document's rock fields standing on [`Editor::heightmap`], one mesh each.
     pub fn rocks(&self) -> &Seated {
         &self.rocks
@@ -337,6 +346,7 @@ impl Editor {
         }
         let applied = edit.apply_to(&mut self.doc)?;
         let changed = self.terrain.update(&self.doc, &applied.scope);
+        self.revisions.record(changed);
         let cells = (changed.c0, changed.r0, changed.width, changed.height);
         self.rocks.follow(&self.doc, self.terrain.heightmap(), Some(cells));
         self.trees.follow(&self.doc, self.terrain.heightmap());

@@ -37,6 +37,7 @@ mod json;
 pub mod persist;
 pub mod profile;
 pub mod rect;
+pub mod revision;
 pub mod ridge;
 pub mod river;
 pub mod rocks;
