@@ -84,6 +84,9 @@ pub struct TerrainSettings {
     /// Fractal detail added to the regions' terrain; none when left out.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub detail: Option<Detail>,
+    /// Thermal erosion of the regions' terrain, after the detail; none when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub erosion: Option<Erosion>,
 }
 
 impl TerrainSettings {
@@ -132,6 +135,45 @@ impl Default for Detail {
             scale: default_detail_scale(),
             octaves: default_detail_octaves(),
             seed: 0,
+        }
+    }
+}
+
+/// Thermal erosion (`crate::erosion`): material slides down between neighbouring cells where
+/// the ground is steeper than the talus angle, a few steps, after the fractal detail.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Erosion {
+    /// The talus angle, degrees (1 to 89): ground steeper than this sheds material.
+    #[serde(default = "default_erosion_talus")]
+    pub talus: f64,
+    /// Steps, 1 to [`MAX_EROSION_ITERATIONS`](crate::validate::MAX_EROSION_ITERATIONS): material
+    /// moves at most one cell per step.
+    #[serde(default = "default_erosion_iterations")]
+    pub iterations: u32,
+    /// The share of the excess over the talus moved per step, 0 to 1.
+    #[serde(default = "default_erosion_amount")]
+    pub amount: f64,
+}
+
+fn default_erosion_talus() -> f64 {
+    33.0
+}
+
+fn default_erosion_iterations() -> u32 {
+    16
+}
+
+fn default_erosion_amount() -> f64 {
+    0.5
+}
+
+impl Default for Erosion {
+    fn default() -> Erosion {
+        Erosion {
+            talus: default_erosion_talus(),
+            iterations: default_erosion_iterations(),
+            amount: default_erosion_amount(),
         }
     }
 }

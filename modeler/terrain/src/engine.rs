@@ -20,6 +20,9 @@
 //! - with the document's fractal detail, [`crate::detail`] adds its noise to that terrain (the
 //!   regions paint the terrain before it and their gates; the detail follows the rectangle that
 //!   changed, grown by a cell).
+//! - with the document's erosion, [`crate::erosion`] erodes the terrain (with detail) after that
+//!   (the regions, or the detail, write the terrain before it; the erosion follows the rectangle
+//!   that changed, grown by its steps).
 //!
 //! Distances move through every cell of the region, including cells a nested region covers. A
 //! cell that no figure can reach (`dp` infinite for all) stays at the base height: an unreachable
@@ -63,6 +66,7 @@ use crate::change::{FigureList, ListChange, Scope};
 use crate::detail;
 use crate::distance;
 use crate::document::{Document, Figure, FigureKind, Grid, Metric, Point, Region};
+use crate::erosion;
 use crate::heightmap::Heightmap;
 use crate::profile;
 use crate::river::layer::{Layer, Water};
@@ -416,6 +420,8 @@ pub struct TerrainEngine {
     map: Heightmap,
     /// The fractal detail and the regions' terrain before it, if the document has detail.
     detail: Option<detail::Layer>,
+    /// The erosion and the terrain before it, if the document has erosion.
+    erosion: Option<erosion::Layer>,
     /// The ridgelines (seed 002) and the ground they make with `map`.
     ridges: crate::ridge::layer::Layer,
     rivers: Layer,
@@ -473,16 +479,22 @@ impl TerrainEngine {
         let regions: Vec<RegionNode> = doc.regions.iter().map(|r| region_node(doc, r)).collect();
         let mut map = Heightmap::new(&grid);
         let mut detail = doc.terrain.detail.map(|d| detail::Layer::new(&grid, d));
+        let mut erosion = doc.terrain.erosion.map(|e| erosion::Layer::new(&grid, e));
+        // The terrain before erosion: the erosion's, or the map itself.
+        let before = erosion.as_mut().map_or(&mut map, |e| &mut e.before);
         for (node, r) in regions.iter().zip(&doc.regions) {
             match &mut detail {
                 Some(layer) => {
                     node.paint_all(&r.figures, 0.0, &mut layer.smooth);
                     node.paint_gates(&mut layer.gate, grid.cols);
                 }
-                None => node.paint_all(&r.figures, 0.0, &mut map),
+                None => node.paint_all(&r.figures, 0.0, before),
             }
         }
         if let Some(layer) = &detail {
+            layer.apply(whole(&grid), before);
+        }
+        if let Some(layer) = &erosion {
             layer.apply(whole(&grid), &mut map);
         }
         let ridges = crate::ridge::layer::Layer::new(doc, &map);
@@ -492,6 +504,7 @@ impl TerrainEngine {
             regions,
             map,
             detail,
+            erosion,
             ridges,
             rivers,
         }
@@ -540,8 +553,14 @@ impl TerrainEngine {
     pub fn update(&mut self, doc: &Document, scope: &Scope) -> Rect {
         match self.regenerate(doc, scope) {
             Some(rect) => {
-                // The detail follows the regions' terrain that changed (and the cells beside it).
+                // The detail follows the regions' terrain that changed (and the cells beside it),
+                // the erosion the terrain before it (and the cells its steps reach).
+                let before = self.erosion.as_mut().map_or(&mut self.map, |e| &mut e.before);
                 let rect = match &self.detail {
+                    Some(layer) => layer.apply(rect, before),
+                    None => rect,
+                };
+                let rect = match &self.erosion {
                     Some(layer) => layer.apply(rect, &mut self.map),
                     None => rect,
                 };
@@ -564,10 +583,15 @@ impl TerrainEngine {
     /// does not fit.
     fn regenerate(&mut self, doc: &Document, scope: &Scope) -> Option<Rect> {
         let TerrainEngine {
-            regions, map, detail, ..
+            regions,
+            map,
+            detail,
+            erosion,
+            ..
         } = self;
         // Settings are not edits with a scope: a change of them regenerates everything.
         if detail.as_ref().map(|l| *l.settings()) != doc.terrain.detail
+            || erosion.as_ref().map(|l| *l.settings()) != doc.terrain.erosion
             || (regions.len() == doc.regions.len()
                 && regions
                     .iter()
@@ -579,7 +603,7 @@ impl TerrainEngine {
         // With detail the regions paint the terrain before it, and the shapes' gates.
         let (map, mut gate) = match detail {
             Some(detail::Layer { smooth, gate, .. }) => (smooth, Some(gate.as_mut_slice())),
-            None => (map, None),
+            None => (erosion.as_mut().map_or(map, |e| &mut e.before), None),
         };
         let grid = doc.grid;
         let before = match scope {

@@ -26,6 +26,7 @@ pub mod edit;
 pub mod editor;
 pub mod edt;
 pub mod engine;
+pub mod erosion;
 pub mod export;
 // The fuzz targets' properties, shared with the stable test that replays their corpora.
 #[doc(hidden)]
@@ -45,7 +46,9 @@ pub mod trees;
 pub mod validate;
 
 pub use address::{CurvePath, FigurePath};
-pub use document::{Detail, Document, Figure, FigureKind, Grid, Metric, Point, Region, River, TerrainSettings};
+pub use document::{
+    Detail, Document, Erosion, Figure, FigureKind, Grid, Metric, Point, Region, River, TerrainSettings,
+};
 pub use edit::{Edit, EditError};
 pub use editor::{Editor, Outcome};
 pub use engine::{Rect, TerrainEngine, generate};

@@ -306,7 +306,7 @@ pub enum Defect {
         "the grove's sampling image would be {width} × {height} pixels, more than {max}: use a smaller region or a lower density"
     )]
     GroveTooLarge { width: u32, height: u32, max: u64 },
-    /// A fractal detail setting (`terrain.detail`) out of its range.
+    /// A terrain setting (`terrain.detail`, `terrain.erosion`) out of its range.
     #[error("{what} must be {range}, got {}", Num(*value))]
     DetailRange {
         what: &'static str,
@@ -347,11 +347,16 @@ pub fn document(doc: &Document) -> Result<(), ValidationError> {
 /// The most octaves of fractal detail: the twelfth's wavelength is 1/2048 of the first's.
 pub const MAX_DETAIL_OCTAVES: u32 = 12;
 
+/// The most steps of thermal erosion: each moves material one cell, and a local change
+/// recomputes a window grown by twice the steps.
+pub const MAX_EROSION_ITERATIONS: u32 = 200;
+
 /// Checks the terrain settings' fractal detail (`docs/document.md`): an amount from 0 to 1, a
 /// scale (the longest wavelength) of at least two cells — a shorter one would alias on the grid
-/// — and at most 10 000 km, and 1 to [`MAX_DETAIL_OCTAVES`] octaves. (The metric's names are
-/// checked when the text is read.)
+/// — and at most 10 000 km, and 1 to [`MAX_DETAIL_OCTAVES`] octaves; and the thermal erosion
+/// ([`erosion`]). (The metric's names are checked when the text is read.)
 pub fn terrain(doc: &Document) -> Result<(), ValidationError> {
+    erosion(doc)?;
     let Some(d) = &doc.terrain.detail else { return Ok(()) };
     let range = |what: &'static str, range: String, value: f64| {
         Err(ValidationError::new(
@@ -378,6 +383,34 @@ pub fn terrain(doc: &Document) -> Result<(), ValidationError> {
             format!("from 1 to {MAX_DETAIL_OCTAVES}"),
             f64::from(d.octaves),
         );
+    }
+    Ok(())
+}
+
+/// Checks the terrain settings' thermal erosion: a talus angle from 1° to 89°, 1 to
+/// [`MAX_EROSION_ITERATIONS`] steps, an amount from 0 to 1.
+pub fn erosion(doc: &Document) -> Result<(), ValidationError> {
+    let Some(e) = &doc.terrain.erosion else { return Ok(()) };
+    let range = |what: &'static str, range: String, value: f64| {
+        Err(ValidationError::new(
+            format!("terrain.erosion.{}", what.rsplit(' ').next().unwrap_or(what)),
+            Defect::DetailRange { what, range, value },
+        ))
+    };
+    finite(e.talus, || "terrain.erosion.talus".into())?;
+    finite(e.amount, || "terrain.erosion.amount".into())?;
+    if !(1.0..=89.0).contains(&e.talus) {
+        return range("the erosion's talus", "from 1 to 89 degrees".into(), e.talus);
+    }
+    if !(1..=MAX_EROSION_ITERATIONS).contains(&e.iterations) {
+        return range(
+            "the erosion's iterations",
+            format!("from 1 to {MAX_EROSION_ITERATIONS}"),
+            f64::from(e.iterations),
+        );
+    }
+    if !(0.0..=1.0).contains(&e.amount) {
+        return range("the erosion's amount", "from 0 to 1".into(), e.amount);
     }
     Ok(())
 }
@@ -514,8 +547,10 @@ pub fn engine_bytes(doc: &Document) -> (u64, u64, u64) {
             region(grid, &f.points, &f.figures, acc);
         }
     }
-    // The heightmap, and with detail its noise, gates and the terrain before it.
-    let per_cell = if doc.terrain.detail.is_some() { 16 } else { 4 };
+    // The heightmap, and with detail its noise, gates and the terrain before it; with erosion
+    // the terrain before it and two f64 windows as large as the grid (a full rebuild's).
+    let per_cell =
+        if doc.terrain.detail.is_some() { 16 } else { 4 } + if doc.terrain.erosion.is_some() { 20 } else { 0 };
     let mut acc = (per_cell * doc.grid.cells() as u64, 0, 0);
     for r in &doc.regions {
         region(&doc.grid, &r.boundary, &r.figures, &mut acc);

@@ -9,7 +9,8 @@ use common::*;
 use penmodel_terrain::change::Scope;
 use penmodel_terrain::editor::{Editor, EditorError, OpenReport};
 use penmodel_terrain::{
-    CurvePath, Defect, Detail, Document, Edit, EditError, Figure, FigurePath, Metric, TerrainEngine, generate, journal,
+    CurvePath, Defect, Detail, Document, Edit, EditError, Erosion, Figure, FigurePath, Metric, TerrainEngine, generate,
+    journal,
 };
 use proptest::prelude::*;
 
@@ -155,6 +156,17 @@ fn detail() -> impl Strategy<Value = Option<Detail>> {
     )
 }
 
+/// No erosion, or erosion of a random talus, 1 to 8 steps and amount.
+fn erosion() -> impl Strategy<Value = Option<Erosion>> {
+    prop::option::of(
+        (5.0..80.0f64, 1u32..=8, 0.0..=1.0f64).prop_map(|(talus, iterations, amount)| Erosion {
+            talus,
+            iterations,
+            amount,
+        }),
+    )
+}
+
 #[track_caller]
 fn assert_matches_full(editor: &Editor, context: &str) {
     let full = generate(editor.document()).unwrap();
@@ -171,9 +183,10 @@ proptest! {
     /// equals a full regeneration of the document within the summation-order tolerance, and a
     /// refused edit leaves the document and terrain exactly as they were; in either metric.
     #[test]
-    fn incremental_equals_full(mut doc in nested_document(), ops in prop::collection::vec(op(), 1..14), metric in metric(), detail in detail()) {
+    fn incremental_equals_full(mut doc in nested_document(), ops in prop::collection::vec(op(), 1..14), metric in metric(), detail in detail(), erosion in erosion()) {
         doc.terrain.metric = metric;
         doc.terrain.detail = detail;
+        doc.terrain.erosion = erosion;
         let mut editor = Editor::new(doc).unwrap();
         for (n, op) in ops.iter().enumerate() {
             let Some(edit) = edit_for(editor.document(), op) else { continue };
@@ -189,13 +202,14 @@ proptest! {
     }
 
     /// Edits of shape alone (moves, points, figures added and deleted: no pull) leave a terrain
-    /// equal to a full regeneration to the bit, in either metric, with or without detail: each
-    /// rebuilt region is painted from its coefficients in the full regeneration's order, and the
-    /// detail is a function of that terrain.
+    /// equal to a full regeneration to the bit, in either metric, with or without detail and
+    /// erosion: each rebuilt region is painted from its coefficients in the full regeneration's
+    /// order, and the detail and the erosion are functions of that terrain.
     #[test]
-    fn shape_edits_equal_full_to_the_bit(mut doc in nested_document(), ops in prop::collection::vec(op(), 1..14), metric in metric(), detail in detail()) {
+    fn shape_edits_equal_full_to_the_bit(mut doc in nested_document(), ops in prop::collection::vec(op(), 1..14), metric in metric(), detail in detail(), erosion in erosion()) {
         doc.terrain.metric = metric;
         doc.terrain.detail = detail;
+        doc.terrain.erosion = erosion;
         let mut editor = Editor::new(doc).unwrap();
         for op in ops.iter().filter(|op| !matches!(op, Op::Height(..) | Op::Slope(..) | Op::Undo | Op::Redo)) {
             let Some(edit) = edit_for(editor.document(), op) else { continue };

@@ -5,6 +5,7 @@ mod detail;
 mod docs;
 mod editing;
 mod equations;
+mod erosion;
 mod examples;
 mod exports;
 mod faults;
