@@ -2,6 +2,7 @@
 """The pictures of docs/renderer.md's "The land look" (issue 20), into docs/pictures/look/.
 
     python3 scripts/look_pictures.py PENMODEL [OLD_PENMODEL]
+    python3 scripts/look_pictures.py PENMODEL --erosion
 
 For each of the five examples: the render in the classic look (`--look classic`, "before") and
 in the land look ("after"), 640 x 360 at `penmodel render`'s default camera, and a hillshade of
@@ -10,7 +11,12 @@ own creases). Then the demo (`--show headless --seed 1`):
 its orbit render and its display view with PENMODEL ("after") and, when given, OLD_PENMODEL (a
 build from before the land look, "before"), and the hillshade of its final terrain. Pictures are
 quantised to 256 colours so that each stays under about 200 KB.
+
+With --erosion, only the pictures of docs/document.md's "Erosion": example 1 as a version 4
+document with its seed 000 taxicab distances, without and with the default erosion
+(`"erosion": {}`): its hillshade and its land look render.
 """
+import json
 import os
 import subprocess
 import sys
@@ -45,8 +51,33 @@ def hillshade(penmodel, doc, tmp):
     return img.resize((img.width * scale, img.height * scale), Image.NEAREST)
 
 
+def erosion(penmodel, tmp):
+    """Example 1 without and with the default erosion: hillshade and land look render."""
+    with open(os.path.join(ROOT, "modeler", "examples", "01-ridges-and-peaks.json")) as f:
+        doc = json.load(f)
+    doc["version"] = 4
+    for tag, terrain in [("before", {"metric": "taxicab"}), ("after", {"metric": "taxicab", "erosion": {}})]:
+        doc["terrain"] = terrain
+        path = os.path.join(tmp, f"erosion-{tag}.json")
+        with open(path, "w") as f:
+            json.dump(doc, f)
+        save(hillshade(penmodel, path, tmp), f"erosion-01-hillshade-{tag}.png")
+        png = os.path.join(tmp, "r.png")
+        subprocess.run(
+            [penmodel, "render", path, "--png", png, "--size", "640x360", "--look", "land"],
+            check=True,
+            capture_output=True,
+        )
+        save(Image.open(png), f"erosion-01-render-{tag}.png")
+
+
 def main():
     penmodel = sys.argv[1]
+    if "--erosion" in sys.argv[2:]:
+        os.makedirs(OUT, exist_ok=True)
+        with tempfile.TemporaryDirectory() as tmp:
+            erosion(penmodel, tmp)
+        return
     old = sys.argv[2] if len(sys.argv) > 2 else None
     os.makedirs(OUT, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
