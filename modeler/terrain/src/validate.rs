@@ -64,13 +64,13 @@ pub const MAX_SLOPE: f64 = 1e3;
 /// the figure that would go deeper.
 pub const MAX_DEPTH: usize = 32;
 
-/// Bytes the terrain engine keeps per figure per cell of its region's bounding box: distances
-/// (`u32`), eq. 3 shares and coefficients (`f32`).
+/// Bytes the terrain engine keeps per figure per cell of its region's bounding box: distances,
+/// eq. 2 shape terms and coefficients (`f32` each).
 pub const BYTES_PER_FIGURE_CELL: u64 = 12;
 
 /// Bytes the terrain engine keeps, or allocates for a moment, per cell of a region's bounding
-/// box whatever its figures: the mask, edge distances, the pull and plateau caches, a search
-/// queue and a distance map being rebuilt.
+/// box whatever its figures: the mask, edge distances, eq. 3's normaliser (`f64`), a search
+/// queue, a distance map being rebuilt and the cells it changed.
 pub const BYTES_PER_REGION_CELL: u64 = 32;
 
 /// The most memory the terrain engine may need for a document, in bytes (2 GiB): see

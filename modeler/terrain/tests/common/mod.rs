@@ -92,27 +92,6 @@ pub fn max_figures(doc: &Document) -> usize {
     m
 }
 
-/// How far an incrementally updated heightmap may be from a full regeneration: both add the same
-/// f32 terms (base, relief_k·coef_k) in different orders, or the algebraically equal
-/// `Σ h_k·coef_k + base·(1 − Σ coef_k)`. Each is within (3K + 8)·u·M of the exact value, K the
-/// figures of the region, u = 2⁻²⁴ the f32 unit roundoff, M the largest absolute height (see
-/// the `terrain` module docs); two of them differ by at most twice that.
-pub fn tolerance(doc: &Document) -> f32 {
-    let k = max_figures(doc) as f64;
-    let smooth = (6.0 * k + 16.0) * f64::from(f32::EPSILON) / 2.0 * max_height(doc);
-    match &doc.terrain.detail {
-        None => smooth as f32,
-        // Detail reads a cell's height e and its neighbours' slope: an error e in the terrain
-        // before detail moves it by at most amount·(e + (scale/4)·√2·e/cell); the sum is rounded
-        // to f32 once more (the height with detail stays within 3·max_height).
-        Some(d) => {
-            let reach = d.scale / 4.0 * 2f64.sqrt() / doc.grid.cell_size;
-            let with = smooth * (1.0 + d.amount * (1.0 + reach)) + f64::from(f32::EPSILON) * 3.0 * max_height(doc);
-            with as f32
-        }
-    }
-}
-
 /// The first cell where two heightmaps differ by more than `tol`.
 pub fn first_difference(a: &Heightmap, b: &Heightmap, tol: f32) -> Option<(u32, u32, f32, f32)> {
     let cols = a.cols();
@@ -122,6 +101,22 @@ pub fn first_difference(a: &Heightmap, b: &Heightmap, tol: f32) -> Option<(u32, 
         .enumerate()
         .find(|(_, (x, y))| (*x - *y).abs() > tol)
         .map(|(i, (x, y))| ((i % cols as usize) as u32, (i / cols as usize) as u32, *x, *y))
+}
+
+/// The first cell where two heightmaps differ in any bit: the terrain engine's updates equal a
+/// full regeneration exactly (`engine/regions.rs`).
+pub fn first_bit_difference(a: &Heightmap, b: &Heightmap) -> Option<(u32, u32, f32, f32)> {
+    let cols = a.cols() as usize;
+    assert_eq!(
+        (a.cols(), a.rows()),
+        (b.cols(), b.rows()),
+        "heightmaps of different sizes"
+    );
+    a.heights()
+        .iter()
+        .zip(b.heights())
+        .position(|(x, y)| x.to_bits() != y.to_bits())
+        .map(|i| ((i % cols) as u32, (i / cols) as u32, a.heights()[i], b.heights()[i]))
 }
 
 /// A star-shaped region boundary around `c`: `k` vertices at evenly spaced angles with radii in

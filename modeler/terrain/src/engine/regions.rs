@@ -1,0 +1,577 @@
+//! The terrain engine's caches per region and per figure, and how an edit updates them (issue 18).
+//!
+//! Per region, over its bounding box: the edge distances `df`, the owned cells (the region's
+//! minus its nested regions'), and eq. 3's normaliser per cell, `norm`: `−n` on a cell where n
+//! figures stand, else `Σ_j 1/dp_j` in figure order (0 where no figure reaches). Per figure:
+//! its distances `dp`, its shape term `shape = eq. 2(w, s)` (eq. 1's `w`, eq. 4's slope for a
+//! nested figure) rounded to `f32`, and its coefficient `coef = shape × share` (an `f32`
+//! product), where `share` is eq. 3's weight read from `norm` and `dp` ([`share`]).
+//!
+//! Every path computes a cell's numbers with the same functions, and a cell's height always as
+//! `base + Σ_k relief_k·coef_k` in `f32`, figures in order ([`RegionNode::paint_own`]), so an
+//! updated terrain equals a full regeneration to the bit:
+//!
+//! - **a moved figure** (a vertex, the whole figure; not a closed one): its new `dp` in full
+//!   (one breadth-first search or distance transform over the box, cheap beside the blend),
+//!   compared with the old one; only the cells where it changed get a new `norm`, the figure's
+//!   shape and every figure's coefficient (the other figures' shapes are kept: their `w` and
+//!   slope did not change), and only those cells are painted.
+//! - **a slope**: the figure's shape and coefficient on the owned cells (`norm` is kept), then
+//!   the region painted; a closed figure's nested region gets all its shapes again (eq. 4 reads
+//!   the enclosing slope).
+//! - **a height** (a pull): the region painted (K multiply-adds per cell), and a closed figure's
+//!   nested region, whose base it is.
+//! - **a figure added, removed or replaced**: the region's `norm` and coefficients, and only the
+//!   new figure's shape; when a closed figure comes, goes or changes its outline, the owned cells
+//!   change, and every shape is computed again.
+//!
+//! The per-cell work runs on all cores (rayon), in bands of rows; the figures' distance maps of
+//! a region are computed in parallel.
+
+use rayon::prelude::*;
+
+use crate::cells::{self, Cell, Mask};
+use crate::change::ListChange;
+use crate::detail;
+use crate::distance;
+use crate::document::{Figure, FigureKind, Grid, Metric, Point};
+use crate::heightmap::Heightmap;
+use crate::profile;
+use crate::rect::Rect;
+
+/// Box rows per band of parallel work: small enough that two cores share the work evenly.
+const BAND_ROWS: usize = 8;
+
+/// A run of cells in one row of a region's box: `start..end` in box columns.
+#[derive(Debug, Clone, Copy)]
+struct Run {
+    row: u32,
+    start: u32,
+    end: u32,
+}
+
+/// Per-figure caches, over the owning region's box.
+pub(super) struct FigureNode {
+    dp: Vec<f32>,
+    /// Eq. 2's shape term on the owned cells, rounded to `f32`.
+    shape: Vec<f32>,
+    /// `shape × share` on the owned cells.
+    coef: Vec<f32>,
+    /// The nested region of a closed figure.
+    pub(super) child: Option<Box<RegionNode>>,
+}
+
+/// Per-region caches, over the region's box.
+pub(super) struct RegionNode {
+    pub(super) mask: Mask,
+    /// The distances' metric, the region's (its nested regions inherit it).
+    pub(super) metric: Metric,
+    df: Vec<f32>,
+    /// The cells this region decides: its cells minus its nested regions', by rows.
+    owned: Vec<Run>,
+    /// Where each box row's runs start in `owned` (one more entry than rows).
+    row_runs: Vec<usize>,
+    /// Eq. 3's normaliser per cell (see the module's documentation).
+    norm: Vec<f64>,
+    pub(super) figures: Vec<FigureNode>,
+}
+
+/// A figure list as its region sees it: the figures (after the change), the region's base
+/// height and, for a nested list, the enclosing figure's slope.
+#[derive(Clone, Copy)]
+pub(super) struct List<'a> {
+    pub(super) figs: &'a [Figure],
+    pub(super) base: f64,
+    pub(super) outer: Option<f64>,
+}
+
+/// Which figures' shape terms a blend recomputes.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Shapes {
+    All,
+    One(usize),
+    None,
+}
+
+impl Shapes {
+    fn has(self, k: usize) -> bool {
+        match self {
+            Shapes::All => true,
+            Shapes::One(j) => j == k,
+            Shapes::None => false,
+        }
+    }
+}
+
+/// Eq. 3's weight of a figure at distance `dp` on a cell with normaliser `norm`: `1/n` on each
+/// of the n figures a cell stands on, `(1/dp)/Σ(1/dp_j)` elsewhere, 0 where no figure reaches.
+fn share(norm: f64, dp: f32) -> f32 {
+    if norm < 0.0 {
+        if dp == 0.0 { (1.0 / -norm) as f32 } else { 0.0 }
+    } else if norm > 0.0 {
+        (profile::inverse_distance_real(f64::from(dp)) / norm) as f32
+    } else {
+        0.0
+    }
+}
+
+/// Eq. 3's normaliser of a cell from its figures' distances, in figure order.
+fn normaliser(dps: &[&[f32]], i: usize) -> f64 {
+    let on = dps.iter().filter(|d| d[i] == 0.0).count();
+    if on > 0 {
+        -(on as f64)
+    } else {
+        dps.iter()
+            .map(|d| profile::inverse_distance_real(f64::from(d[i])))
+            .sum()
+    }
+}
+
+/// Eq. 1, 2 and 4: a figure of slope `s1` (nested in a figure of slope `outer`) at a cell.
+fn shape(df: f32, dp: f32, s1: f64, outer: Option<f64>) -> f32 {
+    let w = profile::weight_real(f64::from(df), f64::from(dp));
+    let s = outer.map_or(s1, |s0| profile::nested_slope(s1, s0, w));
+    profile::shape(w, s) as f32
+}
+
+/// The cells of the nested region a closed curve bounds. Validation keeps a closed figure strictly
+/// inside its region, which puts its cells inside the region's; the intersection only guards
+/// against a rounding tie at a cell border, so that no region paints outside its parent.
+fn nested_mask(grid: &Grid, points: &[Point], parent: &Mask) -> Mask {
+    cells::closed_mask(grid, points).intersect(parent)
+}
+
+/// The cells a figure stands on; a closed figure's are its nested region's.
+fn sources(grid: &Grid, f: &Figure, child: Option<&RegionNode>) -> Vec<Cell> {
+    match child {
+        Some(c) if f.kind == FigureKind::Closed => c.mask.cells().collect(),
+        _ => cells::figure_cells(grid, f),
+    }
+}
+
+/// The box of the cells where `dirty` holds (`width` wide), on the grid; empty when none.
+fn dirty_rect(mask: &Mask, dirty: &[bool]) -> Rect {
+    let w = mask.width as usize;
+    let bounds = dirty
+        .par_chunks(w.max(1))
+        .enumerate()
+        .filter_map(|(r, row)| {
+            let first = row.iter().position(|&d| d)?;
+            let last = row.iter().rposition(|&d| d)?;
+            Some((r, r, first, last))
+        })
+        .reduce_with(|a, b| (a.0.min(b.0), a.1.max(b.1), a.2.min(b.2), a.3.max(b.3)));
+    match bounds {
+        Some((r0, r1, c0, c1)) => Rect {
+            c0: mask.c0 + c0 as u32,
+            r0: mask.r0 + r0 as u32,
+            width: (c1 - c0 + 1) as u32,
+            height: (r1 - r0 + 1) as u32,
+        },
+        None => Rect::EMPTY,
+    }
+}
+
+impl FigureNode {
+    pub(super) fn build(grid: &Grid, region: &Mask, metric: Metric, f: &Figure) -> FigureNode {
+        let child = (f.kind == FigureKind::Closed).then(|| {
+            let mask = nested_mask(grid, &f.points, region);
+            Box::new(RegionNode::build(grid, mask, metric, &f.figures, Some(f.slope)))
+        });
+        let n = region.box_len();
+        FigureNode {
+            dp: distance::figure_map(metric, region, &sources(grid, f, child.as_deref())),
+            shape: vec![0.0; n],
+            coef: vec![0.0; n],
+            child,
+        }
+    }
+}
+
+impl RegionNode {
+    pub(super) fn build(grid: &Grid, mask: Mask, metric: Metric, figs: &[Figure], outer: Option<f64>) -> RegionNode {
+        // The edge distances and each figure's (with its nested region) on all cores.
+        let (df, figures) = rayon::join(
+            || distance::edge_map(metric, &mask),
+            || {
+                figs.par_iter()
+                    .map(|f| FigureNode::build(grid, &mask, metric, f))
+                    .collect()
+            },
+        );
+        let n = mask.box_len();
+        let mut node = RegionNode {
+            mask,
+            metric,
+            df,
+            owned: Vec::new(),
+            row_runs: Vec::new(),
+            norm: vec![0.0; n],
+            figures,
+        };
+        node.owned_runs();
+        node.blend(figs, outer, Shapes::All, None);
+        node
+    }
+
+    /// New cells for the region; its figures' nested regions are kept.
+    pub(super) fn reshape(&mut self, grid: &Grid, mask: Mask, figs: &[Figure], outer: Option<f64>) {
+        self.mask = mask;
+        let n = self.mask.box_len();
+        let (mask, metric) = (&self.mask, self.metric);
+        let (df, ()) = rayon::join(
+            || distance::edge_map(metric, mask),
+            || {
+                figs.par_iter().zip(&mut self.figures).for_each(|(f, node)| {
+                    node.dp = distance::figure_map(metric, mask, &sources(grid, f, node.child.as_deref()));
+                    node.shape = vec![0.0; n];
+                    node.coef = vec![0.0; n];
+                })
+            },
+        );
+        self.df = df;
+        self.norm = vec![0.0; n];
+        self.owned_runs();
+        self.blend(figs, outer, Shapes::All, None);
+    }
+
+    /// Brings the caches up to date after `change` in the region's figure list `figs` (the list
+    /// after it; `outer` the enclosing figure's slope for a nested list) and paints what changed.
+    /// `None` when the change does not fit the caches.
+    pub(super) fn change(
+        &mut self,
+        grid: &Grid,
+        change: ListChange,
+        list: List,
+        map: &mut Heightmap,
+        gate: Option<&mut [f32]>,
+    ) -> Option<Rect> {
+        let List { figs, base, outer } = list;
+        let fits = match change {
+            ListChange::Added(k) => k < figs.len() && k <= self.figures.len(),
+            ListChange::Removed(k) => k < self.figures.len(),
+            ListChange::Replaced(k) | ListChange::Outline(k) => k < figs.len() && k < self.figures.len(),
+        };
+        if !fits {
+            return None;
+        }
+        let closed = |f: &Figure| f.kind == FigureKind::Closed;
+        // With a nested region coming, going or changing its cells, the owned cells change and
+        // every shape is computed again; otherwise only the changed figure's.
+        let shapes = match change {
+            ListChange::Added(k) => {
+                let node = FigureNode::build(grid, &self.mask, self.metric, &figs[k]);
+                self.figures.insert(k, node);
+                if closed(&figs[k]) { Shapes::All } else { Shapes::One(k) }
+            }
+            ListChange::Removed(k) => {
+                let node = self.figures.remove(k);
+                if node.child.is_some() {
+                    Shapes::All
+                } else {
+                    Shapes::None
+                }
+            }
+            ListChange::Replaced(k) => {
+                let node = FigureNode::build(grid, &self.mask, self.metric, &figs[k]);
+                let old = std::mem::replace(&mut self.figures[k], node);
+                if old.child.is_some() || closed(&figs[k]) {
+                    Shapes::All
+                } else {
+                    Shapes::One(k)
+                }
+            }
+            ListChange::Outline(k) if !closed(&figs[k]) && self.figures[k].child.is_none() => {
+                return Some(self.move_figure(grid, k, list, map, gate));
+            }
+            ListChange::Outline(k) => {
+                self.outline(grid, k, figs);
+                Shapes::All
+            }
+        };
+        if self.figures.len() != figs.len() {
+            return None;
+        }
+        if shapes == Shapes::All {
+            self.owned_runs();
+        }
+        self.blend(figs, outer, shapes, None);
+        self.paint_all(figs, base, map);
+        if let Some(g) = gate {
+            self.paint_gates(g, grid.cols);
+        }
+        Some(Rect::of(&self.mask))
+    }
+
+    /// Figure k (not closed) moved: its new distances, and the cells where they changed blended
+    /// and painted again. Returns those cells' box.
+    fn move_figure(
+        &mut self,
+        grid: &Grid,
+        k: usize,
+        list: List,
+        map: &mut Heightmap,
+        gate: Option<&mut [f32]>,
+    ) -> Rect {
+        let List { figs, base, outer } = list;
+        let dp = distance::figure_map(self.metric, &self.mask, &cells::figure_cells(grid, &figs[k]));
+        let old = std::mem::replace(&mut self.figures[k].dp, dp);
+        let dirty: Vec<bool> = old
+            .par_iter()
+            .zip(&self.figures[k].dp)
+            .map(|(a, b)| a.to_bits() != b.to_bits())
+            .collect();
+        drop(old);
+        self.blend(figs, outer, Shapes::One(k), Some(&dirty));
+        self.paint_own(figs, base, map, Some(&dirty));
+        if let Some(g) = gate {
+            self.paint_gates(g, grid.cols);
+        }
+        dirty_rect(&self.mask, &dirty)
+    }
+
+    /// Figure k's points changed (its nested figures did not).
+    fn outline(&mut self, grid: &Grid, k: usize, figs: &[Figure]) {
+        let f = &figs[k];
+        if let Some(child) = self.figures[k].child.as_deref_mut() {
+            child.reshape(
+                grid,
+                nested_mask(grid, &f.points, &self.mask),
+                &f.figures,
+                Some(f.slope),
+            );
+        }
+        let node = &mut self.figures[k];
+        node.dp = distance::figure_map(self.metric, &self.mask, &sources(grid, f, node.child.as_deref()));
+    }
+
+    /// Figure k's height changed (a pull): the region painted again, and a closed figure's
+    /// nested region, whose base it is. Returns the cells painted.
+    pub(super) fn pull(&self, k: usize, figs: &[Figure], base: f64, map: &mut Heightmap) -> Rect {
+        self.paint_own(figs, base, map, None);
+        let mut rect = Rect::of(&self.mask);
+        if let Some(child) = self.figures[k].child.as_deref() {
+            let f = &figs[k];
+            child.paint_own(&f.figures, f.height, map, None);
+            rect = rect.union(Rect::of(&child.mask));
+        }
+        rect
+    }
+
+    /// Figure k's slope changed: its shape and coefficient, the region painted again, and a
+    /// closed figure's nested region blended and painted again. Returns the cells painted.
+    pub(super) fn slope(&mut self, k: usize, list: List, map: &mut Heightmap) -> Rect {
+        let List { figs, base, outer } = list;
+        self.reshape_one(k, figs[k].slope, outer);
+        self.paint_own(figs, base, map, None);
+        let mut rect = Rect::of(&self.mask);
+        if let Some(child) = self.figures[k].child.as_deref_mut() {
+            let f = &figs[k];
+            child.blend(&f.figures, Some(f.slope), Shapes::All, None);
+            child.paint_own(&f.figures, f.height, map, None);
+            rect = rect.union(Rect::of(&child.mask));
+        }
+        rect
+    }
+
+    /// The owned runs and the index of each row's first.
+    fn owned_runs(&mut self) {
+        let mut own = self.mask.bits().to_vec();
+        for child in self.figures.iter().filter_map(|f| f.child.as_deref()) {
+            for cell in child.mask.cells() {
+                if let Some(i) = self.mask.index(cell) {
+                    own[i] = false;
+                }
+            }
+        }
+        let w = self.mask.width as usize;
+        let mut runs = Vec::new();
+        let mut row_runs = Vec::with_capacity(self.mask.height as usize + 1);
+        for (row, line) in own.chunks(w.max(1)).enumerate() {
+            row_runs.push(runs.len());
+            let mut c = 0;
+            while c < line.len() {
+                if line[c] {
+                    let start = c;
+                    while c < line.len() && line[c] {
+                        c += 1;
+                    }
+                    runs.push(Run {
+                        row: row as u32,
+                        start: start as u32,
+                        end: c as u32,
+                    });
+                } else {
+                    c += 1;
+                }
+            }
+        }
+        row_runs.resize(self.mask.height as usize + 1, runs.len());
+        self.owned = runs;
+        self.row_runs = row_runs;
+    }
+
+    /// The owned runs of box row `row`.
+    fn runs(&self, row: usize) -> &[Run] {
+        &self.owned[self.row_runs[row]..self.row_runs[row + 1]]
+    }
+
+    /// Eq. 3's normaliser, the shapes `shapes` names and every figure's coefficient, on the
+    /// owned cells where `dirty` holds (every owned cell without it); in bands of rows on all
+    /// cores.
+    fn blend(&mut self, figs: &[Figure], outer: Option<f64>, shapes: Shapes, dirty: Option<&[bool]>) {
+        let w = (self.mask.width as usize).max(1);
+        let band = w * BAND_ROWS;
+        let slopes: Vec<f64> = figs.iter().map(|f| f.slope).collect();
+        let RegionNode {
+            df,
+            owned,
+            row_runs,
+            norm,
+            figures,
+            ..
+        } = self;
+        // Each band's slices of every figure's maps, so that bands can be written in parallel.
+        let mut per_figure: Vec<_> = figures
+            .iter_mut()
+            .map(|f| {
+                f.dp.chunks(band)
+                    .zip(f.shape.chunks_mut(band))
+                    .zip(f.coef.chunks_mut(band))
+            })
+            .collect();
+        let mut bands = Vec::with_capacity(norm.len().div_ceil(band));
+        for (b, (norm, df)) in norm.chunks_mut(band).zip(df.chunks(band)).enumerate() {
+            let mut dps = Vec::with_capacity(per_figure.len());
+            let mut maps = Vec::with_capacity(per_figure.len());
+            for ((dp, shape), coef) in per_figure.iter_mut().filter_map(Iterator::next) {
+                dps.push(dp);
+                maps.push((shape, coef));
+            }
+            bands.push((b, norm, df, dps, maps));
+        }
+        let (owned, row_runs) = (&*owned, &*row_runs);
+        bands.into_par_iter().for_each(|(b, norm, df, dps, mut maps)| {
+            let row0 = b * BAND_ROWS;
+            for r in 0..norm.len() / w {
+                for run in &owned[row_runs[row0 + r]..row_runs[row0 + r + 1]] {
+                    for x in run.start as usize..run.end as usize {
+                        let i = r * w + x;
+                        if dirty.is_some_and(|d| !d[row0 * w + i]) {
+                            continue;
+                        }
+                        let n = normaliser(&dps, i);
+                        norm[i] = n;
+                        for (k, (dp, (shape_k, coef_k))) in dps.iter().zip(maps.iter_mut()).enumerate() {
+                            if shapes.has(k) {
+                                shape_k[i] = shape(df[i], dp[i], slopes[k], outer);
+                            }
+                            coef_k[i] = shape_k[i] * share(n, dp[i]);
+                        }
+                    }
+                }
+            }
+        });
+    }
+
+    /// Figure k's shape (slope `s1`) and coefficient on the owned cells; `norm` is kept.
+    fn reshape_one(&mut self, k: usize, s1: f64, outer: Option<f64>) {
+        let w = (self.mask.width as usize).max(1);
+        let RegionNode {
+            df,
+            owned,
+            row_runs,
+            norm,
+            figures,
+            ..
+        } = self;
+        let f = &mut figures[k];
+        f.shape
+            .par_chunks_mut(w)
+            .zip(f.coef.par_chunks_mut(w))
+            .enumerate()
+            .for_each(|(r, (shape_row, coef_row))| {
+                for run in &owned[row_runs[r]..row_runs[r + 1]] {
+                    for x in run.start as usize..run.end as usize {
+                        let i = r * w + x;
+                        let s = shape(df[i], f.dp[i], s1, outer);
+                        shape_row[x] = s;
+                        coef_row[x] = s * share(norm[i], f.dp[i]);
+                    }
+                }
+            });
+    }
+
+    /// Paints the owned cells (those where `dirty` holds, if given): `base + Σ relief_k·coef_k`
+    /// in `f32`, figures in order — the one way every path computes a height.
+    fn paint_own(&self, figs: &[Figure], base: f64, map: &mut Heightmap, dirty: Option<&[bool]>) {
+        let cols = map.cols() as usize;
+        let (w, r0, c0) = (self.mask.width as usize, self.mask.r0 as usize, self.mask.c0 as usize);
+        let h = self.mask.height as usize;
+        if w == 0 || h == 0 {
+            return;
+        }
+        let reliefs: Vec<f32> = figs.iter().map(|f| (f.height - base) as f32).collect();
+        let coefs: Vec<&[f32]> = self.figures.iter().map(|f| f.coef.as_slice()).collect();
+        let base = base as f32;
+        map.heights_mut()[r0 * cols..(r0 + h) * cols]
+            .par_chunks_mut(cols)
+            .enumerate()
+            .for_each(|(r, line)| {
+                for run in self.runs(r) {
+                    for x in run.start as usize..run.end as usize {
+                        let i = r * w + x;
+                        if dirty.is_some_and(|d| !d[i]) {
+                            continue;
+                        }
+                        let mut d = base;
+                        for (coef, &rel) in coefs.iter().zip(&reliefs) {
+                            d += rel * coef[i];
+                        }
+                        line[c0 + x] = d;
+                    }
+                }
+            });
+    }
+
+    /// Paints the owned cells and every nested region.
+    pub(super) fn paint_all(&self, figs: &[Figure], base: f64, map: &mut Heightmap) {
+        self.paint_own(figs, base, map, None);
+        for (node, f) in self.figures.iter().zip(figs) {
+            if let Some(child) = node.child.as_deref() {
+                child.paint_all(&f.figures, f.height, map);
+            }
+        }
+    }
+
+    pub(super) fn clear(&self, map: &mut Heightmap, gate: Option<&mut [f32]>) {
+        let cols = map.cols() as usize;
+        let out = map.heights_mut();
+        for (c, r) in self.mask.cells() {
+            out[r as usize * cols + c as usize] = 0.0;
+        }
+        if let Some(gate) = gate {
+            for (c, r) in self.mask.cells() {
+                gate[r as usize * cols + c as usize] = 0.0;
+            }
+        }
+    }
+
+    /// Paints the detail's gates ([`detail::gate`]) of the owned cells and every nested region's:
+    /// they follow the distances, so only a change of shape repaints them.
+    pub(super) fn paint_gates(&self, gate: &mut [f32], cols: u32) {
+        let w = self.mask.width as usize;
+        for run in &self.owned {
+            let b = run.row as usize * w + run.start as usize;
+            let len = (run.end - run.start) as usize;
+            let g = (self.mask.r0 + run.row) as usize * cols as usize + (self.mask.c0 + run.start) as usize;
+            for (i, out) in (b..b + len).zip(&mut gate[g..]) {
+                let near = self.figures.iter().map(|f| f.dp[i]).fold(f32::INFINITY, f32::min);
+                *out = detail::gate(self.df[i], near);
+            }
+        }
+        for child in self.figures.iter().filter_map(|f| f.child.as_deref()) {
+            child.paint_gates(gate, cols);
+        }
+    }
+}
