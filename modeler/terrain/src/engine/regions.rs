@@ -106,24 +106,31 @@ impl Shapes {
 /// Eq. 3's weight of a figure at distance `dp` on a cell with normaliser `norm`: `1/n` on each
 /// of the n figures a cell stands on, `(1/dp)/Σ(1/dp_j)` elsewhere, 0 where no figure reaches.
 fn share(norm: f64, dp: f32) -> f32 {
+    share_of(norm, dp, || profile::inverse_distance_real(f64::from(dp)))
+}
+
+/// [`share`] with the figure's inverse distance `inv` (computed only when needed).
+fn share_of(norm: f64, dp: f32, inv: impl FnOnce() -> f64) -> f32 {
     if norm < 0.0 {
         if dp == 0.0 { (1.0 / -norm) as f32 } else { 0.0 }
     } else if norm > 0.0 {
-        (profile::inverse_distance_real(f64::from(dp)) / norm) as f32
+        (inv() / norm) as f32
     } else {
         0.0
     }
 }
 
-/// Eq. 3's normaliser of a cell from its figures' distances, in figure order.
-fn normaliser(dps: &[&[f32]], i: usize) -> f64 {
+/// Eq. 3's normaliser of a cell from its figures' distances, in figure order; `inv` gets each
+/// figure's inverse distance when the cell is on none of them (for [`share_of`]).
+fn normaliser(dps: &[&[f32]], i: usize, inv: &mut [f64]) -> f64 {
     let on = dps.iter().filter(|d| d[i] == 0.0).count();
     if on > 0 {
         -(on as f64)
     } else {
-        dps.iter()
-            .map(|d| profile::inverse_distance_real(f64::from(d[i])))
-            .sum()
+        for (v, d) in inv.iter_mut().zip(dps) {
+            *v = profile::inverse_distance_real(f64::from(d[i]));
+        }
+        inv.iter().sum()
     }
 }
 
@@ -453,6 +460,7 @@ impl RegionNode {
         let (owned, row_runs) = (&*owned, &*row_runs);
         bands.into_par_iter().for_each(|(b, norm, df, dps, mut maps)| {
             let row0 = b * BAND_ROWS;
+            let mut inv = vec![0.0; dps.len()];
             for r in 0..norm.len() / w {
                 for run in &owned[row_runs[row0 + r]..row_runs[row0 + r + 1]] {
                     for x in run.start as usize..run.end as usize {
@@ -460,13 +468,13 @@ impl RegionNode {
                         if dirty.is_some_and(|d| !d[row0 * w + i]) {
                             continue;
                         }
-                        let n = normaliser(&dps, i);
+                        let n = normaliser(&dps, i, &mut inv);
                         norm[i] = n;
                         for (k, (dp, (shape_k, coef_k))) in dps.iter().zip(maps.iter_mut()).enumerate() {
                             if shapes.has(k) {
                                 shape_k[i] = shape(df[i], dp[i], slopes[k], outer);
                             }
-                            coef_k[i] = shape_k[i] * share(n, dp[i]);
+                            coef_k[i] = shape_k[i] * share_of(n, dp[i], || inv[k]);
                         }
                     }
                 }
