@@ -1,11 +1,12 @@
-//! A client of `pend`: connects to its socket and reads events.
+//! A client of `pend`: connects to its socket, asks for `head` lines (events version 4), and
+//! reads events.
 
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Write};
 use std::os::unix::net::UnixStream;
 use std::path::Path;
 
 use crate::events::PenEvent;
-use crate::wire::SocketLine;
+use crate::wire::{ClientLine, SocketLine};
 
 /// Why an event line could not be read.
 #[derive(Debug, thiserror::Error)]
@@ -75,10 +76,15 @@ pub struct Client {
 }
 
 impl Client {
-    /// Connects to the socket at `path`.
+    /// Connects to the socket at `path` and asks for `head` lines, which this client reads.
     pub fn connect(path: &Path) -> Result<Client, ClientError> {
+        let stream = UnixStream::connect(path)?;
+        // Unanswered: a pend that refused the client has closed its end, and the refusal's
+        // reason is what the client should read next, not a failed write; an older pend
+        // ignores what clients write (and sends every line anyway).
+        let _ = (&stream).write_all(ClientLine::subscribe_head().to_text().as_bytes());
         Ok(Client {
-            reader: BufReader::new(UnixStream::connect(path)?),
+            reader: BufReader::new(stream),
             line: String::new(),
         })
     }

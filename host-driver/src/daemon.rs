@@ -12,9 +12,13 @@
 //!
 //! Clients are bounded (`--max-clients`, 64 by default): one more is sent a `refused` line
 //! saying why, and closed, instead of costing a thread.
+//!
+//! `head` lines go only to clients that asked for them (events version 4: a `subscribe` line
+//! the client writes, which its writer reads between writes, [`crate::requests`]), so a client
+//! built for version 2 reads only the lines it knows.
 
 use std::collections::VecDeque;
-use std::io::{BufWriter, Read, Write};
+use std::io::{BufWriter, Write};
 use std::net::Shutdown;
 use std::os::unix::net::UnixStream;
 use std::path::{Path, PathBuf};
@@ -24,6 +28,7 @@ use std::time::Duration;
 
 use crate::events::{EventKind, PenEvent, PenState};
 use crate::pipeline::Pipeline;
+use crate::requests::Requests;
 use crate::sample::now_us;
 use crate::socket::{self, SocketError};
 
@@ -49,6 +54,14 @@ const BATCH: usize = 64;
 /// client that leaves while the pen is quiet frees its place.
 const IDLE_CHECK: Duration = Duration::from_secs(1);
 
+/// How often a writer with nothing to write looks for its client's request during
+/// [`ASK_WINDOW`] after it connected: a client asks right after connecting, and the pen may be
+/// quiet then (with the pen moving the writer looks after every write).
+const ASK_CHECK: Duration = Duration::from_millis(20);
+
+/// See [`ASK_CHECK`]; later an idle writer looks every [`IDLE_CHECK`].
+const ASK_WINDOW: Duration = Duration::from_secs(2);
+
 /// The default socket: `$XDG_RUNTIME_DIR/penscape/pend.sock`, or `/tmp/penscape-UID/pend.sock`.
 pub fn default_socket() -> PathBuf {
     socket::default_path()
@@ -66,6 +79,8 @@ struct QueueState {
     gone: bool,
     /// The writer is waiting for lines: only then is it worth a wake-up.
     waiting: bool,
+    /// The client asked for `head` lines.
+    head: bool,
 }
 
 /// Events a lagging client has lost since the last one queued for it.
@@ -130,10 +145,15 @@ impl Hub {
             last_t_us,
         } = &mut *inner;
         let mut resync = Vec::new();
+        let head = matches!(event.kind, EventKind::Head(_));
         clients.retain_mut(|c| {
             let mut q = lock(&c.queue.state);
             if q.gone {
                 return false;
+            }
+            // Not asked for: not sent, and not missed either (events version 4).
+            if head && !q.head {
+                return true;
             }
             let queued = match c.gap.take() {
                 None if q.lines.len() < c.capacity => {
@@ -238,6 +258,7 @@ impl Hub {
                 lines,
                 gone: false,
                 waiting: false,
+                head: false,
             }),
             wake: Condvar::new(),
         });
@@ -292,14 +313,18 @@ impl Drop for Leaving<'_> {
     }
 }
 
-/// A client's writer: its queue to its socket, a batch per write.
+/// A client's writer: its queue to its socket, a batch per write; between writes, what the
+/// client asks for.
 fn write_client(stream: UnixStream, queue: &Queue) {
     let _leaving = Leaving(queue);
-    // Reads only check that the client is still there; the receive timeout leaves writes
-    // blocking, so a client that stops reading blocks only this thread.
+    // Reads only take the client's requests and see whether it is still there, after a poll
+    // said there is something; the receive timeout leaves writes blocking, so a client that
+    // stops reading blocks only this thread.
     if stream.set_read_timeout(Some(Duration::from_millis(1))).is_err() {
         return;
     }
+    let connected = std::time::Instant::now();
+    let mut requests = Requests::default();
     let mut out = BufWriter::with_capacity(16 * 1024, &stream);
     let mut batch: Vec<Arc<str>> = Vec::with_capacity(BATCH);
     loop {
@@ -307,18 +332,21 @@ fn write_client(stream: UnixStream, queue: &Queue) {
             let mut q = lock(&queue.state);
             while q.lines.is_empty() {
                 q.waiting = true;
-                let (guard, wait) = queue
-                    .wake
-                    .wait_timeout(q, IDLE_CHECK)
-                    .unwrap_or_else(|e| e.into_inner());
+                let check = if !q.head && connected.elapsed() < ASK_WINDOW {
+                    ASK_CHECK
+                } else {
+                    IDLE_CHECK
+                };
+                let (guard, wait) = queue.wake.wait_timeout(q, check).unwrap_or_else(|e| e.into_inner());
                 q = guard;
                 q.waiting = false;
                 if wait.timed_out() && q.lines.is_empty() {
                     drop(q);
-                    if client_left(&stream) {
+                    if requests.read(&stream) {
                         return;
                     }
                     q = lock(&queue.state);
+                    q.head |= requests.head();
                 }
             }
             let n = q.lines.len().min(BATCH);
@@ -332,20 +360,15 @@ fn write_client(stream: UnixStream, queue: &Queue) {
         if out.flush().is_err() {
             return;
         }
-    }
-}
-
-/// Whether the client closed its end: a read sees the end of its stream. Anything it wrote is
-/// read and ignored (docs/events.md: clients only read).
-fn client_left(stream: &UnixStream) -> bool {
-    let mut buf = [0u8; 512];
-    match (&*stream).read(&mut buf) {
-        Ok(0) => true,
-        Ok(_) => false,
-        Err(e) => !matches!(
-            e.kind(),
-            std::io::ErrorKind::WouldBlock | std::io::ErrorKind::TimedOut | std::io::ErrorKind::Interrupted
-        ),
+        // Once it asked there is nothing more to ask for: no more reads while the pen moves.
+        if !requests.head() {
+            if requests.read(&stream) {
+                return;
+            }
+            if requests.head() {
+                lock(&queue.state).head = true;
+            }
+        }
     }
 }
 

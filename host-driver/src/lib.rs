@@ -12,7 +12,8 @@
 //! * [`events`]: pen events from samples; [`head`]: the tracked head's samples and `head`
 //!   events; [`pipeline`] turns a device into events.
 //! * [`daemon`]: `pend`, serving events to any number of clients on a Unix socket; [`client`]
-//!   reads them; [`wire`] is the socket's line format, shared by both.
+//!   reads them; [`wire`] is the socket's line format, shared by both; [`requests`] reads what
+//!   a client asks for (`head` lines).
 //!
 //! * [`help`]: what every tool's `--help` promises (examples), checked by each tool's tests.
 //!
@@ -31,6 +32,7 @@ pub mod head;
 pub mod help;
 pub mod hex;
 pub mod pipeline;
+pub mod requests;
 pub mod sample;
 pub mod socket;
 pub mod source;

@@ -13,8 +13,52 @@ use crate::events::{DisplayPoint, EventKind, HeadPose, HeadStatus, PenEvent};
 
 /// The events schema's version, the greeting's `events`. Version 2 added the `refused` line and
 /// the events that bring a client up to date when it joins and after a `missed` notice; version
-/// 3 the `head` line (docs/events.md).
-pub const EVENTS_VERSION: u32 = 3;
+/// 3 the `head` line; version 4 made `head` lines go only to clients that ask for them with a
+/// [`Subscribe`] line (docs/events.md).
+pub const EVENTS_VERSION: u32 = 4;
+
+/// The lines a client may write (events version 4), by their `type`; pend ignores any other.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "type", rename_all = "snake_case")]
+pub enum ClientLine {
+    /// Asks for optional lines.
+    Subscribe(Subscribe),
+}
+
+/// The optional lines a client reads, by their `type`: `head`. Names pend does not know are
+/// ignored, so a client may ask a newer pend for more.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct Subscribe {
+    /// The line types asked for.
+    pub lines: Vec<String>,
+}
+
+/// The `type` of the head's line, as a client names it in a [`Subscribe`].
+pub const HEAD_LINES: &str = "head";
+
+impl ClientLine {
+    /// Asking for `head` lines.
+    pub fn subscribe_head() -> ClientLine {
+        ClientLine::Subscribe(Subscribe {
+            lines: vec![HEAD_LINES.to_string()],
+        })
+    }
+
+    /// Whether this line asks for `head` lines.
+    pub fn wants_head(&self) -> bool {
+        match self {
+            ClientLine::Subscribe(s) => s.lines.iter().any(|l| l == HEAD_LINES),
+        }
+    }
+
+    /// The line as written: one JSON object and a newline.
+    pub fn to_text(&self) -> String {
+        // Only strings: serializing cannot fail.
+        let mut s = serde_json::to_string(self).unwrap_or_default();
+        s.push('\n');
+        s
+    }
+}
 
 /// One line on the socket, by its `type`.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -1,9 +1,9 @@
 //! The tracked head end to end: the simulated base station's head reports (the exact device
 //! bytes) through pend's real socket as `head` events, in the display frame; a head behind the
 //! display refused with the reason and a count, the last pose kept; a report without a fix
-//! keeping the last pose and saying so.
+//! keeping the last pose and saying so; `head` lines only to clients that ask (events version 4).
 
-use std::io::{BufRead, BufReader};
+use std::io::{BufRead, BufReader, Write};
 use std::os::unix::net::UnixStream;
 use std::process::Command;
 use std::time::Instant;
@@ -12,14 +12,17 @@ use crate::common::{GUARD, start_pend};
 
 use glam::{DQuat, DVec3};
 use pen_host::calibration::{Calibration, DisplaySize};
-use pen_host::client::{Line, parse_line};
+use pen_host::client::{Client, Line, parse_line};
 use pen_host::events::{DisplayPoint, EventKind};
 use pen_host::head::{HeadPose, HeadSampler, HeadStatus, HeadTracker};
 use pen_host::wire::EVENTS_VERSION;
 use pen_protocol::{HeadReport, Message, Position, Quality};
 
-/// The first `n` head events a client of pend reads, with their report's device time, and the
-/// greeting's events version.
+/// What a client writes to ask for `head` lines, as docs/events.md shows it.
+const ASK_FOR_HEAD: &[u8] = b"{\"type\": \"subscribe\", \"lines\": [\"head\"]}\n";
+
+/// The first `n` head events a client of pend that asked for them reads, with their report's
+/// device time, and the greeting's events version.
 fn head_events(calibration: Calibration, n: usize) -> (u32, Vec<(u64, HeadPose)>) {
     let dir = tempfile::tempdir().expect("tempdir");
     let (socket, file) = (dir.path().join("pend.sock"), dir.path().join("calibration.toml"));
@@ -31,6 +34,7 @@ fn head_events(calibration: Calibration, n: usize) -> (u32, Vec<(u64, HeadPose)>
     );
     let stream = UnixStream::connect(&socket).expect("connects");
     stream.set_read_timeout(Some(GUARD)).expect("timeout");
+    (&stream).write_all(ASK_FOR_HEAD).expect("asks");
     let mut reader = BufReader::new(stream);
     let mut line = String::new();
     reader.read_line(&mut line).expect("greeting");
@@ -115,6 +119,79 @@ fn a_head_behind_the_display_is_refused_and_counted() {
         }
     }
     assert!(refused >= 30, "{refused} of 40 refused");
+}
+
+#[test]
+fn head_lines_go_only_to_clients_that_ask() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let socket = dir.path().join("pend.sock");
+    let _pend = start_pend(&socket, &["--source", "sim:viewer", "--speed", "1"]);
+    // A client built for version 2 only reads; it joins first, so every head line the others
+    // read was offered to it too.
+    let quiet = UnixStream::connect(&socket).expect("connects");
+    let asking = UnixStream::connect(&socket).expect("connects");
+    (&asking).write_all(ASK_FOR_HEAD).expect("asks");
+    asking.set_read_timeout(Some(GUARD)).expect("timeout");
+    // The library's client asks by itself.
+    let mut library = Client::connect(&socket).expect("connects");
+    let mut asking = BufReader::new(asking);
+    let (mut line, mut heads) = (String::new(), 0);
+    let end = Instant::now() + GUARD;
+    while heads < 30 && Instant::now() < end {
+        line.clear();
+        assert!(asking.read_line(&mut line).expect("reads") > 0, "pend closed");
+        let v: serde_json::Value = serde_json::from_str(&line).expect("JSON");
+        heads += usize::from(v["type"] == "head");
+    }
+    assert_eq!(heads, 30, "the client that asked reads head lines");
+    let mut library_heads = 0;
+    while library_heads < 30 && Instant::now() < end {
+        match library.next_line().expect("pend open").expect("a good line") {
+            Line::Event(e) if matches!(e.kind, EventKind::Head(_)) => library_heads += 1,
+            _ => {}
+        }
+    }
+    assert_eq!(library_heads, 30, "pen_host's client asks for head lines");
+    // What the quiet client was sent meanwhile: every line of a kind version 2 knows.
+    quiet
+        .set_read_timeout(Some(std::time::Duration::from_millis(500)))
+        .expect("timeout");
+    let version_2 = [
+        "hello",
+        "refused",
+        "proximity_in",
+        "proximity_out",
+        "tip_down",
+        "tip_up",
+        "button_down",
+        "button_up",
+        "motion",
+        "device_lost",
+        "device_found",
+        "missed",
+    ];
+    let mut quiet = BufReader::new(quiet);
+    let mut read = 0;
+    // Its lines since it joined are waiting in its socket; the pen goes on moving, so a second
+    // more reads them all and then some.
+    let quiet_end = Instant::now() + std::time::Duration::from_secs(1);
+    while Instant::now() < quiet_end {
+        line.clear();
+        match quiet.read_line(&mut line) {
+            Ok(n) if n > 0 => {}
+            // Nothing more within the timeout (or pend closed): all it was sent is read.
+            _ => break,
+        }
+        read += 1;
+        let v: serde_json::Value = serde_json::from_str(&line).expect("JSON");
+        let kind = v["type"].as_str().expect("a type");
+        assert!(version_2.contains(&kind), "a client that did not ask read {line}");
+        if read == 1 {
+            assert_eq!(kind, "hello");
+            assert_eq!(v["events"], EVENTS_VERSION);
+        }
+    }
+    assert!(read >= 1, "the quiet client was greeted");
 }
 
 #[test]
