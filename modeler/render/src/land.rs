@@ -150,6 +150,8 @@ struct SkyLight {
     /// Per block: the sun seen (1 lit, 0 in shadow) and the sky-view factor.
     sun: Vec<f32>,
     sky: Vec<f32>,
+    /// Per vertex, the Lambert term `max(0, n·L)` of the last remake.
+    lambert: Vec<f32>,
 }
 
 /// A rectangle of cells, columns `c0..c1`, rows `r0..r1`.
@@ -721,6 +723,8 @@ impl SkyLight {
             r1: rows,
         };
         let mut relit = rect.grown(1, cols, rows);
+        // Where the normals change.
+        let mut moved = relit;
         if whole {
             self.f = f;
             self.cc = cc;
@@ -735,6 +739,7 @@ impl SkyLight {
             self.sun = sun;
             self.sky = sky;
             relit = everything;
+            moved = everything;
         } else {
             // The blocks the change touches.
             let mut moved = false;
@@ -768,58 +773,68 @@ impl SkyLight {
                 self.sky = sky;
             }
         }
-        self.vertices(map, vertical_scale, style, relit, out);
+        self.vertices(map, vertical_scale, style, (relit, moved), out);
         ((relit.c1 - relit.c0) * (relit.r1 - relit.r0)) as u64
     }
 
-    /// The light of the vertices in `rect` (see the module's notes).
+    /// The light of the vertices in `rect` (see the module's notes); their Lambert term is
+    /// recomputed in `moved` (where the heights changed, grown by a cell) and read from the last
+    /// remake elsewhere, the same `f32`.
     fn vertices(
-        &self,
+        &mut self,
         map: &penmodel_terrain::Heightmap,
         vertical_scale: f32,
         style: &Style,
-        rect: Rect,
+        (rect, moved): (Rect, Rect),
         out: &mut [f32],
     ) {
         let (cols, rows) = (map.cols() as usize, map.rows() as usize);
         let (f, cc, rr) = (self.f, self.cc, self.rr);
+        self.lambert.resize(cols * rows, 0.0);
         let h = map.heights();
         let s = map.cell_size() as f32;
         let light = light::world_light(style);
         let ambient = style.ambient.clamp(0.0, 1.0);
-        // A vertex's place on the coarse grid: block centres at (i + ½)f − ½ cells.
+        // A vertex's place on the coarse grid: block centres at (i + ½)f − ½ cells; the same
+        // for a whole column or row, so worked out once for each.
         let half = (f as f32 - 1.0) * 0.5;
         let inv_f = 1.0 / f as f32;
-        let bilinear = |m: &[f32], c: usize, r: usize| {
-            let u = ((c as f32 - half) * inv_f).clamp(0.0, (cc - 1) as f32);
-            let v = ((r as f32 - half) * inv_f).clamp(0.0, (rr - 1) as f32);
-            let (i, j) = (u as usize, v as usize);
-            let (fu, fv) = (u - i as f32, v - j as f32);
-            let (i1, j1) = ((i + 1).min(cc - 1), (j + 1).min(rr - 1));
-            let top = m[j * cc + i] + fu * (m[j * cc + i1] - m[j * cc + i]);
-            let bottom = m[j1 * cc + i] + fu * (m[j1 * cc + i1] - m[j1 * cc + i]);
-            top + fv * (bottom - top)
+        let place = |c: usize, n: usize| {
+            let u = ((c as f32 - half) * inv_f).clamp(0.0, (n - 1) as f32);
+            let i = u as usize;
+            (i, (i + 1).min(n - 1), u - i as f32)
         };
-        out[rect.r0 * cols..rect.r1 * cols]
+        let across: Vec<(usize, usize, f32)> = (rect.c0..rect.c1).map(|c| place(c, cc)).collect();
+        let (sun, sky) = (&self.sun, &self.sky);
+        let lines = out[rect.r0 * cols..rect.r1 * cols]
             .par_chunks_mut(cols)
-            .enumerate()
-            .for_each(|(k, line)| {
-                let r = rect.r0 + k;
-                let (r0, r1) = (r.saturating_sub(1), (r + 1).min(rows - 1));
-                for (c, o) in line.iter_mut().enumerate().take(rect.c1).skip(rect.c0) {
-                    let centre = h[r * cols + c];
-                    if !centre.is_finite() {
-                        *o = f32::NAN;
-                        continue;
-                    }
+            .zip(self.lambert[rect.r0 * cols..rect.r1 * cols].par_chunks_mut(cols));
+        lines.enumerate().for_each(|(k, (line, lamberts))| {
+            let r = rect.r0 + k;
+            let (r0, r1) = (r.saturating_sub(1), (r + 1).min(rows - 1));
+            let (j, j1, fv) = place(r, rr);
+            let bilinear = |m: &[f32], (i, i1, fu): (usize, usize, f32)| {
+                let top = m[j * cc + i] + fu * (m[j * cc + i1] - m[j * cc + i]);
+                let bottom = m[j1 * cc + i] + fu * (m[j1 * cc + i1] - m[j1 * cc + i]);
+                top + fv * (bottom - top)
+            };
+            let normals = (moved.r0..moved.r1).contains(&r);
+            for (c, at) in (rect.c0..rect.c1).zip(&across) {
+                let centre = h[r * cols + c];
+                if !centre.is_finite() {
+                    line[c] = f32::NAN;
+                    continue;
+                }
+                if normals && (moved.c0..moved.c1).contains(&c) {
                     let [dx, dz] = light::gradient(h, (cols, rows), (c, r), (r0, r1), (vertical_scale, s));
                     let inv = 1.0 / (dx * dx + 1.0 + dz * dz).sqrt();
-                    let lambert = ((-dx * light[0] + light[1] - dz * light[2]) * inv).max(0.0);
-                    let seen = bilinear(&self.sun, c, r);
-                    let open = bilinear(&self.sky, c, r);
-                    *o = ambient * open + (1.0 - ambient) * seen * lambert;
+                    lamberts[c] = ((-dx * light[0] + light[1] - dz * light[2]) * inv).max(0.0);
                 }
-            });
+                let seen = bilinear(sun, *at);
+                let open = bilinear(sky, *at);
+                line[c] = ambient * open + (1.0 - ambient) * seen * lamberts[c];
+            }
+        });
     }
 }
 

@@ -209,6 +209,8 @@ fn measure(n: u32, look: crate::render::LookArg, bar: &ProgressBar) -> Result<Fi
     for i in 0..WARM_UP + FRAMES {
         pull(&mut editor)?;
         let mut scene = Scene::new(editor.heightmap(), camera);
+        // As the live loop: the land look learns what changed from the editor.
+        scene.revisions = Some(editor.revisions());
         scene.overlays = &overlays;
         scene.selection = Some(1);
         scene.mode = "pull  height 62.0 m";
