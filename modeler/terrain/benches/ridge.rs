@@ -13,12 +13,15 @@
 //!   accumulation, is timed by `scripts/ridge_peer.py` in the same run as `penmodel analyze`).
 //!
 //! Run: `cargo bench -p penmodel-terrain --bench ridge` (filter with e.g. `-- sky32`).
+//! `RIDGE_SKY_CALLS=N` runs only N `sky_view(.., 32)` calls on the 1024² DTM and exits, no
+//! criterion: a short run for `valgrind --tool=callgrind` (instruction counts do not depend on
+//! the machine's load).
 
 use std::f64::consts::TAU;
 use std::hint::black_box;
 use std::time::{Duration, Instant};
 
-use criterion::{Criterion, criterion_group, criterion_main};
+use criterion::{Criterion, criterion_group};
 use penmodel_terrain::ridge::polygon::{self, Polygon};
 use penmodel_terrain::ridge::sun::{self, Field, Sun};
 use penmodel_terrain::ridge::{Dtm, Filter, Skeleton, rain};
@@ -87,8 +90,7 @@ fn bench(c: &mut Criterion) {
         })
     });
 
-    // 200 segments on 1024²: 20 lines of 10.
-    let big = scene(1024, 20, 10, 40.0, 150.0, 2);
+    let big = big_scene();
     let full = Dtm::build(1024, 1024, 1.0, Filter::DEFAULT, &ids(&big));
     eprintln!("full_dtm/200seg/1024: {} polygons", full.polygon_count());
     g.bench_function("full_dtm/200seg/1024", |bch| {
@@ -166,6 +168,7 @@ fn bench(c: &mut Criterion) {
         cell: 1.0,
     };
     peer_ray_march(field, 32);
+    sky_against_ray_march(field, 32);
     let sun = Sun::degrees(135.0, 25.0, "sun").expect("a sun above the horizon");
     g.bench_function("sky32/1024", |bch| bch.iter(|| sun::sky_view(black_box(field), 32)));
     g.bench_function("direct/1024", |bch| bch.iter(|| sun::direct(black_box(field), sun)));
@@ -308,5 +311,65 @@ fn peer_ray_march(field: Field<'_>, k: u32) {
     );
 }
 
+/// The sky view beside the one the ray march gives on every 16th cell of every 16th row:
+/// `1 − (1/k)·Σ sin² max(0, H_i)` with the ray march's horizons, the mean and largest difference.
+fn sky_against_ray_march(field: Field<'_>, k: u32) {
+    let sky = sun::sky_view(field, k);
+    let (mut worst, mut sum, mut n) = (0.0f64, 0.0f64, 0usize);
+    for r in (0..field.rows).step_by(16) {
+        for c in (0..field.cols).step_by(16) {
+            let sin2: f64 = (0..k)
+                .map(|d| {
+                    let t = sun::ray_march(field, TAU * f64::from(d) / f64::from(k), c, r).max(0.0);
+                    t * t / (1.0 + t * t)
+                })
+                .sum();
+            let diff = (1.0 - sin2 / f64::from(k) - f64::from(sky[(r * field.cols + c) as usize])).abs();
+            worst = worst.max(diff);
+            sum += diff;
+            n += 1;
+        }
+    }
+    eprintln!(
+        "sky view {k} azimuths against the ray march's: |difference| mean {:.5}, largest {worst:.4} over {n} cells",
+        sum / n.max(1) as f64
+    );
+}
+
+/// The bench's 200 segments on 1024²: 20 lines of 10.
+fn big_scene() -> Vec<Skeleton> {
+    scene(1024, 20, 10, 40.0, 150.0, 2)
+}
+
 criterion_group!(benches, bench);
-criterion_main!(benches);
+
+fn main() {
+    if let Some(calls) = std::env::var("RIDGE_SKY_CALLS")
+        .ok()
+        .and_then(|v| v.parse::<u32>().ok())
+    {
+        let z = Dtm::build(1024, 1024, 1.0, Filter::DEFAULT, &ids(&big_scene()))
+            .heights()
+            .to_vec();
+        let field = Field {
+            z: &z,
+            cols: 1024,
+            rows: 1024,
+            cell: 1.0,
+        };
+        let mut total = 0.0f64;
+        for _ in 0..calls {
+            total += sun::sky_view(black_box(field), 32)
+                .iter()
+                .map(|&v| f64::from(v))
+                .sum::<f64>();
+        }
+        eprintln!(
+            "{calls} sky_view calls, mean sky view {:.6}",
+            total / (f64::from(calls) * 1024.0 * 1024.0)
+        );
+        return;
+    }
+    benches();
+    Criterion::default().configure_from_args().final_summary();
+}

@@ -511,6 +511,92 @@ fn sky_view_of_a_pit_is_one_minus_the_mean_squared_sine_of_its_horizons() {
     assert!((centre - 0.5).abs() < 0.05, "sky view at the pit's bottom {centre}");
 }
 
+/// The sky view by its definition, naively in f64: per azimuth the parallel lines `v = b + u·t`
+/// along the dominant axis u, one per integer b, sampled at every u with the height
+/// interpolated between rows `⌊v⌋` and `⌊v⌋ + 1`; each sample's horizon the largest tangent to
+/// any sample ahead (O(n) each); its `sin² max(0, H)` added to both cells with their
+/// interpolation weights (nothing ahead: 0); the weighted mean.
+fn sky_by_definition(z: &[f32], cols: usize, rows: usize, cell: f64, k: usize) -> Vec<f64> {
+    let (mut sum, mut weight) = (vec![0.0f64; z.len()], vec![0.0f64; z.len()]);
+    for d in 0..k {
+        let az = 2.0 * PI * d as f64 / k as f64;
+        let (dx, dy) = (az.cos(), az.sin());
+        let x_major = dx.abs() >= dy.abs();
+        let (du, dv, nu, nv) = if x_major {
+            (dx, dy, cols, rows)
+        } else {
+            (dy, dx, rows, cols)
+        };
+        let mut t = dv / du;
+        for e in [-1.0, 0.0, 1.0] {
+            if (t - e).abs() < 1e-12 {
+                t = e;
+            }
+        }
+        let spacing = (1.0 + t * t).sqrt() * cell;
+        let at = |u: usize, v: usize| if x_major { v * cols + u } else { u * cols + v };
+        for b in -(nu as i64) - 1..=(nv + nu) as i64 + 1 {
+            // (u, lower row, upper row's weight, height)
+            let samples: Vec<(usize, usize, f64, f64)> = (0..nu)
+                .filter_map(|u| {
+                    let v = b as f64 + u as f64 * t;
+                    if v < 0.0 || v > (nv - 1) as f64 {
+                        return None;
+                    }
+                    let v0 = v.floor() as usize;
+                    let f = v - v0 as f64;
+                    let h = if f > 0.0 {
+                        f64::from(z[at(u, v0)]) * (1.0 - f) + f64::from(z[at(u, v0 + 1)]) * f
+                    } else {
+                        f64::from(z[at(u, v0)])
+                    };
+                    Some((u, v0, f, h))
+                })
+                .collect();
+            for &(u, v0, f, h) in &samples {
+                let horizon = samples
+                    .iter()
+                    .filter(|q| (q.0 as f64 - u as f64) * du > 0.0)
+                    .map(|q| (q.3 - h) / ((q.0 as f64 - u as f64).abs() * spacing))
+                    .fold(0.0f64, f64::max);
+                let value = horizon * horizon / (1.0 + horizon * horizon);
+                sum[at(u, v0)] += (1.0 - f) * value;
+                weight[at(u, v0)] += 1.0 - f;
+                if f > 0.0 {
+                    sum[at(u, v0 + 1)] += f * value;
+                    weight[at(u, v0 + 1)] += f;
+                }
+            }
+        }
+    }
+    sum.iter().zip(&weight).map(|(s, w)| 1.0 - s / w).collect()
+}
+
+#[test]
+fn sky_view_is_its_definition_computed_naively() {
+    let (cols, rows, cell) = (40u32, 28u32, 2.0);
+    let z = bumpy(cols, rows);
+    let field = Field {
+        z: &z,
+        cols,
+        rows,
+        cell,
+    };
+    for k in [5, 16, 32] {
+        let want = sky_by_definition(&z, cols as usize, rows as usize, cell, k);
+        let got = sun::sky_view(field, k as u32);
+        for (i, (g, w)) in got.iter().zip(&want).enumerate() {
+            // The sweep works in f32.
+            assert!(
+                (f64::from(*g) - w).abs() < 1e-4,
+                "{k} azimuths, cell ({}, {}): sweep {g}, definition {w}",
+                i % cols as usize,
+                i / cols as usize
+            );
+        }
+    }
+}
+
 #[test]
 fn growth_is_seeded_and_its_lines_run_downhill_from_the_ridge() {
     let (cols, rows, cell) = (80u32, 64u32, 1.0);

@@ -29,6 +29,7 @@ use rayon::prelude::*;
 
 use super::RidgeError;
 use super::gradient::sobel;
+use super::sections::{Hull, Sections, transpose};
 use crate::Heightmap;
 
 /// The diffuse share of clear-sky light used by [`insolation`].
@@ -93,219 +94,60 @@ impl<'a> Field<'a> {
 /// tangent is `-∞` where nothing lies ahead.
 pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
     let Field { z, cols, rows, cell } = field;
-    let n = z.len();
-    let (mut sum, mut weight) = (vec![0.0f32; n], vec![0.0f32; n]);
+    let (cols, rows) = (cols as usize, rows as usize);
     let (dx, dy) = (azimuth.cos(), azimuth.sin());
     let x_major = dx.abs() >= dy.abs();
-    let mut sink = |line: &Line, k: usize, t: Option<f32>| {
-        if let Some(t) = t {
-            line.spread(k, t, &mut sum, &mut weight);
-        }
-    };
-    if x_major {
-        sweep(z, cols, rows, cell, (dx, dy), false, &mut sink);
+    // The grid with the direction's dominant axis along its rows, and a row more (see
+    // `Sections::heights`).
+    let (grid, w, h, du, dv) = if x_major {
+        let mut g = Vec::with_capacity(z.len() + cols);
+        g.extend_from_slice(z);
+        g.resize(z.len() + cols, 0.0);
+        (g, cols, rows, dx, dy)
     } else {
-        let zt = transpose(z, cols, rows);
-        sweep(&zt, rows, cols, cell, (dy, dx), false, &mut sink);
+        (transpose(z, cols, rows, rows), rows, cols, dy, dx)
+    };
+    let lines = Sections::new(w, h, slope(du, dv), cell);
+    let (mut sum, mut weight) = (vec![0.0f32; (h + 1) * w], vec![0.0f32; (h + 1) * w]);
+    let [mut heights, mut rise, mut steps] = [(); 3].map(|_| vec![0.0f32; w]);
+    let mut hull = Hull::default();
+    let spacing = lines.spacing;
+    for b in lines.lines() {
+        let cols = lines.columns(b);
+        let n = cols.len();
+        let (zs, rs, ds) = (&mut heights[..n], &mut rise[..n], &mut steps[..n]);
+        lines.heights(&grid, b, cols.clone(), zs);
+        if du > 0.0 {
+            hull.pass::<true>(zs, rs, ds);
+        } else {
+            hull.pass::<false>(zs, rs, ds);
+        }
+        // Nothing ahead of the first sample swept: NaN, no value.
+        for (r, &d) in rs.iter_mut().zip(ds.iter()) {
+            *r /= d * spacing;
+        }
+        lines.spread_weighted(b, cols, rs, &mut sum, &mut weight);
     }
+    sum.truncate(h * w);
+    weight.truncate(h * w);
     if !x_major {
         // Back to the grid's layout: the transposed grid is rows wide.
-        sum = transpose(&sum, rows, cols);
-        weight = transpose(&weight, rows, cols);
+        sum = transpose(&sum, w, h, 0);
+        weight = transpose(&weight, w, h, 0);
     }
     for (i, (&s, &w)) in sum.iter().zip(&weight).enumerate() {
         f(i, if w > 0.0 { f64::from(s / w) } else { f64::NEG_INFINITY });
     }
 }
 
-/// One section's samples, in increasing u from `u0`: the lower cell's index, the interpolation
-/// weight of the cell one row further, and the interpolated height; sample k lies `(u0 + k)·spacing`
-/// along the line.
-#[derive(Default)]
-struct Line {
-    i0: Vec<u32>,
-    frac: Vec<f32>,
-    h: Vec<f32>,
-    u0: f32,
-    spacing: f32,
-    /// Grid columns (the row stride of `i0`).
-    stride: usize,
-}
-
-impl Line {
-    /// Adds `value` to sample k's two cells, weighted by nearness, and the weights.
-    #[inline]
-    fn spread(&self, k: usize, value: f32, sum: &mut [f32], weight: &mut [f32]) {
-        let (i0, frac) = (self.i0[k] as usize, self.frac[k]);
-        let w0 = 1.0 - frac;
-        sum[i0] += w0 * value;
-        weight[i0] += w0;
-        if frac > 0.0 {
-            sum[i0 + self.stride] += frac * value;
-            weight[i0 + self.stride] += frac;
-        }
-    }
-}
-
-/// The upper hull of the samples passed so far, nearest vertex last.
-///
-/// The nearest vertex is kept in registers and the others in two `f32` stacks. Why: the pop
-/// test reads the vertex pushed one sample earlier; stored as a `(f32, f32)` pair it was written
-/// as two 4-byte stores and read back as one 8- or 16-byte load, which the CPU cannot forward
-/// from the store buffer, a stall of a dozen cycles on every sample (`perf` put most of the
-/// sweep there). Same-width stores and loads forward.
-#[derive(Default)]
-struct Hull {
-    s: Vec<f32>,
-    h: Vec<f32>,
-}
-
-/// The upper-hull pass over a line's samples in the order `order`, the first ones the farthest
-/// ahead: calls `sink(line, k, tangent)` for each sample (`None` when nothing is ahead).
-/// `sign` is 1 when ahead is increasing u, −1 when decreasing, so that positions grow ahead.
-#[inline]
-fn hull_pass(
-    line: &Line,
-    hull: &mut Hull,
-    sign: f32,
-    order: impl Iterator<Item = usize>,
-    sink: &mut impl FnMut(&Line, usize, Option<f32>),
-) {
-    hull.s.clear();
-    hull.h.clear();
-    // The nearest hull vertex, once there is one.
-    let mut near: Option<(f32, f32)> = None;
-    for k in order {
-        let (s, h) = (sign * (line.u0 + k as f32) * line.spacing, line.h[k]);
-        let t = near.map(|(mut s1, mut h1)| {
-            // Pop the nearest vertex while it lies on or under the line to the next one.
-            while let (Some(&s2), Some(&h2)) = (hull.s.last(), hull.h.last()) {
-                if (h1 - h) * (s2 - s) <= (h2 - h) * (s1 - s) {
-                    (s1, h1) = (s2, h2);
-                    hull.s.pop();
-                    hull.h.pop();
-                } else {
-                    break;
-                }
-            }
-            hull.s.push(s1);
-            hull.h.push(h1);
-            (h1 - h) / (s1 - s)
-        });
-        sink(line, k, t);
-        near = Some((s, h));
-    }
-}
-
-/// `z` (`cols × rows`, row-major) transposed: `rows × cols`. In tiles, so that both the reads
-/// and the writes stay within a few cache lines and pages (a plain column walk misses the cache
-/// on every cell of a large grid).
-fn transpose(z: &[f32], cols: u32, rows: u32) -> Vec<f32> {
-    const TILE: usize = 64;
-    let (w, h) = (cols as usize, rows as usize);
-    let mut t = vec![0.0f32; z.len()];
-    // Each task writes TILE rows of the result (TILE columns of `z`).
-    t.par_chunks_mut(h * TILE).enumerate().for_each(|(tc, out)| {
-        let c0 = tc * TILE;
-        let nc = out.len() / h;
-        for r0 in (0..h).step_by(TILE) {
-            for c in c0..c0 + nc {
-                let dst = &mut out[(c - c0) * h..(c - c0 + 1) * h];
-                for r in r0..(r0 + TILE).min(h) {
-                    dst[r] = z[r * w + c];
-                }
-            }
-        }
-    });
-    t
-}
-
-/// The horizon sweep for a direction `(du, dv)` with `|du| ≥ |dv|`, u along the columns of the
-/// `cols × rows` grid `z`: every line's samples through `sink`, and with `both` again for the
-/// opposite direction (the same lines swept the other way).
-fn sweep(
-    z: &[f32],
-    cols: u32,
-    rows: u32,
-    cell: f64,
-    (du, dv): (f64, f64),
-    both: bool,
-    sink: &mut impl FnMut(&Line, usize, Option<f32>),
-) {
-    let (nu, nv) = (cols, rows);
-    // A step ahead (u += sign du) moves v by dv/|du|: line b is v = b + u·dv/du.
-    let mut slope = dv / du;
-    // cos 45° and sin 45° differ in the last bit: snap the diagonals and axes so that their
-    // lines run exactly through the cell centres.
-    for exact in [-1.0, 0.0, 1.0] {
-        if (slope - exact).abs() < 1e-12 {
-            slope = exact;
-        }
-    }
-    let spacing = ((1.0 + slope * slope).sqrt() * cell) as f32;
-    let w = cols as usize;
-    let (lo, hi) = (f64::from(nu - 1) * slope.min(0.0), f64::from(nu - 1) * slope.max(0.0));
-    let ahead_up = du > 0.0;
-    let mut hull = Hull {
-        s: Vec::with_capacity(nu as usize),
-        h: Vec::with_capacity(nu as usize),
-    };
-    let mut line = Line {
-        stride: w,
-        spacing,
-        ..Line::default()
-    };
-    let nvf = f64::from(nv);
-    let last_u = i64::from(nu) - 1;
-    for b in (-hi.ceil() as i64 - 1)..(i64::from(nv) - lo.floor() as i64 + 1) {
-        // The columns where the line is on the grid (a column wider each way; checked below).
-        let (ua, ub) = if slope == 0.0 {
-            (0, last_u)
-        } else {
-            let (a, c) = ((-(b as f64)) / slope, (nvf - 1.0 - b as f64) / slope);
-            let (a, c) = (a.min(c), a.max(c));
-            ((a.floor() as i64 - 1).max(0), (c.ceil() as i64 + 1).min(last_u))
-        };
-        line.i0.clear();
-        line.frac.clear();
-        line.h.clear();
-        // The samples on the grid are consecutive in u.
-        let mut first = None;
-        for u in ua..=ub {
-            let v = b as f64 + u as f64 * slope;
-            if v < 0.0 || v > nvf - 1.0 {
-                if first.is_some() {
-                    break;
-                }
-                continue;
-            }
-            first.get_or_insert(u);
-            // v ≥ 0: truncation is the floor.
-            let v0 = v as usize;
-            let frac = (v - v0 as f64) as f32;
-            let i0 = v0 * w + u as usize;
-            let h = if frac > 0.0 {
-                z[i0] * (1.0 - frac) + z[i0 + w] * frac
-            } else {
-                z[i0]
-            };
-            line.i0.push(i0 as u32);
-            line.frac.push(frac);
-            line.h.push(h);
-        }
-        line.u0 = first.unwrap_or(0) as f32;
-        let n = line.h.len();
-        if n == 0 {
-            continue;
-        }
-        // From the far end back: the first samples swept are the farthest ahead.
-        if ahead_up || both {
-            hull_pass(&line, &mut hull, 1.0, (0..n).rev(), sink);
-        }
-        if !ahead_up || both {
-            hull_pass(&line, &mut hull, -1.0, 0..n, sink);
-        }
-    }
+/// The slope `dv/du` of a direction with `|du| ≥ |dv|`, the axes and diagonals exact: cos 45°
+/// and sin 45° differ in the last bit, and their lines should run through the cell centres.
+fn slope(du: f64, dv: f64) -> f64 {
+    let t = dv / du;
+    [-1.0, 0.0, 1.0]
+        .into_iter()
+        .find(|e: &f64| (t - e).abs() < 1e-12)
+        .unwrap_or(t)
 }
 
 /// The brute-force horizon of cell `(c, r)` in azimuth `azimuth`: the largest tangent to the
@@ -378,67 +220,190 @@ pub fn direct(field: Field<'_>, sun: Sun) -> Vec<f32> {
 /// do not depend on the number of threads.
 const GROUP: usize = 8;
 
-/// The sky-view fraction per cell from `k` azimuths (`2πi/k`): `1 − (1/k)·Σ sin² H_i`.
-///
-/// Each line sample's `sin² H` is spread over its two cells like a horizon (see [`horizons`]),
-/// with the weights summed alongside: the mean over all directions is the weighted mean (every
-/// cell gets weight 1 per azimuth but at the grid's edge). Opposite azimuths share their lines
-/// and are swept together.
-pub fn sky_view(field: Field<'_>, k: u32) -> Vec<f32> {
-    let Field { z, cols, rows, cell } = field;
-    let n = z.len();
-    let k = k.max(1) as usize;
-    let zt = transpose(z, cols, rows);
-    // Azimuth d with its opposite d + k/2 when k is even.
-    let pairs: Vec<(usize, Option<usize>)> = if k.is_multiple_of(2) {
-        (0..k / 2).map(|d| (d, Some(d + k / 2))).collect()
-    } else {
-        (0..k).map(|d| (d, None)).collect()
-    };
-    // Per group: sums and weights in the grid's layout and in the transposed one.
-    let groups: Vec<[Vec<f32>; 4]> = pairs
-        .par_chunks(GROUP)
-        .map(|chunk| {
-            let [mut acc, mut wt, mut acc_t, mut wt_t] = [(); 4].map(|_| vec![0.0f32; n]);
-            for &(d, opposite) in chunk {
-                let az = TAU * d as f64 / k as f64;
-                let (dx, dy) = (az.cos(), az.sin());
-                let (grid, sum, weight) = if dx.abs() >= dy.abs() {
-                    (z, &mut acc, &mut wt)
-                } else {
-                    (&zt[..], &mut acc_t, &mut wt_t)
-                };
-                let (c, r, dir) = if dx.abs() >= dy.abs() {
-                    (cols, rows, (dx, dy))
-                } else {
-                    (rows, cols, (dy, dx))
-                };
-                let mut add = |line: &Line, j: usize, t: Option<f32>| {
-                    let m = t.unwrap_or(0.0).max(0.0);
-                    line.spread(j, m * m / (1.0 + m * m), sum, weight);
-                };
-                sweep(grid, c, r, cell, dir, opposite.is_some(), &mut add);
-            }
-            [acc, wt, acc_t, wt_t]
-        })
-        .collect();
-    // The groups' sums in a fixed order, the transposed ones brought back to the grid's layout.
-    let mut total = [(); 4].map(|_| vec![0.0f32; n]);
-    for g in &groups {
-        for (t, a) in total.iter_mut().zip(g) {
-            t.par_iter_mut().zip(a.par_iter()).for_each(|(t, a)| *t += a);
+/// One layout's share of the sky view: per cell the sum of the spread `sin² H`, and the weights
+/// of the first and last rows and of every other row (see `Sections::weight`).
+struct Layout {
+    /// The layout's row length and rows.
+    w: usize,
+    h: usize,
+    sum: Vec<f32>,
+    first: Vec<f32>,
+    last: Vec<f32>,
+    inner: f32,
+}
+
+impl Layout {
+    fn new(w: usize, h: usize) -> Layout {
+        Layout {
+            w,
+            h,
+            sum: vec![0.0; (h + 1) * w],
+            first: vec![0.0; w],
+            last: vec![0.0; w],
+            inner: 0.0,
         }
     }
-    let [acc, wt, acc_t, wt_t] = total;
-    let (acc_t, wt_t) = (transpose(&acc_t, rows, cols), transpose(&wt_t, rows, cols));
-    acc.par_iter()
-        .zip(wt.par_iter())
-        .zip(acc_t.par_iter().zip(wt_t.par_iter()))
-        .map(|((&a, &w), (&at, &wt))| {
-            let (s, ws) = (a + at, w + wt);
-            if ws > 0.0 { 1.0 - s / ws } else { 1.0 }
+
+    /// Adds `other`, cell by cell.
+    fn add(&mut self, other: &Layout) {
+        self.sum
+            .par_iter_mut()
+            .zip(other.sum.par_iter())
+            .for_each(|(t, a)| *t += a);
+        for (t, a) in self.first.iter_mut().zip(&other.first) {
+            *t += a;
+        }
+        for (t, a) in self.last.iter_mut().zip(&other.last) {
+            *t += a;
+        }
+        self.inner += other.inner;
+    }
+
+    /// The weights of the cells of row r.
+    fn weights(&self, r: usize, h: usize) -> Option<&[f32]> {
+        if r == 0 {
+            Some(&self.first)
+        } else if r + 1 == h {
+            Some(&self.last)
+        } else {
+            None
+        }
+    }
+}
+
+/// The `sin² H` of a horizon `rise / (steps·spacing)`, 0 for one below the horizontal or none
+/// (a NaN rise); `sp2` is the spacing squared.
+#[inline]
+fn sin2(rise: f32, steps: f32, sp2: f32) -> f32 {
+    let r = if rise > 0.0 { rise } else { 0.0 };
+    r * r / (r * r + steps * steps * sp2)
+}
+
+/// Adds the sky view's `sin² H` of the direction `(du, dv)` (`|du| ≥ |dv|`, u along the rows of
+/// the grid `z`, laid out like `layout` with a row more), and with `both` of the opposite
+/// direction, to `layout`. `buf` is scratch.
+fn sky_sweep(z: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &mut Layout, buf: &mut Scratch) {
+    let (w, h) = (layout.w, layout.h);
+    let lines = Sections::new(w, h, slope(du, dv), cell);
+    let sp2 = lines.spacing * lines.spacing;
+    let passes = if both { 2.0 } else { 1.0 };
+    let Scratch {
+        heights,
+        up,
+        down,
+        hull,
+    } = buf;
+    heights.resize(w, 0.0);
+    for v in [&mut up.0, &mut up.1, &mut down.0, &mut down.1] {
+        v.resize(w, 0.0);
+    }
+    for b in lines.lines() {
+        let cols = lines.columns(b);
+        let n = cols.len();
+        let zs = &mut heights[..n];
+        lines.heights(z, b, cols.clone(), zs);
+        let (ru, su) = (&mut up.0[..n], &mut up.1[..n]);
+        let (rd, dd) = (&mut down.0[..n], &mut down.1[..n]);
+        match (du > 0.0 || both, du < 0.0 || both) {
+            (true, true) => {
+                hull.pass::<true>(zs, ru, su);
+                hull.pass::<false>(zs, rd, dd);
+                // sin² H of both, in place of the first's rises (vectorised: no position math).
+                for (((r, &d), &r2), &d2) in ru.iter_mut().zip(su.iter()).zip(rd.iter()).zip(dd.iter()) {
+                    *r = sin2(*r, d, sp2) + sin2(r2, d2, sp2);
+                }
+            }
+            (up_only, _) => {
+                if up_only {
+                    hull.pass::<true>(zs, ru, su);
+                } else {
+                    hull.pass::<false>(zs, ru, su);
+                }
+                for (r, &d) in ru.iter_mut().zip(su.iter()) {
+                    *r = sin2(*r, d, sp2);
+                }
+            }
+        }
+        lines.spread(b, cols, ru, &mut layout.sum);
+    }
+    for u in 0..w {
+        layout.first[u] += passes * lines.weight(u, 0);
+        layout.last[u] += passes * lines.weight(u, h - 1);
+    }
+    layout.inner += passes;
+}
+
+/// Buffers reused from line to line: a line's heights, and the rises and steps to the horizon
+/// ahead in both directions.
+#[derive(Default)]
+struct Scratch {
+    heights: Vec<f32>,
+    up: (Vec<f32>, Vec<f32>),
+    down: (Vec<f32>, Vec<f32>),
+    hull: Hull,
+}
+
+/// The sky-view fraction per cell from `k` azimuths (`2πi/k`): `1 − (1/k)·Σ sin² H_i`.
+///
+/// Each line sample's `sin² H` is spread over its two cells like a horizon (see [`horizons`]):
+/// the mean over all directions is the weighted mean, every cell getting weight 1 per azimuth
+/// but on the grid's edge rows across a direction's lines, where the weights are known in closed
+/// form (`Sections::weight`). Opposite azimuths share their lines and are swept together.
+pub fn sky_view(field: Field<'_>, k: u32) -> Vec<f32> {
+    let Field { z, cols, rows, cell } = field;
+    let (cols, rows) = (cols as usize, rows as usize);
+    let k = k.max(1) as usize;
+    // Both layouts with a row more (see `Sections::heights`).
+    let mut zp = Vec::with_capacity(z.len() + cols);
+    zp.extend_from_slice(z);
+    zp.resize(z.len() + cols, 0.0);
+    let zt = transpose(z, cols, rows, rows);
+    // Azimuth d with its opposite d + k/2 when k is even.
+    let pairs: Vec<(usize, bool)> = if k.is_multiple_of(2) {
+        (0..k / 2).map(|d| (d, true)).collect()
+    } else {
+        (0..k).map(|d| (d, false)).collect()
+    };
+    // Per group: the grid's layout and the transposed one.
+    let groups: Vec<[Layout; 2]> = pairs
+        .par_chunks(GROUP)
+        .map(|chunk| {
+            let mut out = [Layout::new(cols, rows), Layout::new(rows, cols)];
+            let mut buf = Scratch::default();
+            for &(d, both) in chunk {
+                let az = TAU * d as f64 / k as f64;
+                let (dx, dy) = (az.cos(), az.sin());
+                if dx.abs() >= dy.abs() {
+                    sky_sweep(&zp, cell, (dx, dy), both, &mut out[0], &mut buf);
+                } else {
+                    sky_sweep(&zt, cell, (dy, dx), both, &mut out[1], &mut buf);
+                }
+            }
+            out
         })
-        .collect()
+        .collect();
+    // The groups' sums in a fixed order, the transposed one brought back to the grid's layout.
+    let mut groups = groups.into_iter();
+    let Some([mut grid, mut trans]) = groups.next() else {
+        return vec![1.0; z.len()];
+    };
+    for [g, t] in groups {
+        grid.add(&g);
+        trans.add(&t);
+    }
+    let across = transpose(&trans.sum[..z.len()], rows, cols, 0);
+    let mut out = vec![0.0f32; z.len()];
+    out.par_chunks_mut(cols).enumerate().for_each(|(r, line)| {
+        let (a, at) = (&grid.sum[r * cols..(r + 1) * cols], &across[r * cols..(r + 1) * cols]);
+        let wg = grid.weights(r, rows);
+        for (c, o) in line.iter_mut().enumerate() {
+            // Cell (c, r) is cell (r, c) of the transposed layout.
+            let wt = trans.weights(c, cols).map_or(trans.inner, |w| w[r]);
+            let ws = wg.map_or(grid.inner, |w| w[c]) + wt;
+            *o = if ws > 0.0 { 1.0 - (a[c] + at[c]) / ws } else { 1.0 };
+        }
+    });
+    out
 }
 
 /// `(1 − f)·direct + f·sky` with `f` = [`DIFFUSE`].

@@ -1,0 +1,248 @@
+//! The parallel sections of the horizon sweep ([`super::sun`], Alg. 3.1) and the upper-hull pass
+//! along one.
+//!
+//! For a direction whose dominant axis is u (the grid's columns; a column-major direction works
+//! on the transposed grid) with slope `t = dv/du` in [−1, 1], line b samples column u at row
+//! `v = b + u·t`, the height interpolated linearly between rows `⌊v⌋` and `⌊v⌋ + 1`. With b an
+//! integer, the row offset `⌊u·t⌋` and the upper row's weight `frac(u·t)` depend on u alone: all
+//! lines are translates of line 0. Both are tabled once per direction, so a line's samples and
+//! the spreading of their values back to the cells cost no position arithmetic per sample.
+
+use std::ops::Range;
+
+use rayon::prelude::*;
+
+/// One direction's lines over a `w × h` grid (row-major, u along the rows).
+pub(super) struct Sections {
+    w: usize,
+    h: usize,
+    /// Per column u: `⌊u·t⌋`.
+    o: Vec<isize>,
+    /// Per column u: `⌊u·t⌋·w + u`, line 0's lower cell there (line b adds `b·w`).
+    off: Vec<isize>,
+    /// Per column u: the lower row's weight `1 − frac(u·t)` and the upper row's `frac(u·t)`.
+    lo: Vec<f32>,
+    hi: Vec<f32>,
+    /// Whether `t ≥ 0` (rows grow with u).
+    rising: bool,
+    /// Metres between neighbouring samples of a line.
+    pub spacing: f32,
+}
+
+impl Sections {
+    /// The lines of slope `t` (|t| ≤ 1) over a `w × h` grid of `cell`-metre cells.
+    pub fn new(w: usize, h: usize, t: f64, cell: f64) -> Sections {
+        let mut s = Sections {
+            w,
+            h,
+            o: Vec::with_capacity(w),
+            off: Vec::with_capacity(w),
+            lo: Vec::with_capacity(w),
+            hi: Vec::with_capacity(w),
+            rising: t >= 0.0,
+            spacing: ((1.0 + t * t).sqrt() * cell) as f32,
+        };
+        for u in 0..w {
+            let p = u as f64 * t;
+            let o = p.floor();
+            let hi = (p - o) as f32;
+            s.o.push(o as isize);
+            s.off.push(o as isize * w as isize + u as isize);
+            s.lo.push(1.0 - hi);
+            s.hi.push(hi);
+        }
+        s
+    }
+
+    /// The lines with samples on the grid (some at the ends may have none).
+    pub fn lines(&self) -> Range<isize> {
+        let (min, max) = self.o.iter().fold((0, 0), |(a, b), &o| (o.min(a), o.max(b)));
+        -max..self.h as isize - min
+    }
+
+    /// The columns where line b's samples lie on the grid: both rows inside (or the upper one's
+    /// weight 0). Consecutive, as `u·t` is monotonic.
+    pub fn columns(&self, b: isize) -> Range<usize> {
+        let last = self.h as isize - 1;
+        let (o, hi) = (&self.o, &self.hi);
+        let top = |u: usize| b + o[u] + isize::from(hi[u] > 0.0);
+        let n = self.w;
+        let (start, end) = if self.rising {
+            (part(n, |u| b + o[u] < 0), part(n, |u| top(u) <= last))
+        } else {
+            (part(n, |u| top(u) > last), part(n, |u| b + o[u] >= 0))
+        };
+        start..end.max(start)
+    }
+
+    /// Line b's heights over `cols` (from [`Sections::columns`]) into `out` (as long). `z` holds a
+    /// row more than the grid (any finite values), read with weight 0.
+    #[inline]
+    pub fn heights(&self, z: &[f32], b: isize, cols: Range<usize>, out: &mut [f32]) {
+        let (base, w) = (b * self.w as isize, self.w);
+        let taps = self.off[cols.clone()]
+            .iter()
+            .zip(&self.lo[cols.clone()])
+            .zip(&self.hi[cols]);
+        for (o, ((&off, &lo), &hi)) in out.iter_mut().zip(taps) {
+            let i = (base + off) as usize;
+            *o = z[i] * lo + z[i + w] * hi;
+        }
+    }
+
+    /// Adds line b's `values` over `cols` to the cells they were sampled from, weighted like the
+    /// heights. `sum` holds a row more than the grid (it gets weight-0 terms).
+    #[inline]
+    pub fn spread(&self, b: isize, cols: Range<usize>, values: &[f32], sum: &mut [f32]) {
+        let (base, w) = (b * self.w as isize, self.w);
+        let taps = self.off[cols.clone()]
+            .iter()
+            .zip(&self.lo[cols.clone()])
+            .zip(&self.hi[cols]);
+        for (&v, ((&off, &lo), &hi)) in values.iter().zip(taps) {
+            let i = (base + off) as usize;
+            sum[i] += lo * v;
+            sum[i + w] += hi * v;
+        }
+    }
+
+    /// [`Sections::spread`] skipping NaN values, with the weights summed into `weight`.
+    pub fn spread_weighted(&self, b: isize, cols: Range<usize>, values: &[f32], sum: &mut [f32], weight: &mut [f32]) {
+        let (base, w) = (b * self.w as isize, self.w);
+        let taps = self.off[cols.clone()]
+            .iter()
+            .zip(&self.lo[cols.clone()])
+            .zip(&self.hi[cols]);
+        for (&v, ((&off, &lo), &hi)) in values.iter().zip(taps) {
+            if v.is_nan() {
+                continue;
+            }
+            let i = (base + off) as usize;
+            sum[i] += lo * v;
+            weight[i] += lo;
+            sum[i + w] += hi * v;
+            weight[i + w] += hi;
+        }
+    }
+
+    /// The weight all lines together give cell `(u, r)` when every sample is spread: 1 but on
+    /// the first and last rows, where one of the cell's two lines has no sample.
+    pub fn weight(&self, u: usize, r: usize) -> f32 {
+        let (lo, hi) = (self.lo[u], self.hi[u]);
+        // The line whose lower row is r, and the one whose upper row is r.
+        let below = if r + usize::from(hi > 0.0) < self.h { lo } else { 0.0 };
+        if r >= 1 { below + hi } else { below }
+    }
+}
+
+/// The first index in `0..n` where `f` is false, `f` true on a prefix.
+fn part(n: usize, f: impl Fn(usize) -> bool) -> usize {
+    let (mut a, mut b) = (0, n);
+    while a < b {
+        let m = (a + b) / 2;
+        if f(m) { a = m + 1 } else { b = m }
+    }
+    a
+}
+
+/// The upper hull of the samples swept so far, in two `f32` stacks reused from line to line.
+///
+/// Two stacks rather than one of `(f32, f32)` pairs: the pop test reads the vertex pushed one
+/// sample earlier, and a pair written as two 4-byte stores and read back as one 8-byte load
+/// cannot be forwarded from the store buffer, a stall on every sample. Same-width stores and
+/// loads forward.
+#[derive(Default)]
+pub(super) struct Hull {
+    s: Vec<f32>,
+    h: Vec<f32>,
+}
+
+impl Hull {
+    /// Sweeps a line's heights `z` from the far end back — from the last sample to the first
+    /// when `AHEAD_UP` (ahead is increasing index), else from the first — keeping the upper
+    /// hull of the samples passed (those ahead). Sample k's horizon is the tangent
+    /// `rise[k] / (steps[k] · spacing)` to the hull, `steps[k] ≥ 1` samples ahead; the first
+    /// sample swept has nothing ahead: `rise` NaN. Samples under the hull are popped for good:
+    /// O(1) amortised per sample.
+    #[inline]
+    pub fn pass<const AHEAD_UP: bool>(&mut self, z: &[f32], rise: &mut [f32], steps: &mut [f32]) {
+        let samples = z.iter().zip(rise.iter_mut().zip(steps.iter_mut()));
+        if AHEAD_UP {
+            self.run(z.len(), samples.rev());
+        } else {
+            self.run(z.len(), samples);
+        }
+    }
+
+    #[inline]
+    fn run<'a>(&mut self, n: usize, mut samples: impl Iterator<Item = (&'a f32, (&'a mut f32, &'a mut f32))>) {
+        // A power of two above n + 1: indices masked with `cap − 1` need no bounds checks.
+        let cap = (n + 1).next_power_of_two();
+        if self.s.len() < cap {
+            self.s.resize(cap, 0.0);
+            self.h.resize(cap, 0.0);
+        }
+        let mask = cap - 1;
+        let (ss, hs) = (&mut self.s[..mask + 1], &mut self.h[..mask + 1]);
+        // At the bottom a vertex no line to the next one passes over (infinitely low), so
+        // that the pop test needs no check for an empty stack.
+        ss[0] = 1.0;
+        hs[0] = f32::NEG_INFINITY;
+        let mut top = 1usize;
+        let Some((&h0, (r0, d0))) = samples.next() else {
+            return;
+        };
+        (*r0, *d0) = (f32::NAN, 1.0);
+        // Positions: minus the sweep count, so that they grow ahead; exact integers in f32.
+        let (mut h1, mut s) = (h0, 0.0f32);
+        for (&h, (rise, steps)) in samples {
+            s -= 1.0;
+            // The nearest vertex (the previous sample, one step ahead) relative to this one.
+            let (mut a, mut b) = (h1 - h, 1.0f32);
+            // Pop it while it lies on or under the line to the next one.
+            loop {
+                let i = (top - 1) & mask;
+                let (h2, c) = (hs[i], ss[i] - s);
+                let d = h2 - h;
+                if a * c <= d * b {
+                    (a, b, h1) = (d, c, h2);
+                    top -= 1;
+                } else {
+                    break;
+                }
+            }
+            // b + s is the vertex's position, exactly (integers).
+            ss[top & mask] = b + s;
+            hs[top & mask] = h1;
+            top += 1;
+            (*rise, *steps) = (a, b);
+            h1 = h;
+        }
+    }
+}
+
+/// `z` (`cols × rows`, row-major) transposed: `rows × cols`, followed by `pad` zeros. In tiles,
+/// so that both the reads and the writes stay within a few cache lines and pages (a plain
+/// column walk misses the cache on every cell of a large grid).
+pub(super) fn transpose(z: &[f32], cols: usize, rows: usize, pad: usize) -> Vec<f32> {
+    const TILE: usize = 64;
+    let (w, h) = (cols, rows);
+    let mut t = vec![0.0f32; z.len() + pad];
+    // Each task writes TILE rows of the result (TILE columns of `z`).
+    t[..z.len()]
+        .par_chunks_mut(h.max(1) * TILE)
+        .enumerate()
+        .for_each(|(tc, out)| {
+            let c0 = tc * TILE;
+            let nc = out.len() / h.max(1);
+            for r0 in (0..h).step_by(TILE) {
+                for c in c0..c0 + nc {
+                    let dst = &mut out[(c - c0) * h..(c - c0 + 1) * h];
+                    for r in r0..(r0 + TILE).min(h) {
+                        dst[r] = z[r * w + c];
+                    }
+                }
+            }
+        });
+    t
+}
