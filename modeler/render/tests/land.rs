@@ -410,3 +410,58 @@ fn the_maps_follow_the_editors_revisions_and_equal_fresh_ones_exactly() {
         assert_eq!(frame.pixels(), other.pixels(), "{light_cells} light cells");
     }
 }
+
+#[test]
+fn the_maps_follow_changes_to_the_edge_of_the_rectangle_told() {
+    use penmodel_render::land::Land;
+    use penmodel_terrain::rect::Rect;
+    use penmodel_terrain::revision::Revisions;
+    let n = 90u32;
+    let mut heights: Vec<f32> = (0..n * n)
+        .map(|i| {
+            let (x, y) = (f64::from(i % n), f64::from(i / n));
+            (20.0 * (-((x - 40.0).powi(2) + (y - 50.0).powi(2)) / 400.0).exp()) as f32
+        })
+        .collect();
+    let mut revisions = Revisions::new();
+    let mut land = Land::default();
+    let mut light = Vec::new();
+    let mut s = style();
+    s.light_cells = 30;
+    s.light_lag = 0;
+    let camera = crate::common::above(f64::from(n));
+    // Bumps whose changed cells fill the rectangle told, up to its edges.
+    for (k, (c0, r0, w, h)) in [(10u32, 12u32, 7u32, 5u32), (60, 3, 4, 9), (33, 70, 1, 1), (0, 0, 3, 3)]
+        .into_iter()
+        .enumerate()
+    {
+        let map = Heightmap::from_heights(n, n, 1.0, heights.clone()).expect("heights");
+        let mut scene = Scene::new(&map, camera);
+        scene.style = s.clone();
+        scene.revisions = Some(&revisions);
+        land.prepare(&scene, &mut light);
+        for r in r0..r0 + h {
+            for c in c0..c0 + w {
+                heights[(r * n + c) as usize] += 3.0 + (k as f32) + (c % 3) as f32;
+            }
+        }
+        revisions.record(Rect {
+            c0,
+            r0,
+            width: w,
+            height: h,
+        });
+    }
+    let map = Heightmap::from_heights(n, n, 1.0, heights).expect("heights");
+    let mut scene = Scene::new(&map, camera);
+    scene.style = s.clone();
+    scene.revisions = Some(&revisions);
+    land.prepare(&scene, &mut light);
+    scene.revisions = None;
+    let (mut fresh, mut fresh_light) = (Land::default(), Vec::new());
+    fresh.prepare(&scene, &mut fresh_light);
+    let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<u32>>();
+    assert_eq!(bits(&light), bits(&fresh_light));
+    let albedo = |l: &Land| l.albedo().iter().flatten().map(|x| x.to_bits()).collect::<Vec<u32>>();
+    assert_eq!(albedo(&land), albedo(&fresh));
+}
