@@ -67,6 +67,21 @@ fn a_sequence_writes_each_frame_and_an_animation_of_them_all() {
 /// Plays an APNG as a viewer does (dispose NONE, blend SOURCE or OVER), from the spec's rules,
 /// and returns the canvas after each frame.
 fn play(path: &std::path::Path) -> Vec<Vec<u8>> {
+    played(path).into_iter().map(|p| p.canvas).collect()
+}
+
+/// One frame of an APNG as played.
+struct Played {
+    /// The canvas after it.
+    canvas: Vec<u8>,
+    /// How long it shows, seconds.
+    delay_s: f64,
+    /// Pixels of its data that are opaque and equal to the canvas under them (stored though
+    /// unchanged).
+    restated: usize,
+}
+
+fn played(path: &std::path::Path) -> Vec<Played> {
     let mut decoder = png::Decoder::new(BufReader::new(File::open(path).unwrap()));
     // RGB with a tRNS key comes out as RGBA, the key's pixels with alpha 0.
     decoder.set_transformations(png::Transformations::EXPAND);
@@ -83,9 +98,11 @@ fn play(path: &std::path::Path) -> Vec<Vec<u8>> {
         let fc = reader.info().frame_control.unwrap();
         assert_eq!(fc.dispose_op, png::DisposeOp::None);
         let (x0, y0, fw) = (fc.x_offset as usize, fc.y_offset as usize, fc.width as usize);
+        let mut restated = 0;
         for (j, src) in buf[..info.buffer_size()].chunks_exact(fw * 4).enumerate() {
             for (i, px) in src.chunks_exact(4).enumerate() {
                 let at = ((y0 + j) * w + x0 + i) * 4;
+                restated += usize::from(px[3] == 255 && canvas[at..at + 4] == *px);
                 match (fc.blend_op, px[3]) {
                     (png::BlendOp::Over, 0) => {}
                     (png::BlendOp::Over, 255) | (png::BlendOp::Source, _) => canvas[at..at + 4].copy_from_slice(px),
@@ -93,7 +110,13 @@ fn play(path: &std::path::Path) -> Vec<Vec<u8>> {
                 }
             }
         }
-        shown.push(canvas.clone());
+        // A zero denominator means 100 (the APNG spec).
+        let den = if fc.delay_den == 0 { 100 } else { fc.delay_den };
+        shown.push(Played {
+            canvas: canvas.clone(),
+            delay_s: f64::from(fc.delay_num) / f64::from(den),
+            restated,
+        });
     }
     shown
 }
@@ -202,4 +225,85 @@ fn difference_is_the_mean_absolute_channel_error_and_psnr() {
     let mse = (900.0 + 144.0) / n;
     assert!((psnr - 10.0 * (65025.0 / mse).log10()).abs() < 1e-9, "{psnr}");
     assert_eq!(a.difference(&frame(2, 4, 0)), None);
+}
+
+#[test]
+fn scattered_changes_play_back_exactly_whichever_way_a_delta_is_stored() {
+    // A quarter of the pixels of a smooth frame change by one, so a delta of transparent unchanged
+    // pixels between them deflates worse than the unchanged ones restated.
+    let (w, h) = (96u32, 64u32);
+    let mut first = Frame::new(w, h).unwrap();
+    for (i, p) in first.pixels_mut().iter_mut().enumerate() {
+        let (x, y) = (i as u32 % w, i as u32 / w);
+        *p = [(2 * x) as u8, (3 * y) as u8, (x + y) as u8, 255];
+    }
+    let mut next = first.clone();
+    for (i, p) in next.pixels_mut().iter_mut().enumerate() {
+        // Scattered: a multiplicative hash's top two bits.
+        if (i as u32).wrapping_mul(2_654_435_761) >> 30 == 0 {
+            p[0] = p[0].wrapping_add(1);
+        }
+    }
+    // And a frame with one small changed box, stored with its unchanged pixels transparent.
+    let mut last = next.clone();
+    last.pixels_mut()[(10 * w + 10) as usize] = [1, 2, 3, 255];
+    let frames = [first, next, last];
+    let dir = tempfile::tempdir().unwrap();
+    let mut seq = Sequence::create(dir.path(), 25).unwrap();
+    for f in &frames {
+        seq.push(f).unwrap();
+    }
+    let anim = seq.finish().unwrap().unwrap();
+    let shown = played(&anim);
+    assert_eq!(shown.len(), frames.len());
+    for (i, (s, f)) in shown.iter().zip(&frames).enumerate() {
+        assert!(s.canvas == f.as_bytes(), "frame {i} plays back differently");
+        assert!((s.delay_s - 1.0 / 25.0).abs() < 1e-9, "frame {i} shows {} s", s.delay_s);
+    }
+    assert!(shown[1].restated > 0, "the scattered delta restates unchanged pixels");
+}
+
+#[test]
+fn moving_frames_are_thinned_and_the_rest_shown_longer_on_the_same_clock() {
+    let (w, h) = (48u32, 32u32);
+    let fps = 10;
+    // 1..=6 and 9..=11 change everywhere (the view moving); 7 and 8 one pixel each.
+    let mut frames = vec![frame(w, h, 0)];
+    for k in 1..12u8 {
+        let f = if (7..=8).contains(&k) {
+            let mut f = frames.last().unwrap().clone();
+            f.pixels_mut()[usize::from(k)] = [k, k, k, 255];
+            f
+        } else {
+            frame(w, h, 7 * k)
+        };
+        frames.push(f);
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let mut seq = Sequence::create(dir.path(), fps).unwrap().moving_every(3);
+    for f in &frames {
+        seq.push(f).unwrap();
+    }
+    // The first; of each moving run every third since the last held; each still frame; the last.
+    let expected = vec![0, 3, 6, 7, 8, 11];
+    assert_eq!(seq.held(), expected);
+    let animation = seq.finish_animation().unwrap().unwrap();
+    assert_eq!(animation.held, expected);
+    let shown = played(&animation.path);
+    assert_eq!(shown.len(), expected.len());
+    for (k, (s, &i)) in shown.iter().zip(&expected).enumerate() {
+        assert!(s.canvas == frames[i].as_bytes(), "held frame {k} is not frame {i}");
+        // Shown until the next one held: the frames left out pass on the same clock.
+        let until = expected.get(k + 1).copied().unwrap_or(frames.len());
+        let want = (until - i) as f64 / f64::from(fps);
+        assert!(
+            (s.delay_s - want).abs() < 1e-9,
+            "frame {i} shows {} s, not {want}",
+            s.delay_s
+        );
+    }
+    let total: f64 = shown.iter().map(|s| s.delay_s).sum();
+    assert!((total - frames.len() as f64 / f64::from(fps)).abs() < 1e-9);
+    // Every frame is still written as its own file.
+    assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), frames.len() + 1);
 }
