@@ -20,8 +20,9 @@ use penmodel::picture::{Look, Picture};
 use penmodel::session::{Session, State, blank_document};
 use penmodel_render::output::{self, Sequence, Viewer, ViewerEvent, WindowError};
 use penmodel_render::ui::{self, Place};
-use penmodel_render::{Frame, Renderer, Stereo};
+use penmodel_render::{Frame, Renderer, Scene, Stereo};
 use penmodel_terrain::editor::Editor;
+use penmodel_terrain::revision::Revisions;
 use penmodel_terrain::{Heightmap, export};
 use serde_json::json;
 
@@ -543,8 +544,10 @@ impl Painter {
         Ok(())
     }
 
-    fn draw(&mut self, picture: &Picture, map: &Heightmap) -> Result<&Frame> {
-        self.renderer.render(&picture.scene(map), &mut self.view)?;
+    /// `picture` with the overview; `revisions`, the terrain's history when `map` is an editor's,
+    /// lets the land look recompute only what changed since the last frame.
+    fn draw(&mut self, picture: &Picture, map: &Heightmap, revisions: Option<&Revisions>) -> Result<&Frame> {
+        self.renderer.render(&scene(picture, map, revisions), &mut self.view)?;
         self.frame.blit(&self.view, 0, 0);
         if self.overview == Overview::Off {
             return Ok(&self.frame);
@@ -554,7 +557,7 @@ impl Painter {
             f64::from(map.rows()) * map.cell_size(),
         ];
         self.inset_renderer
-            .render(&picture.overview(extent).scene(map), &mut self.inset)?;
+            .render(&scene(&picture.overview(extent), map, revisions), &mut self.inset)?;
         let (w, h) = (self.view.width(), self.view.height());
         match self.overview {
             Overview::Corner => {
@@ -570,7 +573,7 @@ impl Painter {
             Overview::Beside => {
                 self.frame.blit(&self.inset, w, 0);
                 self.inset_renderer
-                    .render(&picture.map(extent).scene(map), &mut self.inset)?;
+                    .render(&scene(&picture.map(extent), map, revisions), &mut self.inset)?;
                 self.frame.blit(&self.inset, w, h - self.inset.height());
             }
             Overview::Off => {}
@@ -586,7 +589,15 @@ impl Painter {
 
     fn session(&mut self, session: &Session, look: &Look) -> Result<&Frame> {
         let picture = Picture::of(session, look);
-        self.draw(&picture, session.editor.heightmap())
+        self.draw(&picture, session.editor.heightmap(), Some(session.editor.revisions()))
+    }
+}
+
+/// `p`'s scene of `map`, with the terrain's history when known.
+fn scene<'a>(p: &'a Picture, map: &'a Heightmap, revisions: Option<&'a Revisions>) -> Scene<'a> {
+    Scene {
+        revisions,
+        ..p.scene(map)
     }
 }
 
@@ -914,7 +925,7 @@ mod tests {
                 (Overview::Beside, w + (w / 2).max(1)),
             ] {
                 let mut painter = Painter::new(w, h, overview).expect("painter");
-                let frame = painter.draw(&picture, &map).expect("drawn");
+                let frame = painter.draw(&picture, &map, None).expect("drawn");
                 assert_eq!((frame.width(), frame.height()), (width, h));
             }
         }
