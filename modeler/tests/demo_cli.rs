@@ -18,6 +18,28 @@ fn run(dir: &Path, extra: &[&str]) -> std::process::Output {
         .expect("penmodel runs")
 }
 
+/// An APNG's frames as its chunks say: (frames in acTL, each frame's delay in seconds from fcTL).
+fn apng_frames(path: &Path) -> (u32, Vec<f64>) {
+    let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let be = |i: usize| u32::from_be_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+    let (mut count, mut delays, mut at) = (0, Vec::new(), 8);
+    while at + 8 <= bytes.len() {
+        let (len, kind, body) = (be(at) as usize, &bytes[at + 4..at + 8], at + 8);
+        match kind {
+            b"acTL" => count = be(body),
+            b"fcTL" => {
+                // After sequence number, width, height, x, y: delay numerator and denominator.
+                let num = u16::from_be_bytes([bytes[body + 20], bytes[body + 21]]);
+                let den = u16::from_be_bytes([bytes[body + 22], bytes[body + 23]]);
+                delays.push(f64::from(num) / f64::from(if den == 0 { 100 } else { den }));
+            }
+            _ => {}
+        }
+        at = body + len + 4;
+    }
+    (count, delays)
+}
+
 fn png_size(path: &Path) -> (u32, u32) {
     let bytes = std::fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{} is a PNG", path.display());
@@ -78,6 +100,19 @@ fn the_demo_runs_headless_and_writes_its_results() {
     // By default the animation only; single frames and meshes on request (a compact default).
     assert!(!out_dir.join("frames/frame_00000.png").exists());
     assert_eq!(png_size(&out_dir.join("frames/animation.png")), (480, 180));
+    // Where the view moves (the ground tilts while a figure is pulled; the tracked head's last
+    // 12 s) the animation holds 1 frame in 3 (--moving-every), shown the longer: fewer frames,
+    // and still the session's time, a second per frame at --fps 1.
+    let held = summary["animation_frames"].as_u64().expect("frames held");
+    let (count, delays) = apng_frames(&out_dir.join("frames/animation.png"));
+    assert_eq!((u64::from(count), delays.len() as u64), (held, held), "{summary}");
+    assert!(held < frames * 9 / 10, "{held} of {frames} frames held");
+    let played: f64 = delays.iter().sum();
+    assert!(
+        (played - frames as f64).abs() < 1e-6,
+        "{played} s for {frames} frames at 1 a second"
+    );
+    assert!(delays.iter().all(|&d| (0.999..=3.001).contains(&d)), "{delays:?}");
     // The terrain: 16-bit heightmap, float32, meshes, renders; the document.
     assert_eq!(png_size(&out_dir.join("terrain.png")), (480, 272));
     let raw = std::fs::metadata(out_dir.join("terrain.f32"))
@@ -115,6 +150,8 @@ fn the_demo_runs_headless_and_writes_its_results() {
             "--no-overview",
             "--frames",
             "--meshes",
+            "--moving-every",
+            "1",
         ],
     );
     assert!(again.status.success(), "{}", String::from_utf8_lossy(&again.stderr));
@@ -124,6 +161,19 @@ fn the_demo_runs_headless_and_writes_its_results() {
         "{stdout}"
     );
     assert_eq!(png_size(&out_dir.join("frames/frame_00000.png")), (160, 90));
+    // --moving-every 1: the animation holds every frame written, in far fewer bytes (deltas).
+    let files: Vec<_> = std::fs::read_dir(out_dir.join("frames"))
+        .expect("frames")
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().starts_with("frame_"))
+        .collect();
+    let (count, _) = apng_frames(&out_dir.join("frames/animation.png"));
+    assert_eq!(count as usize, files.len());
+    let whole: u64 = files.iter().filter_map(|e| e.metadata().ok()).map(|m| m.len()).sum();
+    let stored = std::fs::metadata(out_dir.join("frames/animation.png"))
+        .expect("animation")
+        .len();
+    assert!(stored * 2 < whole, "{stored} bytes for frames of {whole} bytes");
     for name in ["terrain.obj", "terrain.glb"] {
         assert!(out_dir.join(name).exists(), "{name}");
     }

@@ -71,6 +71,12 @@ pub struct LiveArgs {
     /// Keep every frame of the animation as its own PNG in OUT/frames (large).
     #[arg(long)]
     frames: bool,
+    /// Where the view moves (most of the picture changes from frame to frame: the ground tilting
+    /// while a figure is pulled, the view following a tracked head), the animation holds every
+    /// Nth frame, each shown until the next: a whole changed frame costs ~250 KB. 1 holds every
+    /// frame (with --frames, each is also its own PNG).
+    #[arg(long, value_name = "N", default_value_t = 3, value_parser = clap::value_parser!(u16).range(1..))]
+    moving_every: u16,
     /// Also write the terrain as meshes: OUT/terrain.obj and OUT/terrain.glb (large).
     #[arg(long)]
     meshes: bool,
@@ -168,6 +174,8 @@ impl Created {
 struct Written {
     frames: usize,
     animation: Option<PathBuf>,
+    /// How many of the frames the animation holds (--moving-every).
+    held: usize,
     /// The frames were shown in a window, not written.
     shown: bool,
 }
@@ -389,6 +397,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
             "frames": written.frames,
             "frames_shown_in_window": written.shown,
             "animation": written.animation,
+            "animation_frames": written.held,
             "results": results,
             "heights_m": [lo, hi],
             "stats": {
@@ -426,6 +435,13 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
                     anim.display()
                 )
             }
+            (false, Some(anim)) if written.held < written.frames => format!(
+                "wrote the animation of {} ({}; {} of them: 1 in {} where the view moves),",
+                count(written.frames as u64, "frame"),
+                anim.display(),
+                written.held,
+                args.moving_every,
+            ),
             (false, Some(anim)) => format!(
                 "wrote the animation of {} ({}),",
                 count(written.frames as u64, "frame"),
@@ -622,7 +638,7 @@ fn run_headless(
     // No frames at all with --fps 0: the results alone.
     let mut frames = match args.fps {
         0 => None,
-        fps => Some(Sequence::create(&args.out.join("frames"), fps)?),
+        fps => Some(Sequence::create(&args.out.join("frames"), fps)?.moving_every(args.moving_every.into())),
     };
     let step_us = 1_000_000 / u64::from(args.fps.max(1));
     let mut next_us: Option<u64> = None;
@@ -672,23 +688,25 @@ fn run_headless(
         }
     }
     progress.finish_and_clear();
-    let (count, animation) = match frames {
-        None => (0, None),
+    let (count, animation, held) = match frames {
+        None => (0, None, 0),
         Some(frames) => {
             let paths = frames.frames().to_vec();
-            let animation = frames.finish()?;
+            let animation = frames.finish_animation()?;
             if !args.frames {
                 // The animation holds them all; the single frames only on request.
                 for f in &paths {
                     std::fs::remove_file(f).with_context(|| format!("cannot remove {}", f.display()))?;
                 }
             }
-            (paths.len(), animation)
+            let held = animation.as_ref().map_or(0, |a| a.held.len());
+            (paths.len(), animation.map(|a| a.path), held)
         }
     };
     Ok(Written {
         frames: count,
         animation,
+        held,
         shown: false,
     })
 }
@@ -833,6 +851,7 @@ fn run_window(
     Ok(Written {
         frames,
         animation: None,
+        held: 0,
         shown: true,
     })
 }
