@@ -88,6 +88,8 @@ fn usage_errors_exit_2() {
     // Without a subcommand penmodel models with the pen (tests/demo_cli.rs); its options are
     // checked like any others.
     assert_eq!(penmodel(&["--fps", "61"]).status.code(), Some(2));
+    // Holding 1 frame in 0 of the moving ones means nothing: 1 holds them all.
+    assert_eq!(penmodel(&["--moving-every", "0"]).status.code(), Some(2));
     assert_eq!(penmodel(&["--show", "sideways"]).status.code(), Some(2));
     let help = penmodel(&["generate", "--help"]);
     assert!(help.status.success());
