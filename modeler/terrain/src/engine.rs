@@ -36,13 +36,14 @@
 //! `base + Σ_k relief_k·coef_k(x)`, where `coef_k = shape_k × share_k`: `shape_k` is eq. 2's
 //! term (eq. 1's `w_k`, eq. 4's slope) and `share_k` figure k's eq. 3 weight (1/|on| on figures,
 //! `(1/dp_k)/Σ(1/dp_j)` elsewhere). The engine keeps, per region, the edge distances and eq. 3's
-//! normaliser per cell, and per figure `dp_k`, `shape_k` and `coef_k` over the region's bounding
-//! box (`engine/regions.rs` says how each edit updates them):
+//! normaliser per cell, and per figure `dp_k`, `shape_k` (with its logarithm) and `coef_k` over
+//! the region's bounding box (`engine/regions.rs` says how each edit updates them):
 //!
 //! - **height** of figure k (a pull): the region painted again, K multiply-adds per cell; a
 //!   closed figure's nested region too (its base).
-//! - **slope** of figure k: `shape_k` and `coef_k` (one `powf` per cell), the region painted; a
-//!   closed figure's nested region blended again (eq. 4 reads `s0`).
+//! - **slope** of figure k: `shape_k` and `coef_k` (one `exp` per cell: a top-level figure keeps
+//!   eq. 2's logarithm per cell), the region painted; a closed figure's nested region blended
+//!   again (eq. 4 reads `s0`).
 //! - **a moved figure** or a moved point of one: the figure's `dp` by one breadth-first search
 //!   (or distance transform), compared with the old; only the cells where it changed get new
 //!   shares and coefficients (the other figures' shape terms are kept) and are painted.

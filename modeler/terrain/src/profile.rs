@@ -42,6 +42,34 @@ pub fn shape(w: f64, s: f64) -> f64 {
     }
 }
 
+/// The logarithm eq. 2's power takes for a weight `w` and the sign of the slope `s`, rounded to
+/// `f32`: `ln(1 − w)` for `s > 0`, `ln(w)` for `s < 0` (0 for `s = 0`, where it is not used).
+/// The terrain engine keeps it per cell, so that a slope change costs one `exp` per cell
+/// ([`shape_from_log`]).
+pub fn shape_log(w: f64, s: f64) -> f32 {
+    if s > 0.0 {
+        (1.0 - w).ln() as f32
+    } else if s < 0.0 {
+        w.ln() as f32
+    } else {
+        0.0
+    }
+}
+
+/// Eq. 2 divided by the relief as the terrain engine evaluates it, from [`shape_log`]'s `l` for
+/// the same sign of `s`: `1 − e^((1+s)·l)` for `s > 0`, `e^((1−s)·l)` for `s < 0`, `w` for
+/// `s = 0`. It differs from [`shape`] by less than an `f32` unit at 1: the rounding of `l`
+/// moves the power by `|p·ln x|·2⁻²⁴` relative, and `x^p·|p·ln x| ≤ 1/e`.
+pub fn shape_from_log(w: f64, l: f32, s: f64) -> f64 {
+    if s == 0.0 {
+        w
+    } else if s > 0.0 {
+        1.0 - ((1.0 + s) * f64::from(l)).exp()
+    } else {
+        ((1.0 - s) * f64::from(l)).exp()
+    }
+}
+
 /// Eq. 2: the height of a cell of weight `w` for a figure of relief `h` and slope `s`.
 pub fn profile(h: f64, w: f64, s: f64) -> f64 {
     h * shape(w, s)

@@ -37,7 +37,7 @@ use crate::cells::{self, Cell, Mask};
 use crate::document::{Document, Figure, FigureKind, Grid, OLDEST_VERSION, Point, Region, VERSION};
 use crate::geometry::{self, Side};
 
-/// The most cells a grid may have: 4096 × 4096. The engine keeps about 12 bytes per cell per
+/// The most cells a grid may have: 4096 × 4096. The engine keeps about 16 bytes per cell per
 /// figure of a region plus about 30 per cell, so a larger grid would not fit a workstation.
 pub const MAX_CELLS: u64 = 1 << 24;
 
@@ -65,8 +65,9 @@ pub const MAX_SLOPE: f64 = 1e3;
 pub const MAX_DEPTH: usize = 32;
 
 /// Bytes the terrain engine keeps per figure per cell of its region's bounding box: distances,
-/// eq. 2 shape terms and coefficients (`f32` each).
-pub const BYTES_PER_FIGURE_CELL: u64 = 12;
+/// eq. 2 shape terms, their logarithms (a slope change is one `exp` per cell) and coefficients
+/// (`f32` each).
+pub const BYTES_PER_FIGURE_CELL: u64 = 16;
 
 /// Bytes the terrain engine keeps, or allocates for a moment, per cell of a region's bounding
 /// box whatever its figures: the mask, edge distances, eq. 3's normaliser (`f64`), a search
@@ -74,8 +75,8 @@ pub const BYTES_PER_FIGURE_CELL: u64 = 12;
 pub const BYTES_PER_REGION_CELL: u64 = 32;
 
 /// The most memory the terrain engine may need for a document, in bytes (2 GiB): see
-/// [`engine_bytes`]. 100 figures over 1024² cells need about 1.3 GB; 300 over 2048² would need
-/// 15 GB, which aborted the process before this limit.
+/// [`engine_bytes`]. 100 figures over 1024² cells need about 1.6 GB; 300 over 2048² would need
+/// 20 GB, which aborted the process before this limit.
 pub const MAX_ENGINE_BYTES: u64 = 2 << 30;
 
 /// A number written compactly for a message: the shortest form that reads back, in exponent

@@ -4,8 +4,10 @@
 //! minus its nested regions'), and eq. 3's normaliser per cell, `norm`: `−n` on a cell where n
 //! figures stand, else `Σ_j 1/dp_j` in figure order (0 where no figure reaches). Per figure:
 //! its distances `dp`, its shape term `shape = eq. 2(w, s)` (eq. 1's `w`, eq. 4's slope for a
-//! nested figure) rounded to `f32`, and its coefficient `coef = shape × share` (an `f32`
-//! product), where `share` is eq. 3's weight read from `norm` and `dp` ([`share`]).
+//! nested figure) evaluated as `profile::shape_from_log` and rounded to `f32`, the logarithm that
+//! takes (`profile::shape_log`, kept for a top-level figure so that a slope change of the same
+//! sign is one `exp` per cell), and its coefficient `coef = shape × share` (an `f32` product),
+//! where `share` is eq. 3's weight read from `norm` and `dp` ([`share`]).
 //!
 //! Every path computes a cell's numbers with the same functions, and a cell's height always as
 //! `base + Σ_k relief_k·coef_k` in `f32`, figures in order ([`RegionNode::paint_own`]), so an
@@ -16,7 +18,8 @@
 //!   compared with the old one; only the cells where it changed get a new `norm`, the figure's
 //!   shape and every figure's coefficient (the other figures' shapes are kept: their `w` and
 //!   slope did not change), and only those cells are painted.
-//! - **a slope**: the figure's shape and coefficient on the owned cells (`norm` is kept), then
+//! - **a slope**: the figure's shape and coefficient on the owned cells (`norm` and, for a slope
+//!   of the same sign, the logarithms are kept), then
 //!   the region painted; a closed figure's nested region gets all its shapes again (eq. 4 reads
 //!   the enclosing slope).
 //! - **a height** (a pull): the region painted (K multiply-adds per cell), and a closed figure's
@@ -57,6 +60,11 @@ pub(super) struct FigureNode {
     shape: Vec<f32>,
     /// `shape × share` on the owned cells.
     coef: Vec<f32>,
+    /// Eq. 2's logarithm ([`profile::shape_log`]) on the owned cells, kept for a top-level
+    /// figure so that a slope change is one `exp` per cell; valid for slopes of the sign
+    /// `log_sign` (0: not valid).
+    log: Vec<f32>,
+    log_sign: i8,
     /// The nested region of a closed figure.
     pub(super) child: Option<Box<RegionNode>>,
 }
@@ -134,11 +142,25 @@ fn normaliser(dps: &[&[f32]], i: usize, inv: &mut [f64]) -> f64 {
     }
 }
 
-/// Eq. 1, 2 and 4: a figure of slope `s1` (nested in a figure of slope `outer`) at a cell.
-fn shape(df: f32, dp: f32, s1: f64, outer: Option<f64>) -> f32 {
+/// The sign of a slope, as the kept logarithms are valid for it.
+fn sign(s: f64) -> i8 {
+    if s > 0.0 {
+        1
+    } else if s < 0.0 {
+        -1
+    } else {
+        0
+    }
+}
+
+/// Eq. 1, 2 and 4: a figure of slope `s1` (nested in a figure of slope `outer`) at a cell; its
+/// shape term and eq. 2's logarithm. With `log`, the logarithm kept for this `w` and the sign of
+/// `s1` (a top-level figure), instead of computing it again.
+fn shape(df: f32, dp: f32, s1: f64, outer: Option<f64>, log: Option<f32>) -> (f32, f32) {
     let w = profile::weight_real(f64::from(df), f64::from(dp));
     let s = outer.map_or(s1, |s0| profile::nested_slope(s1, s0, w));
-    profile::shape(w, s) as f32
+    let l = log.unwrap_or_else(|| profile::shape_log(w, s));
+    (profile::shape_from_log(w, l, s) as f32, l)
 }
 
 /// The cells of the nested region a closed curve bounds. Validation keeps a closed figure strictly
@@ -190,6 +212,8 @@ impl FigureNode {
             dp: distance::figure_map(metric, region, &sources(grid, f, child.as_deref())),
             shape: vec![0.0; n],
             coef: vec![0.0; n],
+            log: vec![0.0; n],
+            log_sign: 0,
             child,
         }
     }
@@ -233,6 +257,8 @@ impl RegionNode {
                     node.dp = distance::figure_map(metric, mask, &sources(grid, f, node.child.as_deref()));
                     node.shape = vec![0.0; n];
                     node.coef = vec![0.0; n];
+                    node.log = vec![0.0; n];
+                    node.log_sign = 0;
                 })
             },
         );
@@ -438,22 +464,32 @@ impl RegionNode {
             figures,
             ..
         } = self;
+        // The logarithms are kept for top-level figures of nonzero slope.
+        let keep: Vec<bool> = slopes.iter().map(|&s| outer.is_none() && s != 0.0).collect();
+        for (k, f) in figures.iter_mut().enumerate().filter(|(k, _)| shapes.has(*k)) {
+            // Valid after a blend of every cell; after one of some cells only if it was before.
+            f.log_sign = match dirty {
+                None if keep[k] => sign(slopes[k]),
+                Some(_) if keep[k] && f.log_sign == sign(slopes[k]) => f.log_sign,
+                _ => 0,
+            };
+        }
         // Each band's slices of every figure's maps, so that bands can be written in parallel.
         let mut per_figure: Vec<_> = figures
             .iter_mut()
             .map(|f| {
                 f.dp.chunks(band)
                     .zip(f.shape.chunks_mut(band))
-                    .zip(f.coef.chunks_mut(band))
+                    .zip(f.coef.chunks_mut(band).zip(f.log.chunks_mut(band)))
             })
             .collect();
         let mut bands = Vec::with_capacity(norm.len().div_ceil(band));
         for (b, (norm, df)) in norm.chunks_mut(band).zip(df.chunks(band)).enumerate() {
             let mut dps = Vec::with_capacity(per_figure.len());
             let mut maps = Vec::with_capacity(per_figure.len());
-            for ((dp, shape), coef) in per_figure.iter_mut().filter_map(Iterator::next) {
+            for ((dp, shape), (coef, log)) in per_figure.iter_mut().filter_map(Iterator::next) {
                 dps.push(dp);
-                maps.push((shape, coef));
+                maps.push((shape, coef, log));
             }
             bands.push((b, norm, df, dps, maps));
         }
@@ -470,9 +506,13 @@ impl RegionNode {
                         }
                         let n = normaliser(&dps, i, &mut inv);
                         norm[i] = n;
-                        for (k, (dp, (shape_k, coef_k))) in dps.iter().zip(maps.iter_mut()).enumerate() {
+                        for (k, (dp, (shape_k, coef_k, log_k))) in dps.iter().zip(maps.iter_mut()).enumerate() {
                             if shapes.has(k) {
-                                shape_k[i] = shape(df[i], dp[i], slopes[k], outer);
+                                let (sh, l) = shape(df[i], dp[i], slopes[k], outer, None);
+                                shape_k[i] = sh;
+                                if keep[k] {
+                                    log_k[i] = l;
+                                }
                             }
                             coef_k[i] = shape_k[i] * share_of(n, dp[i], || inv[k]);
                         }
@@ -494,17 +534,30 @@ impl RegionNode {
             ..
         } = self;
         let f = &mut figures[k];
+        // A top-level figure reads its kept logarithms when they are for this slope's sign (or
+        // the slope is 0, where they are not read), else computes and keeps them.
+        let top = outer.is_none();
+        let reuse = top && (s1 == 0.0 || f.log_sign == sign(s1));
+        let keep = top && !reuse;
+        if keep {
+            f.log_sign = sign(s1);
+        }
+        let dp = &f.dp;
         f.shape
             .par_chunks_mut(w)
             .zip(f.coef.par_chunks_mut(w))
+            .zip(f.log.par_chunks_mut(w))
             .enumerate()
-            .for_each(|(r, (shape_row, coef_row))| {
+            .for_each(|(r, ((shape_row, coef_row), log_row))| {
                 for run in &owned[row_runs[r]..row_runs[r + 1]] {
                     for x in run.start as usize..run.end as usize {
                         let i = r * w + x;
-                        let s = shape(df[i], f.dp[i], s1, outer);
+                        let (s, l) = shape(df[i], dp[i], s1, outer, reuse.then_some(log_row[x]));
                         shape_row[x] = s;
-                        coef_row[x] = s * share(norm[i], f.dp[i]);
+                        coef_row[x] = s * share(norm[i], dp[i]);
+                        if keep {
+                            log_row[x] = l;
+                        }
                     }
                 }
             });
