@@ -199,17 +199,25 @@ impl Hull {
             s -= 1.0;
             // The nearest vertex (the previous sample, one step ahead) relative to this one.
             let (mut a, mut b) = (h1 - h, 1.0f32);
-            // Pop it while it lies on or under the line to the next one.
+            // Pop it while it lies on or under the line to the next one. Two tests a turn, so
+            // that the vertex popped and the one under it need no register copies.
             loop {
                 let i = (top - 1) & mask;
                 let (h2, c) = (hs[i], ss[i] - s);
                 let d = h2 - h;
-                if a * c <= d * b {
-                    (a, b, h1) = (d, c, h2);
-                    top -= 1;
-                } else {
+                if a * c > d * b {
                     break;
                 }
+                top -= 1;
+                let i = (top - 1) & mask;
+                let (h3, e) = (hs[i], ss[i] - s);
+                let f = h3 - h;
+                if d * e > f * c {
+                    (a, b, h1) = (d, c, h2);
+                    break;
+                }
+                top -= 1;
+                (a, b, h1) = (f, e, h3);
             }
             // b + s is the vertex's position, exactly (integers).
             ss[top & mask] = b + s;
