@@ -95,6 +95,9 @@ pub struct Renderer {
     light: Vec<f32>,
     /// The land look's maps, kept while the terrain does not change.
     land: land::Land,
+    /// What the classic light in `light` was made for — the terrain's revision, the vertical
+    /// scale and the style — and the vertices it skipped: kept while they stay.
+    classic: Option<(penmodel_terrain::revision::Mark, f32, Style, usize)>,
     /// The land look's background per eye (centre, left, right), kept while the camera stays.
     backdrops: [atmosphere::Backdrop; 3],
     samples: Vec<Sample>,
@@ -122,6 +125,7 @@ impl Renderer {
             tile_rows: rows.max(1),
             light: Vec::new(),
             land: land::Land::default(),
+            classic: None,
             backdrops: Default::default(),
             samples: Vec::new(),
             eye: EyeBuffers::default(),
@@ -217,12 +221,28 @@ impl Renderer {
     /// Per-frame work shared by both eyes: the light.
     fn prepare(&mut self, scene: &Scene) -> RenderStats {
         if scene.style.look == scene::Look::Land {
+            // The light buffer is about to hold the land look's light.
+            self.classic = None;
             return RenderStats {
                 skipped_vertices: self.land.prepare(scene, &mut self.light),
             };
         }
         // The light buffer is about to hold the classic light.
         self.land.forget();
+        // A terrain whose revision has not moved, drawn the same way: the light is as it was.
+        let map = scene.terrain;
+        let cells = map.cols() as usize * map.rows() as usize;
+        if let (Some(revisions), Some((made, scale, style, skipped)), None) =
+            (scene.revisions, &self.classic, scene.light_map)
+            && revisions.since(*made) == Some(penmodel_terrain::Rect::EMPTY)
+            && *scale == scene.vertical_scale
+            && *style == scene.style
+            && self.light.len() == cells
+        {
+            return RenderStats {
+                skipped_vertices: *skipped,
+            };
+        }
         let skipped = light::vertex_light(
             scene.terrain,
             scene.vertical_scale,
@@ -230,6 +250,10 @@ impl Renderer {
             scene.light_map,
             &mut self.light,
         );
+        self.classic = match (scene.revisions, scene.light_map) {
+            (Some(r), None) => Some((r.mark(), scene.vertical_scale, scene.style.clone(), skipped)),
+            _ => None,
+        };
         RenderStats {
             skipped_vertices: skipped,
         }

@@ -465,3 +465,31 @@ fn the_maps_follow_changes_to_the_edge_of_the_rectangle_told() {
     let albedo = |l: &Land| l.albedo().iter().flatten().map(|x| x.to_bits()).collect::<Vec<u32>>();
     assert_eq!(albedo(&land), albedo(&fresh));
 }
+
+#[test]
+fn the_classic_light_is_kept_for_an_unchanged_revision_and_remade_after_an_edit() {
+    use penmodel_terrain::{Edit, Editor, FigurePath};
+    let camera = crate::common::above(240.0);
+    let mut editor = Editor::new(edited_document()).expect("valid");
+    let mut renderer = Renderer::new();
+    let mut frame = Frame::new(160, 120).expect("frame");
+    let mut render = |editor: &Editor, renderer: &mut Renderer, tracked: bool| {
+        let mut s = Scene::new(editor.heightmap(), camera);
+        s.revisions = tracked.then(|| editor.revisions());
+        renderer.render(&s, &mut frame).expect("render");
+        frame.clone()
+    };
+    let first = render(&editor, &mut renderer, true);
+    assert_eq!(render(&editor, &mut renderer, true).pixels(), first.pixels());
+    for height in [45.0, 12.0] {
+        editor
+            .apply(Edit::SetHeight {
+                at: FigurePath::new(1, 0),
+                height,
+            })
+            .expect("applies");
+        let after = render(&editor, &mut renderer, true);
+        assert_ne!(after.pixels(), first.pixels());
+        assert_eq!(after.pixels(), render(&editor, &mut Renderer::new(), false).pixels());
+    }
+}
