@@ -34,7 +34,9 @@ pub mod frame;
 pub mod impostor;
 pub mod land;
 pub mod light;
+pub mod lod;
 pub mod meshes;
+pub mod nodes;
 pub mod overlay;
 pub mod ramp;
 pub mod rasterise;
@@ -87,6 +89,10 @@ struct EyeBuffers {
     meshes: meshes::Projected,
     /// The trees' simplified shapes.
     textured: textured::Projected,
+    /// The terrain's level-of-detail nodes, when [`Scene::terrain_lod`] is above 0.
+    nodes: nodes::Projected,
+    /// Whether the last projection drew the nodes rather than the full grid.
+    lod: bool,
 }
 
 /// Renders scenes into frames, keeping its buffers from one frame to the next.
@@ -105,6 +111,9 @@ pub struct Renderer {
     left: Option<Frame>,
     /// The trees drawn this frame and the simplified shapes' textures.
     trees: forest::Trees,
+    /// The terrain's level-of-detail pyramid and the revision it was made for.
+    pyramid: lod::Pyramid,
+    pyramid_made: Option<penmodel_terrain::revision::Mark>,
 }
 
 impl Default for Renderer {
@@ -131,6 +140,8 @@ impl Renderer {
             eye: EyeBuffers::default(),
             left: None,
             trees: forest::Trees::default(),
+            pyramid: lod::Pyramid::default(),
+            pyramid_made: None,
         }
     }
 
@@ -204,6 +215,7 @@ impl Renderer {
             light: &self.light,
             affine: &affine,
             projected: &self.eye.projected,
+            nodes: self.eye.lod.then_some(&self.eye.nodes),
             near,
             viewport: full,
         };
@@ -218,8 +230,44 @@ impl Renderer {
         self.land.remakes()
     }
 
+    /// The level-of-detail pyramid, as of the last frame drawn with [`Scene::terrain_lod`] above 0.
+    pub fn pyramid(&self) -> &lod::Pyramid {
+        &self.pyramid
+    }
+
+    /// The nodes the last eye drew, each at its level ([`lod::Pick`]); empty at full detail.
+    pub fn lod_picks(&self) -> &[lod::Pick] {
+        if self.eye.lod { &self.eye.nodes.picks } else { &[] }
+    }
+
+    /// Brings the pyramid up to date: only the nodes over the cells changed since it was made
+    /// when the scene has the terrain's revisions, all of it otherwise.
+    fn sync_pyramid(&mut self, scene: &Scene) {
+        let map = scene.terrain;
+        let since = match (scene.revisions, self.pyramid_made) {
+            (Some(r), Some(made)) if self.pyramid.fits(map) => r.since(made),
+            _ => None,
+        };
+        match since {
+            Some(rect) => self.pyramid.update(
+                map,
+                (
+                    rect.c0 as usize,
+                    (rect.c0 + rect.width) as usize,
+                    rect.r0 as usize,
+                    (rect.r0 + rect.height) as usize,
+                ),
+            ),
+            None => self.pyramid.build(map),
+        }
+        self.pyramid_made = scene.revisions.map(|r| r.mark());
+    }
+
     /// Per-frame work shared by both eyes: the light.
     fn prepare(&mut self, scene: &Scene) -> RenderStats {
+        if scene.terrain_lod > 0.0 {
+            self.sync_pyramid(scene);
+        }
         if scene.style.look == scene::Look::Land {
             // The light buffer is about to hold the land look's light.
             self.classic = None;
@@ -281,14 +329,31 @@ impl Renderer {
         );
         let affine = Affine::new(&projection, scene.terrain.cell_size(), f64::from(scene.vertical_scale));
         let near = projection.near as f32;
-        transform::project_grid(
-            scene.terrain,
-            &self.light,
-            &affine,
-            near,
-            viewport,
-            &mut self.eye.projected,
-        );
+        self.eye.lod = scene.terrain_lod > 0.0;
+        if self.eye.lod {
+            self.eye.projected.chunks.clear();
+            let map = scene.terrain;
+            let pixels = scene.terrain_lod;
+            nodes::project(
+                &self.pyramid,
+                map,
+                &self.light,
+                &affine,
+                near,
+                viewport,
+                pixels,
+                &mut self.eye.nodes,
+            );
+        } else {
+            transform::project_grid(
+                scene.terrain,
+                &self.light,
+                &affine,
+                near,
+                viewport,
+                &mut self.eye.projected,
+            );
+        }
         overlay::capsules(scene, &projection, &mut self.eye.capsules);
         let meshes = &mut self.eye.meshes;
         let cell = scene.terrain.cell_size();
@@ -332,6 +397,7 @@ impl Renderer {
             light: &self.light,
             affine: &affine,
             projected: &self.eye.projected,
+            nodes: self.eye.lod.then_some(&self.eye.nodes),
             near,
             viewport,
         };

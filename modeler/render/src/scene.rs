@@ -230,6 +230,9 @@ pub struct Scene<'a> {
     /// How trees choose their roughness `Q` by distance and gaze; `None` draws every tree in
     /// full (level of detail off).
     pub tree_lod: Option<Roughness>,
+    /// The terrain's level of detail: the largest error, in pixels, a coarser level of the
+    /// heightfield may make on screen ([`crate::lod`]); 0 draws every cell (full detail).
+    pub terrain_lod: f32,
     /// The tracked head's view direction, world `[X, Y up, Z]`, when known; otherwise the gaze
     /// is the line from the centre eye through the screen's centre.
     pub gaze: Option<[f64; 3]>,
@@ -265,6 +268,7 @@ impl<'a> Scene<'a> {
             style: Style::default(),
             trees: &[],
             tree_lod: Some(Roughness::default()),
+            terrain_lod: crate::lod::DEFAULT_PIXELS,
             gaze: None,
             looking_at: None,
             time: 0.0,

@@ -12,9 +12,9 @@
 
 use rayon::prelude::*;
 
-use super::clip;
 use super::frame::Rgba;
-use super::rasterise::{self, Bounds, Capsule, Sample, Sink, Vtx};
+use super::nodes;
+use super::rasterise::{self, Bounds, Capsule, Sample, Sink};
 use super::scene::Style;
 use super::shade::{self, Shading};
 use super::transform::{self, Affine, ChunkState, Projected};
@@ -30,6 +30,8 @@ pub struct EyePass<'a> {
     pub affine: &'a Affine,
     /// The eye's projected grid and chunks.
     pub projected: &'a Projected,
+    /// The eye's level-of-detail nodes, drawn instead of the grid's chunks when given.
+    pub nodes: Option<&'a nodes::Projected>,
     /// The near plane.
     pub near: f32,
     /// The eye's columns.
@@ -44,18 +46,15 @@ impl EyePass<'_> {
             let k = r * cols + c;
             self.affine.clip_vertex(c, r, h[k], self.light[k])
         });
-        let poly = clip::triangle(tri, self.near);
-        if poly.len < 3 {
-            return;
-        }
-        let v: Vec<Vtx> = poly.vertices[..poly.len].iter().map(transform::project).collect();
-        for i in 1..poly.len - 1 {
-            rasterise::triangle(&v[0], &v[i], &v[i + 1], bounds, sink);
-        }
+        transform::draw_clipped(tri, self.near, bounds, sink);
     }
 
     /// Draws the terrain's triangles over `bounds` into `sink`.
     pub fn terrain<S: Sink>(&self, bounds: &Bounds, sink: &mut S) {
+        if let Some(nodes) = self.nodes {
+            nodes::draw(nodes, self.near, bounds, sink);
+            return;
+        }
         let cols = self.map.cols() as usize;
         let v = &self.projected.vertices;
         let f = &self.projected.flags;

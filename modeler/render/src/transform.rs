@@ -16,7 +16,7 @@ use rayon::prelude::*;
 
 use super::camera::Projection;
 use super::clip::ClipVertex;
-use super::rasterise::{Bounds, Vtx, snap};
+use super::rasterise::{Bounds, Sink, Vtx, snap};
 use penmodel_terrain::Heightmap;
 
 /// Quads per chunk side.
@@ -68,6 +68,12 @@ impl Affine {
 }
 
 impl Affine {
+    /// The change of the clip coordinates `(X, Y, w)` per metre of height (the vertical scale
+    /// included): what a height error moves on screen ([`super::lod::Bound`]).
+    pub fn height_axis(&self) -> [f32; 3] {
+        self.dh
+    }
+
     /// The clip-space vertex at fractional column and row `(c, r)` (a point off the grid's
     /// centres: a rock's vertex), height `h`, light `l`.
     #[inline]
@@ -93,6 +99,18 @@ pub fn project(v: &ClipVertex) -> Vtx {
         invw,
         hw: v.h * invw,
         lw: v.l * invw,
+    }
+}
+
+/// Draws the triangle `tri` cut by the near plane and the guard band, as a fan, over `bounds`.
+pub fn draw_clipped<S: Sink>(tri: [ClipVertex; 3], near: f32, bounds: &Bounds, sink: &mut S) {
+    let poly = super::clip::triangle(tri, near);
+    if poly.len < 3 {
+        return;
+    }
+    let v: Vec<Vtx> = poly.vertices[..poly.len].iter().map(project).collect();
+    for i in 1..poly.len - 1 {
+        super::rasterise::triangle(&v[0], &v[i], &v[i + 1], bounds, sink);
     }
 }
 

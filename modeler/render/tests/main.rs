@@ -1,6 +1,7 @@
 //! The integration tests of penmodel-render, in one binary: a module per area.
 mod common;
 mod land;
+mod lod;
 mod outputs;
 mod render;
 mod rocks;
