@@ -39,18 +39,35 @@ pub(crate) fn on_edge(mask: &Mask, i: usize) -> bool {
     neighbours(mask, i).iter().any(|n| n.is_none_or(|j| !bits[j]))
 }
 
-fn bfs(mask: &Mask, dist: &mut [u32], queue: &mut Vec<u32>) {
+/// The breadth-first search from the cells queued (each with its box column), which hold 0.
+/// Each queued cell carries its column so that finding its neighbours needs no division.
+fn bfs(mask: &Mask, dist: &mut [u32], queue: &mut Vec<(u32, u32)>) {
     let bits = mask.bits();
+    let (w, n) = (mask.width as usize, bits.len());
     let mut head = 0;
     while head < queue.len() {
-        let i = queue[head] as usize;
+        let (i, x) = queue[head];
+        let (i, x) = (i as usize, x as usize);
         head += 1;
         let d = dist[i] + 1;
-        for j in neighbours(mask, i).into_iter().flatten() {
+        let mut visit = |j: usize, xj: usize| {
             if bits[j] && dist[j] == UNREACHABLE {
                 dist[j] = d;
-                queue.push(j as u32);
+                queue.push((j as u32, xj as u32));
             }
+        };
+        // The order of `neighbours`: left, right, up, down.
+        if x > 0 {
+            visit(i - 1, x - 1);
+        }
+        if x + 1 < w {
+            visit(i + 1, x + 1);
+        }
+        if i >= w {
+            visit(i - w, x);
+        }
+        if i + w < n {
+            visit(i + w, x);
         }
     }
 }
@@ -63,7 +80,7 @@ pub fn from_sources(mask: &Mask, sources: &[Cell]) -> Vec<u32> {
     for &s in sources {
         if let Some(i) = mask.index(s).filter(|&i| mask.bits()[i] && dist[i] != 0) {
             dist[i] = 0;
-            queue.push(i as u32);
+            queue.push((i as u32, s.0 - mask.c0));
         }
     }
     bfs(mask, &mut dist, &mut queue);
@@ -75,10 +92,11 @@ pub fn from_sources(mask: &Mask, sources: &[Cell]) -> Vec<u32> {
 pub fn edge_layers(mask: &Mask) -> Vec<u32> {
     let mut dist = vec![UNREACHABLE; mask.box_len()];
     let mut queue = Vec::with_capacity(mask.box_len());
+    let w = (mask.width as usize).max(1);
     for (i, &inside) in mask.bits().iter().enumerate() {
         if inside && on_edge(mask, i) {
             dist[i] = 0;
-            queue.push(i as u32);
+            queue.push((i as u32, (i % w) as u32));
         }
     }
     bfs(mask, &mut dist, &mut queue);
