@@ -45,6 +45,8 @@ pub struct Session {
     head_m: Option<[f64; 3]>,
     /// The device time of that pose's burst, and how far past it the pose was predicted, ms.
     head_burst: Option<(u64, u8)>,
+    /// Tracked poses taken.
+    head_poses: u64,
     /// The simulated device's clock, when the feed has one.
     clock: Option<DeviceClock>,
     /// Emission to frame of the frames drawn with a tracked pose.
@@ -67,6 +69,7 @@ impl Session {
             last_event_us: None,
             head_m: None,
             head_burst: None,
+            head_poses: 0,
             clock: None,
             latency: HeadLatency::default(),
             frame_started_us: None,
@@ -149,6 +152,7 @@ impl Session {
                 && let Some((_, device_us)) = e.seq
             {
                 self.head_burst = Some((device_us, h.prediction_ms));
+                self.head_poses += 1;
             }
         }
         self.interaction.handle(&mut self.editor, e);
@@ -176,6 +180,27 @@ impl Session {
         if let (Some(done_us), Some((burst_us, prediction_ms))) = (self.paced_now_us(), self.head_burst) {
             self.latency
                 .frame(started.unwrap_or(done_us), done_us, burst_us, prediction_ms);
+        }
+    }
+
+    /// Whether events come in real time: from a device, or a simulated one paced to the wall
+    /// clock. An unpaced simulation (`--speed 0`) runs as far ahead as the feed holds, so a
+    /// frame must not wait for its next event or take everything it holds.
+    pub fn realtime(&self) -> bool {
+        self.clock.as_ref().is_none_or(DeviceClock::is_paced)
+    }
+
+    /// Tracked head poses taken so far: a frame waiting for a fresh pose watches this change.
+    pub fn head_poses(&self) -> u64 {
+        self.head_poses
+    }
+
+    /// Whether a tracked pose came within `us` device µs of the last event: the glasses are
+    /// reporting, so another pose is due soon.
+    pub fn head_tracked_within(&self, us: u64) -> bool {
+        match (self.head_burst, self.last_event_us) {
+            (Some((burst_us, _)), Some(last_us)) => last_us.saturating_sub(burst_us) <= us,
+            _ => false,
         }
     }
 

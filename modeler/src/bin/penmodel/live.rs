@@ -563,10 +563,16 @@ impl Painter {
     /// `picture` with the overview; `revisions`, the terrain's history when `map` is an editor's,
     /// lets the land look recompute only what changed since the last frame.
     fn draw(&mut self, picture: &Picture, map: &Heightmap, revisions: Option<&Revisions>) -> Result<&Frame> {
-        self.renderer.render(&scene(picture, map, revisions), &mut self.view)?;
-        self.frame.blit(&self.view, 0, 0);
+        self.insets(picture, map, revisions)?;
+        self.view(picture, map, revisions)
+    }
+
+    /// Draws what does not follow the head: the overview (and beside it the map), so that a
+    /// tracked frame can draw them before it takes the head's newest pose for its view (issue
+    /// 16). [`view`](Self::view) completes the frame.
+    fn insets(&mut self, picture: &Picture, map: &Heightmap, revisions: Option<&Revisions>) -> Result<()> {
         if self.overview == Overview::Off {
-            return Ok(&self.frame);
+            return Ok(());
         }
         let extent = [
             f64::from(map.cols()) * map.cell_size(),
@@ -574,25 +580,33 @@ impl Painter {
         ];
         self.inset_renderer
             .render(&scene(&picture.overview(extent), map, revisions), &mut self.inset)?;
-        let (w, h) = (self.view.width(), self.view.height());
-        match self.overview {
-            Overview::Corner => {
-                let margin = 8.min(w / 8).min(h / 8) + 1;
-                // At least 1 from the edge, for the border; blit clips what does not fit.
-                let x = w.saturating_sub(self.inset.width() + margin).max(1);
-                let y = h.saturating_sub(self.inset.height() + margin).max(1);
-                let mut border = Frame::new(self.inset.width() + 2, self.inset.height() + 2)?;
-                border.pixels_mut().fill([255, 255, 255, 255]);
-                self.frame.blit(&border, x - 1, y - 1);
-                self.frame.blit(&self.inset, x, y);
-            }
-            Overview::Beside => {
-                self.frame.blit(&self.inset, w, 0);
-                self.inset_renderer
-                    .render(&scene(&picture.map(extent), map, revisions), &mut self.inset)?;
-                self.frame.blit(&self.inset, w, h - self.inset.height());
-            }
-            Overview::Off => {}
+        if self.overview == Overview::Beside {
+            // Its column is clear of the view: both go straight into the frame.
+            let (w, h) = (self.view.width(), self.view.height());
+            self.frame.blit(&self.inset, w, 0);
+            self.inset_renderer
+                .render(&scene(&picture.map(extent), map, revisions), &mut self.inset)?;
+            self.frame.blit(&self.inset, w, h - self.inset.height());
+        }
+        Ok(())
+    }
+
+    /// The display's view of `picture` into the frame, with the insets [`insets`](Self::insets)
+    /// drew: the frame complete.
+    fn view(&mut self, picture: &Picture, map: &Heightmap, revisions: Option<&Revisions>) -> Result<&Frame> {
+        self.renderer.render(&scene(picture, map, revisions), &mut self.view)?;
+        self.frame.blit(&self.view, 0, 0);
+        if self.overview == Overview::Corner {
+            // Over the view, so after it.
+            let (w, h) = (self.view.width(), self.view.height());
+            let margin = 8.min(w / 8).min(h / 8) + 1;
+            // At least 1 from the edge, for the border; blit clips what does not fit.
+            let x = w.saturating_sub(self.inset.width() + margin).max(1);
+            let y = h.saturating_sub(self.inset.height() + margin).max(1);
+            let mut border = Frame::new(self.inset.width() + 2, self.inset.height() + 2)?;
+            border.pixels_mut().fill([255, 255, 255, 255]);
+            self.frame.blit(&border, x - 1, y - 1);
+            self.frame.blit(&self.inset, x, y);
         }
         Ok(&self.frame)
     }
@@ -607,6 +621,30 @@ impl Painter {
         let picture = Picture::of(session, look);
         self.draw(&picture, session.editor.heightmap(), Some(session.editor.revisions()))
     }
+
+    /// A frame of `session` in real time: the insets from what it shows now, then the feed
+    /// [latched](latch_head) to the head's next pose, then the view from that pose. Returns
+    /// the frame and whether the feed ended meanwhile. `advance`: the interaction's own clock
+    /// is moved to the last event's time first (the window's); `said` takes what the feed said.
+    fn session_latched(
+        &mut self,
+        rx: &std::sync::mpsc::Receiver<Feed>,
+        session: &mut Session,
+        look: &Look,
+        advance: bool,
+        said: &mut dyn FnMut(Vec<String>),
+    ) -> Result<(&Frame, bool)> {
+        let revisions = Some(session.editor.revisions());
+        self.insets(&Picture::of(session, look), session.editor.heightmap(), revisions)?;
+        let ended = latch_head(rx, session, said);
+        if let Some(t) = session.last_event_us().filter(|_| advance) {
+            session.interaction.advance(t);
+        }
+        session.frame_started();
+        let picture = Picture::of(session, look);
+        let frame = self.view(&picture, session.editor.heightmap(), Some(session.editor.revisions()))?;
+        Ok((frame, ended))
+    }
 }
 
 /// `p`'s scene of `map`, with the terrain's history when known.
@@ -614,6 +652,58 @@ fn scene<'a>(p: &'a Picture, map: &'a Heightmap, revisions: Option<&'a Revisions
     Scene {
         revisions,
         ..p.scene(map)
+    }
+}
+
+/// How long a due frame waits for the head's next pose, device µs: a little over the head's
+/// period (60 poses/s and more), so glasses that stop reporting hold no frame up for long.
+const HEAD_WAIT_US: u64 = 25_000;
+
+/// The longest a frame takes events before it is drawn anyway.
+const LATCH_MAX: Duration = Duration::from_millis(100);
+
+/// Late latching for the tracked head (issue 16): a due frame takes everything the feed holds,
+/// and while the glasses report, waits for their next pose, so its view starts right after a
+/// pose arrived and shows the newest one, not the one that happened to be in when the frame
+/// fell due (up to a head period older), nor one queued behind events that arrived while the
+/// last frame was drawn. Only for a real-time feed ([`Session::realtime`]): an unpaced
+/// simulation would be run to its end. `said` takes what the feed said. Returns whether the
+/// feed ended.
+fn latch_head(rx: &std::sync::mpsc::Receiver<Feed>, session: &mut Session, said: &mut dyn FnMut(Vec<String>)) -> bool {
+    // Whether the last thing taken was a new pose: the newest, once the feed holds no more.
+    let mut fresh = false;
+    let started = Instant::now();
+    loop {
+        let feed = match rx.try_recv() {
+            Ok(f) => f,
+            Err(std::sync::mpsc::TryRecvError::Disconnected) => return true,
+            // The glasses are reporting while their last pose is recent beside the last event.
+            Err(std::sync::mpsc::TryRecvError::Empty) if fresh || !session.head_tracked_within(HEAD_WAIT_US) => {
+                return false;
+            }
+            // Real time: a head period of the wall clock bounds the wait (at --speed 1 exactly).
+            Err(std::sync::mpsc::TryRecvError::Empty) => match rx.recv_timeout(Duration::from_micros(HEAD_WAIT_US)) {
+                Ok(f) => f,
+                Err(RecvTimeoutError::Timeout) => return false,
+                Err(RecvTimeoutError::Disconnected) => return true,
+            },
+        };
+        let done = matches!(feed, Feed::End(_) | Feed::Failed(_));
+        // A failure ends the session, which says it then.
+        let failed = matches!(feed, Feed::Failed(_));
+        let poses = session.head_poses();
+        let messages = session.feed(feed);
+        if !failed {
+            said(messages);
+        }
+        if done {
+            return true;
+        }
+        fresh = session.head_poses() != poses;
+        // Events that take longer to handle than to come would hold the frame up for ever.
+        if started.elapsed() > LATCH_MAX {
+            return false;
+        }
     }
 }
 
@@ -659,7 +749,7 @@ fn run_headless(
             Err(RecvTimeoutError::Timeout) => continue,
             Err(RecvTimeoutError::Disconnected) => break,
         };
-        let done = matches!(feed, Feed::End(_) | Feed::Failed(_));
+        let mut done = matches!(feed, Feed::End(_) | Feed::Failed(_));
         // A failure ends the session, which says it then.
         let failed = matches!(feed, Feed::Failed(_));
         let messages = session.feed(feed);
@@ -674,9 +764,18 @@ fn run_headless(
             }
             let due = *next_us.get_or_insert(t);
             if let Some(frames) = frames.as_mut().filter(|_| t >= due) {
-                // Its head pose's age on the device's clock, drawn and produced (issue 16).
-                session.frame_started();
-                let frame = painter.session(session, look)?;
+                // Its head pose's age on the device's clock, drawn and produced (issue 16). In
+                // real time the frame is latched to the head's newest pose; an unpaced
+                // simulation's frames show the session exactly at their tick.
+                let frame = if session.realtime() && !done {
+                    let (frame, ended) =
+                        painter.session_latched(rx, session, look, false, &mut |m| say(m, Some(&progress)))?;
+                    done |= ended;
+                    frame
+                } else {
+                    session.frame_started();
+                    painter.session(session, look)?
+                };
                 session.frame_produced();
                 frames.push(frame)?;
                 next_us = Some(due + step_us);
@@ -816,11 +915,17 @@ fn run_window(
             .as_ref()
             .is_some_and(|n| n.since.elapsed() < Notice::SHOWN + FRAME * 2);
         if (dirty || noticed) && last.elapsed() >= FRAME {
-            if let Some(t) = session.last_event_us() {
-                session.interaction.advance(t);
-            }
-            session.frame_started();
-            let mut frame = painter.session(session, look)?.clone();
+            let mut frame = if session.realtime() {
+                // Latched to the head's newest pose (issue 16); the feed's end shows next round.
+                let said = &mut |m| tell(m, &mut notice);
+                painter.session_latched(rx, session, look, true, said)?.0.clone()
+            } else {
+                if let Some(t) = session.last_event_us() {
+                    session.interaction.advance(t);
+                }
+                session.frame_started();
+                painter.session(session, look)?.clone()
+            };
             let (w, h) = (painter.view.width() as i32, painter.view.height() as i32);
             let viewport = penmodel_render::rasterise::Bounds {
                 x0: 0,
@@ -929,6 +1034,65 @@ mod tests {
             let e = eye_separation_mm(bad).expect_err(bad);
             assert!(e.contains("40…80 mm"), "{e}");
         }
+    }
+
+    #[test]
+    fn a_latched_frame_takes_the_newest_pose_and_the_next_one() {
+        use pen_host::events::{DisplayPoint, EventKind, HeadPose, HeadStatus, PenEvent};
+        // A head report at `device_us`: a pose `u_mm` along the display, or none (no fix).
+        let head = |u_mm: Option<f64>, device_us: u64| {
+            Feed::Event(PenEvent {
+                kind: EventKind::Head(HeadPose {
+                    at: u_mm.map(|u_mm| DisplayPoint {
+                        u_mm,
+                        v_mm: 170.0,
+                        h_mm: 650.0,
+                        u_px: 0.0,
+                        v_px: 0.0,
+                    }),
+                    status: if u_mm.is_some() {
+                        HeadStatus::Tracked
+                    } else {
+                        HeadStatus::Held
+                    },
+                    prediction_ms: 20,
+                    refused: 0,
+                    reason: None,
+                }),
+                t_us: device_us,
+                point: None,
+                sw: None,
+                seq: Some((0, device_us)),
+            })
+        };
+        // Metres right of the 600 mm display's centre, as the camera takes the head.
+        let x = |session: &Session| session.head_m().map(|h| h[0]);
+        let editor = Editor::new(blank_document()).expect("a valid document");
+        let mut session = Session::new(editor, [600.0, 340.0], Tuning::default());
+        session.feed(head(Some(100.0), 0));
+        let (tx, rx) = std::sync::mpsc::channel();
+        // Queued while the last frame was drawn: two newer poses, then a report without a fix.
+        for f in [head(Some(110.0), 16_000), head(Some(120.0), 32_000), head(None, 40_000)] {
+            tx.send(f).expect("queued");
+        }
+        // The next pose comes once the queue is taken: the frame waits for it.
+        let later = std::thread::spawn(move || {
+            std::thread::sleep(Duration::from_millis(5));
+            tx.send(head(Some(130.0), 48_000)).expect("sent");
+            tx
+        });
+        let mut said = Vec::new();
+        assert!(!latch_head(&rx, &mut session, &mut |m| said.extend(m)));
+        assert_eq!(x(&session), Some((130.0 - 300.0) * 1e-3));
+        assert_eq!(session.events(), 5, "everything queued was taken");
+        // Glasses that stop reporting hold a frame up no longer than a head period.
+        let tx = later.join().expect("sender");
+        tx.send(head(None, 60_000)).expect("queued");
+        assert!(!latch_head(&rx, &mut session, &mut |m| said.extend(m)));
+        assert_eq!((x(&session), session.events()), (Some((130.0 - 300.0) * 1e-3), 6));
+        // A feed that ended: said so at once.
+        drop(tx);
+        assert!(latch_head(&rx, &mut session, &mut |m| said.extend(m)));
     }
 
     #[test]
