@@ -91,22 +91,8 @@ impl Sections {
     }
 
     /// Adds line b's `values` over `cols` to the cells they were sampled from, weighted like the
-    /// heights. `sum` holds a row more than the grid (it gets weight-0 terms).
-    #[inline]
-    pub fn spread(&self, b: isize, cols: Range<usize>, values: &[f32], sum: &mut [f32]) {
-        let (base, w) = (b * self.w as isize, self.w);
-        let taps = self.off[cols.clone()]
-            .iter()
-            .zip(&self.lo[cols.clone()])
-            .zip(&self.hi[cols]);
-        for (&v, ((&off, &lo), &hi)) in values.iter().zip(taps) {
-            let i = (base + off) as usize;
-            sum[i] += lo * v;
-            sum[i + w] += hi * v;
-        }
-    }
-
-    /// [`Sections::spread`] skipping NaN values, with the weights summed into `weight`.
+    /// heights, skipping NaN values, with the weights summed into `weight`. `sum` and `weight`
+    /// hold a row more than the grid (they get weight-0 terms).
     pub fn spread_weighted(&self, b: isize, cols: Range<usize>, values: &[f32], sum: &mut [f32], weight: &mut [f32]) {
         let (base, w) = (b * self.w as isize, self.w);
         let taps = self.off[cols.clone()]
@@ -122,6 +108,54 @@ impl Sections {
             weight[i] += lo;
             sum[i + w] += hi * v;
             weight[i + w] += hi;
+        }
+    }
+
+    /// The lines `b0..b0 + nb` valid at column u, as indices from b0.
+    #[inline]
+    fn valid(&self, u: usize, b0: isize, nb: usize) -> Range<usize> {
+        let first = -self.o[u];
+        let last = self.h as isize - 1 - self.o[u] - isize::from(self.hi[u] > 0.0);
+        let start = (first - b0).clamp(0, nb as isize) as usize;
+        let end = (last + 1 - b0).clamp(0, nb as isize) as usize;
+        start..end.max(start)
+    }
+
+    /// The heights of lines `b0..b0 + nb` into `block[u·nb + j]` (line `b0 + j`, column u) where
+    /// the line is on the grid. `zc` is the grid with its columns contiguous (`zc[u·h + v]`),
+    /// an element more: per column the lines' samples are then one shifted linear interpolation
+    /// of contiguous cells (vectorised).
+    pub fn block_heights(&self, zc: &[f32], b0: isize, nb: usize, block: &mut [f32]) {
+        for (u, dst) in block.chunks_exact_mut(nb).enumerate().take(self.w) {
+            let j = self.valid(u, b0, nb);
+            if j.is_empty() {
+                continue;
+            }
+            let at = ((u * self.h) as isize + b0 + j.start as isize + self.o[u]) as usize;
+            let (lo, hi, m) = (self.lo[u], self.hi[u], j.len());
+            for ((d, &a), &b) in dst[j].iter_mut().zip(&zc[at..at + m]).zip(&zc[at + 1..at + 1 + m]) {
+                *d = a * lo + b * hi;
+            }
+        }
+    }
+
+    /// Adds `block` (laid out like [`Sections::block_heights`]'s) to the cells its values were
+    /// sampled from, weighted like the heights, in `sum` laid out like `zc`.
+    pub fn block_spread(&self, b0: isize, nb: usize, block: &[f32], sum: &mut [f32]) {
+        for (u, src) in block.chunks_exact(nb).enumerate().take(self.w) {
+            let j = self.valid(u, b0, nb);
+            if j.is_empty() {
+                continue;
+            }
+            let at = ((u * self.h) as isize + b0 + j.start as isize + self.o[u]) as usize;
+            let (lo, hi, m) = (self.lo[u], self.hi[u], j.len());
+            let src = &src[j];
+            for (d, &v) in sum[at..at + m].iter_mut().zip(src) {
+                *d += lo * v;
+            }
+            for (d, &v) in sum[at + 1..at + 1 + m].iter_mut().zip(src) {
+                *d += hi * v;
+            }
         }
     }
 

@@ -220,8 +220,9 @@ pub fn direct(field: Field<'_>, sun: Sun) -> Vec<f32> {
 /// do not depend on the number of threads.
 const GROUP: usize = 8;
 
-/// One layout's share of the sky view: per cell the sum of the spread `sin² H`, and the weights
-/// of the first and last rows and of every other row (see `Sections::weight`).
+/// One layout's share of the sky view (u along its `w` rows, v across its `h`): per cell the sum
+/// of the spread `sin² H`, stored `sum[u·h + v]` (columns contiguous), and the weights of the
+/// first and last v and of every other (see `Sections::weight`).
 struct Layout {
     /// The layout's row length and rows.
     w: usize,
@@ -237,7 +238,7 @@ impl Layout {
         Layout {
             w,
             h,
-            sum: vec![0.0; (h + 1) * w],
+            sum: vec![0.0; w * h + 1],
             first: vec![0.0; w],
             last: vec![0.0; w],
             inner: 0.0,
@@ -259,7 +260,7 @@ impl Layout {
         self.inner += other.inner;
     }
 
-    /// The weights of the cells of row r.
+    /// The weights of the cells of row v, or `None` for `inner`.
     fn weights(&self, r: usize, h: usize) -> Option<&[f32]> {
         if r == 0 {
             Some(&self.first)
@@ -279,52 +280,75 @@ fn sin2(rise: f32, steps: f32, sp2: f32) -> f32 {
     r * r / (r * r + steps * steps * sp2)
 }
 
+/// Lines swept as one block: their heights and values laid out column by column, so that
+/// building and spreading them are shifted interpolations of contiguous cells.
+const BLOCK: usize = 32;
+
 /// Adds the sky view's `sin² H` of the direction `(du, dv)` (`|du| ≥ |dv|`, u along the rows of
-/// the grid `z`, laid out like `layout` with a row more), and with `both` of the opposite
-/// direction, to `layout`. `buf` is scratch.
-fn sky_sweep(z: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &mut Layout, buf: &mut Scratch) {
+/// `layout`), and with `both` of the opposite direction, to `layout`. `zc` is the grid with u's
+/// columns contiguous (the layout transposed), an element more. `buf` is scratch.
+fn sky_sweep(zc: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &mut Layout, buf: &mut Scratch) {
     let (w, h) = (layout.w, layout.h);
     let lines = Sections::new(w, h, slope(du, dv), cell);
     let sp2 = lines.spacing * lines.spacing;
     let passes = if both { 2.0 } else { 1.0 };
     let Scratch {
+        block,
         heights,
         up,
         down,
         hull,
     } = buf;
+    block.resize(w * BLOCK, 0.0);
     heights.resize(w, 0.0);
     for v in [&mut up.0, &mut up.1, &mut down.0, &mut down.1] {
         v.resize(w, 0.0);
     }
-    for b in lines.lines() {
-        let cols = lines.columns(b);
-        let n = cols.len();
-        let zs = &mut heights[..n];
-        lines.heights(z, b, cols.clone(), zs);
-        let (ru, su) = (&mut up.0[..n], &mut up.1[..n]);
-        let (rd, dd) = (&mut down.0[..n], &mut down.1[..n]);
-        match (du > 0.0 || both, du < 0.0 || both) {
-            (true, true) => {
-                hull.pass::<true>(zs, ru, su);
-                hull.pass::<false>(zs, rd, dd);
-                // sin² H of both, in place of the first's rises (vectorised: no position math).
-                for (((r, &d), &r2), &d2) in ru.iter_mut().zip(su.iter()).zip(rd.iter()).zip(dd.iter()) {
-                    *r = sin2(*r, d, sp2) + sin2(r2, d2, sp2);
+    let all = lines.lines();
+    for b0 in all.clone().step_by(BLOCK) {
+        let nb = BLOCK.min((all.end - b0) as usize);
+        let block = &mut block[..w * nb];
+        lines.block_heights(zc, b0, nb, block);
+        for j in 0..nb {
+            let cols = lines.columns(b0 + j as isize);
+            let n = cols.len();
+            if n == 0 {
+                continue;
+            }
+            // Line j's samples: element j of each column's chunk of the block.
+            let span = cols.start * nb..cols.end * nb;
+            let zs = &mut heights[..n];
+            for (z, c) in zs.iter_mut().zip(block[span.clone()].chunks_exact(nb)) {
+                *z = c[j];
+            }
+            let (ru, su) = (&mut up.0[..n], &mut up.1[..n]);
+            let (rd, dd) = (&mut down.0[..n], &mut down.1[..n]);
+            match (du > 0.0 || both, du < 0.0 || both) {
+                (true, true) => {
+                    hull.pass::<true>(zs, ru, su);
+                    hull.pass::<false>(zs, rd, dd);
+                    // sin² H of both, in place of the first's rises (vectorised).
+                    for (((r, &d), &r2), &d2) in ru.iter_mut().zip(su.iter()).zip(rd.iter()).zip(dd.iter()) {
+                        *r = sin2(*r, d, sp2) + sin2(r2, d2, sp2);
+                    }
+                }
+                (up_only, _) => {
+                    if up_only {
+                        hull.pass::<true>(zs, ru, su);
+                    } else {
+                        hull.pass::<false>(zs, ru, su);
+                    }
+                    for (r, &d) in ru.iter_mut().zip(su.iter()) {
+                        *r = sin2(*r, d, sp2);
+                    }
                 }
             }
-            (up_only, _) => {
-                if up_only {
-                    hull.pass::<true>(zs, ru, su);
-                } else {
-                    hull.pass::<false>(zs, ru, su);
-                }
-                for (r, &d) in ru.iter_mut().zip(su.iter()) {
-                    *r = sin2(*r, d, sp2);
-                }
+            // The values in place of the heights.
+            for (c, &r) in block[span].chunks_exact_mut(nb).zip(ru.iter()) {
+                c[j] = r;
             }
         }
-        lines.spread(b, cols, ru, &mut layout.sum);
+        lines.block_spread(b0, nb, block, &mut layout.sum);
     }
     for u in 0..w {
         layout.first[u] += passes * lines.weight(u, 0);
@@ -333,10 +357,11 @@ fn sky_sweep(z: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &mu
     layout.inner += passes;
 }
 
-/// Buffers reused from line to line: a line's heights, and the rises and steps to the horizon
-/// ahead in both directions.
+/// Buffers reused from line to line: a block of lines, a line's heights, and the rises and
+/// steps to the horizon ahead in both directions.
 #[derive(Default)]
 struct Scratch {
+    block: Vec<f32>,
     heights: Vec<f32>,
     up: (Vec<f32>, Vec<f32>),
     down: (Vec<f32>, Vec<f32>),
@@ -353,18 +378,19 @@ pub fn sky_view(field: Field<'_>, k: u32) -> Vec<f32> {
     let Field { z, cols, rows, cell } = field;
     let (cols, rows) = (cols as usize, rows as usize);
     let k = k.max(1) as usize;
-    // Both layouts with a row more (see `Sections::heights`).
-    let mut zp = Vec::with_capacity(z.len() + cols);
+    // The grid and its transpose, each an element more (see `Sections::block_heights`).
+    let mut zp = Vec::with_capacity(z.len() + 1);
     zp.extend_from_slice(z);
-    zp.resize(z.len() + cols, 0.0);
-    let zt = transpose(z, cols, rows, rows);
+    zp.push(0.0);
+    let zt = transpose(z, cols, rows, 1);
     // Azimuth d with its opposite d + k/2 when k is even.
     let pairs: Vec<(usize, bool)> = if k.is_multiple_of(2) {
         (0..k / 2).map(|d| (d, true)).collect()
     } else {
         (0..k).map(|d| (d, false)).collect()
     };
-    // Per group: the grid's layout and the transposed one.
+    // Per group: the row-major azimuths' layout (u along the grid's rows, sums transposed) and
+    // the column-major ones' (u down the columns, sums in the grid's layout).
     let groups: Vec<[Layout; 2]> = pairs
         .par_chunks(GROUP)
         .map(|chunk| {
@@ -374,9 +400,9 @@ pub fn sky_view(field: Field<'_>, k: u32) -> Vec<f32> {
                 let az = TAU * d as f64 / k as f64;
                 let (dx, dy) = (az.cos(), az.sin());
                 if dx.abs() >= dy.abs() {
-                    sky_sweep(&zp, cell, (dx, dy), both, &mut out[0], &mut buf);
+                    sky_sweep(&zt, cell, (dx, dy), both, &mut out[0], &mut buf);
                 } else {
-                    sky_sweep(&zt, cell, (dy, dx), both, &mut out[1], &mut buf);
+                    sky_sweep(&zp, cell, (dy, dx), both, &mut out[1], &mut buf);
                 }
             }
             out
@@ -384,22 +410,22 @@ pub fn sky_view(field: Field<'_>, k: u32) -> Vec<f32> {
         .collect();
     // The groups' sums in a fixed order, the transposed one brought back to the grid's layout.
     let mut groups = groups.into_iter();
-    let Some([mut grid, mut trans]) = groups.next() else {
+    let Some([mut x, mut y]) = groups.next() else {
         return vec![1.0; z.len()];
     };
-    for [g, t] in groups {
-        grid.add(&g);
-        trans.add(&t);
+    for [gx, gy] in groups {
+        x.add(&gx);
+        y.add(&gy);
     }
-    let across = transpose(&trans.sum[..z.len()], rows, cols, 0);
+    let along = transpose(&x.sum[..z.len()], rows, cols, 0);
     let mut out = vec![0.0f32; z.len()];
     out.par_chunks_mut(cols).enumerate().for_each(|(r, line)| {
-        let (a, at) = (&grid.sum[r * cols..(r + 1) * cols], &across[r * cols..(r + 1) * cols]);
-        let wg = grid.weights(r, rows);
+        let (a, at) = (&along[r * cols..(r + 1) * cols], &y.sum[r * cols..(r + 1) * cols]);
+        let wx = x.weights(r, rows);
         for (c, o) in line.iter_mut().enumerate() {
-            // Cell (c, r) is cell (r, c) of the transposed layout.
-            let wt = trans.weights(c, cols).map_or(trans.inner, |w| w[r]);
-            let ws = wg.map_or(grid.inner, |w| w[c]) + wt;
+            // Cell (c, r) is (u, v) = (r, c) for the column-major azimuths.
+            let wy = y.weights(c, cols).map_or(y.inner, |w| w[r]);
+            let ws = wx.map_or(x.inner, |w| w[c]) + wy;
             *o = if ws > 0.0 { 1.0 - (a[c] + at[c]) / ws } else { 1.0 };
         }
     });
