@@ -14,14 +14,13 @@
 //! updated terrain equals a full regeneration to the bit:
 //!
 //! - **a moved figure** (a vertex, the whole figure; not a closed one): its new `dp` in full
-//!   (one breadth-first search or distance transform over the box, cheap beside the blend),
+//!   (one breadth-first search or distance transform over the box, linear in its cells),
 //!   compared with the old one; only the cells where it changed get a new `norm`, the figure's
 //!   shape and every figure's coefficient (the other figures' shapes are kept: their `w` and
 //!   slope did not change), and only those cells are painted.
 //! - **a slope**: the figure's shape and coefficient on the owned cells (`norm` and, for a slope
-//!   of the same sign, the logarithms are kept), then
-//!   the region painted; a closed figure's nested region gets all its shapes again (eq. 4 reads
-//!   the enclosing slope).
+//!   of the same sign, the logarithms are kept), then the region painted; a closed figure's
+//!   nested region gets all its shapes again (eq. 4 reads the enclosing slope).
 //! - **a height** (a pull): the region painted (K multiply-adds per cell), and a closed figure's
 //!   nested region, whose base it is.
 //! - **a figure added, removed or replaced**: the region's `norm` and coefficients, and only the
