@@ -139,6 +139,22 @@ fn bench(c: &mut Criterion) {
             ..at
         },
     ];
+    // The seated meshes' bits (positions and normals) on each path of `seat_on`: a move, the
+    // samples found, and a terrain change read through them — equal digests before and after a
+    // change of the code mean the same meshes.
+    {
+        let mut m = penmodel_terrain::export::Mesh::default();
+        let mut s = place::Samples::default();
+        let mut digests = Vec::new();
+        for place in [moves[1], at, at, at] {
+            flat.seat_on(place, &map, &mut s, &mut m);
+            digests.push(format!("{:016x}", mesh_digest(&m)));
+        }
+        eprintln!(
+            "reseat/fig1/512: mesh digests (move, at, samples found, terrain change) {}",
+            digests.join(" ")
+        );
+    }
     // CPU time of one thread per re-seat, which other processes on a loaded machine do not
     // inflate as they do wall time (Linux: the scheduler's count for the thread). 50 re-seats
     // of each kind (one with `ROCKS_COLD_RUNS=0`, to count their instructions).
@@ -220,6 +236,23 @@ fn digest(s: &rocks::Scatter) -> u64 {
         r.mesh.vertices.iter().flatten().for_each(|c| eat(c.to_bits()));
         r.mesh.triangles.iter().flatten().for_each(|&i| eat(u64::from(i)));
     }
+    h
+}
+
+/// FNV-1a over a mesh's positions and normals (their bits) and indices.
+fn mesh_digest(m: &penmodel_terrain::export::Mesh) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut eat = |v: u32| {
+        for b in v.to_le_bytes() {
+            h = (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3);
+        }
+    };
+    m.positions
+        .iter()
+        .chain(&m.normals)
+        .flatten()
+        .for_each(|c| eat(c.to_bits()));
+    m.indices.iter().for_each(|&i| eat(i));
     h
 }
 

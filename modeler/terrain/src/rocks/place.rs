@@ -182,14 +182,10 @@ impl Flat {
             && g.wide;
         // The samples are found on the second seat at one place: while a field is being moved
         // every seat is at a new place, and writing them would only slow those seats down.
-        if !again && samples.last != key {
-            samples.key = None;
-            samples.last = key;
-            return self.seat_into(at, g.surface(), mesh);
-        }
+        let find = !again && samples.last == key;
         samples.last = key;
-        if !again {
-            samples.key = None;
+        samples.key = None;
+        if find {
             samples.at.resize(n, Sample::default());
         }
         if mesh.indices.len() != self.indices.len() {
@@ -198,44 +194,64 @@ impl Flat {
         mesh.positions.resize(n, [0.0; 3]);
         mesh.normals.resize(n, [0.0; 3]);
         let mut parts = Vec::with_capacity(self.blocks.len());
-        let (mut positions, mut normals, mut sampled) =
-            (&mut mesh.positions[..], &mut mesh.normals[..], &mut samples.at[..]);
+        // A moving field keeps no samples: its blocks get none.
+        let (mut positions, mut normals, mut sampled) = (
+            &mut mesh.positions[..],
+            &mut mesh.normals[..],
+            if again || find {
+                &mut samples.at[..]
+            } else {
+                &mut [][..]
+            },
+        );
         for w in self.blocks.windows(2) {
             let len = w[1].0 - w[0].0;
             let (p, rest_p) = std::mem::take(&mut positions).split_at_mut(len);
             let (q, rest_q) = std::mem::take(&mut normals).split_at_mut(len);
-            let (r, rest_r) = std::mem::take(&mut sampled).split_at_mut(len);
+            let kept = len.min(sampled.len());
+            let (r, rest_r) = std::mem::take(&mut sampled).split_at_mut(kept);
             (positions, normals, sampled) = (rest_p, rest_q, rest_r);
             parts.push((w[0], w[1], p, q, r));
         }
+        let cell = at.cell_size;
         parts
             .into_par_iter()
             .for_each(|((v0, k0), (_, k1), out, norms, sampled)| {
                 for w in self.starts[k0..=k1].windows(2) {
                     let ((a, t0), (b, t1)) = (w[0], w[1]);
                     let (a, b) = (a as usize - v0, b as usize - v0);
-                    let (out, sampled) = (&mut out[a..b], &mut sampled[a..b]);
+                    let out = &mut out[a..b];
+                    let verts = &self.vertices[a + v0..b + v0];
                     if again {
                         // The sample holds the vertex's height above the ground too, so the
                         // vertices need not be read at all.
-                        for (o, q) in out.iter_mut().zip(&*sampled) {
-                            o[1] = (g.at(*q) + f64::from(q.lift) * at.cell_size) as f32;
+                        for (o, q) in out.iter_mut().zip(&sampled[a..b]) {
+                            o[1] = (g.at(*q) + f64::from(q.lift) * cell) as f32;
                         }
-                    } else {
-                        let verts = &self.vertices[a + v0..b + v0];
-                        for ((o, v), q) in out.iter_mut().zip(verts).zip(sampled.iter_mut()) {
+                    } else if find {
+                        for ((o, v), q) in out.iter_mut().zip(verts).zip(&mut sampled[a..b]) {
                             let (x, y) = place(at, *v);
                             *q = Sample {
                                 lift: v[2],
                                 ..g.sample(x, y)
                             };
-                            *o = [x as f32, (g.at(*q) + f64::from(v[2]) * at.cell_size) as f32, y as f32];
+                            *o = [x as f32, (g.at(*q) + f64::from(v[2]) * cell) as f32, y as f32];
+                        }
+                    } else {
+                        // Moving: [`Flat::seat_into`]'s heights, with the ground's code inlined
+                        // here rather than called through a closure at every vertex (the call
+                        // was a fifth of a move's re-seat).
+                        for (o, v) in out.iter_mut().zip(verts) {
+                            let (x, y) = place(at, *v);
+                            *o = [x as f32, (g.height(x, y) + f64::from(v[2]) * cell) as f32, y as f32];
                         }
                     }
                     normals_of(out, &self.local[t0 as usize..t1 as usize], &mut norms[a..b]);
                 }
             });
-        samples.key = key;
+        if again || find {
+            samples.key = key;
+        }
     }
 }
 
