@@ -654,6 +654,14 @@ fn the_river_tool_draws_ages_reshapes_and_widens_a_river() {
     };
     assert!(near(by, slide, 15.0), "moved by {by:?}, slid {slide:?}");
     assert_eq!(moved.points[0], river.points[0], "only the held point moves");
+    // The drag's preview redid only part of the course; the river committed is processed whole:
+    // the engine's shape is a full rebuild of the moved entry, exactly.
+    let rebuilt = penmodel_terrain::river::Shape::process(
+        &moved,
+        &pen.doc().grid,
+        &penmodel_terrain::river::Constants::default(),
+    );
+    assert_eq!(pen.editor.terrain().rivers().shape(0), Some(&rebuilt));
     // Held on its course, SW3 and a move right and up: wider and deeper, one edit.
     let on = pen.view().to_display(moved.points[0]);
     pen.grab(on[0], on[1]);

@@ -806,7 +806,7 @@ impl Interaction {
                     grab.by = minus(g, self.view.to_ground(grab.at_mm[0], grab.at_mm[1]));
                 }
                 let doc = editor.document();
-                self.river_preview = grab.river(doc).map(|r| river::preview(&r, &doc.grid));
+                self.river_preview = grab.preview(doc);
             }
             State::Idle | State::Armed if self.tool == rocks::Tool::Rocks => {
                 self.hover = None;
@@ -1047,15 +1047,9 @@ impl Interaction {
                 };
                 match grab {
                     Some((index, control)) => {
-                        self.river_preview = doc.rivers.get(index).map(|r| river::preview(r, &doc.grid));
-                        self.state = State::River(river::RiverGrab {
-                            index,
-                            control,
-                            at_mm: [p.u_mm, p.v_mm],
-                            by: [0.0, 0.0],
-                            moving: false,
-                            tuning: None,
-                        });
+                        let grab = river::RiverGrab::new(doc, index, control, [p.u_mm, p.v_mm]);
+                        self.river_preview = grab.preview(doc);
+                        self.state = State::River(grab);
                     }
                     None => self.say("no river here to grab".into()),
                 }

@@ -21,6 +21,7 @@
 
 use glam::DVec2;
 use penmodel_terrain::document::{Document, Grid, Point, River};
+use penmodel_terrain::river::drag::{Cells, Drag};
 use penmodel_terrain::river::{Constants, MAX_ITERATIONS, Shape, course};
 
 use super::palette::Button;
@@ -137,24 +138,18 @@ pub fn aged(river: &River, years: u32) -> Option<River> {
 /// The next iteration's erosion (red) and deposition (light blue) cells of `river` on `grid`, as
 /// their centres in metres.
 pub fn preview(river: &River, grid: &Grid) -> (Vec<Point>, Vec<Point>) {
-    let shape = Shape::process(river, grid, &Constants::default());
-    let p = shape.preview();
-    let w = shape.window;
+    in_metres(&Cells::of(&Shape::process(river, grid, &Constants::default())), grid)
+}
+
+/// Grid cells as their centres in metres.
+fn in_metres(cells: &Cells, grid: &Grid) -> (Vec<Point>, Vec<Point>) {
     let s = grid.cell_size;
-    let centre = |i: usize| {
-        [
-            (f64::from(w.c0) + (i % w.width) as f64 + 0.5) * s,
-            (f64::from(w.r0) + (i / w.width) as f64 + 0.5) * s,
-        ]
-    };
-    let cells = |m: &[u8]| {
-        m.iter()
-            .enumerate()
-            .filter(|(_, v)| **v != 0)
-            .map(|(i, _)| centre(i))
+    let centres = |c: &[[u32; 2]]| {
+        c.iter()
+            .map(|p| [(f64::from(p[0]) + 0.5) * s, (f64::from(p[1]) + 0.5) * s])
             .collect()
     };
-    (cells(&p.erosion), cells(&p.deposition))
+    (centres(&cells.erosion), centres(&cells.deposition))
 }
 
 /// A river held with SW2.
@@ -172,9 +167,40 @@ pub struct RiverGrab {
     pub moving: bool,
     /// SW3 held: where it was pressed (u, h mm) and the width and depth factors so far.
     pub tuning: Option<([f64; 2], f64, f64)>,
+    /// With a control point held: the river as grabbed, processed once, so that the preview
+    /// while the point moves redoes only the part of the course it reaches (`river::drag`). The
+    /// river committed when the pen lets go is processed whole, as every edit's.
+    pub drag: Option<std::sync::Arc<Drag>>,
 }
 
 impl RiverGrab {
+    /// A grab of river `index` (control point `control`, if one), at `at_mm` on the display.
+    pub fn new(doc: &Document, index: usize, control: Option<usize>, at_mm: [f64; 2]) -> RiverGrab {
+        let drag = control
+            .zip(doc.rivers.get(index))
+            .map(|(k, r)| std::sync::Arc::new(Drag::new(r, k, &doc.grid, &Constants::default())));
+        RiverGrab {
+            index,
+            control,
+            at_mm,
+            by: [0.0, 0.0],
+            moving: false,
+            tuning: None,
+            drag,
+        }
+    }
+
+    /// The held river's next erosion and deposition cells (metres) as the pen is making it: a
+    /// carried point's from its drag, anything else from the whole river.
+    pub fn preview(&self, doc: &Document) -> Option<(Vec<Point>, Vec<Point>)> {
+        let river = self.river(doc)?;
+        Some(match (&self.drag, self.moving, self.tuning) {
+            (Some(drag), true, None) => in_metres(&drag.preview(&river), &doc.grid),
+            (Some(drag), false, None) => in_metres(drag.base_cells(), &doc.grid),
+            _ => preview(&river, &doc.grid),
+        })
+    }
+
     /// The river as the pen is making it: the point carried, the width and depth tuned.
     pub fn river(&self, doc: &Document) -> Option<River> {
         let r = doc.rivers.get(self.index)?;

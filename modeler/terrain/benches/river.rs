@@ -7,6 +7,9 @@
 //! - `preview/512/N`: what a drag costs: the river rebuilt from its entry (disc sweep, field, its
 //!   N committed iterations) and the next iteration's erosion and deposition, 40 control points,
 //!   4 m wide, on 512², for N = 0, 3 and 10: each committed iteration adds about a step.
+//! - `drag/512/N`: the same drag's preview by `river::drag::Drag` (control point 20 of 40 moved
+//!   6 m across, 4 m down): only the part of the course the point reaches is processed, the rest
+//!   of the preview is the river's as grabbed.
 //! - `carve/1024`: the carving of that river into flat ground.
 //! - `morph/dilate|erode/L/1024`: the diamond of level L over a whole 1024² mask (the river's),
 //!   the step `scripts/river_peer.py` times beside scipy.ndimage in one run.
@@ -48,6 +51,15 @@ fn bench(c: &mut Criterion) {
                 let s = Shape::process(black_box(small), &grid(512), &Constants::default());
                 s.preview()
             })
+        });
+    }
+    for iterations in [0, 3, 10] {
+        let small = river::meander(512, 14, 4.0, iterations);
+        let drag = river::drag::Drag::new(&small, 20, &grid(512), &Constants::default());
+        let mut moved = small.clone();
+        moved.points[20] = [moved.points[20][0] + 6.0, moved.points[20][1] - 4.0];
+        c.bench_with_input(BenchmarkId::new("drag/512", iterations), &moved, |b, moved| {
+            b.iter(|| drag.preview(black_box(moved)))
         });
     }
     let ground = Heightmap::from_heights(1024, 1024, 1.0, vec![10.0; 1024 * 1024]).expect("1024² heights");

@@ -22,6 +22,7 @@
 
 pub mod carve;
 pub mod course;
+pub mod drag;
 pub mod edt;
 pub mod layer;
 pub mod level;
