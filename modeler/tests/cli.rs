@@ -226,8 +226,23 @@ fn bench_json_has_the_documented_shape() {
     let obj = v.as_object().unwrap();
     assert_eq!(
         obj.keys().collect::<Vec<_>>(),
-        ["render", "pull_update", "memory", "terrain"]
+        ["render", "pull_update", "memory", "terrain", "still"]
     );
+    // Still frames (issue 18): each grid with LOD off and on, mono and stereo.
+    let still = v["still"].as_array().unwrap();
+    assert_eq!(still.len(), 8);
+    for (k, s) in still.iter().enumerate() {
+        assert_eq!(
+            s.as_object().unwrap().keys().collect::<Vec<_>>(),
+            ["grid", "lod_error", "stereo", "frame_ms", "nodes_per_level"]
+        );
+        assert_eq!(s["grid"], if k < 4 { 16 } else { 24 });
+        assert_eq!(s["stereo"], k % 4 >= 2);
+        assert_eq!(s["lod_error"].as_f64(), Some(if k % 2 == 0 { 0.0 } else { 1.0 }));
+        assert!(s["frame_ms"].as_f64().unwrap() > 0.0);
+        // LOD off draws no nodes; on, at least one.
+        assert_eq!(s["nodes_per_level"].as_array().unwrap().is_empty(), k % 2 == 0);
+    }
     // The terrain engine's figures (issue 18): each grid in both metrics.
     let terrain = v["terrain"].as_array().unwrap();
     assert_eq!(terrain.len(), 4);

@@ -240,6 +240,15 @@ impl Renderer {
         if self.eye.lod { &self.eye.nodes.picks } else { &[] }
     }
 
+    /// How many nodes of each level the last eye drew (level 0 first); empty at full detail.
+    pub fn lod_levels(&self) -> Vec<usize> {
+        if self.eye.lod {
+            self.eye.nodes.per_level()
+        } else {
+            Vec::new()
+        }
+    }
+
     /// Brings the pyramid up to date: only the nodes over the cells changed since it was made
     /// when the scene has the terrain's revisions, all of it otherwise.
     fn sync_pyramid(&mut self, scene: &Scene) {

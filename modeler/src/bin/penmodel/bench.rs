@@ -36,7 +36,7 @@ use penmodel_terrain::{
 /// Grid sizes measured.
 const GRIDS: [u32; 3] = [256, 512, 1024];
 /// The frame measured.
-const FRAME: (u32, u32) = (1280, 720);
+pub const FRAME: (u32, u32) = (1280, 720);
 /// Timed frames per grid.
 const FRAMES: usize = 25;
 /// Timed pull updates per grid.
@@ -69,6 +69,14 @@ pub struct Args {
     /// and sky light are remade every frame, since every frame follows a pull) or the classic one.
     #[arg(long, value_enum, default_value = "land")]
     look: crate::render::LookArg,
+    /// The terrain's level of detail in the pulls' frames and the still frames' second run: the
+    /// largest error on screen, pixels (0: every cell).
+    #[arg(long, value_name = "PX", default_value_t = penmodel_render::lod::DEFAULT_PIXELS, value_parser = crate::render::lod_error)]
+    lod_error: f32,
+    /// Measure only the still frames (`frames.rs`: LOD off and on, mono and stereo); grids above
+    /// 1024 are measured this way only.
+    #[arg(long)]
+    still_only: bool,
     /// The memory case's number of point figures.
     #[arg(long, value_name = "K", default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=10000))]
     memory_figures: u32,
@@ -145,7 +153,7 @@ fn mb(bytes: u64) -> f64 {
     (bytes as f64 / 1e6 * 10.0).round() / 10.0
 }
 
-fn document(n: u32) -> Result<Document> {
+pub fn document(n: u32) -> Result<Document> {
     let mut doc = Document::from_json(include_str!("../../../examples/01-ridges-and-peaks.json"))
         .context("example 1 is not valid")?;
     let extent = doc.grid.width();
@@ -155,7 +163,7 @@ fn document(n: u32) -> Result<Document> {
     Ok(doc)
 }
 
-fn median(mut v: Vec<f64>) -> f64 {
+pub fn median(mut v: Vec<f64>) -> f64 {
     v.sort_by(f64::total_cmp);
     let n = v.len();
     if n == 0 {
@@ -182,7 +190,7 @@ struct Figures {
     covered: f64,
 }
 
-fn measure(n: u32, look: crate::render::LookArg, bar: &ProgressBar) -> Result<Figures> {
+fn measure(n: u32, look: crate::render::LookArg, lod_error: f32, bar: &ProgressBar) -> Result<Figures> {
     let doc = document(n)?;
     let extent = [doc.grid.width(), doc.grid.height()];
     let overlays = penmodel::picture::document_overlays(&doc);
@@ -211,6 +219,7 @@ fn measure(n: u32, look: crate::render::LookArg, bar: &ProgressBar) -> Result<Fi
         let mut scene = Scene::new(editor.heightmap(), camera);
         // As the live loop: the land look learns what changed from the editor.
         scene.revisions = Some(editor.revisions());
+        scene.terrain_lod = lod_error;
         scene.overlays = &overlays;
         scene.selection = Some(1);
         scene.mode = "pull  height 62.0 m";
@@ -321,6 +330,15 @@ pub fn run(args: &Args) -> Result<()> {
     } else {
         args.grids.clone()
     };
+    if args.still_only {
+        let still = still_figures(&grids, args)?;
+        if args.json {
+            pen_host::outln!("{}", serde_json::json!({ "still": still_json(&still) }));
+        } else {
+            print_still(&still)?;
+        }
+        return Ok(());
+    }
     let metrics = [Metric::Taxicab, Metric::Euclidean];
     let render_steps = if args.terrain_only { 0 } else { WARM_UP + FRAMES + PULLS };
     let total = grids.len() * (render_steps + metrics.len() * (FULLS + EDITS));
@@ -337,16 +355,22 @@ pub fn run(args: &Args) -> Result<()> {
     let memory = measure_memory(args.memory_grid, args.memory_figures)?;
     let mut results = Vec::new();
     let mut engines = Vec::new();
-    for &n in &grids {
+    // The engine of example 1 above 1024² would need gigabytes: those grids get still frames only.
+    for &n in grids.iter().filter(|&&n| n <= 1024) {
         bar.set_message(format!("{n}×{n}"));
         if !args.terrain_only {
-            results.push(measure(n, args.look, &bar)?);
+            results.push(measure(n, args.look, args.lod_error, &bar)?);
         }
         for metric in metrics {
             engines.push(measure_engine(n, metric, &bar)?);
         }
     }
     bar.finish_and_clear();
+    let still = if args.terrain_only {
+        Vec::new()
+    } else {
+        still_figures(&grids, args)?
+    };
     let (w, h) = FRAME;
     let look = match args.look {
         crate::render::LookArg::Land => "land",
@@ -380,7 +404,8 @@ pub fn run(args: &Args) -> Result<()> {
             .collect();
         pen_host::outln!(
             "{}",
-            serde_json::json!({"render": render, "pull_update": pull, "memory": memory, "terrain": terrain})
+            serde_json::json!({"render": render, "pull_update": pull, "memory": memory, "terrain": terrain,
+                "still": still_json(&still)})
         );
     } else {
         if !results.is_empty() {
@@ -418,6 +443,7 @@ pub fn run(args: &Args) -> Result<()> {
         pen_host::outln!(
             "terrain engine: medians of {FULLS} regenerations, {EDITS} moves and {EDITS} slope changes; targets at 512×512: ≤ 10 ms, ≤ 4 ms, ≤ 1 ms"
         );
+        print_still(&still)?;
         let show = |v: Option<u64>| v.map_or("unknown".to_owned(), |b| format!("{} MB", mb(b)));
         pen_host::outln!(
             "memory: {} figures on {}×{}: peak resident {} (before building {}), bound {} MB (limit {} MB)",
@@ -430,6 +456,53 @@ pub fn run(args: &Args) -> Result<()> {
             mb(validate::MAX_ENGINE_BYTES)
         );
     }
+    Ok(())
+}
+
+/// Still frames ([`crate::frames`]) of every grid: LOD off and at `--lod-error`, mono and stereo.
+fn still_figures(grids: &[u32], args: &Args) -> Result<Vec<crate::frames::Still>> {
+    let mut out = Vec::new();
+    for &n in grids {
+        let map = crate::frames::terrain(n)?;
+        for stereo in [false, true] {
+            for lod in [0.0, args.lod_error] {
+                out.push(crate::frames::measure(&map, lod, stereo, args.look, STILL_FRAMES)?);
+            }
+        }
+    }
+    Ok(out)
+}
+
+/// Timed still frames per grid, LOD setting and eye count.
+const STILL_FRAMES: usize = 9;
+
+fn still_json(still: &[crate::frames::Still]) -> Vec<serde_json::Value> {
+    still
+        .iter()
+        .map(|s| {
+            serde_json::json!({"grid": s.grid, "lod_error": s.lod_error, "stereo": s.stereo,
+                "frame_ms": round3(s.frame_ms), "nodes_per_level": s.levels})
+        })
+        .collect()
+}
+
+fn print_still(still: &[crate::frames::Still]) -> Result<()> {
+    if still.is_empty() {
+        return Ok(());
+    }
+    pen_host::outln!("still frames  LOD error   eyes   frame        nodes per level (0 first)");
+    for s in still {
+        pen_host::outln!(
+            "{:>4}×{:<4}   {:>6} px   {:>4}   {:>8.2} ms   {:?}",
+            s.grid,
+            s.grid,
+            s.lod_error,
+            if s.stereo { 2 } else { 1 },
+            s.frame_ms,
+            s.levels
+        );
+    }
+    pen_host::outln!("medians of {STILL_FRAMES} frames, the view turning 0.1° a frame; target: ≤ 16.7 ms");
     Ok(())
 }
 

@@ -8,6 +8,7 @@
 
 mod analyze;
 mod bench;
+mod frames;
 mod generate;
 mod live;
 mod out;

@@ -192,6 +192,22 @@ pub struct Args {
     /// (`render: M ms median of N, trees: T, polygons: P`), for comparing renderers.
     #[arg(long, value_name = "N", value_parser = clap::value_parser!(u32).range(1..=1000))]
     repeat: Option<u32>,
+    /// The terrain's level of detail: the largest error, in pixels, a coarser level of the
+    /// heightfield may make on screen; 0 draws every cell (docs/renderer.md).
+    #[arg(long, value_name = "PX", default_value_t = penmodel_render::lod::DEFAULT_PIXELS, value_parser = lod_error)]
+    pub lod_error: f32,
+}
+
+/// A `--lod-error` value: finite pixels, at least 0.
+pub fn lod_error(s: &str) -> Result<f32, String> {
+    let v: f32 = s.parse().map_err(|_| format!("'{s}' is not a number of pixels"))?;
+    if v.is_finite() && v >= 0.0 {
+        Ok(v)
+    } else {
+        Err(format!(
+            "--lod-error must be a finite number of pixels at least 0, not {s}"
+        ))
+    }
 }
 
 /// Runs the command.
@@ -257,6 +273,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     scene.mode = &args.mode;
     scene.vertical_scale = args.vertical_scale as f32;
+    scene.terrain_lod = args.lod_error;
     match args.look {
         LookArg::Classic => scene.style.ramp_top = ramp_top(hi),
         LookArg::Land => {
