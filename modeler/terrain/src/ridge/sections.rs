@@ -208,20 +208,55 @@ impl Hull {
         }
     }
 
-    #[inline]
-    fn run<'a>(&mut self, n: usize, mut samples: impl Iterator<Item = (&'a f32, (&'a mut f32, &'a mut f32))>) {
-        // A power of two above n + 1: indices masked with `cap − 1` need no bounds checks.
+    /// Both passes of [`Hull::pass`] over `z` in lock-step, this hull for `AHEAD_UP` into `up`
+    /// and `other` for the opposite into `down`: the two walks are independent, so the CPU
+    /// overlaps one's pop tests with the other's.
+    pub fn pass_both(
+        &mut self,
+        other: &mut Hull,
+        z: &[f32],
+        up: (&mut [f32], &mut [f32]),
+        down: (&mut [f32], &mut [f32]),
+    ) {
+        let n = z.len();
+        if n == 0 {
+            return;
+        }
+        let (mask, (su, hu)) = self.stacks(n);
+        let (_, (sd, hd)) = other.stacks(n);
+        let (ru, du) = (&mut up.0[..n], &mut up.1[..n]);
+        let (rd, dd) = (&mut down.0[..n], &mut down.1[..n]);
+        (ru[n - 1], du[n - 1], rd[0], dd[0]) = (f32::NAN, 1.0, f32::NAN, 1.0);
+        let (mut tu, mut td) = (1usize, 1usize);
+        let (mut h1u, mut h1d, mut s) = (z[n - 1], z[0], 0.0f32);
+        for j in 1..n {
+            s -= 1.0;
+            let (ku, kd) = (n - 1 - j, j);
+            let (hu_, hd_) = (z[ku], z[kd]);
+            (ru[ku], du[ku]) = step(su, hu, mask, &mut tu, &mut h1u, s, hu_);
+            (rd[kd], dd[kd]) = step(sd, hd, mask, &mut td, &mut h1d, s, hd_);
+        }
+    }
+
+    /// The stacks for a line of n samples, a power of two above n + 1 long (indices masked with
+    /// the returned mask need no bounds checks), with the bottom vertex in place.
+    fn stacks(&mut self, n: usize) -> (usize, (&mut [f32], &mut [f32])) {
         let cap = (n + 1).next_power_of_two();
         if self.s.len() < cap {
             self.s.resize(cap, 0.0);
             self.h.resize(cap, 0.0);
         }
-        let mask = cap - 1;
-        let (ss, hs) = (&mut self.s[..mask + 1], &mut self.h[..mask + 1]);
+        let (ss, hs) = (&mut self.s[..cap], &mut self.h[..cap]);
         // At the bottom a vertex no line to the next one passes over (infinitely low), so
         // that the pop test needs no check for an empty stack.
         ss[0] = 1.0;
         hs[0] = f32::NEG_INFINITY;
+        (cap - 1, (ss, hs))
+    }
+
+    #[inline]
+    fn run<'a>(&mut self, n: usize, mut samples: impl Iterator<Item = (&'a f32, (&'a mut f32, &'a mut f32))>) {
+        let (mask, (ss, hs)) = self.stacks(n);
         let mut top = 1usize;
         let Some((&h0, (r0, d0))) = samples.next() else {
             return;
@@ -231,36 +266,45 @@ impl Hull {
         let (mut h1, mut s) = (h0, 0.0f32);
         for (&h, (rise, steps)) in samples {
             s -= 1.0;
-            // The nearest vertex (the previous sample, one step ahead) relative to this one.
-            let (mut a, mut b) = (h1 - h, 1.0f32);
-            // Pop it while it lies on or under the line to the next one. Two tests a turn, so
-            // that the vertex popped and the one under it need no register copies.
-            loop {
-                let i = (top - 1) & mask;
-                let (h2, c) = (hs[i], ss[i] - s);
-                let d = h2 - h;
-                if a * c > d * b {
-                    break;
-                }
-                top -= 1;
-                let i = (top - 1) & mask;
-                let (h3, e) = (hs[i], ss[i] - s);
-                let f = h3 - h;
-                if d * e > f * c {
-                    (a, b, h1) = (d, c, h2);
-                    break;
-                }
-                top -= 1;
-                (a, b, h1) = (f, e, h3);
-            }
-            // b + s is the vertex's position, exactly (integers).
-            ss[top & mask] = b + s;
-            hs[top & mask] = h1;
-            top += 1;
-            (*rise, *steps) = (a, b);
-            h1 = h;
+            (*rise, *steps) = step(ss, hs, mask, &mut top, &mut h1, s, h);
         }
     }
+}
+
+/// One sample of a hull walk: the sample at position s, height h; `h1` the previous sample's
+/// height (one step ahead, not yet on the stacks `ss`, `hs` of `top` vertices). Returns the rise
+/// and the steps to the horizon vertex, and leaves this sample as the previous one.
+#[inline(always)]
+fn step(ss: &mut [f32], hs: &mut [f32], mask: usize, top: &mut usize, h1: &mut f32, s: f32, h: f32) -> (f32, f32) {
+    // The nearest vertex (the previous sample, one step ahead) relative to this one.
+    let (mut a, mut b, mut hv) = (*h1 - h, 1.0f32, *h1);
+    let mut t = *top;
+    // Pop it while it lies on or under the line to the next one. Two tests a turn, so that the
+    // vertex popped and the one under it need no register copies.
+    loop {
+        let i = (t - 1) & mask;
+        let (h2, c) = (hs[i], ss[i] - s);
+        let d = h2 - h;
+        if a * c > d * b {
+            break;
+        }
+        t -= 1;
+        let i = (t - 1) & mask;
+        let (h3, e) = (hs[i], ss[i] - s);
+        let f = h3 - h;
+        if d * e > f * c {
+            (a, b, hv) = (d, c, h2);
+            break;
+        }
+        t -= 1;
+        (a, b, hv) = (f, e, h3);
+    }
+    // b + s is the vertex's position, exactly (integers).
+    ss[t & mask] = b + s;
+    hs[t & mask] = hv;
+    *top = t + 1;
+    *h1 = h;
+    (a, b)
 }
 
 /// `z` (`cols × rows`, row-major) transposed: `rows × cols`, followed by `pad` zeros. In tiles,

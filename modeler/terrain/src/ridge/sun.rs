@@ -298,6 +298,7 @@ fn sky_sweep(zc: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &m
         up,
         down,
         hull,
+        other,
     } = buf;
     block.resize(w * BLOCK, 0.0);
     heights.resize(w, 0.0);
@@ -325,8 +326,7 @@ fn sky_sweep(zc: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &m
             let (rd, dd) = (&mut down.0[..n], &mut down.1[..n]);
             match (du > 0.0 || both, du < 0.0 || both) {
                 (true, true) => {
-                    hull.pass::<true>(zs, ru, su);
-                    hull.pass::<false>(zs, rd, dd);
+                    hull.pass_both(other, zs, (&mut *ru, &mut *su), (&mut *rd, &mut *dd));
                     // sin² H of both, in place of the first's rises (vectorised).
                     for (((r, &d), &r2), &d2) in ru.iter_mut().zip(su.iter()).zip(rd.iter()).zip(dd.iter()) {
                         *r = sin2(*r, d, sp2) + sin2(r2, d2, sp2);
@@ -366,6 +366,7 @@ struct Scratch {
     up: (Vec<f32>, Vec<f32>),
     down: (Vec<f32>, Vec<f32>),
     hull: Hull,
+    other: Hull,
 }
 
 /// The sky-view fraction per cell from `k` azimuths (`2πi/k`): `1 − (1/k)·Σ sin² H_i`.
