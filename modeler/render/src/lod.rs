@@ -342,7 +342,7 @@ impl Pyramid {
             let mut split = false;
             let mut next = Vec::with_capacity(picks.len());
             for p in picks.iter() {
-                let finest = map.finest_around(self, p);
+                let finest = map.finest_around(p);
                 if finest.is_some_and(|f| p.level > f + MAX_STEP) {
                     split = true;
                     for (di, dj) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
@@ -538,8 +538,7 @@ impl Levels {
     }
 
     /// The finest level chosen along `pk`'s four sides.
-    fn finest_around(&self, p: &Pyramid, pk: &Pick) -> Option<u32> {
-        let _ = p;
+    fn finest_around(&self, pk: &Pick) -> Option<u32> {
         let n = 1isize << pk.level;
         let (i0, j0) = ((pk.i as isize) << pk.level, (pk.j as isize) << pk.level);
         let mut finest: Option<u32> = None;
