@@ -8,7 +8,8 @@
 //! which runs this machine's `penmodel rocks` on the same radius and area in the same run.
 //!
 //! `reseat/fig1/512`: fig. 1's rocks stood again on a changed 512² terrain (the edit target:
-//! one frame, ≤ 5 ms); `reseat-move/fig1/512`: the same after each move of the field.
+//! one frame, ≤ 5 ms); `reseat-local/fig1/512`: the same for a change within 64 × 64 cells;
+//! `reseat-move/fig1/512`: the same after each move of the field.
 //!
 //! Run: `cargo bench -p penmodel-terrain --bench rocks` (filter with e.g. `-- fig1`).
 
@@ -183,6 +184,13 @@ fn bench(c: &mut Criterion) {
     flat.seat_on(at, &map, &mut samples, &mut seated);
     g.bench_function("reseat/fig1/512", |b| {
         b.iter(|| black_box(&flat).seat_on(at, &map, &mut samples, &mut seated))
+    });
+    // A change of the terrain within 64 × 64 cells under the field (a pull's reach): only the
+    // blocks of rocks over it are stood again.
+    g.bench_function("reseat-local/fig1/512", |b| {
+        b.iter(|| {
+            black_box(&flat).seat_on_within(at, &map, &mut samples, &mut seated, Some([224.0, 224.0, 288.0, 288.0]))
+        })
     });
     let mut step = 0;
     g.bench_function("reseat-move/fig1/512", |b| {

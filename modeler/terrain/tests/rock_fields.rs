@@ -381,3 +381,41 @@ fn rocks_follow_successive_pulls_and_moves() {
         }
     }
 }
+
+/// A change of the terrain in a small rectangle re-seats only the blocks of rocks over it
+/// (`Flat::seat_on_within`), and the mesh is what seating everything afresh on the changed
+/// terrain gives, bit for bit; a rectangle that misses the change would leave it stale.
+#[test]
+fn a_local_change_of_the_terrain_reseats_the_rocks_over_it_as_a_whole_reseat_would() {
+    use penmodel_terrain::rocks::place::{self, Flat, Placement, Samples};
+    use penmodel_terrain::rocks::{Recipe, scatter};
+    let n = 128u32;
+    let s = scatter(&Recipe::figure_1(n, n, 3), None).expect("a valid recipe");
+    let flat = Flat::of(&s);
+    let hill = |x: f64, y: f64| (5.0 * (x / 17.0).sin() * (y / 23.0).cos()) as f32;
+    let heights: Vec<f32> = (0..n * n).map(|i| hill(f64::from(i % n), f64::from(i / n))).collect();
+    let map = Heightmap::from_heights(n, n, 1.0, heights.clone()).expect("heights");
+    let at = Placement {
+        origin: [0.0, 0.0],
+        cell_size: 1.0,
+    };
+    let (mut mesh, mut samples) = (Default::default(), Samples::default());
+    // Twice at the place: the second finds the samples, so the next reads only the heights.
+    flat.seat_on(at, &map, &mut samples, &mut mesh);
+    flat.seat_on(at, &map, &mut samples, &mut mesh);
+    // Cells 40..50 × 60..70 raised.
+    let mut raised = heights;
+    for r in 60..70 {
+        for c in 40..50 {
+            raised[(r * n + c) as usize] += 3.0;
+        }
+    }
+    let changed = Heightmap::from_heights(n, n, 1.0, raised).expect("heights");
+    let fresh = flat.seat(at, place::ground(&changed).surface());
+    let mut stale = mesh.clone();
+    let mut stale_samples = samples.clone();
+    flat.seat_on_within(at, &changed, &mut samples, &mut mesh, Some([40.0, 60.0, 50.0, 70.0]));
+    assert_eq!(mesh, fresh);
+    flat.seat_on_within(at, &changed, &mut stale_samples, &mut stale, Some([100.0, 100.0, 110.0, 110.0]));
+    assert_ne!(stale, fresh, "the blocks over the change were skipped");
+}

@@ -44,6 +44,9 @@ pub struct Flat {
     /// Blocks of whole rocks, about [`BLOCK`] vertices each: `(first vertex, first rock)` in
     /// [`Flat::order`], with the ends last. Blocks are seated on all cores.
     blocks: Vec<(usize, usize)>,
+    /// Per block (each window of [`Flat::blocks`]), the box of its vertices in field cells:
+    /// `[min x, min y, max x, max y]` (a change of the terrain elsewhere leaves it as it is).
+    boxes: Vec<[f32; 4]>,
     /// Per rock in [`Flat::order`]: its first vertex and its first triangle in `local`; then
     /// the ends.
     starts: Vec<(u32, u32)>,
@@ -80,6 +83,7 @@ impl Flat {
             indices: Vec::with_capacity(3 * t),
             order,
             blocks: vec![(0, 0)],
+            boxes: Vec::new(),
             starts: Vec::with_capacity(scatter.rocks.len() + 1),
             local: Vec::with_capacity(t),
         };
@@ -109,6 +113,16 @@ impl Flat {
         if f.blocks.last() != Some(&(f.vertices.len(), f.order.len())) {
             f.blocks.push((f.vertices.len(), f.order.len()));
         }
+        f.boxes = f
+            .blocks
+            .windows(2)
+            .map(|w| {
+                f.vertices[w[0].0..w[1].0].iter().fold(
+                    [f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY],
+                    |b, v| [b[0].min(v[0]), b[1].min(v[1]), b[2].max(v[0]), b[3].max(v[1])],
+                )
+            })
+            .collect();
         f
     }
 
@@ -171,6 +185,22 @@ impl Flat {
     /// about half of a re-seat). The samples are written on the second seat at a place, not
     /// while the field moves. `samples` belongs to `mesh` (clear it when the mesh is reset).
     pub fn seat_on(&self, at: Placement, map: &Heightmap, samples: &mut Samples, mesh: &mut Mesh) {
+        self.seat_on_within(at, map, samples, mesh, None);
+    }
+
+    /// [`Flat::seat_on`] after a change of the terrain only within `changed` (metres, `[x0, y0,
+    /// x1, y1]`; `None`: anywhere): when only the heights are read again, the blocks of rocks
+    /// whose vertices all lie outside it (and a cell beyond, whose heights they blend) keep
+    /// their positions and normals. Each rock's normals are its own, so the mesh is the same bit
+    /// for bit as a whole re-seat's.
+    pub fn seat_on_within(
+        &self,
+        at: Placement,
+        map: &Heightmap,
+        samples: &mut Samples,
+        mesh: &mut Mesh,
+        changed: Option<[f64; 4]>,
+    ) {
         let g = ground(map);
         let key = Some((at, map.cols(), map.rows(), map.cell_size().to_bits()));
         let n = self.vertices.len();
@@ -214,6 +244,22 @@ impl Flat {
             parts.push((w[0], w[1], p, q, r));
         }
         let cell = at.cell_size;
+        // The changed rectangle in field cells, a terrain cell wider each way.
+        let within = changed.filter(|_| again).map(|r| {
+            let m = map.cell_size();
+            [
+                ((r[0] - m - at.origin[0]) / cell) as f32,
+                ((r[1] - m - at.origin[1]) / cell) as f32,
+                ((r[2] + m - at.origin[0]) / cell) as f32,
+                ((r[3] + m - at.origin[1]) / cell) as f32,
+            ]
+        });
+        let parts: Vec<_> = parts
+            .into_iter()
+            .zip(&self.boxes)
+            .filter(|(_, b)| within.is_none_or(|r| b[0] <= r[2] && r[0] <= b[2] && b[1] <= r[3] && r[1] <= b[3]))
+            .map(|(p, _)| p)
+            .collect();
         parts
             .into_par_iter()
             .for_each(|((v0, k0), (_, k1), out, norms, sampled)| {
