@@ -97,8 +97,10 @@ pub struct Land {
     water: bool,
     /// Per cell, how near water is ([`Shore`]); empty without water.
     shore: Vec<Shore>,
-    /// Ground colour per cell, sRGB 0–255, before light.
-    albedo: Vec<[f32; 3]>,
+    /// Ground colour per cell, sRGB 0–255, before light and without the fine noise's
+    /// brightness, and that brightness as a factor − 1 (see [`material_parts`]): a pixel fades
+    /// it by its footprint ([`Ground::fine_fade`]).
+    albedo: Vec<[f32; 4]>,
     /// The broad and fine noise per cell: they depend on the grid alone.
     noise: Vec<[f32; 2]>,
     /// The grid the noise is for: columns, rows, cell size.
@@ -107,6 +109,8 @@ pub struct Land {
     rows: usize,
     /// Cell size, metres.
     pub(crate) cell: f32,
+    /// The fine noise's wavelength, metres ([`fine_wavelength`]).
+    fine_metres: f32,
     /// Non-finite heights.
     bad: usize,
     /// Times the maps were remade (a test and the bench read it).
@@ -211,8 +215,9 @@ impl Land {
         self.remakes
     }
 
-    /// The ground's colour per cell (sRGB 0–255, before light), row-major like the heights.
-    pub fn albedo(&self) -> &[[f32; 3]] {
+    /// The ground's colour per cell (sRGB 0–255, before light, without the fine noise's
+    /// brightness) and that brightness − 1, row-major like the heights.
+    pub fn albedo(&self) -> &[[f32; 4]] {
         &self.albedo
     }
 
@@ -290,6 +295,7 @@ impl Land {
         self.cols = cols;
         self.rows = rows;
         self.cell = map.cell_size() as f32;
+        self.fine_metres = fine_wavelength(map.cell_size()) as f32;
         if !same {
             rect = full;
         }
@@ -317,7 +323,7 @@ impl Land {
             self.noise = noise(cols, rows, map.cell_size());
             self.noise_grid = (cols, rows, map.cell_size());
         }
-        self.albedo.resize(cols * rows, [0.0; 3]);
+        self.albedo.resize(cols * rows, [0.0; 4]);
         colours(map, &scene.style, &self.shore, grown, &self.noise, &mut self.albedo);
         self.remade.coloured = ((grown.c1 - grown.c0) * (grown.r1 - grown.r0)) as u64;
         // Non-finite heights, counted again in the changed rows.
@@ -343,51 +349,107 @@ impl Land {
         self.bad
     }
 
-    /// The ground's colour (sRGB 0–255, before light) of the cell holding world `(x, z)`
-    /// metres: for pixels where a cell is smaller than a pixel, where interpolating between cells
-    /// would show nothing more and costs three times as much.
-    #[inline]
-    pub fn nearest_at(&self, x: f32, z: f32) -> [f32; 3] {
-        if self.cols == 0 || self.rows == 0 {
-            return [0.0; 3];
+    /// What a tile's pixels read of the maps: the colours and the grid, kept in locals.
+    pub(crate) fn ground(&self) -> Ground<'_> {
+        const NOTHING: [[f32; 4]; 1] = [[0.0; 4]];
+        if self.cols == 0 || self.rows == 0 || self.albedo.len() < self.cols * self.rows {
+            return Ground {
+                albedo: &NOTHING,
+                cols: 1,
+                inv: 0.0,
+                last: [0.0, 0.0],
+                fine_metres: 0.0,
+            };
         }
-        let inv = 1.0 / self.cell;
-        // Negative and NaN positions cast to 0.
-        let c = ((x * inv) as usize).min(self.cols - 1);
-        let r = ((z * inv) as usize).min(self.rows - 1);
-        self.albedo[r * self.cols + c]
+        Ground {
+            albedo: &self.albedo,
+            cols: self.cols,
+            inv: 1.0 / self.cell,
+            last: [(self.cols - 1) as f32, (self.rows - 1) as f32],
+            fine_metres: self.fine_metres,
+        }
+    }
+}
+
+/// The land look's maps as a pixel reads them ([`Land::ground`]).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Ground<'a> {
+    albedo: &'a [[f32; 4]],
+    cols: usize,
+    /// 1 / cell size.
+    inv: f32,
+    /// The last column and row.
+    last: [f32; 2],
+    fine_metres: f32,
+}
+
+/// Where the fine noise fades, in pixels per wavelength along the ground's shorter side on
+/// screen: its mean below the first, all of it above the second (smooth between). With the
+/// noise's 3-cell wavelength on coarse grids that is a cell under 2 px on screen (the mean) to
+/// over 4 px (all of it): finer, the noise would alias — shimmer as the view moves, and every
+/// pixel of a moving frame changed.
+pub const FINE_FADE: [f32; 2] = [6.0, 12.0];
+
+impl Ground<'_> {
+    /// How much of the fine noise a pixel shows (0 to 1): `pixels_per_metre` the screen's
+    /// pixels per metre across the view at the sample's depth, `sin` the sine of the view ray's
+    /// elevation (flat ground seen at a grazing angle is foreshortened by it along the ray).
+    #[inline]
+    pub(crate) fn fine_fade(&self, pixels_per_metre: f32, sin: f32) -> f32 {
+        let px = self.fine_metres * pixels_per_metre * sin;
+        let t = ((px - FINE_FADE[0]) * (1.0 / (FINE_FADE[1] - FINE_FADE[0]))).clamp(0.0, 1.0);
+        t * t * (3.0 - 2.0 * t)
+    }
+
+    /// The cell position `(x, z)` metres falls in, clamped to the grid; a NaN (a point from a
+    /// degenerate view) gives the first cell (`f32::max` returns the other operand).
+    #[inline]
+    fn place(&self, x: f32, z: f32, half: f32) -> (f32, f32) {
+        (
+            (x * self.inv - half).max(0.0).min(self.last[0]),
+            (z * self.inv - half).max(0.0).min(self.last[1]),
+        )
+    }
+
+    /// The ground's colour (sRGB 0–255, before light) of the cell holding world `(x, z)`
+    /// metres, with `fade` of the fine noise: for pixels where a cell is smaller than a pixel,
+    /// where interpolating between cells would show nothing more and costs three times as much.
+    #[inline]
+    pub(crate) fn nearest_at(&self, x: f32, z: f32, fade: f32) -> [f32; 3] {
+        let (u, v) = self.place(x, z, 0.0);
+        let a = self.albedo[v as u32 as usize * self.cols + u as u32 as usize];
+        let k = 1.0 + fade * a[3];
+        [a[0] * k, a[1] * k, a[2] * k]
     }
 
     /// The ground's colour (sRGB 0–255, before light) at world `(x, z)` metres, bilinear between
-    /// the cell centres.
+    /// the cell centres, with `fade` of the fine noise.
     #[inline]
-    pub fn albedo_at(&self, x: f32, z: f32) -> [f32; 3] {
-        if self.cols == 0 || self.rows == 0 {
-            return [0.0; 3];
-        }
-        let inv = 1.0 / self.cell;
-        let u = (x * inv - 0.5).clamp(0.0, (self.cols - 1) as f32);
-        let v = (z * inv - 0.5).clamp(0.0, (self.rows - 1) as f32);
-        // NaN (a point from a degenerate view) clamps to NaN: read the first cell instead.
-        let (u, v) = if u.is_finite() && v.is_finite() {
-            (u, v)
-        } else {
-            (0.0, 0.0)
-        };
-        let (c, r) = (u as usize, v as usize);
+    pub(crate) fn albedo_at(&self, x: f32, z: f32, fade: f32) -> [f32; 3] {
+        let (u, v) = self.place(x, z, 0.5);
+        let (c, r) = (u as u32 as usize, v as u32 as usize);
         let (fu, fv) = (u - c as f32, v - r as f32);
-        let c1 = (c + 1).min(self.cols - 1);
-        let r1 = (r + 1).min(self.rows - 1);
-        let a = &self.albedo;
-        let (p00, p10, p01, p11) = (
-            a[r * self.cols + c],
-            a[r * self.cols + c1],
-            a[r1 * self.cols + c],
-            a[r1 * self.cols + c1],
-        );
-        let top = lerp(p00, p10, fu);
-        lerp(top, lerp(p01, p11, fu), fv)
+        // The next column and row, or these on the last.
+        let dc = usize::from(u < self.last[0]);
+        let dr = if v < self.last[1] { self.cols } else { 0 };
+        let i = r * self.cols + c;
+        let a = self.albedo;
+        let top = lerp4(a[i], a[i + dc], fu);
+        let p = lerp4(top, lerp4(a[i + dr], a[i + dr + dc], fu), fv);
+        let k = 1.0 + fade * p[3];
+        [p[0] * k, p[1] * k, p[2] * k]
     }
+}
+
+/// `a + t·(b − a)` on four lanes.
+#[inline]
+fn lerp4(a: [f32; 4], b: [f32; 4], t: f32) -> [f32; 4] {
+    [
+        a[0] + t * (b[0] - a[0]),
+        a[1] + t * (b[1] - a[1]),
+        a[2] + t * (b[2] - a[2]),
+        a[3] + t * (b[3] - a[3]),
+    ]
 }
 
 /// A fingerprint of the heights' bits (a multiply-xor hash per row, rows combined in order).
@@ -440,7 +502,6 @@ fn smoothstep(a: f32, b: f32, t: f32) -> f32 {
 }
 
 use super::atmosphere::lerp as mix;
-use super::atmosphere::lerp;
 
 fn rgb(c: [u8; 3]) -> [f32; 3] {
     c.map(f32::from)
@@ -488,11 +549,20 @@ pub const SHORE_METRES: f32 = 12.0;
 pub const SHORE_CELLS: f32 = 3.0;
 
 /// The ground's colour (sRGB 0–255, before light) at true height `h` metres, slope `slope`
-/// degrees, with noises `broad` and `fine` in `[0, 1)`, and `shore` for the beach.
+/// degrees, with noises `broad` and `fine` in `[0, 1)`, and `shore` for the beach: its
+/// [`material_parts`] with all of the fine noise.
 pub fn material(style: &Style, h: f32, slope: f32, broad: f32, fine: f32, shore: Shore) -> [f32; 3] {
+    let (c, k) = material_parts(style, h, slope, broad, fine, shore);
+    c.map(|v| v * (1.0 + k))
+}
+
+/// [`material`] in two parts: the colour without the fine noise's brightness (its mean), and that
+/// brightness as a factor − 1, at most what keeps every channel ≤ 255: a pixel shows
+/// `colour × (1 + fade·k)`, the fade by its footprint ([`FINE_FADE`]).
+pub fn material_parts(style: &Style, h: f32, slope: f32, broad: f32, fine: f32, shore: Shore) -> ([f32; 3], f32) {
     if h < 0.0 {
         let depth = style.ramp_depth.max(f32::MIN_POSITIVE);
-        return rgb(ramp::interpolate(&WATER, -h / depth));
+        return (rgb(ramp::interpolate(&WATER, -h / depth)), 0.0);
     }
     let snow_line = style.snow_line.max(f32::MIN_POSITIVE);
     let jitter = broad - 0.5;
@@ -520,8 +590,9 @@ pub fn material(style: &Style, h: f32, slope: f32, broad: f32, fine: f32, shore:
         c = mix(c, rgb(SAND), beach);
     }
     // Brightness varies by ±7 % on the fine scale (less on snow).
-    let k = 1.0 + (fine - 0.5) * 0.14 * (1.0 - 0.7 * snow);
-    c.map(|v| (v * k).clamp(0.0, 255.0))
+    let k = (fine - 0.5) * 0.14 * (1.0 - 0.7 * snow);
+    let top = c[0].max(c[1]).max(c[2]).max(f32::MIN_POSITIVE);
+    (c, k.min(255.0 / top - 1.0))
 }
 
 /// How near each cell is to water: the sea (heights below 0, level 0) and the cells under the
@@ -607,17 +678,29 @@ fn atan_degrees(g: f32) -> f32 {
     if flip { 90.0 - d } else { d }
 }
 
+/// The fine noise's wavelength on cells of `s` metres: 24 m, at least 3 cells.
+fn fine_wavelength(s: f64) -> f64 {
+    24f64.max(3.0 * s)
+}
+
 /// The broad and fine noise at each cell's centre.
 fn noise(cols: usize, rows: usize, s: f64) -> Vec<[f32; 2]> {
     // The noises' wavelengths in metres, at least a few cells.
-    let fine_l = 24f64.max(3.0 * s);
+    let fine_l = fine_wavelength(s);
     let broad_l = 96f64.max(12.0 * s);
     let mut out = vec![[0.0; 2]; cols * rows];
     out.par_chunks_mut(cols.max(1)).enumerate().for_each(|(r, line)| {
         for (c, o) in line.iter_mut().enumerate() {
             let (x, y) = ((c as f64 + 0.5) * s, (r as f64 + 0.5) * s);
+            // The broad noise: two octaves on lattices turned from the grid's axes and from
+            // each other. One octave on the grid's own lattice showed its squares as blocks of
+            // grass once the fine noise faded out at a distance.
+            let turned = |(cos, sin): (f64, f64), l: f64| ((x * cos - y * sin) / l, (x * sin + y * cos) / l);
+            let (u1, v1) = turned((0.866_025_4, 0.5), broad_l);
+            let (u2, v2) = turned((0.939_692_6, -0.342_020_1), 0.45 * broad_l);
+            let broad = 0.75 * (value_noise(u1, v1, 1) - 0.5) + 0.35 * (value_noise(u2, v2, 3) - 0.5);
             *o = [
-                value_noise(x / broad_l, y / broad_l, 1),
+                (0.5 + 1.2 * broad).clamp(0.0, 0.999),
                 value_noise(x / fine_l, y / fine_l, 2),
             ];
         }
@@ -632,7 +715,7 @@ fn colours(
     shore: &[Shore],
     rect: Rect,
     noise: &[[f32; 2]],
-    out: &mut [[f32; 3]],
+    out: &mut [[f32; 4]],
 ) {
     let (cols, rows) = (map.cols() as usize, map.rows() as usize);
     if cols == 0 || rows == 0 || rect.c1 <= rect.c0 {
@@ -649,7 +732,7 @@ fn colours(
             for (c, o) in line.iter_mut().enumerate().take(rect.c1).skip(rect.c0) {
                 let centre = h[r * cols + c];
                 if !centre.is_finite() {
-                    *o = [0.0; 3];
+                    *o = [0.0; 4];
                     continue;
                 }
                 // The true slope: heights unscaled.
@@ -657,7 +740,8 @@ fn colours(
                 let slope = atan_degrees((dx * dx + dz * dz).sqrt());
                 let [broad, fine] = noise[r * cols + c];
                 let near = shore.get(r * cols + c).copied().unwrap_or(Shore::NONE);
-                *o = material(style, centre, slope, broad, fine, near);
+                let ([r, g, b], k) = material_parts(style, centre, slope, broad, fine, near);
+                *o = [r, g, b, k];
             }
         });
 }
@@ -870,5 +954,76 @@ fn footprint(b: Rect, f: usize, (cc, rr): (usize, usize), (cols, rows): (usize, 
         c1: hi(b.c1 - 1, cc, cols),
         r0: lo(b.r0),
         r1: hi(b.r1 - 1, rr, rows),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A 2 × 2 grid of 10 m cells: colours and fine terms chosen by the test.
+    fn ground(albedo: &[[f32; 4]]) -> Ground<'_> {
+        Ground {
+            albedo,
+            cols: 2,
+            inv: 0.1,
+            last: [1.0, 1.0],
+            fine_metres: 30.0,
+        }
+    }
+
+    #[test]
+    fn the_fine_noise_fades_with_its_footprint() {
+        let cells = [
+            [100.0, 80.0, 60.0, 0.05],
+            [200.0, 180.0, 160.0, -0.05],
+            [0.0; 4],
+            [0.0; 4],
+        ];
+        let g = ground(&cells);
+        // Pixels per metre that put a wavelength (30 m) at `px` pixels seen from straight above.
+        let fade = |px: f32, sin: f32| g.fine_fade(px / 30.0, sin);
+        assert_eq!(fade(FINE_FADE[0], 1.0), 0.0);
+        assert_eq!(fade(0.5 * FINE_FADE[0], 1.0), 0.0);
+        assert_eq!(fade(FINE_FADE[1], 1.0), 1.0);
+        assert_eq!(fade(10.0 * FINE_FADE[1], 1.0), 1.0);
+        // Foreshortened: the same distance at a grazing angle shows less of it.
+        assert_eq!(fade(FINE_FADE[1], 0.4), 0.0);
+        let mut last = 0.0;
+        for i in 0..=100 {
+            let f = fade(FINE_FADE[0] + (FINE_FADE[1] - FINE_FADE[0]) * i as f32 / 100.0, 1.0);
+            assert!(f >= last && f <= 1.0);
+            last = f;
+        }
+        // Faded out, a pixel sees the cells' colour without the noise; in full, × (1 + k).
+        let mid = g.albedo_at(10.0, 5.0, 0.0);
+        for (m, (a, b)) in mid.iter().zip(cells[0].iter().zip(&cells[1])) {
+            assert!((m - 0.5 * (a + b)).abs() < 1e-3);
+        }
+        let near = g.nearest_at(4.0, 4.0, 1.0);
+        for (n, want) in near.iter().zip([105.0, 84.0, 63.0]) {
+            assert!((n - want).abs() < 1e-3);
+        }
+        assert_eq!(g.nearest_at(4.0, 4.0, 0.0), [100.0, 80.0, 60.0]);
+        // A NaN point reads the first cell.
+        assert_eq!(g.nearest_at(f32::NAN, f32::NAN, 0.0), [100.0, 80.0, 60.0]);
+    }
+
+    #[test]
+    fn the_parts_make_the_material() {
+        let style = Style::land();
+        for (h, slope, fine) in [
+            (20.0, 3.0, 0.9),
+            (2500.0, 10.0, 0.99),
+            (900.0, 40.0, 0.1),
+            (-3.0, 0.0, 0.7),
+        ] {
+            let (c, k) = material_parts(&style, h, slope, 0.4, fine, Shore::NONE);
+            assert!(k.abs() <= 0.07 + 1e-6);
+            let full = material(&style, h, slope, 0.4, fine, Shore::NONE);
+            for (f, c) in full.iter().zip(c) {
+                assert!((f - c * (1.0 + k)).abs() < 1e-3 && *f <= 255.0 + 1e-3);
+            }
+        }
     }
 }

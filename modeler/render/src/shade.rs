@@ -80,7 +80,8 @@ pub fn resolve(
 }
 
 /// [`resolve`] in the land look: a terrain sample's ground colour where its world point lies
-/// ([`Land::albedo_at`]), every surface hazed by its distance, the atmosphere behind.
+/// ([`crate::land::Ground::albedo_at`]) with as much of the fine noise as its footprint resolves
+/// ([`crate::land::FINE_FADE`]), every surface hazed by its distance, the atmosphere behind.
 #[allow(clippy::too_many_arguments)]
 fn resolve_land(
     samples: &[Sample],
@@ -92,23 +93,37 @@ fn resolve_land(
     style: &Style,
 ) {
     let step = air.step();
+    let ground = land.ground();
+    // Pixels a metre spans across the view at `w = 1`.
+    let per_metre = air.pixels(1.0, 1.0);
     // Where a cell spans less than a pixel (1/w below this), the nearest cell's colour.
-    let fine = 1.0 / air.pixels(land.cell, 1.0).max(f32::MIN_POSITIVE);
+    let fine = 1.0 / (per_metre * land.cell).max(f32::MIN_POSITIVE);
     let rows = samples
         .chunks(width)
         .zip(pixels.chunks_mut(width))
         .zip(back.chunks(width));
+    let sine = |r: [f32; 3]| {
+        let len = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
+        if len > 0.0 { r[1].abs() / len } else { 0.0 }
+    };
     for (row, ((srow, prow), brow)) in rows.enumerate() {
-        let mut ray = air.ray(x0 as f32 + 0.5, (y0 + row) as f32 + 0.5);
+        let y = (y0 + row) as f32 + 0.5;
+        let mut ray = air.ray(x0 as f32 + 0.5, y);
+        // The ray's elevation, for the ground's foreshortening: linear along the tile's row
+        // between its ends (it is smooth, and a fade needs no more).
+        let mut sin = sine(ray);
+        let last = sine(air.ray(x1.max(x0 + 1) as f32 - 0.5, y));
+        let d_sin = (last - sin) / (x1.saturating_sub(x0 + 1)).max(1) as f32;
         for ((s, p), b) in srow[x0..x1].iter().zip(&mut prow[x0..x1]).zip(&brow[x0..x1]) {
             let c = if s.invw > 0.0 {
                 let w = 1.0 / s.invw;
                 let (at, d) = air.point(ray, w);
                 let c = surface_colour(s.surface, style).unwrap_or_else(|| {
+                    let fade = ground.fine_fade(per_metre * s.invw, sin);
                     if s.invw < fine {
-                        land.nearest_at(at[0], at[1])
+                        ground.nearest_at(at[0], at[1], fade)
                     } else {
-                        land.albedo_at(at[0], at[1])
+                        ground.albedo_at(at[0], at[1], fade)
                     }
                 });
                 let l = (s.lw * w).clamp(0.0, 1.0);
@@ -119,6 +134,7 @@ fn resolve_land(
             };
             *p = [c[0], c[1], c[2], 255];
             ray = [ray[0] + step[0], ray[1] + step[1], ray[2] + step[2]];
+            sin += d_sin;
         }
     }
 }
