@@ -79,7 +79,7 @@ pub struct Atmosphere {
     inv_haze: f32,
     haze: f32,
     /// `1 − exp(−d/L)` over `d/L ∈ [0, HAZE_SPAN]`.
-    table: Vec<f32>,
+    table: Box<[f32; HAZE_ENTRIES]>,
     horizon: [f32; 3],
     zenith: [f32; 3],
     /// Lit colours of the table, the model's side and the far land.
@@ -121,9 +121,10 @@ impl Atmosphere {
         } else {
             3.0 * diagonal
         };
-        let table = (0..HAZE_ENTRIES)
-            .map(|i| 1.0 - (-(i as f32) * HAZE_SPAN / (HAZE_ENTRIES - 1) as f32).exp())
-            .collect();
+        // A fixed-size table: the clamped index needs no bounds check per pixel.
+        let table = Box::new(std::array::from_fn(|i| {
+            1.0 - (-(i as f32) * HAZE_SPAN / (HAZE_ENTRIES - 1) as f32).exp()
+        }));
         let [lx, ly, lup] = style.light;
         let len = (lx * lx + ly * ly + lup * lup).sqrt();
         let up = if len > 0.0 && len.is_finite() {
@@ -198,7 +199,8 @@ impl Atmosphere {
     fn fog(&self, d: f32) -> f32 {
         let x = d * self.inv_haze * ((HAZE_ENTRIES - 1) as f32 / HAZE_SPAN);
         if x.is_finite() {
-            self.table[(x as usize).min(HAZE_ENTRIES - 1)]
+            // A 32-bit cast (saturating, as the 64-bit one did: the same entry, cheaper).
+            self.table[(x as u32 as usize).min(HAZE_ENTRIES - 1)]
         } else {
             1.0
         }
