@@ -5,10 +5,11 @@
 //!   (`--look classic`: the first renderer's).
 //! - Camera: an orbit at eye height over the grid's middle (azimuth 30°, elevation 10°, 40 m
 //!   away, 45° field of view), so the trees stand from near to far as in the seed's picture.
-//! - Trees: Table 3.1, 8–14 m tall, turned by their index; tree k stands at a distance growing
-//!   geometrically from 18 m to 150 m from the eye along the ground, at an angle across the view
-//!   from a golden-ratio sequence within ±28° (inside the 16:9 frame's ±36° horizontally). The
-//!   seed mixed 15 of its Sample 3.1 (Table 3.1) with 15 of Sample 3.2, which is no preset here.
+//! - Trees: the seed's two species of Table 3.1 in turn (even k Sample 3.1, `table-3.1`; odd k
+//!   Sample 3.2, `sample-3.2`: 15 of each in 30, as the seed's scene), 8–14 m tall, turned by
+//!   their index; tree k stands at a distance growing geometrically from 18 m to 150 m from the
+//!   eye along the ground, at an angle across the view from a golden-ratio sequence within ±28°
+//!   (inside the 16:9 frame's ±36° horizontally).
 //! - LOD off: every tree in full (`Scene::tree_lod` `None`); on: the default `Roughness` by
 //!   distance and gaze (the view axis). Stereo: the anaglyph, two full-size eyes with the trees
 //!   drawn once for both.
@@ -62,7 +63,7 @@ pub struct SceneArgs {
 
 /// The scene's trees on `map` (`extent` metres across), seen from `camera` in a frame of `aspect`.
 fn layout(n: u32, map: &penmodel_terrain::Heightmap, extent: [f64; 2], camera: &Camera, aspect: f64) -> Vec<Standing> {
-    let nodes = Arc::new(NodeTree::build(&Species::preset(Preset::Table31)));
+    let species = [Preset::Table31, Preset::Sample32].map(|p| Arc::new(NodeTree::build(&Species::preset(p))));
     let vp = camera.viewpoint(Eye::Centre, aspect);
     let centre = 0.5 * (vp.lower_right + vp.upper_left);
     let ahead = DVec3::new(centre.x - vp.eye.x, 0.0, centre.z - vp.eye.z).normalize_or(DVec3::X);
@@ -83,7 +84,7 @@ fn layout(n: u32, map: &penmodel_terrain::Heightmap, extent: [f64; 2], camera: &
                 base: ground.height(at[0], at[1]),
                 height: 8.0 + 6.0 * (f64::from(k) * golden * golden).fract(),
                 turn: turn(u64::from(k)),
-                nodes: Arc::clone(&nodes),
+                nodes: Arc::clone(&species[k as usize % 2]),
                 wind: None,
             }
         })
@@ -205,7 +206,7 @@ pub fn run(args: &SceneArgs) -> Result<()> {
     super::say(
         json,
         &format!(
-            "{} Table 3.1 trees on example 1 at {}×{}, {look} look: full {} polygons, {}; LOD {} polygons ({} copied + {} shapes), {}; LOD stereo (anaglyph) {}",
+            "{} Table 3.1 trees (Samples 3.1 and 3.2 in turn) on example 1 at {}×{}, {look} look: full {} polygons, {}; LOD {} polygons ({} copied + {} shapes), {}; LOD stereo (anaglyph) {}",
             stats_full.trees,
             args.width,
             args.height,
