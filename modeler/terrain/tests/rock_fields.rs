@@ -416,6 +416,12 @@ fn a_local_change_of_the_terrain_reseats_the_rocks_over_it_as_a_whole_reseat_wou
     let mut stale_samples = samples.clone();
     flat.seat_on_within(at, &changed, &mut samples, &mut mesh, Some([40.0, 60.0, 50.0, 70.0]));
     assert_eq!(mesh, fresh);
-    flat.seat_on_within(at, &changed, &mut stale_samples, &mut stale, Some([100.0, 100.0, 110.0, 110.0]));
+    flat.seat_on_within(
+        at,
+        &changed,
+        &mut stale_samples,
+        &mut stale,
+        Some([100.0, 100.0, 110.0, 110.0]),
+    );
     assert_ne!(stale, fresh, "the blocks over the change were skipped");
 }
