@@ -200,19 +200,7 @@ pub fn project(
                     *span = if lo <= hi { (lo >> 8, (hi >> 8) + 1) } else { (0, 0) };
                 }
             }
-            let bounds = if state == ChunkState::Mixed && nearest == 0.0 {
-                viewport
-            } else {
-                Bounds {
-                    x0: (x0 >> 8).max(viewport.x0),
-                    x1: ((x1 >> 8) + 1).min(viewport.x1),
-                    y0: (y0 >> 8).max(viewport.y0),
-                    y1: ((y1 >> 8) + 1).min(viewport.y1),
-                }
-            };
-            if !any_drawable || bounds.x0 >= bounds.x1 || bounds.y0 >= bounds.y1 {
-                state = ChunkState::Culled;
-            }
+            let (bounds, state) = transform::screen_bounds(state, nearest, any_drawable, [x0, x1, y0, y1], viewport);
             NodeChunk {
                 base: k * SLOT,
                 nc,

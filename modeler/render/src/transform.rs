@@ -19,6 +19,38 @@ use super::clip::ClipVertex;
 use super::rasterise::{Bounds, Sink, Vtx, snap};
 use penmodel_terrain::Heightmap;
 
+/// A chunk's pixel bounds from its vertices' fixed-point extent `[x0, x1, y0, y1]` (8 fraction
+/// bits), and its state: the whole viewport when a vertex is clipped at the near plane (clipped
+/// triangles may reach anywhere), culled when nothing is drawable or the bounds are empty. The
+/// grid's chunks ([`Projected`]) and the level-of-detail nodes (`nodes.rs`) share it.
+pub(crate) fn screen_bounds(
+    state: ChunkState,
+    nearest: f32,
+    any_drawable: bool,
+    [x0, x1, y0, y1]: [i32; 4],
+    viewport: Bounds,
+) -> (Bounds, ChunkState) {
+    let bounds = if state == ChunkState::Mixed && nearest == 0.0 {
+        viewport
+    } else {
+        Bounds {
+            x0: (x0 >> 8).max(viewport.x0),
+            x1: ((x1 >> 8) + 1).min(viewport.x1),
+            y0: (y0 >> 8).max(viewport.y0),
+            y1: ((y1 >> 8) + 1).min(viewport.y1),
+        }
+    };
+    let empty = bounds.x0 >= bounds.x1 || bounds.y0 >= bounds.y1;
+    (
+        bounds,
+        if !any_drawable || empty {
+            ChunkState::Culled
+        } else {
+            state
+        },
+    )
+}
+
 /// Quads per chunk side.
 pub const CHUNK: usize = 16;
 
@@ -243,20 +275,7 @@ pub fn project_grid(map: &Heightmap, light: &[f32], affine: &Affine, near: f32, 
                     *span = if lo <= hi { (lo >> 8, (hi >> 8) + 1) } else { (0, 0) };
                 }
             }
-            let bounds = if state == ChunkState::Mixed && nearest == 0.0 {
-                // Clipped triangles may reach anywhere.
-                viewport
-            } else {
-                Bounds {
-                    x0: (x0 >> 8).max(viewport.x0),
-                    x1: ((x1 >> 8) + 1).min(viewport.x1),
-                    y0: (y0 >> 8).max(viewport.y0),
-                    y1: ((y1 >> 8) + 1).min(viewport.y1),
-                }
-            };
-            if !any_drawable || bounds.x0 >= bounds.x1 || bounds.y0 >= bounds.y1 {
-                state = ChunkState::Culled;
-            }
+            let (bounds, state) = screen_bounds(state, nearest, any_drawable, [x0, x1, y0, y1], viewport);
             Chunk {
                 c0,
                 r0,

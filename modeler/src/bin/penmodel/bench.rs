@@ -176,6 +176,17 @@ pub fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
+/// The style the bench draws `look` in: the classic ramp topped at the bench document's 70 m.
+pub fn style(look: crate::render::LookArg) -> Style {
+    match look {
+        crate::render::LookArg::Land => Style::land(),
+        crate::render::LookArg::Classic => Style {
+            ramp_top: 70.0,
+            ..Style::default()
+        },
+    }
+}
+
 fn ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
@@ -229,13 +240,7 @@ fn measure(n: u32, look: crate::render::LookArg, lod_error: f32, bar: &ProgressB
             max: 4.0,
             label: "slope".into(),
         });
-        scene.style = match look {
-            crate::render::LookArg::Land => Style::land(),
-            crate::render::LookArg::Classic => Style {
-                ramp_top: 70.0,
-                ..Style::default()
-            },
-        };
+        scene.style = style(look);
         let t = Instant::now();
         renderer.render(&scene, &mut frame)?;
         if i >= WARM_UP {

@@ -14,7 +14,7 @@
 use std::time::Instant;
 
 use anyhow::{Context, Result};
-use penmodel_render::{Camera, Frame, Renderer, Scene, Stereo, Style};
+use penmodel_render::{Camera, Frame, Renderer, Scene, Stereo};
 use penmodel_terrain::revision::Revisions;
 use penmodel_terrain::{Editor, Heightmap};
 
@@ -83,13 +83,7 @@ pub fn measure(
         scene.revisions = Some(&history);
         scene.terrain_lod = lod_error;
         scene.stereo = if stereo { Stereo::Anaglyph } else { Stereo::None };
-        scene.style = match look {
-            crate::render::LookArg::Land => Style::land(),
-            crate::render::LookArg::Classic => Style {
-                ramp_top: 70.0,
-                ..Style::default()
-            },
-        };
+        scene.style = super::bench::style(look);
         let t = Instant::now();
         renderer.render(&scene, &mut frame)?;
         if i >= WARM_UP {
