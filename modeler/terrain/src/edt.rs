@@ -5,9 +5,11 @@
 //! every cell its vertical distance `g` to the nearest source in its column, then each row is
 //! the lower envelope of the parabolas `(x − q)² + g(q)²` over its columns q, built and read in
 //! one sweep. Both passes are linear, so a map costs O(cells of the box) whatever its distances.
-//! Intersections of parabolas are compared as exact fractions (128-bit cross products), not as
+//! Intersections of parabolas are compared as exact fractions (integer cross products), not as
 //! floating-point numbers, so the squared distances are exact integers; the distance is their
-//! square root rounded once to `f32`.
+//! square root rounded once to `f32`. The cross products fit 64 bits for boxes up to 2^20 cells a
+//! side ([`Wide`]), which is every box a usual grid has; a longer box (a grid may be 2^24 × 1)
+//! uses 128 bits. Rows are independent, so the row pass runs on all cores.
 //!
 //! `df` is the distance to the nearest cell outside the region, less one (so that a cell with a
 //! 4-neighbour outside has `df = 0`, as in the taxicab metric, where `df` is the taxicab distance
@@ -16,6 +18,10 @@
 //! the straight segment to the nearest outside cell crosses only region cells. `dp`, the distance
 //! from a figure, is the straight-line distance to its nearest cell, which in a region with a
 //! bay may cross the bay (`docs/modeler.md` says what that does).
+
+use std::ops::{Mul, Sub};
+
+use rayon::prelude::*;
 
 use crate::cells::{Cell, Mask};
 
@@ -46,23 +52,43 @@ pub fn squared(w: usize, h: usize, source: &[bool]) -> Vec<u64> {
         }
     }
     let mut out = vec![u64::MAX; w * h];
-    let mut env = Envelope::with_capacity(w);
-    for (row, dst) in g.chunks(w.max(1)).zip(out.chunks_mut(w.max(1))) {
-        env.row(row, dst);
+    if w.max(h) <= NARROW_SIDE {
+        rows::<i64>(w, &g, &mut out);
+    } else {
+        rows::<i128>(w, &g, &mut out);
     }
     out
 }
 
-/// The lower envelope of one row's parabolas: their vertices `v` (columns, increasing) and for
-/// each the fraction `z = num/den` where it starts to be the lowest.
-struct Envelope {
-    v: Vec<i64>,
-    f: Vec<i64>,
-    z: Vec<(i128, i128)>,
+/// The longest box side whose envelope fractions fit `i64`: numerators are at most
+/// `2·side²` (2^41) and denominators `2·side` (2^21), so their cross products stay below 2^62.
+const NARROW_SIDE: usize = 1 << 20;
+
+/// The row pass over `g`'s rows into `out`, rows in parallel, with fractions in `T`.
+fn rows<T: Wide>(w: usize, g: &[u32], out: &mut [u64]) {
+    let w1 = w.max(1);
+    g.par_chunks(w1)
+        .zip(out.par_chunks_mut(w1))
+        .with_min_len(16)
+        .for_each_init(|| Envelope::<T>::with_capacity(w), |env, (row, dst)| env.row(row, dst));
 }
 
-impl Envelope {
-    fn with_capacity(n: usize) -> Envelope {
+/// The integer type of the envelope's fractions: `i64` for boxes up to [`NARROW_SIDE`] a side,
+/// `i128` beyond.
+trait Wide: Copy + PartialOrd + From<i64> + Mul<Output = Self> + Sub<Output = Self> + Send {}
+impl Wide for i64 {}
+impl Wide for i128 {}
+
+/// The lower envelope of one row's parabolas: their vertices `v` (columns, increasing) and for
+/// each the fraction `z = num/den` where it starts to be the lowest.
+struct Envelope<T> {
+    v: Vec<i64>,
+    f: Vec<i64>,
+    z: Vec<(T, T)>,
+}
+
+impl<T: Wide> Envelope<T> {
+    fn with_capacity(n: usize) -> Envelope<T> {
         Envelope {
             v: Vec::with_capacity(n),
             f: Vec::with_capacity(n),
@@ -73,14 +99,14 @@ impl Envelope {
     /// Where the parabola of column `q` (height `fq`) starts to lie below the one of the last
     /// vertex `k`: `((fq + q²) − (fk + vk²)) / (2(q − vk))`, as a fraction with a positive
     /// denominator.
-    fn meet(&self, k: usize, q: i64, fq: i64) -> (i128, i128) {
+    fn meet(&self, k: usize, q: i64, fq: i64) -> (T, T) {
         let (vk, fk) = (self.v[k], self.f[k]);
-        let num = i128::from(fq + q * q) - i128::from(fk + vk * vk);
-        (num, 2 * i128::from(q - vk))
+        // Both terms fit i64 (at most 2·side² each); their difference too.
+        ((fq + q * q - (fk + vk * vk)).into(), (2 * (q - vk)).into())
     }
 
     /// `a ≤ b` for fractions with positive denominators.
-    fn at_most(a: (i128, i128), b: (i128, i128)) -> bool {
+    fn at_most(a: (T, T), b: (T, T)) -> bool {
         a.0 * b.1 <= b.0 * a.1
     }
 
@@ -113,7 +139,7 @@ impl Envelope {
                 self.v.push(q);
                 self.f.push(fq);
                 // The first vertex's stretch starts at −∞.
-                self.z.push((-1, 0));
+                self.z.push(((-1).into(), 0.into()));
             }
         }
         if self.v.is_empty() {
@@ -125,7 +151,7 @@ impl Envelope {
             // Move on while the next vertex's stretch starts at or before x (x·den ≥ num).
             while k + 1 < self.v.len() && {
                 let (num, den) = self.z[k + 1];
-                i128::from(x) * den >= num
+                T::from(x) * den >= num
             } {
                 k += 1;
             }
@@ -184,4 +210,67 @@ pub fn to_edge(mask: &Mask) -> Vec<f32> {
         }
     }
     out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The squared distances by brute force, for comparison.
+    fn brute(w: usize, h: usize, source: &[bool]) -> Vec<u64> {
+        let sources: Vec<(i64, i64)> = (0..w * h)
+            .filter(|&i| source[i])
+            .map(|i| ((i % w) as i64, (i / w) as i64))
+            .collect();
+        (0..w * h)
+            .map(|i| {
+                let (x, y) = ((i % w) as i64, (i / w) as i64);
+                sources
+                    .iter()
+                    .map(|&(sx, sy)| ((x - sx).pow(2) + (y - sy).pow(2)) as u64)
+                    .min()
+                    .unwrap_or(u64::MAX)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn both_widths_of_fraction_give_the_brute_force_distances() {
+        let (w, h) = (37, 23);
+        // A fixed scatter of sources (a multiplicative hash), some rows and columns without any.
+        let source: Vec<bool> = (0..w * h).map(|i| (i as u64 * 2_654_435_761) % 97 < 3).collect();
+        let mut g = vec![FAR; w * h];
+        let full = squared(w, h, &source);
+        assert_eq!(full, brute(w, h, &source));
+        // The row pass alone, in each width, on the same column distances.
+        for (x, y) in (0..w * h).map(|i| (i % w, i / w)) {
+            g[y * w + x] = (0..h)
+                .filter(|&r| source[r * w + x])
+                .map(|r| r.abs_diff(y) as u32)
+                .min()
+                .unwrap_or(FAR);
+        }
+        let (mut narrow, mut wide) = (vec![u64::MAX; w * h], vec![u64::MAX; w * h]);
+        rows::<i64>(w, &g, &mut narrow);
+        rows::<i128>(w, &g, &mut wide);
+        assert_eq!(narrow, full);
+        assert_eq!(wide, full);
+    }
+
+    #[test]
+    fn a_box_longer_than_the_narrow_side_takes_the_wide_fractions_and_stays_exact() {
+        let w = NARROW_SIDE + 3;
+        let mut source = vec![false; w];
+        for s in [0, 5, w / 2, w - 1] {
+            source[s] = true;
+        }
+        let got = squared(w, 1, &source);
+        for x in [1usize, 3, 6, w / 4, w / 2 + 1, w - 2] {
+            let want = [0usize, 5, w / 2, w - 1]
+                .iter()
+                .map(|&s| (x.abs_diff(s) as u64).pow(2))
+                .min();
+            assert_eq!(Some(got[x]), want, "x {x}");
+        }
+    }
 }
