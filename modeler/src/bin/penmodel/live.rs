@@ -636,7 +636,7 @@ impl Painter {
     ) -> Result<(&Frame, bool)> {
         let revisions = Some(session.editor.revisions());
         self.insets(&Picture::of(session, look), session.editor.heightmap(), revisions)?;
-        let ended = latch_head(rx, session, said);
+        let ended = latch_head(rx, session, said, Duration::from_micros(HEAD_WAIT_US));
         if let Some(t) = session.last_event_us().filter(|_| advance) {
             session.interaction.advance(t);
         }
@@ -667,9 +667,15 @@ const LATCH_MAX: Duration = Duration::from_millis(100);
 /// pose arrived and shows the newest one, not the one that happened to be in when the frame
 /// fell due (up to a head period older), nor one queued behind events that arrived while the
 /// last frame was drawn. Only for a real-time feed ([`Session::realtime`]): an unpaced
-/// simulation would be run to its end. `said` takes what the feed said. Returns whether the
-/// feed ended.
-fn latch_head(rx: &std::sync::mpsc::Receiver<Feed>, session: &mut Session, said: &mut dyn FnMut(Vec<String>)) -> bool {
+/// simulation would be run to its end. `said` takes what the feed said; `wait` bounds the wall
+/// time it waits for the next pose (a head period, [`HEAD_WAIT_US`]; the test gives a longer
+/// one, so a loaded machine's scheduling cannot fail it). Returns whether the feed ended.
+fn latch_head(
+    rx: &std::sync::mpsc::Receiver<Feed>,
+    session: &mut Session,
+    said: &mut dyn FnMut(Vec<String>),
+    wait: Duration,
+) -> bool {
     // Whether the last thing taken was a new pose: the newest, once the feed holds no more.
     let mut fresh = false;
     let started = Instant::now();
@@ -682,7 +688,7 @@ fn latch_head(rx: &std::sync::mpsc::Receiver<Feed>, session: &mut Session, said:
                 return false;
             }
             // Real time: a head period of the wall clock bounds the wait (at --speed 1 exactly).
-            Err(std::sync::mpsc::TryRecvError::Empty) => match rx.recv_timeout(Duration::from_micros(HEAD_WAIT_US)) {
+            Err(std::sync::mpsc::TryRecvError::Empty) => match rx.recv_timeout(wait) {
                 Ok(f) => f,
                 Err(RecvTimeoutError::Timeout) => return false,
                 Err(RecvTimeoutError::Disconnected) => return true,
@@ -1075,24 +1081,26 @@ mod tests {
         for f in [head(Some(110.0), 16_000), head(Some(120.0), 32_000), head(None, 40_000)] {
             tx.send(f).expect("queued");
         }
-        // The next pose comes once the queue is taken: the frame waits for it.
+        // The next pose comes once the queue is taken: the frame waits for it (up to `WAIT` of
+        // the wall clock here, far more than the sender's 5 ms, so a busy machine cannot fail it).
+        const WAIT: Duration = Duration::from_secs(1);
         let later = std::thread::spawn(move || {
             std::thread::sleep(Duration::from_millis(5));
             tx.send(head(Some(130.0), 48_000)).expect("sent");
             tx
         });
         let mut said = Vec::new();
-        assert!(!latch_head(&rx, &mut session, &mut |m| said.extend(m)));
+        assert!(!latch_head(&rx, &mut session, &mut |m| said.extend(m), WAIT));
         assert_eq!(x(&session), Some((130.0 - 300.0) * 1e-3));
         assert_eq!(session.events(), 5, "everything queued was taken");
         // Glasses that stop reporting hold a frame up no longer than a head period.
         let tx = later.join().expect("sender");
         tx.send(head(None, 60_000)).expect("queued");
-        assert!(!latch_head(&rx, &mut session, &mut |m| said.extend(m)));
+        assert!(!latch_head(&rx, &mut session, &mut |m| said.extend(m), WAIT));
         assert_eq!((x(&session), session.events()), (Some((130.0 - 300.0) * 1e-3), 6));
         // A feed that ended: said so at once.
         drop(tx);
-        assert!(latch_head(&rx, &mut session, &mut |m| said.extend(m)));
+        assert!(latch_head(&rx, &mut session, &mut |m| said.extend(m), WAIT));
     }
 
     #[test]
