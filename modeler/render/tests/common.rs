@@ -1,7 +1,32 @@
-//! What the render test modules share: a camera looking down on a grid, and a count of the
-//! pixels lit in one colour.
+//! What the render test modules share: terrains from a function, orbit cameras, and a count of
+//! the pixels lit in one colour.
 
 use penmodel_render::{Camera, Frame, Orbit, View};
+use penmodel_terrain::Heightmap;
+
+/// An `n × n` heightmap of cell size 1 with heights `f(x, y)` at the cell centres.
+pub fn terrain(n: u32, f: impl Fn(f64, f64) -> f64) -> Heightmap {
+    let heights = (0..n * n)
+        .map(|i| f(f64::from(i % n) + 0.5, f64::from(i / n) + 0.5) as f32)
+        .collect();
+    Heightmap::from_heights(n, n, 1.0, heights).unwrap()
+}
+
+/// An orbit camera (angles in degrees) with a 45° field of view.
+pub fn orbit(target: [f64; 2], azimuth: f64, elevation: f64, distance: f64) -> Camera {
+    Camera {
+        view: View::Orbit(Orbit {
+            target,
+            target_height: 0.0,
+            azimuth: azimuth.to_radians(),
+            elevation: elevation.to_radians(),
+            distance,
+            fov_y: 45f64.to_radians(),
+            separation: 1.0 / 30.0,
+        }),
+        tilt: 0.0,
+    }
+}
 
 /// An orbit camera 80° above a grid of `n` × `n` one-metre cells, looking at its middle.
 pub fn above(n: f64) -> Camera {

@@ -7,6 +7,8 @@ use penmodel_render::land::{self, Shore, material};
 use penmodel_render::{Camera, Eye, Frame, Orbit, Projection, Renderer, Scene, Style, View, Viewport};
 use penmodel_terrain::Heightmap;
 
+use crate::common::orbit;
+
 fn style() -> Style {
     Style::land()
 }
@@ -109,18 +111,7 @@ fn value_noise_is_deterministic_and_continuous() {
 
 /// A camera straight above the middle of an `n`-metre square, looking down, north up.
 fn overhead(n: f64) -> Camera {
-    Camera {
-        view: View::Orbit(Orbit {
-            target: [n / 2.0, n / 2.0],
-            target_height: 0.0,
-            azimuth: 0.0,
-            elevation: 89.9f64.to_radians(),
-            distance: n * 1.4,
-            fov_y: 45f64.to_radians(),
-            separation: 1.0 / 30.0,
-        }),
-        tilt: 0.0,
-    }
+    orbit([n / 2.0, n / 2.0], 0.0, 89.9, n * 1.4)
 }
 
 /// The pixel of ground point `(x, y)` at height `h`.

@@ -3,8 +3,10 @@
 //! crack between levels.
 
 use penmodel_render::lod::{Area, Pyramid};
-use penmodel_render::{Camera, Frame, Orbit, Renderer, Scene, Style, View};
+use penmodel_render::{Camera, Frame, Renderer, Scene, Style};
 use penmodel_terrain::Heightmap;
+
+use crate::common::{orbit, terrain};
 
 /// A rough `n × n` terrain of 1 m cells: broad hills, a ridge and fine ripples, so the pyramid's
 /// errors vary over the grid.
@@ -16,25 +18,7 @@ fn rough(n: u32) -> Heightmap {
             + 0.15 * (x * 0.9).sin() * (y * 1.3).cos()
             + 0.05 * (x * 2.7 + y * 1.9).sin()
     };
-    let heights = (0..n * n)
-        .map(|i| f(f64::from(i % n) + 0.5, f64::from(i / n) + 0.5) as f32)
-        .collect();
-    Heightmap::from_heights(n, n, 1.0, heights).unwrap()
-}
-
-fn orbit(target: [f64; 2], azimuth: f64, elevation: f64, distance: f64) -> Camera {
-    Camera {
-        view: View::Orbit(Orbit {
-            target,
-            target_height: 0.0,
-            azimuth: azimuth.to_radians(),
-            elevation: elevation.to_radians(),
-            distance,
-            fov_y: 45f64.to_radians(),
-            separation: 1.0 / 30.0,
-        }),
-        tilt: 0.0,
-    }
+    terrain(n, f)
 }
 
 /// The height at vertex `(c, r)` of the node's decimated surface, interpolated here with

@@ -9,32 +9,11 @@ use penmodel_render::{
     View, Viewport,
 };
 use penmodel_terrain::Heightmap;
+
+use crate::common::{orbit, terrain};
 use proptest::prelude::*;
 
 const MAGENTA: [u8; 4] = [255, 0, 255, 255];
-
-/// An `n × n` heightmap of cell size 1 with heights `f(x, y)` at the cell centres.
-fn terrain(n: u32, f: impl Fn(f64, f64) -> f64) -> Heightmap {
-    let heights = (0..n * n)
-        .map(|i| f(f64::from(i % n) + 0.5, f64::from(i / n) + 0.5) as f32)
-        .collect();
-    Heightmap::from_heights(n, n, 1.0, heights).unwrap()
-}
-
-fn orbit(target: [f64; 2], azimuth: f64, elevation: f64, distance: f64) -> Camera {
-    Camera {
-        view: View::Orbit(Orbit {
-            target,
-            target_height: 0.0,
-            azimuth: azimuth.to_radians(),
-            elevation: elevation.to_radians(),
-            distance,
-            fov_y: 45f64.to_radians(),
-            separation: 1.0 / 30.0,
-        }),
-        tilt: 0.0,
-    }
-}
 
 fn render(scene: &Scene, w: u32, h: u32) -> Frame {
     let mut frame = Frame::new(w, h).unwrap();
