@@ -602,6 +602,121 @@ fn the_tree_tool_plants_moves_and_sizes_trees_and_groves() {
     assert_eq!(pen.ui.tool(), Tool::Figures);
 }
 
+/// The tree tool's pull and SW3 gesture show as they go (issue 14): before the release, the held
+/// tree's height in the document and in the editor's standing forest follows the pen, with nothing
+/// journaled; the release records one edit (one journal line, one undo step). A grove's pull
+/// scales its standing trees. Losing the pen mid-pull restores the tree.
+#[test]
+fn a_tree_pull_shows_as_it_goes_and_records_one_edit() {
+    use penmodel_terrain::trees::Source;
+    // The reference display shows the 6000 m grid on 600 mm: 10 m per mm, across and up.
+    const M_PER_MM: f64 = 10.0;
+    let dir = tempfile::tempdir().expect("temporary directory");
+    let path = dir.path().join("trees.json");
+    let mut pen = Pen::new(blank());
+    pen.editor = Editor::create(&path, blank()).expect("create");
+    let lines = |path: &std::path::Path| {
+        std::fs::read_to_string(penmodel_terrain::journal::path_for(path)).map_or(0, |t| t.lines().count())
+    };
+    pen.hover(18.0, 66.0).touch().lift(HOVER);
+    pen.hover(200.0, 150.0).touch().lift(HOVER);
+    let planted = pen.doc().trees[0].clone();
+    let before = lines(&path);
+
+    pen.grab(200.0, 150.0);
+    for h_mm in [10.0, 25.0, 15.0] {
+        pen.pull_to(h_mm);
+        let shown = pen.doc().trees[0].height;
+        assert!(
+            (shown - h_mm * M_PER_MM).abs() < 0.2 * M_PER_MM,
+            "{shown} m at {h_mm} mm"
+        );
+        let standing = &pen.editor.trees().trees()[0];
+        assert_eq!(standing.source, Source::Tree(0));
+        assert_eq!(standing.height, shown, "the forest draws the height shown");
+        assert!(pen.editor.previewing());
+        assert_eq!(lines(&path), before, "nothing journaled while pulling");
+    }
+    pen.let_go();
+    let set = pen.doc().trees[0].height;
+    assert!((set - 15.0 * M_PER_MM).abs() < 0.2 * M_PER_MM, "{set} m");
+    assert!(!pen.editor.previewing());
+    assert_eq!(lines(&path), before + 1, "one journal entry");
+    assert_eq!(pen.ui.stats().pulls, 1);
+    // One undo step: it returns to the planted tree, the next undoes the planting.
+    pen.editor.undo().expect("undo");
+    assert_eq!(pen.doc().trees[0], planted);
+    pen.editor.undo().expect("undo");
+    assert!(pen.doc().trees.is_empty());
+    pen.editor.redo().expect("redo");
+    pen.editor.redo().expect("redo");
+    assert_eq!(pen.doc().trees[0].height, set);
+
+    // SW3 and 20 mm right: the height × e^(0.02 × 20) shows before SW3 is released, then is set.
+    let before = lines(&path);
+    pen.grab(200.0, 150.0);
+    pen.set(2, true).set(0, false);
+    let to = pen.at + DVec3::new(20.0, 0.0, 0.0);
+    pen.move_to(to);
+    let k = (0.02f64 * 20.0).exp();
+    assert!((pen.doc().trees[0].height / set - k).abs() < 0.01, "shown while held");
+    assert!((pen.editor.trees().trees()[0].height / set - k).abs() < 0.01);
+    assert_eq!(lines(&path), before);
+    pen.set(2, false).let_go();
+    assert!((pen.doc().trees[0].height / set - k).abs() < 0.01);
+    assert_eq!(lines(&path), before + 1, "one journal entry");
+    pen.editor.undo().expect("undo");
+    assert_eq!(pen.doc().trees[0].height, set);
+
+    // A grove's pull: its standing trees are scattered again at the height shown, 0.8 to 1.2 of it.
+    let outline = [
+        (300.0, 100.0),
+        (420.0, 100.0),
+        (420.0, 200.0),
+        (300.0, 200.0),
+        (300.0, 100.0),
+    ];
+    pen.hover(outline[0].0, outline[0].1).touch();
+    for &(u, v) in &outline[1..] {
+        pen.drag_to(u, v);
+    }
+    pen.lift(HOVER);
+    assert_eq!(pen.doc().groves.len(), 1, "{:?}", pen.ui.take_messages());
+    pen.grab(360.0, 150.0).pull_to(30.0);
+    let mean = pen.doc().groves[0].height;
+    assert!((mean - 30.0 * M_PER_MM).abs() < 0.2 * M_PER_MM, "{mean} m");
+    let grove: Vec<f64> = pen
+        .editor
+        .trees()
+        .trees()
+        .iter()
+        .filter(|t| matches!(t.source, Source::Grove(0, _)))
+        .map(|t| t.height)
+        .collect();
+    assert!(!grove.is_empty());
+    assert!(
+        grove
+            .iter()
+            .all(|h| (0.8 * mean - 1e-9..=1.2 * mean + 1e-9).contains(h)),
+        "{grove:?}"
+    );
+    pen.let_go();
+    assert!(!pen.editor.previewing());
+
+    // Lost mid-pull: the tree is as it was before the grab.
+    let doc = pen.doc().clone();
+    pen.grab(200.0, 150.0).pull_to(40.0);
+    assert_ne!(pen.doc(), &doc, "the pull shows");
+    let mut out = Vec::new();
+    pen.detector.on_device_lost(pen.t_us, "unplugged", &mut out);
+    for ev in &out {
+        pen.ui.handle(&mut pen.editor, ev);
+    }
+    assert_eq!(pen.doc(), &doc);
+    assert_eq!(pen.editor.trees().trees()[0].height, doc.trees[0].height);
+    assert!(!pen.editor.previewing());
+}
+
 /// The river tool (issue 13): the river button picks it; a stroke becomes a river fitted to
 /// Bézier segments; an SW3 click over it adds a year; SW2 on a control point reshapes it, with
 /// the next year's erosion and deposition previewed; SW2 + SW3 sideways widens it.

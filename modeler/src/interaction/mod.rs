@@ -826,6 +826,7 @@ impl Interaction {
                     grab.moving = true;
                     grab.by = minus(g, self.view.to_ground(grab.at_mm[0], grab.at_mm[1]));
                 }
+                self.show_tree(editor);
             }
             State::Idle | State::Armed => {
                 self.hover = pick::pick(editor.document(), g, self.view.metres(s.pick_mm));
@@ -1125,6 +1126,7 @@ impl Interaction {
             State::Tree(grab) if !grab.tuned && grab.tuning.is_none() => {
                 let h = self.pen.map_or(0.0, |p| p.h_mm.max(0.0));
                 grab.pull = Some(trees::clamp_height(self.view.height_at(h)));
+                self.show_tree(editor);
             }
             State::Drawing { positions, touching } => {
                 *touching = false;
@@ -1300,8 +1302,10 @@ impl Interaction {
                 if let Some(p) = self.pen
                     && !grab.moving
                     && grab.pull.is_none()
+                    && let Some(size) = trees::size_of(editor.document(), grab.held)
                 {
                     grab.tuning = Some((p.u_mm, 1.0));
+                    grab.tuned_from = size;
                     grab.tuned = true;
                 }
             }
@@ -1340,27 +1344,18 @@ impl Interaction {
                 }
             }
             State::Tree(grab) => {
-                let Some((_, k)) = grab.tuning.take() else { return };
+                let Some((_, k)) = grab.tuning else { return };
                 let held = grab.held;
-                let doc = editor.document();
-                let edit = match held {
-                    trees::Held::Tree(index) => doc.trees.get(index).map(|t| Edit::ReplaceTree {
-                        index,
-                        tree: trees::with_height(t, t.height * k),
-                    }),
-                    trees::Held::Grove(index) => doc.groves.get(index).map(|g| Edit::ReplaceGrove {
-                        index,
-                        grove: trees::denser(g, k),
-                    }),
-                };
-                let Some(edit) = edit else { return };
                 let what = if matches!(held, trees::Held::Tree(_)) {
                     "height"
                 } else {
                     "density"
                 };
-                if self.commit(editor, edit, &format!("the {what} of {}", held.name())) {
+                if self.commit_tree(editor, &format!("the {what} of {}", held.name())) {
                     self.say(format!("{}: {what} ×{k:.2}", held.name()));
+                }
+                if let State::Tree(grab) = &mut self.state {
+                    grab.tuning = None;
                 }
             }
             State::River(grab) => {
@@ -1419,6 +1414,9 @@ impl Interaction {
             }
             State::Tree(g) => {
                 let name = g.held.name();
+                if let Err(e) = editor.cancel_preview() {
+                    self.say(format!("cannot restore {name}: {e}"));
+                }
                 self.say(format!("pen lost ({reason}): {name} stays as it was"));
                 self.state = State::Idle;
             }
@@ -1714,38 +1712,49 @@ impl Interaction {
         }
     }
 
-    /// Sets the held tree or grove: where the pen slid it, or the height it pulled to.
+    /// Sets the held tree or grove: where the pen slid it, or the height it pulled to (or the
+    /// SW3 gesture's size, when SW2 is released first), shown since the pull began.
     fn drop_tree(&mut self, editor: &mut Editor) {
         let State::Tree(grab) = &self.state else { return };
         let (held, by) = (grab.held, grab.by);
-        let doc = editor.document();
-        let edit = match (grab.moving, grab.pull, held) {
-            (true, _, _) if by == [0.0, 0.0] => return,
-            (true, _, trees::Held::Tree(index)) => Edit::MoveTree { index, by },
-            (true, _, trees::Held::Grove(index)) => Edit::MoveGrove { index, by },
-            (false, Some(h), trees::Held::Tree(index)) => {
-                let Some(t) = doc.trees.get(index) else { return };
-                Edit::ReplaceTree {
-                    index,
-                    tree: trees::with_height(t, h),
-                }
-            }
-            (false, Some(h), trees::Held::Grove(index)) => {
-                let Some(g) = doc.groves.get(index) else { return };
-                Edit::ReplaceGrove {
-                    index,
-                    grove: trees::grove_with_height(g, h),
-                }
-            }
-            (false, None, _) => return,
-        };
-        let moved = matches!(edit, Edit::MoveTree { .. } | Edit::MoveGrove { .. });
-        let what = if moved { "moving" } else { "the height of" };
-        if self.commit(editor, edit, &format!("{what} {}", held.name())) {
-            if moved {
-                self.stats.moves += 1;
-            } else {
+        if !grab.moving {
+            let pulled = grab.tuning.is_none() && grab.pull.is_some();
+            if self.commit_tree(editor, &format!("the height of {}", held.name())) && pulled {
                 self.stats.pulls += 1;
+            }
+            return;
+        }
+        let edit = match held {
+            _ if by == [0.0, 0.0] => return,
+            trees::Held::Tree(index) => Edit::MoveTree { index, by },
+            trees::Held::Grove(index) => Edit::MoveGrove { index, by },
+        };
+        if self.commit(editor, edit, &format!("moving {}", held.name())) {
+            self.stats.moves += 1;
+        }
+    }
+
+    /// Shows the held tree or grove as the pen sizes it (the pull, the SW3 gesture) at once,
+    /// unrecorded: the forest and the frames follow it before the release records it.
+    fn show_tree(&mut self, editor: &mut Editor) {
+        let State::Tree(grab) = &self.state else { return };
+        let Some(edit) = trees::sized(editor.document(), grab) else {
+            return;
+        };
+        if let Err(e) = editor.preview_tree(&edit) {
+            self.stats.refused += 1;
+            self.say(format!("cannot show {}: {e}", grab.held.name()));
+        }
+    }
+
+    /// Records the tree preview shown as one edit; whether there was one and it was recorded.
+    fn commit_tree(&mut self, editor: &mut Editor, what: &str) -> bool {
+        match editor.commit_tree_preview() {
+            Ok(edit) => edit.is_some(),
+            Err(e) => {
+                self.stats.refused += 1;
+                self.say(format!("{what} refused: {e}"));
+                false
             }
         }
     }

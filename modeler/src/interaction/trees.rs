@@ -16,10 +16,14 @@
 //!   under the tip; sliding carries it and lifting the tip (or releasing SW2) drops it there.
 //! - **Height**: with it held, lift the tip: the pull, as a figure's — the top follows the pen's
 //!   height (× the view's vertical scale); releasing SW2 sets it. Or hold SW3 and move sideways:
-//!   the height × e^(k·du) (right taller), k = [`GAIN_PER_MM`] per mm.
+//!   the height × e^(k·du) (right taller), k = [`GAIN_PER_MM`] per mm; releasing SW3 sets it.
+//!   A held grove's pull sets its mean height.
 //! - **Density**: a grove held, SW3 and sideways: its density × e^(k·du) (right denser).
 //!
-//! Every change is one editor edit (undo, journal); new trees sway in [`breeze`].
+//! The pull and the SW3 gesture show as they go: each pen move previews the held element as
+//! [`sized`] makes it ([`penmodel_terrain::Editor::preview_tree`]), so the tree grows in the
+//! frames and a grove is scattered again; the release records it as one edit, losing the pen
+//! restores it. Every change is one editor edit (undo, journal); new trees sway in [`breeze`].
 
 use penmodel_terrain::document::{Document, Grove, GroveSpecies, Point, Sway, Tree, Wind};
 use penmodel_terrain::geometry::{Side, locate};
@@ -166,6 +170,9 @@ pub struct TreeGrab {
     pub pull: Option<f64>,
     /// The sideways SW3 gesture: the pen's `u` when SW3 went down, and the factor.
     pub tuning: Option<(f64, f64)>,
+    /// The held tree's height (a grove's density) when the SW3 gesture began: what the factor
+    /// multiplies while the document shows the gesture's preview.
+    pub tuned_from: f64,
     /// Whether this grab has tuned it: it then neither moves nor pulls.
     pub tuned: bool,
 }
@@ -180,6 +187,7 @@ impl TreeGrab {
             moving: false,
             pull: None,
             tuning: None,
+            tuned_from: 0.0,
             tuned: false,
         }
     }
@@ -201,10 +209,40 @@ pub fn grove_with_height(grove: &Grove, height: f64) -> Grove {
     }
 }
 
-/// Grove `grove` with its density × `factor`.
-pub fn denser(grove: &Grove, factor: f64) -> Grove {
-    Grove {
-        density: grove.density * factor,
-        ..grove.clone()
+/// The edit that shows `held` in `doc` as `grab` makes it: the pulled height, or the SW3
+/// gesture's height (a grove's density) × its factor; `None` while it neither pulls nor tunes,
+/// or when `held` is not in `doc`. The editor previews it at each pen move
+/// ([`penmodel_terrain::Editor::preview_tree`]) and records it on release.
+pub fn sized(doc: &Document, grab: &TreeGrab) -> Option<penmodel_terrain::Edit> {
+    use penmodel_terrain::Edit;
+    match (grab.held, grab.tuning, grab.pull) {
+        (Held::Tree(index), Some((_, k)), _) => doc.trees.get(index).map(|t| Edit::ReplaceTree {
+            index,
+            tree: with_height(t, grab.tuned_from * k),
+        }),
+        (Held::Grove(index), Some((_, k)), _) => doc.groves.get(index).map(|g| Edit::ReplaceGrove {
+            index,
+            grove: Grove {
+                density: grab.tuned_from * k,
+                ..g.clone()
+            },
+        }),
+        (Held::Tree(index), None, Some(h)) => doc.trees.get(index).map(|t| Edit::ReplaceTree {
+            index,
+            tree: with_height(t, h),
+        }),
+        (Held::Grove(index), None, Some(h)) => doc.groves.get(index).map(|g| Edit::ReplaceGrove {
+            index,
+            grove: grove_with_height(g, h),
+        }),
+        (_, None, None) => None,
+    }
+}
+
+/// The held element's size the SW3 gesture multiplies: a tree's height, a grove's density.
+pub fn size_of(doc: &Document, held: Held) -> Option<f64> {
+    match held {
+        Held::Tree(i) => doc.trees.get(i).map(|t| t.height),
+        Held::Grove(i) => doc.groves.get(i).map(|g| g.density),
     }
 }

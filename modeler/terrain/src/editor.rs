@@ -143,6 +143,9 @@ pub struct Editor {
     preview: Option<Preview>,
     /// The `ridges` entry from before an unrecorded ridge preview ([`Editor::preview_ridges`]).
     ridge_preview: Option<Option<crate::document::Ridges>>,
+    /// The edit restoring a tree or grove from before an unrecorded preview
+    /// ([`Editor::preview_tree`]).
+    tree_preview: Option<Edit>,
     /// The rock fields standing on the terrain, following every change.
     rocks: Seated,
     /// The trees and groves standing on the terrain, following every change.
@@ -187,6 +190,15 @@ fn preview_target(edit: &Edit) -> Option<(FigurePath, Property, f64)> {
     }
 }
 
+/// What a tree preview replaces: `(is a grove, index)`.
+fn tree_target(edit: &Edit) -> Option<(bool, usize)> {
+    match edit {
+        Edit::ReplaceTree { index, .. } => Some((false, *index)),
+        Edit::ReplaceGrove { index, .. } => Some((true, *index)),
+        _ => None,
+    }
+}
+
 fn set(at: FigurePath, property: Property, value: f64) -> Edit {
     match property {
         Property::Height => Edit::SetHeight { at, height: value },
@@ -208,6 +220,7 @@ impl Editor {
             store: None,
             preview: None,
             ridge_preview: None,
+            tree_preview: None,
             revisions: Revisions::new(),
         })
     }
@@ -407,7 +420,7 @@ impl Editor {
 
     /// Applies `edit`, journals it and makes it undoable.
     pub fn apply(&mut self, edit: Edit) -> Result<Outcome, EditorError> {
-        if self.ridge_preview.is_some() {
+        if self.ridge_preview.is_some() || self.tree_preview.is_some() {
             self.cancel_preview()?;
         }
         // Committing the previewed property: undo returns to the value before the preview.
@@ -525,7 +538,7 @@ impl Editor {
     /// first restores them.
     pub fn preview(&mut self, edit: &Edit) -> Result<Outcome, EditorError> {
         let (at, property, _) = preview_target(edit).ok_or(EditorError::NotPreviewable)?;
-        if self.ridge_preview.is_some() {
+        if self.ridge_preview.is_some() || self.tree_preview.is_some() {
             self.cancel_preview()?;
         }
         if self.preview.as_ref().is_some_and(|p| p.at != at) {
@@ -552,7 +565,7 @@ impl Editor {
 
     /// Whether a preview is showing.
     pub fn previewing(&self) -> bool {
-        self.preview.is_some() || self.ridge_preview.is_some()
+        self.preview.is_some() || self.ridge_preview.is_some() || self.tree_preview.is_some()
     }
 
     /// Shows `ridges` as the `ridges` entry at once without recording it: the frames of a
@@ -561,7 +574,7 @@ impl Editor {
     /// undo returns to the entry from before the preview; any other operation, or
     /// [`Editor::cancel_preview`], first restores it.
     pub fn preview_ridges(&mut self, ridges: Option<crate::document::Ridges>) -> Result<Outcome, EditorError> {
-        if self.preview.is_some() {
+        if self.preview.is_some() || self.tree_preview.is_some() {
             self.cancel_preview()?;
         }
         let outcome = self.change(&Edit::SetRidges { ridges })?;
@@ -584,6 +597,50 @@ impl Editor {
             ridges: self.doc.ridges.clone(),
         };
         let inverse = Edit::SetRidges { ridges: old };
+        self.record_previewed(edit, inverse).map(Some)
+    }
+
+    /// Shows a `replace_tree` or `replace_grove` at once without recording it: the frames of a
+    /// tree's pull or a grove's resize with the pen, the forest following each one.
+    /// [`Editor::commit_tree_preview`] records what is shown as one step whose undo returns to
+    /// the element from before the preview; a preview of another element, any other operation,
+    /// or [`Editor::cancel_preview`], first restores it.
+    pub fn preview_tree(&mut self, edit: &Edit) -> Result<Outcome, EditorError> {
+        let target = tree_target(edit).ok_or(EditorError::NotPreviewable)?;
+        let other = self
+            .tree_preview
+            .as_ref()
+            .is_some_and(|old| tree_target(old) != Some(target));
+        if self.preview.is_some() || self.ridge_preview.is_some() || other {
+            self.cancel_preview()?;
+        }
+        let outcome = self.change(edit)?;
+        if self.tree_preview.is_none() {
+            self.tree_preview = Some(outcome.inverse.clone());
+        }
+        Ok(outcome)
+    }
+
+    /// Records the previewed tree or grove as one undoable `replace_tree` or `replace_grove`
+    /// step and returns it; `None` when no tree preview is showing. If the journal cannot be
+    /// written, the preview is undone and the error returned.
+    pub fn commit_tree_preview(&mut self) -> Result<Option<Edit>, EditorError> {
+        let Some(inverse) = self.tree_preview.take() else {
+            return Ok(None);
+        };
+        let edit = match tree_target(&inverse) {
+            Some((false, index)) => self
+                .doc
+                .trees
+                .get(index)
+                .map(|t| Edit::ReplaceTree { index, tree: t.clone() }),
+            Some((true, index)) => self.doc.groves.get(index).map(|g| Edit::ReplaceGrove {
+                index,
+                grove: g.clone(),
+            }),
+            None => None,
+        };
+        let Some(edit) = edit else { return Ok(None) };
         self.record_previewed(edit, inverse).map(Some)
     }
 
@@ -629,6 +686,9 @@ impl Editor {
 
     /// Restores the values from before an unrecorded preview; `None` when there is none.
     pub fn cancel_preview(&mut self) -> Result<Option<Outcome>, EditorError> {
+        if let Some(restore) = self.tree_preview.take() {
+            return Ok(Some(self.change(&restore)?));
+        }
         if let Some(old) = self.ridge_preview.take() {
             return Ok(Some(self.change(&Edit::SetRidges { ridges: old })?));
         }
