@@ -15,16 +15,22 @@
 //!   silhouettes (128 px) of each preset nudged by 1.5 fit steps per parameter with 2 % of the
 //!   pixels flipped — the correlations it starts from and reaches in 30 steps, and its time.
 //!
+//! - `follow/<n>/512/{all,local}`: the editor's forest brought up to date after a change of the
+//!   terrain on 512² cells of 2 m, with `n` trees (30 single ones; or with a grove of about
+//!   5,000 more): `all` stands every tree again (what every edit did before the forest kept its
+//!   trees in squares of the ground, with that index built), `local` only those over a change of
+//!   64 × 64 cells ([`Forest::follow`] given the engine's changed rectangle).
+//!
 //! Run: `cargo bench -p penmodel-terrain --bench trees` (filter with e.g. `-- draw`).
 
 use std::hint::black_box;
 
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::DAffine3;
-use penmodel_terrain::document::{Grove, GroveSpecies, Sway, Wind};
+use penmodel_terrain::document::{Document, Grid, Grove, GroveSpecies, Sway, Tree, Wind};
 use penmodel_terrain::trees::nodes::STOP;
 use penmodel_terrain::trees::silhouette::{self, View};
-use penmodel_terrain::trees::{Drawn, NodeTree, Preset, Species, fit, grove, wind};
+use penmodel_terrain::trees::{Drawn, Forest, NodeTree, Preset, Species, fit, grove, wind};
 
 fn clear(d: &mut Drawn) {
     d.mesh.positions.clear();
@@ -143,5 +149,70 @@ fn trees(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, trees);
+/// 30 trees spread over a 512² grid of 2 m cells, and with `grove` a grove of about 5,000 trees
+/// (a circle of 282 m at 200 trees per hectare) in the middle.
+fn forest_scene(grove: bool) -> (Document, penmodel_terrain::Heightmap) {
+    let n = 512u32;
+    let mut doc = Document::new(Grid {
+        cols: n,
+        rows: n,
+        cell_size: 2.0,
+    });
+    doc.trees = (0..30u32)
+        .map(|k| Tree {
+            at: [
+                20.0 + 984.0 * f64::from(k % 6) / 5.0,
+                20.0 + 984.0 * f64::from(k / 6) / 4.0,
+            ],
+            height: 12.0,
+            preset: Some(Preset::ALL[k as usize % Preset::ALL.len()].name().to_owned()),
+            maps: None,
+            seed: u64::from(k),
+            wind: None,
+        })
+        .collect();
+    if grove {
+        let region: Vec<[f64; 2]> = (0..=96)
+            .map(|k| {
+                let a = std::f64::consts::TAU * f64::from(k % 96) / 96.0;
+                [512.0 + 282.0 * a.cos(), 512.0 + 282.0 * a.sin()]
+            })
+            .collect();
+        doc.groves.push(Grove {
+            region,
+            density: 200.0,
+            mix: vec![GroveSpecies {
+                preset: "oak".into(),
+                weight: 1.0,
+            }],
+            height: 10.0,
+            seed: 2,
+            wind: None,
+        });
+    }
+    let hill = |x: f64, y: f64| (20.0 * (x / 37.0).sin() * (y / 53.0).cos()) as f32;
+    let heights = (0..n * n).map(|i| hill(f64::from(i % n), f64::from(i / n))).collect();
+    let map = penmodel_terrain::Heightmap::from_heights(n, n, 2.0, heights).expect("a 512² map");
+    (doc, map)
+}
+
+fn follow(c: &mut Criterion) {
+    let mut g = c.benchmark_group("trees");
+    for with_grove in [false, true] {
+        let (doc, map) = forest_scene(with_grove);
+        let mut forest = Forest::of(&doc, &map);
+        let n = forest.trees().len();
+        println!("follow: {n} trees");
+        g.bench_function(format!("follow/{n}/512/all"), |b| {
+            b.iter(|| forest.follow(black_box(&doc), &map, None))
+        });
+        // A change of 64 × 64 cells in the grove's quarter.
+        g.bench_function(format!("follow/{n}/512/local"), |b| {
+            b.iter(|| forest.follow(black_box(&doc), &map, Some((200, 200, 64, 64))))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, trees, follow);
 criterion_main!(benches);

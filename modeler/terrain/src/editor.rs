@@ -362,7 +362,7 @@ impl Editor {
         self.revisions.record(changed);
         let cells = (changed.c0, changed.r0, changed.width, changed.height);
         self.rocks.follow(&self.doc, self.terrain.heightmap(), Some(cells));
-        self.trees.follow(&self.doc, self.terrain.heightmap());
+        self.trees.follow(&self.doc, self.terrain.heightmap(), Some(cells));
         Ok(Outcome {
             inverse: applied.inverse,
             changed,

@@ -48,6 +48,26 @@ impl Heightmap {
         self.cell_size
     }
 
+    /// The ground a change of cells `(c0, r0, width, height)` covers, metres `[x0, y0, x1, y1]`:
+    /// the cells' extent, without end where it reaches the grid's edge (the terrain's surface is
+    /// held at the outer cells' heights beyond it, so a change there reaches out without end).
+    /// What reads the heights around a point still has to widen it by a cell.
+    pub fn extent_of(&self, (c0, r0, w, h): (u32, u32, u32, u32)) -> [f64; 4] {
+        let s = self.cell_size;
+        let end = |first: u32, n: u32, all: u32, lower: bool| match (lower, first, first + n >= all) {
+            (true, 0, _) => f64::NEG_INFINITY,
+            (true, f, _) => f64::from(f) * s,
+            (false, _, true) => f64::INFINITY,
+            (false, f, false) => f64::from(f + n) * s,
+        };
+        [
+            end(c0, w, self.cols, true),
+            end(r0, h, self.rows, true),
+            end(c0, w, self.cols, false),
+            end(r0, h, self.rows, false),
+        ]
+    }
+
     /// The height of cell `(c, r)`.
     ///
     /// # Panics

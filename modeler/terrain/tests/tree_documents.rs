@@ -326,3 +326,163 @@ fn a_large_weighted_mix_draws_presets_by_weight() {
     // Weights 2 : 1 (found 0.667); a binomial share of ~900 trees is within 0.06 of 2/3 at 3 sigma.
     assert!((share - 2.0 / 3.0).abs() < 0.06, "{share} of {}", trees.len());
 }
+
+/// Whether two forests stand the same trees, bit for bit (the species' node trees by their
+/// height and size: each forest builds its own).
+fn same_forest(a: &penmodel_terrain::trees::Forest, b: &penmodel_terrain::trees::Forest) -> Result<(), String> {
+    let (a, b) = (a.trees(), b.trees());
+    if a.len() != b.len() {
+        return Err(format!("{} trees against {}", a.len(), b.len()));
+    }
+    for (k, (s, t)) in a.iter().zip(b).enumerate() {
+        let key = |x: &penmodel_terrain::trees::Standing| {
+            (
+                x.source,
+                x.at.map(f64::to_bits),
+                x.base.to_bits(),
+                x.height.to_bits(),
+                x.turn.to_bits(),
+                x.nodes.height.to_bits(),
+                x.nodes.nodes.len(),
+                x.wind.as_deref().cloned(),
+            )
+        };
+        if key(s) != key(t) {
+            return Err(format!("tree {k}: {:?} against {:?}", key(s), key(t)));
+        }
+    }
+    Ok(())
+}
+
+/// Trees over a whole 128² grid: single trees (some at its edges) and a grove.
+fn forest_doc() -> Document {
+    let mut d = doc();
+    let mut state = 12345u64;
+    let mut next = || {
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (state >> 11) as f64 / (1u64 << 53) as f64
+    };
+    d.trees = (0..60)
+        .map(|_| tree([0.5 + 127.0 * next(), 0.5 + 127.0 * next()]))
+        .collect();
+    d.trees
+        .extend([tree([0.1, 0.1]), tree([127.9, 64.0]), tree([64.0, 127.9])]);
+    d.groves = vec![a_grove()];
+    d
+}
+
+/// A change of the terrain in a rectangle re-stands only the trees over it (found through the
+/// forest's squares of the ground), and the forest is what standing every tree afresh on the
+/// changed terrain gives, bit for bit; a rectangle that misses the change leaves it stale.
+#[test]
+fn a_local_change_of_the_terrain_restands_the_trees_over_it_as_a_whole_forest_would() {
+    use penmodel_terrain::Heightmap;
+    use penmodel_terrain::trees::Forest;
+    let n = 128u32;
+    let d = forest_doc();
+    let hill = |x: f64, y: f64| (5.0 * (x / 17.0).sin() * (y / 23.0).cos()) as f32;
+    let heights: Vec<f32> = (0..n * n).map(|i| hill(f64::from(i % n), f64::from(i / n))).collect();
+    let map = Heightmap::from_heights(n, n, 1.0, heights.clone()).expect("heights");
+    // Raised: cells 50..85 × 60..100 (the grove's west side and single trees) and, at the grid's
+    // corner, 0..3 × 0..3 (the ground beyond the edge is held at them: a tree outside still reads
+    // them).
+    let mut raised = heights;
+    let cells = [(50u32, 60u32, 35u32, 40u32), (0, 0, 3, 3)];
+    for &(c0, r0, w, h) in &cells {
+        for r in r0..r0 + h {
+            for c in c0..c0 + w {
+                raised[(r * n + c) as usize] += 3.0;
+            }
+        }
+    }
+    let changed = Heightmap::from_heights(n, n, 1.0, raised).expect("heights");
+    let fresh = Forest::of(&d, &changed);
+    let before = Forest::of(&d, &map);
+    let moved = fresh
+        .trees()
+        .iter()
+        .zip(before.trees())
+        .filter(|(a, b)| a.base != b.base)
+        .count();
+    assert!(moved > 10, "the change moves {moved} trees");
+    let mut forest = before.clone();
+    for &rect in &cells {
+        forest.follow(&d, &changed, Some(rect));
+    }
+    same_forest(&forest, &fresh).expect("the same as standing afresh");
+    // A rectangle elsewhere: the trees over the change keep their old bases.
+    let mut stale = before.clone();
+    stale.follow(&d, &changed, Some((100, 10, 8, 8)));
+    assert!(
+        same_forest(&stale, &fresh).is_err(),
+        "the trees over the change were skipped"
+    );
+    // A tree of the document moved: it alone is stood again, where it went.
+    let mut d2 = d.clone();
+    d2.trees[3].at = [20.5, 110.5];
+    d2.trees[4].height = 30.0;
+    forest.follow(&d2, &changed, Some((0, 0, 0, 0)));
+    same_forest(&forest, &Forest::of(&d2, &changed)).expect("a changed tree stood again");
+    // And the terrain changed under where it went: it is found in its new square.
+    let mut raised2: Vec<f32> = changed.heights().to_vec();
+    raised2[(110 * n + 20) as usize] -= 2.0;
+    let changed2 = Heightmap::from_heights(n, n, 1.0, raised2).expect("heights");
+    forest.follow(&d2, &changed2, Some((20, 110, 1, 1)));
+    same_forest(&forest, &Forest::of(&d2, &changed2)).expect("found where it went");
+}
+
+/// Random edits through the editor (figures' heights that change the terrain locally, trees
+/// moved, resized, added and removed, a grove changed, undo): after each, the editor's forest is
+/// a fresh one on its terrain, bit for bit.
+#[test]
+fn the_editors_forest_follows_random_edits_as_a_fresh_one() {
+    use penmodel_terrain::trees::Forest;
+    use rand::{RngExt, SeedableRng};
+    let mut d = forest_doc();
+    d.regions[0].figures.extend([
+        point([30.0, 40.0], 8.0, 0.0),
+        point([90.0, 30.0], -6.0, 0.0),
+        point([40.0, 95.0], 12.0, 0.0),
+    ]);
+    let mut ed = Editor::new(d).expect("valid");
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+    for step in 0..40 {
+        let doc = ed.document();
+        let edit = match rng.random_range(0..6) {
+            0 | 1 => Edit::SetHeight {
+                at: FigurePath::new(0, rng.random_range(0..doc.regions[0].figures.len())),
+                height: rng.random_range(-20.0..40.0),
+            },
+            2 => Edit::MoveTree {
+                index: rng.random_range(0..doc.trees.len()),
+                by: [rng.random_range(-5.0..5.0), rng.random_range(-5.0..5.0)],
+            },
+            3 => {
+                let index = rng.random_range(0..doc.trees.len());
+                let mut tree = doc.trees[index].clone();
+                tree.height = rng.random_range(2.0..30.0);
+                Edit::ReplaceTree { index, tree }
+            }
+            4 => Edit::AddTree {
+                index: rng.random_range(0..=doc.trees.len()),
+                tree: tree([rng.random_range(5.0..120.0), rng.random_range(5.0..120.0)]),
+            },
+            _ => {
+                let mut grove = doc.groves[0].clone();
+                grove.height = rng.random_range(5.0..15.0);
+                Edit::ReplaceGrove { index: 0, grove }
+            }
+        };
+        if ed.apply(edit.clone()).is_err() {
+            // Refused (a tree moved off the grid): nothing changed.
+            continue;
+        }
+        if step % 7 == 6 {
+            ed.undo().expect("undo");
+        }
+        same_forest(ed.trees(), &Forest::of(ed.document(), ed.heightmap()))
+            .unwrap_or_else(|e| panic!("step {step} ({edit:?}): {e}"));
+    }
+}

@@ -209,20 +209,7 @@ impl Seated {
                 // Only the rocks over the changed cells, when only the terrain changed.
                 // Beyond the grid's edge the ground is held at the outer cells' heights: a change
                 // there reaches out without end.
-                let within = changed.filter(|_| same_rocks).map(|(c0, r0, w, h)| {
-                    let end = |first: u32, n: u32, all: u32, lower: bool| match (lower, first, first + n >= all) {
-                        (true, 0, _) => f64::NEG_INFINITY,
-                        (true, f, _) => f64::from(f) * s,
-                        (false, _, true) => f64::INFINITY,
-                        (false, f, false) => f64::from(f + n) * s,
-                    };
-                    [
-                        end(c0, w, map.cols(), true),
-                        end(r0, h, map.rows(), true),
-                        end(c0, w, map.cols(), false),
-                        end(r0, h, map.rows(), false),
-                    ]
-                });
+                let within = changed.filter(|_| same_rocks).map(|cells| map.extent_of(cells));
                 f.flat
                     .seat_on_within(placements[i], map, &mut self.samples[i], mesh, within);
                 self.seated_as[i] = Some((Arc::clone(&f.flat), placements[i]));

@@ -41,8 +41,8 @@ pub struct Standing {
     pub turn: f64,
     /// Its species' full tree (shared).
     pub nodes: Arc<NodeTree>,
-    /// Its sway, if any.
-    pub wind: Option<Wind>,
+    /// Its sway, if any (shared by a grove's trees).
+    pub wind: Option<Arc<Wind>>,
 }
 
 impl Standing {
@@ -55,7 +55,7 @@ impl Standing {
 
     /// Draws the tree at roughness `q` and time `t` seconds (the sway's), appending to `out`.
     pub fn draw(&self, q: f64, t: f64, out: &mut Drawn) {
-        let pose = self.wind.as_ref().map(|w| wind::pose(w, t));
+        let pose = self.wind.as_deref().map(|w| wind::pose(w, t));
         self.nodes.draw(q, &self.place(), pose.as_ref(), out);
     }
 }
@@ -68,6 +68,27 @@ pub fn turn(seed: u64) -> f64 {
     z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
     z ^= z >> 31;
     (z >> 11) as f64 / (1u64 << 53) as f64 * std::f64::consts::TAU
+}
+
+/// A tree standing at `at` on `ground`.
+fn stand(
+    source: Source,
+    at: Point,
+    ground: &crate::rocks::place::Ground<'_>,
+    height: f64,
+    seed: u64,
+    nodes: Arc<NodeTree>,
+    wind: Option<Arc<Wind>>,
+) -> Standing {
+    Standing {
+        source,
+        at,
+        base: ground.height(at[0], at[1]),
+        height,
+        turn: turn(seed),
+        nodes,
+        wind,
+    }
 }
 
 impl Species {
@@ -90,9 +111,23 @@ impl Species {
 #[derive(Debug, Clone, Default)]
 pub struct Forest {
     species: Vec<(Vec<IfsMap>, Arc<NodeTree>)>,
-    groves: Vec<(Grove, Arc<Vec<GroveTree>>)>,
+    groves: Vec<Scattered>,
+    /// The document's own trees as they were stood.
+    planted: Vec<Tree>,
     /// Shared with the pictures drawn from it, so that a frame takes them without a copy.
     trees: Arc<Vec<Standing>>,
+    /// The standing trees by square of the ground: a change of the terrain finds those over it.
+    index: Buckets,
+    /// The grid they stand on: columns, rows, cell size's bits.
+    grid: Option<(u32, u32, u64)>,
+}
+
+/// A grove as its trees were scattered, and its wind, shared by them.
+#[derive(Debug, Clone)]
+struct Scattered {
+    grove: Grove,
+    trees: Arc<Vec<GroveTree>>,
+    wind: Option<Arc<Wind>>,
 }
 
 /// The node tree of `species` from `built`, building and keeping it the first time.
@@ -105,11 +140,77 @@ fn nodes_of(built: &mut Vec<(Vec<IfsMap>, Arc<NodeTree>)>, species: &Species) ->
     n
 }
 
+/// Terrain cells per side of a [`Buckets`] square: a local change of the terrain looks at a few
+/// squares, and a grid of 512² has 1024 of them.
+pub const BUCKET_CELLS: f64 = 16.0;
+
+/// Indices of points in squares of the ground, `side` metres, row by row; points beyond the
+/// grid in the squares at its edge.
+#[derive(Debug, Clone, Default)]
+struct Buckets {
+    side: f64,
+    cols: usize,
+    rows: usize,
+    cells: Vec<Vec<u32>>,
+}
+
+impl Buckets {
+    /// Empty squares over `map`.
+    fn over(map: &Heightmap) -> Buckets {
+        let side = BUCKET_CELLS * map.cell_size();
+        let count = |cells: u32| (f64::from(cells) / BUCKET_CELLS).ceil().max(1.0) as usize;
+        let (cols, rows) = (count(map.cols()), count(map.rows()));
+        Buckets {
+            side,
+            cols,
+            rows,
+            cells: vec![Vec::new(); cols * rows],
+        }
+    }
+
+    /// The square column (or row) of coordinate `x` along an axis of `n` squares.
+    fn along(&self, x: f64, n: usize) -> usize {
+        // NaN and negatives to 0 (the cast saturates), the far side to the last.
+        ((x / self.side).floor() as usize).min(n - 1)
+    }
+
+    fn of(&self, p: Point) -> usize {
+        self.along(p[1], self.rows) * self.cols + self.along(p[0], self.cols)
+    }
+
+    fn insert(&mut self, i: usize, p: Point) {
+        let b = self.of(p);
+        self.cells[b].push(i as u32);
+    }
+
+    /// Moves point `i` from `from` to `to`.
+    fn relocate(&mut self, i: usize, from: Point, to: Point) {
+        let (a, b) = (self.of(from), self.of(to));
+        if a != b {
+            self.cells[a].retain(|&k| k as usize != i);
+            self.cells[b].push(i as u32);
+        }
+    }
+
+    /// The points in the squares that `r` (metres `[x0, y0, x1, y1]`, ends maybe infinite)
+    /// overlaps: every point inside `r`, and some beside it.
+    fn near(&self, r: [f64; 4]) -> impl Iterator<Item = usize> + '_ {
+        let (c0, c1) = (self.along(r[0], self.cols), self.along(r[2], self.cols));
+        let (r0, r1) = (self.along(r[1], self.rows), self.along(r[3], self.rows));
+        (r0..=r1).flat_map(move |row| {
+            self.cells[row * self.cols + c0..=row * self.cols + c1]
+                .iter()
+                .flatten()
+                .map(|&k| k as usize)
+        })
+    }
+}
+
 impl Forest {
     /// The trees of `doc` (valid) on `map`.
     pub fn of(doc: &Document, map: &Heightmap) -> Forest {
         let mut f = Forest::default();
-        f.follow(doc, map);
+        f.follow(doc, map, None);
         f
     }
 
@@ -118,46 +219,105 @@ impl Forest {
         nodes_of(&mut self.species, species)
     }
 
-    /// Brings the trees up to date with `doc` and its terrain `map`: groves that changed are
-    /// scattered again, every base height is read again.
-    pub fn follow(&mut self, doc: &Document, map: &Heightmap) {
+    /// Brings the trees up to date with `doc` and its terrain `map`, whose heights changed only
+    /// in the cells `changed` (`(c0, r0, width, height)`; `None`: anywhere). Groves that changed
+    /// are scattered again and then every tree stood again; else the document's own trees that
+    /// changed are stood again, and the trees over the changed cells (and a cell beyond, whose
+    /// heights their ground blends) read their base again — the same bits as standing all.
+    pub fn follow(&mut self, doc: &Document, map: &Heightmap, changed: Option<(u32, u32, u32, u32)>) {
         if doc.trees.is_empty() && doc.groves.is_empty() && self.trees.is_empty() {
             return;
         }
+        let grid = (map.cols(), map.rows(), map.cell_size().to_bits());
+        let groves_same =
+            self.groves.len() == doc.groves.len() && self.groves.iter().zip(&doc.groves).all(|(o, g)| o.grove == *g);
+        let Some(changed) =
+            changed.filter(|_| groves_same && self.grid == Some(grid) && self.planted.len() == doc.trees.len())
+        else {
+            return self.stand_all(doc, map);
+        };
+        let ground = crate::rocks::place::ground(map);
+        let redo: Vec<usize> = (0..doc.trees.len())
+            .filter(|&i| self.planted[i] != doc.trees[i])
+            .collect();
+        let over: Vec<usize> = if changed.2 > 0 && changed.3 > 0 {
+            let r = map.extent_of(changed);
+            let m = map.cell_size();
+            let r = [r[0] - m, r[1] - m, r[2] + m, r[3] + m];
+            self.index
+                .near(r)
+                .filter(|&k| {
+                    let at = self.trees[k].at;
+                    (r[0]..=r[2]).contains(&at[0]) && (r[1]..=r[3]).contains(&at[1])
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        if redo.is_empty() && over.is_empty() {
+            return;
+        }
+        let trees = Arc::make_mut(&mut self.trees);
+        for i in redo {
+            let t = &doc.trees[i];
+            let nodes = nodes_of(&mut self.species, &Species::of_tree(t));
+            self.index.relocate(i, trees[i].at, t.at);
+            trees[i] = stand(
+                Source::Tree(i),
+                t.at,
+                &ground,
+                t.height,
+                t.seed,
+                nodes,
+                t.wind.clone().map(Arc::new),
+            );
+            self.planted[i].clone_from(t);
+        }
+        for k in over {
+            let at = trees[k].at;
+            trees[k].base = ground.height(at[0], at[1]);
+        }
+    }
+
+    /// Scatters the groves that changed again and stands every tree.
+    fn stand_all(&mut self, doc: &Document, map: &Heightmap) {
         let mut old = std::mem::take(&mut self.groves);
         for g in &doc.groves {
-            let kept = old.iter().position(|(o, _)| o == g).map(|k| old.swap_remove(k));
-            let entry = kept.unwrap_or_else(|| (g.clone(), Arc::new(grove::trees(g))));
+            let kept = old.iter().position(|o| o.grove == *g).map(|k| old.swap_remove(k));
+            let entry = kept.unwrap_or_else(|| Scattered {
+                grove: g.clone(),
+                trees: Arc::new(grove::trees(g)),
+                wind: g.wind.clone().map(Arc::new),
+            });
             self.groves.push(entry);
         }
         let ground = crate::rocks::place::ground(map);
         let mut trees = Vec::new();
         for (i, t) in doc.trees.iter().enumerate() {
-            let nodes = self.nodes(&Species::of_tree(t));
-            trees.push(Standing {
-                source: Source::Tree(i),
-                at: t.at,
-                base: ground.height(t.at[0], t.at[1]),
-                height: t.height,
-                turn: turn(t.seed),
-                nodes,
-                wind: t.wind.clone(),
-            });
+            let nodes = nodes_of(&mut self.species, &Species::of_tree(t));
+            let wind = t.wind.clone().map(Arc::new);
+            trees.push(stand(Source::Tree(i), t.at, &ground, t.height, t.seed, nodes, wind));
         }
-        for (i, (g, list)) in self.groves.iter().enumerate() {
+        for (i, Scattered { trees: list, wind, .. }) in self.groves.iter().enumerate() {
             for (k, t) in list.iter().enumerate() {
                 let nodes = nodes_of(&mut self.species, &Species::preset(t.preset));
-                trees.push(Standing {
-                    source: Source::Grove(i, k),
-                    at: t.at,
-                    base: ground.height(t.at[0], t.at[1]),
-                    height: t.height,
-                    turn: turn(t.seed),
+                trees.push(stand(
+                    Source::Grove(i, k),
+                    t.at,
+                    &ground,
+                    t.height,
+                    t.seed,
                     nodes,
-                    wind: g.wind.clone(),
-                });
+                    wind.clone(),
+                ));
             }
         }
+        self.index = Buckets::over(map);
+        for (k, t) in trees.iter().enumerate() {
+            self.index.insert(k, t.at);
+        }
+        self.planted.clone_from(&doc.trees);
+        self.grid = Some((map.cols(), map.rows(), map.cell_size().to_bits()));
         self.trees = Arc::new(trees);
     }
 
