@@ -116,7 +116,7 @@ impl Trees {
             tree.draw(q, scene.time, &mut self.drawn);
             for imp in &self.drawn.impostors[first..] {
                 let group = self.cache.group(&tree.nodes, imp.node, &scene.style);
-                self.quads.push(self.cache.quad(group, imp, eye));
+                self.quads.extend(self.cache.quad(group, imp, eye));
             }
         }
         self.stats = TreeStats {

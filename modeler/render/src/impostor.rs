@@ -10,6 +10,10 @@
 //! - **Which polygon** ([`facing`]): of the two crossed polygons (through the group's box
 //!   centre, one across Z, one across X), the one whose normal makes the smaller angle with the
 //!   line to the eye, with the texture of the side the eye is on.
+//! - **Cropped** ([`opaque`]): the polygon drawn spans only the texels its image covers (the
+//!   smallest texel-aligned rectangle holding every opaque texel), not the whole box: the rest
+//!   of the image is transparent, and its pixels were each a depth test, a division and a texel
+//!   fetch for nothing. A side whose image is empty draws no polygon.
 //! - **Cache** ([`Cache`]): a node's sub-model in its own frame depends only on its scale (the
 //!   product of its maps' scales decides where its branches stop), so textures are kept per
 //!   species and scale and baked the first time a group of that scale is drawn.
@@ -194,20 +198,55 @@ pub fn facing(transform: &DAffine3, bounds: &[Vec3; 2], eye: DVec3) -> Side {
 /// The polygon of `side` through the box's centre, corners in the world (by `transform`) with
 /// their texture coordinates, drawn with texture `texture`.
 pub fn quad(transform: &DAffine3, bounds: &[Vec3; 2], side: Side, texture: u32) -> Quad {
+    quad_within(transform, bounds, side, texture, WHOLE)
+}
+
+/// The whole texture, `[u0, v0, u1, v1]`.
+pub const WHOLE: [f32; 4] = [0.0, 0.0, 1.0, 1.0];
+
+/// [`quad`] cut to the texture rectangle `crop` (`[u0, v0, u1, v1]`, 0 to 1, v down): the part
+/// of the polygon that shows those texels, with their coordinates.
+pub fn quad_within(transform: &DAffine3, bounds: &[Vec3; 2], side: Side, texture: u32, crop: [f32; 4]) -> Quad {
     let (right, toward) = side.basis();
     let (r0, r1) = span(bounds, right);
     let (y0, y1) = (bounds[0].y, bounds[1].y);
     let axis = toward.abs();
     let middle = axis * axis.dot((bounds[0] + bounds[1]) * 0.5);
-    let at = |s: f32, y: f32| {
-        let p = right * s + middle + Vec3::Y * y;
+    // Weighted, so that 0 and 1 give the box's sides exactly.
+    let across = |u: f32| r0 * (1.0 - u) + r1 * u;
+    let down = |v: f32| y1 * (1.0 - v) + y0 * v;
+    let at = |u: f32, v: f32| {
+        let p = right * across(u) + middle + Vec3::Y * down(v);
         transform.transform_point3(p.as_dvec3()).as_vec3().to_array()
     };
+    let [u0, v0, u1, v1] = crop;
     Quad {
-        corners: [at(r0, y1), at(r1, y1), at(r1, y0), at(r0, y0)],
-        uv: [[0.0, 0.0], [1.0, 0.0], [1.0, 1.0], [0.0, 1.0]],
+        corners: [at(u0, v0), at(u1, v0), at(u1, v1), at(u0, v1)],
+        uv: [[u0, v0], [u1, v0], [u1, v1], [u0, v1]],
         texture,
     }
+}
+
+/// The smallest texel-aligned rectangle of `texture` holding every texel the alpha test keeps
+/// (alpha ≥ 128), `[u0, v0, u1, v1]` from 0 to 1; `None` when it keeps none.
+pub fn opaque(texture: &Texture) -> Option<[f32; 4]> {
+    let (w, h) = (texture.width() as usize, texture.height() as usize);
+    let (mut lo, mut hi) = ([usize::MAX; 2], [0usize; 2]);
+    for (i, t) in texture.texels().iter().enumerate() {
+        if t[3] >= 128 {
+            let (x, y) = (i % w, i / w);
+            lo = [lo[0].min(x), lo[1].min(y)];
+            hi = [hi[0].max(x + 1), hi[1].max(y + 1)];
+        }
+    }
+    (lo[0] != usize::MAX).then(|| {
+        [
+            lo[0] as f32 / w as f32,
+            lo[1] as f32 / h as f32,
+            hi[0] as f32 / w as f32,
+            hi[1] as f32 / h as f32,
+        ]
+    })
 }
 
 /// Baked groups, per species and scale; their textures in one table, four per group.
@@ -219,6 +258,8 @@ pub struct Cache {
     held: Vec<Arc<NodeTree>>,
     bounds: Vec<[Vec3; 2]>,
     textures: Vec<Texture>,
+    /// Each texture's [`opaque`] rectangle.
+    crops: Vec<Option<[f32; 4]>>,
 }
 
 impl Cache {
@@ -237,6 +278,7 @@ impl Cache {
         let baked = bake(&mesh, style, TEXELS);
         let g = self.bounds.len() as u32;
         self.bounds.push(baked.bounds);
+        self.crops.extend(baked.textures.iter().map(opaque));
         self.textures.extend(baked.textures);
         if !self.held.iter().any(|t| Arc::ptr_eq(t, tree)) {
             self.held.push(Arc::clone(tree));
@@ -245,11 +287,14 @@ impl Cache {
         g
     }
 
-    /// The quad facing `eye` for `impostor`, a group of [`Cache::group`].
-    pub fn quad(&self, group: u32, impostor: &Impostor, eye: DVec3) -> Quad {
+    /// The quad facing `eye` for `impostor`, a group of [`Cache::group`], cut to its image's
+    /// opaque texels; `None` when that image has none.
+    pub fn quad(&self, group: u32, impostor: &Impostor, eye: DVec3) -> Option<Quad> {
         let bounds = &self.bounds[group as usize];
         let side = facing(&impostor.transform, bounds, eye);
-        quad(&impostor.transform, bounds, side, group * 4 + side as u32)
+        let texture = group * 4 + side as u32;
+        let crop = self.crops[texture as usize]?;
+        Some(quad_within(&impostor.transform, bounds, side, texture, crop))
     }
 
     /// Every baked texture, four per group in [`Side`] order.

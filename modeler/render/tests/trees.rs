@@ -170,6 +170,75 @@ fn the_facing_polygon_flips_as_the_camera_moves_round() {
     }
 }
 
+/// A simplified shape's polygon is cut to the texels its image covers: the rectangle is the
+/// opaque texels' bounding box (found here by scanning rows and columns), and the cut polygon
+/// draws what the whole one draws (within a few pixels where the texture coordinates round
+/// differently at a texel's edge); an empty image gives no polygon.
+#[test]
+fn a_simplified_shapes_polygon_is_cut_to_its_opaque_texels() {
+    // Opaque red in columns 3..9 of rows 5..12, transparent elsewhere.
+    let texels = (0..16 * 16)
+        .map(|i| {
+            let (x, y) = (i % 16, i / 16);
+            if (3..9).contains(&x) && (5..12).contains(&y) {
+                RED
+            } else {
+                [255, 255, 255, 0]
+            }
+        })
+        .collect();
+    let texture = Texture::new(16, 16, texels).expect("texture");
+    let rows: Vec<usize> = (0..16)
+        .filter(|y| (0..16).any(|x| texture.texels()[y * 16 + x][3] >= 128))
+        .collect();
+    let cols: Vec<usize> = (0..16)
+        .filter(|x| (0..16).any(|y| texture.texels()[y * 16 + x][3] >= 128))
+        .collect();
+    let expected = [
+        cols[0] as f32 / 16.0,
+        rows[0] as f32 / 16.0,
+        (cols[cols.len() - 1] + 1) as f32 / 16.0,
+        (rows[rows.len() - 1] + 1) as f32 / 16.0,
+    ];
+    let crop = impostor::opaque(&texture).expect("some opaque texels");
+    assert_eq!(crop, expected);
+    assert_eq!(impostor::opaque(&half_texture(0)), None);
+
+    // A box 8 m wide and 7 m tall standing on flat ground, its front polygon drawn whole and cut.
+    let map = flat(64, 0.0);
+    let camera = orbit([32.0, 4.5, 32.0], 20.0, 10.0, 14.0, 70.0);
+    let (w, h) = (320, 240);
+    let scene = Scene::new(&map, camera);
+    let mut renderer = Renderer::new();
+    let bounds = [Vec3::new(-4.0, 1.0, -1.0), Vec3::new(4.0, 8.0, 1.0)];
+    let place = DAffine3::from_translation(DVec3::new(32.0, 0.0, 32.0));
+    let whole = [impostor::quad(&place, &bounds, Side::Front, 0)];
+    let cut = [impostor::quad_within(&place, &bounds, Side::Front, 0, crop)];
+    let textures = [texture];
+    let draw = |quads: &[Quad], renderer: &mut Renderer| {
+        let with = Scene {
+            polygons: quads,
+            textures: &textures,
+            ..scene.clone()
+        };
+        render(&with, renderer, w, h)
+    };
+    let bare = render(&scene, &mut renderer, w, h);
+    let a = draw(&whole, &mut renderer);
+    let b = draw(&cut, &mut renderer);
+    let drawn = a.pixels().iter().zip(bare.pixels()).filter(|(x, y)| x != y).count();
+    let differ = a.pixels().iter().zip(b.pixels()).filter(|(x, y)| x != y).count();
+    assert!(drawn > 500, "{drawn} pixels of the red texels drawn");
+    assert!(differ * 100 <= drawn, "{differ} of {drawn} pixels differ");
+    // The cut polygon's area is the rectangle's share of the whole one's.
+    let area = |q: &Quad| {
+        let [p0, p1, _, p3] = q.corners.map(Vec3::from_array);
+        (p1 - p0).cross(p3 - p0).length()
+    };
+    let share = (expected[2] - expected[0]) * (expected[3] - expected[1]);
+    assert!((area(&cut[0]) / area(&whole[0]) - share).abs() < 1e-5);
+}
+
 fn standing(nodes: &Arc<NodeTree>, at: [f64; 2], height: f64) -> Standing {
     Standing {
         source: Source::Tree(0),
