@@ -573,6 +573,35 @@ fn sky_by_definition(z: &[f32], cols: usize, rows: usize, cell: f64, k: usize) -
 }
 
 #[test]
+fn sky_view_has_the_same_bits_on_any_number_of_threads() {
+    // The sweep shares each direction's lines and columns among the threads; every cell's sum
+    // must be added in the same order whatever the sharing.
+    let (cols, rows, cell) = (150u32, 90u32, 1.5);
+    let z = bumpy(cols, rows);
+    let field = Field {
+        z: &z,
+        cols,
+        rows,
+        cell,
+    };
+    let on = |threads: usize| {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool");
+        pool.install(|| sun::sky_view(field, 32))
+    };
+    let one = on(1);
+    for threads in [2, 3, 5] {
+        let got = on(threads);
+        assert!(
+            one.iter().zip(&got).all(|(a, b)| a.to_bits() == b.to_bits()),
+            "{threads} threads differ from one"
+        );
+    }
+}
+
+#[test]
 fn sky_view_is_its_definition_computed_naively() {
     let (cols, rows, cell) = (40u32, 28u32, 2.0);
     let z = bumpy(cols, rows);

@@ -216,10 +216,6 @@ pub fn direct(field: Field<'_>, sun: Sun) -> Vec<f32> {
     out
 }
 
-/// Azimuth pairs summed together on one thread; fixed so that the sum's order, and so its bits,
-/// do not depend on the number of threads.
-const GROUP: usize = 8;
-
 /// One layout's share of the sky view (u along its `w` rows, v across its `h`): per cell the sum
 /// of the spread `sin² H`, stored `sum[u·h + v]` (columns contiguous), and the weights of the
 /// first and last v and of every other (see `Sections::weight`).
@@ -238,26 +234,11 @@ impl Layout {
         Layout {
             w,
             h,
-            sum: vec![0.0; w * h + 1],
+            sum: vec![0.0; w * h],
             first: vec![0.0; w],
             last: vec![0.0; w],
             inner: 0.0,
         }
-    }
-
-    /// Adds `other`, cell by cell.
-    fn add(&mut self, other: &Layout) {
-        self.sum
-            .par_iter_mut()
-            .zip(other.sum.par_iter())
-            .for_each(|(t, a)| *t += a);
-        for (t, a) in self.first.iter_mut().zip(&other.first) {
-            *t += a;
-        }
-        for (t, a) in self.last.iter_mut().zip(&other.last) {
-            *t += a;
-        }
-        self.inner += other.inner;
     }
 
     /// The weights of the cells of row v, or `None` for `inner`.
@@ -281,75 +262,50 @@ fn sin2(rise: f32, steps: f32, sp2: f32) -> f32 {
 }
 
 /// Lines swept as one block: their heights and values laid out column by column, so that
-/// building and spreading them are shifted interpolations of contiguous cells.
+/// building and spreading them are shifted interpolations of contiguous cells. A block is also
+/// the unit of work the cores share.
 const BLOCK: usize = 32;
+
+/// Columns of a layout spread as one piece of work.
+const SPREAD_COLUMNS: usize = 16;
 
 /// Adds the sky view's `sin² H` of the direction `(du, dv)` (`|du| ≥ |dv|`, u along the rows of
 /// `layout`), and with `both` of the opposite direction, to `layout`. `zc` is the grid with u's
-/// columns contiguous (the layout transposed), an element more. `buf` is scratch.
-fn sky_sweep(zc: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &mut Layout, buf: &mut Scratch) {
+/// columns contiguous (the layout transposed), an element more. `values` is scratch.
+///
+/// On all cores in two passes: the blocks of lines, each swept into its own part of `values`,
+/// then the columns of `layout`, each adding the blocks' values in block order — so that every
+/// cell's sum is added in the same order however the work is shared.
+fn sky_sweep(zc: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &mut Layout, values: &mut Vec<f32>) {
     let (w, h) = (layout.w, layout.h);
     let lines = Sections::new(w, h, slope(du, dv), cell);
-    let sp2 = lines.spacing * lines.spacing;
-    let passes = if both { 2.0 } else { 1.0 };
-    let Scratch {
-        block,
-        heights,
-        up,
-        down,
-        hull,
-        other,
-    } = buf;
-    block.resize(w * BLOCK, 0.0);
-    heights.resize(w, 0.0);
-    for v in [&mut up.0, &mut up.1, &mut down.0, &mut down.1] {
-        v.resize(w, 0.0);
-    }
     let all = lines.lines();
-    for b0 in all.clone().step_by(BLOCK) {
-        let nb = BLOCK.min((all.end - b0) as usize);
-        let block = &mut block[..w * nb];
-        lines.block_heights(zc, b0, nb, block);
-        for j in 0..nb {
-            let cols = lines.columns(b0 + j as isize);
-            let n = cols.len();
-            if n == 0 {
-                continue;
-            }
-            // Line j's samples: element j of each column's chunk of the block.
-            let span = cols.start * nb..cols.end * nb;
-            let zs = &mut heights[..n];
-            for (z, c) in zs.iter_mut().zip(block[span.clone()].chunks_exact(nb)) {
-                *z = c[j];
-            }
-            let (ru, su) = (&mut up.0[..n], &mut up.1[..n]);
-            let (rd, dd) = (&mut down.0[..n], &mut down.1[..n]);
-            match (du > 0.0 || both, du < 0.0 || both) {
-                (true, true) => {
-                    hull.pass_both(other, zs, (&mut *ru, &mut *su), (&mut *rd, &mut *dd));
-                    // sin² H of both, in place of the first's rises (vectorised).
-                    for (((r, &d), &r2), &d2) in ru.iter_mut().zip(su.iter()).zip(rd.iter()).zip(dd.iter()) {
-                        *r = sin2(*r, d, sp2) + sin2(r2, d2, sp2);
-                    }
-                }
-                (up_only, _) => {
-                    if up_only {
-                        hull.pass::<true>(zs, ru, su);
-                    } else {
-                        hull.pass::<false>(zs, ru, su);
-                    }
-                    for (r, &d) in ru.iter_mut().zip(su.iter()) {
-                        *r = sin2(*r, d, sp2);
-                    }
+    let blocks = (all.len()).div_ceil(BLOCK);
+    values.resize(blocks * w * BLOCK, 0.0);
+    values
+        .par_chunks_mut(w * BLOCK)
+        .enumerate()
+        .for_each_init(Scratch::default, |buf, (k, block)| {
+            let b0 = all.start + (k * BLOCK) as isize;
+            let nb = BLOCK.min((all.end - b0) as usize);
+            sweep_block(zc, &lines, (du, both), b0, &mut block[..w * nb], buf);
+        });
+    let values = &values[..];
+    layout
+        .sum
+        .par_chunks_mut(h * SPREAD_COLUMNS)
+        .enumerate()
+        .for_each(|(piece, cols)| {
+            for (i, col) in cols.chunks_exact_mut(h).enumerate() {
+                let u = piece * SPREAD_COLUMNS + i;
+                for (k, block) in values.chunks_exact(w * BLOCK).take(blocks).enumerate() {
+                    let b0 = all.start + (k * BLOCK) as isize;
+                    let nb = BLOCK.min((all.end - b0) as usize);
+                    lines.column_spread(u, b0, &block[u * nb..(u + 1) * nb], col);
                 }
             }
-            // The values in place of the heights.
-            for (c, &r) in block[span].chunks_exact_mut(nb).zip(ru.iter()) {
-                c[j] = r;
-            }
-        }
-        lines.block_spread(b0, nb, block, &mut layout.sum);
-    }
+        });
+    let passes = if both { 2.0 } else { 1.0 };
     for u in 0..w {
         layout.first[u] += passes * lines.weight(u, 0);
         layout.last[u] += passes * lines.weight(u, h - 1);
@@ -357,11 +313,69 @@ fn sky_sweep(zc: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &m
     layout.inner += passes;
 }
 
-/// Buffers reused from line to line: a block of lines, a line's heights, and the rises and
-/// steps to the horizon ahead in both directions.
+/// The lines `b0..` of `lines` as one block (`block`, laid out like
+/// [`Sections::block_heights`]'s): their heights, then in their place the `sin² H` of each
+/// sample (towards `du`'s sign, and with `both` the opposite way added).
+fn sweep_block(zc: &[f32], lines: &Sections, (du, both): (f64, bool), b0: isize, block: &mut [f32], buf: &mut Scratch) {
+    let w = lines.width();
+    let nb = block.len() / w;
+    let sp2 = lines.spacing * lines.spacing;
+    let Scratch {
+        heights,
+        up,
+        down,
+        hull,
+        other,
+    } = buf;
+    heights.resize(w, 0.0);
+    for v in [&mut up.0, &mut up.1, &mut down.0, &mut down.1] {
+        v.resize(w, 0.0);
+    }
+    lines.block_heights(zc, b0, nb, block);
+    for j in 0..nb {
+        let cols = lines.columns(b0 + j as isize);
+        let n = cols.len();
+        if n == 0 {
+            continue;
+        }
+        // Line j's samples: element j of each column's chunk of the block.
+        let span = cols.start * nb..cols.end * nb;
+        let zs = &mut heights[..n];
+        for (z, c) in zs.iter_mut().zip(block[span.clone()].chunks_exact(nb)) {
+            *z = c[j];
+        }
+        let (ru, su) = (&mut up.0[..n], &mut up.1[..n]);
+        let (rd, dd) = (&mut down.0[..n], &mut down.1[..n]);
+        match (du > 0.0 || both, du < 0.0 || both) {
+            (true, true) => {
+                hull.pass_both_positive(other, zs, (&mut *ru, &mut *su), (&mut *rd, &mut *dd));
+                // sin² H of both, in place of the first's rises (vectorised).
+                for (((r, &d), &r2), &d2) in ru.iter_mut().zip(su.iter()).zip(rd.iter()).zip(dd.iter()) {
+                    *r = sin2(*r, d, sp2) + sin2(r2, d2, sp2);
+                }
+            }
+            (up_only, _) => {
+                if up_only {
+                    hull.pass::<true>(zs, ru, su);
+                } else {
+                    hull.pass::<false>(zs, ru, su);
+                }
+                for (r, &d) in ru.iter_mut().zip(su.iter()) {
+                    *r = sin2(*r, d, sp2);
+                }
+            }
+        }
+        // The values in place of the heights.
+        for (c, &r) in block[span].chunks_exact_mut(nb).zip(ru.iter()) {
+            c[j] = r;
+        }
+    }
+}
+
+/// Buffers reused from line to line: a line's heights, and the rises and steps to the horizon
+/// ahead in both directions.
 #[derive(Default)]
 struct Scratch {
-    block: Vec<f32>,
     heights: Vec<f32>,
     up: (Vec<f32>, Vec<f32>),
     down: (Vec<f32>, Vec<f32>),
@@ -374,10 +388,15 @@ struct Scratch {
 /// Each line sample's `sin² H` is spread over its two cells like a horizon (see [`horizons`]):
 /// the mean over all directions is the weighted mean, every cell getting weight 1 per azimuth
 /// but on the grid's edge rows across a direction's lines, where the weights are known in closed
-/// form (`Sections::weight`). Opposite azimuths share their lines and are swept together.
+/// form (`Sections::weight`). Opposite azimuths share their lines and are swept together. The
+/// azimuths are swept one after another, each on all cores ([`sky_sweep`]); the result does not
+/// depend on the number of threads.
 pub fn sky_view(field: Field<'_>, k: u32) -> Vec<f32> {
     let Field { z, cols, rows, cell } = field;
     let (cols, rows) = (cols as usize, rows as usize);
+    if z.is_empty() {
+        return Vec::new();
+    }
     let k = k.max(1) as usize;
     // The grid and its transpose, each an element more (see `Sections::block_heights`).
     let mut zp = Vec::with_capacity(z.len() + 1);
@@ -390,35 +409,20 @@ pub fn sky_view(field: Field<'_>, k: u32) -> Vec<f32> {
     } else {
         (0..k).map(|d| (d, false)).collect()
     };
-    // Per group: the row-major azimuths' layout (u along the grid's rows, sums transposed) and
-    // the column-major ones' (u down the columns, sums in the grid's layout).
-    let groups: Vec<[Layout; 2]> = pairs
-        .par_chunks(GROUP)
-        .map(|chunk| {
-            let mut out = [Layout::new(cols, rows), Layout::new(rows, cols)];
-            let mut buf = Scratch::default();
-            for &(d, both) in chunk {
-                let az = TAU * d as f64 / k as f64;
-                let (dx, dy) = (az.cos(), az.sin());
-                if dx.abs() >= dy.abs() {
-                    sky_sweep(&zt, cell, (dx, dy), both, &mut out[0], &mut buf);
-                } else {
-                    sky_sweep(&zp, cell, (dy, dx), both, &mut out[1], &mut buf);
-                }
-            }
-            out
-        })
-        .collect();
-    // The groups' sums in a fixed order, the transposed one brought back to the grid's layout.
-    let mut groups = groups.into_iter();
-    let Some([mut x, mut y]) = groups.next() else {
-        return vec![1.0; z.len()];
-    };
-    for [gx, gy] in groups {
-        x.add(&gx);
-        y.add(&gy);
+    // The row-major azimuths' layout (u along the grid's rows, sums transposed) and the
+    // column-major ones' (u down the columns, sums in the grid's layout).
+    let (mut x, mut y) = (Layout::new(cols, rows), Layout::new(rows, cols));
+    let mut values = Vec::new();
+    for (d, both) in pairs {
+        let az = TAU * d as f64 / k as f64;
+        let (dx, dy) = (az.cos(), az.sin());
+        if dx.abs() >= dy.abs() {
+            sky_sweep(&zt, cell, (dx, dy), both, &mut x, &mut values);
+        } else {
+            sky_sweep(&zp, cell, (dy, dx), both, &mut y, &mut values);
+        }
     }
-    let along = transpose(&x.sum[..z.len()], rows, cols, 0);
+    let along = transpose(&x.sum, rows, cols, 0);
     let mut out = vec![0.0f32; z.len()];
     out.par_chunks_mut(cols).enumerate().for_each(|(r, line)| {
         let (a, at) = (&along[r * cols..(r + 1) * cols], &y.sum[r * cols..(r + 1) * cols]);
