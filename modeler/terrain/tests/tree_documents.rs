@@ -486,3 +486,78 @@ fn the_editors_forest_follows_random_edits_as_a_fresh_one() {
             .unwrap_or_else(|e| panic!("step {step} ({edit:?}): {e}"));
     }
 }
+
+/// `Editor::preview_tree` shows a tree's or grove's replacement unrecorded: a preview of another
+/// element first restores the one shown, `commit_tree_preview` records what is shown as one step
+/// whose undo returns to the element before the preview, and any other edit restores it first.
+#[test]
+fn tree_previews_restore_commit_once_and_give_way() {
+    let mut d = doc();
+    d.trees = vec![tree([20.5, 20.5]), tree([40.5, 40.5])];
+    d.groves = vec![a_grove()];
+    let original = d.clone();
+    let mut ed = Editor::new(d).expect("valid");
+    let taller = |ed: &Editor, i: usize, h: f64| Edit::ReplaceTree {
+        index: i,
+        tree: Tree {
+            height: h,
+            ..ed.document().trees[i].clone()
+        },
+    };
+    for h in [15.0, 20.0, 18.0] {
+        let e = taller(&ed, 0, h);
+        ed.preview_tree(&e).expect("shown");
+        assert_eq!(ed.document().trees[0].height, h);
+        assert_eq!(ed.trees().trees()[0].height, h, "the forest shows it");
+    }
+    // Another element: the first is restored before the second shows.
+    let e = taller(&ed, 1, 30.0);
+    ed.preview_tree(&e).expect("shown");
+    assert_eq!(ed.document().trees[0], original.trees[0]);
+    assert_eq!(ed.document().trees[1].height, 30.0);
+    // A grove, then committed: one step.
+    let mut g = ed.document().groves[0].clone();
+    g.height = 12.0;
+    ed.preview_tree(&Edit::ReplaceGrove {
+        index: 0,
+        grove: g.clone(),
+    })
+    .expect("shown");
+    assert_eq!(ed.document().trees, original.trees);
+    let done = ed.commit_tree_preview().expect("recorded");
+    assert_eq!(
+        done,
+        Some(Edit::ReplaceGrove {
+            index: 0,
+            grove: g.clone()
+        })
+    );
+    assert!(!ed.previewing());
+    assert_eq!(ed.commit_tree_preview().expect("nothing"), None);
+    ed.undo().expect("undo");
+    assert_eq!(ed.document(), &original);
+    assert!(!ed.can_undo(), "one step");
+    // Another edit while a preview shows restores it first; only that edit is recorded.
+    let e = taller(&ed, 0, 25.0);
+    ed.preview_tree(&e).expect("shown");
+    ed.apply(Edit::MoveTree {
+        index: 1,
+        by: [1.0, 0.0],
+    })
+    .expect("moved");
+    assert_eq!(ed.document().trees[0], original.trees[0]);
+    ed.undo().expect("undo");
+    assert_eq!(ed.document(), &original);
+    // Cancelled: as before; only replacements of trees and groves preview.
+    let e = taller(&ed, 0, 25.0);
+    ed.preview_tree(&e).expect("shown");
+    ed.cancel_preview().expect("cancelled");
+    assert_eq!(ed.document(), &original);
+    assert!(
+        ed.preview_tree(&Edit::MoveTree {
+            index: 0,
+            by: [1.0, 0.0]
+        })
+        .is_err()
+    );
+}
