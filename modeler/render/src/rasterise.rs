@@ -171,6 +171,32 @@ impl Edge {
     }
 }
 
+/// Boxes narrower and shorter than this many pixels are tested for a covered centre before
+/// their triangle's attributes are set up ([`triangle`]).
+const SMALL_BOX: i32 = 4;
+
+/// Whether the edges `es` (started at the box's first centre) cover a centre of the box of
+/// `dx + 1` × `dy + 1` pixels: the same test as [`triangle`]'s loop.
+#[inline]
+fn covers_a_centre(es: [&Edge; 3], dx: i32, dy: i32) -> bool {
+    let (mut r0, mut r1, mut r2) = (es[0].start, es[1].start, es[2].start);
+    for _ in 0..=dy {
+        let (mut w0, mut w1, mut w2) = (r0, r1, r2);
+        for _ in 0..=dx {
+            if (w0 | w1 | w2) >= 0 {
+                return true;
+            }
+            w0 += es[0].step_x;
+            w1 += es[1].step_x;
+            w2 += es[2].step_x;
+        }
+        r0 += es[0].step_y;
+        r1 += es[1].step_y;
+        r2 += es[2].step_y;
+    }
+    false
+}
+
 /// Whether the bounding box of `vs` holds no pixel centre of `bounds`: then nothing made of these
 /// vertices can cover a pixel. A 512² grid's quad is under a pixel across at 1280 × 720, so one
 /// test per quad rejects most of them before either triangle is looked at.
@@ -217,6 +243,12 @@ pub fn triangle<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut 
     let e0 = Edge::new(b, c, sx, sy);
     let e1 = Edge::new(c, a, sx, sy);
     let e2 = Edge::new(a, b, sx, sy);
+    // A fine level of detail's triangles are a pixel or two, and many cover no pixel centre
+    // although their box holds one: the integer edge test over a small box finds that before the
+    // attribute planes and their division are set up (the pixels drawn are the same).
+    if px1 - px0 < SMALL_BOX && py1 - py0 < SMALL_BOX && !covers_a_centre([&e0, &e1, &e2], px1 - px0, py1 - py0) {
+        return;
+    }
 
     // Attribute planes in pixel units, relative to a.
     let (ax, ay) = (a.x as f32 / ONE as f32, a.y as f32 / ONE as f32);

@@ -27,9 +27,10 @@ fn mix(a: Rgba, b: Rgba, t: f32) -> Rgba {
 pub struct Shading<'a> {
     /// The classic look's colour table (unused by the land look).
     pub ramp: &'a Ramp,
-    /// The land look's maps of the terrain, this eye's atmosphere and its background (row-major
-    /// over the frame: [`crate::atmosphere::Backdrop`]).
-    pub land: Option<(&'a Land, &'a Atmosphere, &'a [[u8; 3]])>,
+    /// The land look's maps of the terrain, this eye's atmosphere and its background when kept
+    /// (row-major over the frame: [`crate::atmosphere::Backdrop`]; else computed per pixel that
+    /// shows no surface).
+    pub land: Option<(&'a Land, &'a Atmosphere, Option<&'a [[u8; 3]]>)>,
 }
 
 /// A sample's colour before light, for surfaces other than the terrain.
@@ -58,7 +59,7 @@ pub fn resolve(
     style: &Style,
 ) {
     if let Some((land, air, back)) = shading.land {
-        let back = &back[(y0 * width).min(back.len())..];
+        let back = back.map(|b| &b[(y0 * width).min(b.len())..]);
         resolve_land(samples, pixels, width, (x0, x1), y0, (land, air, back), style);
         return;
     }
@@ -89,7 +90,7 @@ fn resolve_land(
     width: usize,
     (x0, x1): (usize, usize),
     y0: usize,
-    (land, air, back): (&Land, &Atmosphere, &[[u8; 3]]),
+    (land, air, back): (&Land, &Atmosphere, Option<&[[u8; 3]]>),
     style: &Style,
 ) {
     let step = air.step();
@@ -98,15 +99,13 @@ fn resolve_land(
     let per_metre = air.pixels(1.0, 1.0);
     // Where a cell spans less than a pixel (1/w below this), the nearest cell's colour.
     let fine = 1.0 / (per_metre * land.cell).max(f32::MIN_POSITIVE);
-    let rows = samples
-        .chunks(width)
-        .zip(pixels.chunks_mut(width))
-        .zip(back.chunks(width));
+    let rows = samples.chunks(width).zip(pixels.chunks_mut(width));
     let sine = |r: [f32; 3]| {
         let len = (r[0] * r[0] + r[1] * r[1] + r[2] * r[2]).sqrt();
         if len > 0.0 { r[1].abs() / len } else { 0.0 }
     };
-    for (row, ((srow, prow), brow)) in rows.enumerate() {
+    for (row, (srow, prow)) in rows.enumerate() {
+        let brow = back.and_then(|b| b.get(row * width + x0..row * width + x1));
         let y = (y0 + row) as f32 + 0.5;
         let mut ray = air.ray(x0 as f32 + 0.5, y);
         // The ray's elevation, for the ground's foreshortening: linear along the tile's row
@@ -114,7 +113,7 @@ fn resolve_land(
         let mut sin = sine(ray);
         let last = sine(air.ray(x1.max(x0 + 1) as f32 - 0.5, y));
         let d_sin = (last - sin) / (x1.saturating_sub(x0 + 1)).max(1) as f32;
-        for ((s, p), b) in srow[x0..x1].iter().zip(&mut prow[x0..x1]).zip(&brow[x0..x1]) {
+        for (k, (s, p)) in srow[x0..x1].iter().zip(&mut prow[x0..x1]).enumerate() {
             let c = if s.invw > 0.0 {
                 let w = 1.0 / s.invw;
                 let (at, d) = air.point(ray, w);
@@ -129,8 +128,10 @@ fn resolve_land(
                 let l = (s.lw * w).clamp(0.0, 1.0);
                 let c = air.hazed([c[0] * l, c[1] * l, c[2] * l], d);
                 [c[0] as u8, c[1] as u8, c[2] as u8]
+            } else if let Some(b) = brow {
+                b[k]
             } else {
-                *b
+                air.background_bytes(ray)
             };
             *p = [c[0], c[1], c[2], 255];
             ray = [ray[0] + step[0], ray[1] + step[1], ray[2] + step[2]];

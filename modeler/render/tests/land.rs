@@ -4,10 +4,10 @@
 
 use glam::DVec3;
 use penmodel_render::land::{self, Shore, material};
-use penmodel_render::{Camera, Eye, Frame, Orbit, Projection, Renderer, Scene, Style, View, Viewport};
+use penmodel_render::{Camera, Eye, Frame, Orbit, Projection, Renderer, Scene, Stereo, Style, View, Viewport};
 use penmodel_terrain::Heightmap;
 
-use crate::common::orbit;
+use crate::common::{self, orbit};
 
 fn style() -> Style {
     Style::land()
@@ -482,5 +482,32 @@ fn the_classic_light_is_kept_for_an_unchanged_revision_and_remade_after_an_edit(
         let after = render(&editor, &mut renderer, true);
         assert_ne!(after.pixels(), first.pixels());
         assert_eq!(after.pixels(), render(&editor, &mut Renderer::new(), false).pixels());
+    }
+}
+
+#[test]
+fn a_still_views_kept_background_equals_the_one_computed_per_pixel() {
+    // While the view moves the shading computes the background of the empty pixels only; once it
+    // stays, the whole background is made and kept. Every frame of a still view, mono and
+    // stereo, is then the same as the first.
+    let n = 64u32;
+    let map = common::terrain(n, |x, y| 4.0 * ((x / 9.0).sin() + (y / 13.0).cos()));
+    for stereo in [Stereo::None, Stereo::Anaglyph, Stereo::SideBySide] {
+        // Low over the terrain: sky, far land, table and the model's side all show.
+        let mut scene = Scene::new(&map, orbit([32.0, 32.0], 20.0, 12.0, 110.0));
+        scene.style = style();
+        scene.stereo = stereo;
+        let mut renderer = Renderer::new();
+        let mut frames = Vec::new();
+        for _ in 0..4 {
+            let mut frame = Frame::new(320, 200).expect("frame");
+            renderer.render(&scene, &mut frame).expect("render");
+            frames.push(frame);
+        }
+        let sky = frames[0].pixels().iter().filter(|p| p[2] > p[0] + 20).count();
+        assert!(sky > 1000, "{sky} sky pixels");
+        for (i, f) in frames.iter().enumerate().skip(1) {
+            assert!(f == &frames[0], "{stereo:?}: frame {i} differs from the first");
+        }
     }
 }
