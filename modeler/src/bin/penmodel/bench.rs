@@ -77,6 +77,10 @@ pub struct Args {
     /// 1024 are measured this way only.
     #[arg(long)]
     still_only: bool,
+    /// The still frames at `--lod-error` only, not also at full detail (a profile of the LOD
+    /// frames).
+    #[arg(long)]
+    still_lod_only: bool,
     /// The memory case's number of point figures.
     #[arg(long, value_name = "K", default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=10000))]
     memory_figures: u32,
@@ -471,6 +475,9 @@ fn still_figures(grids: &[u32], args: &Args) -> Result<Vec<crate::frames::Still>
         let map = crate::frames::terrain(n)?;
         for stereo in [false, true] {
             for lod in [0.0, args.lod_error] {
+                if args.still_lod_only && lod != args.lod_error {
+                    continue;
+                }
                 out.push(crate::frames::measure(&map, lod, stereo, args.look, STILL_FRAMES)?);
             }
         }
