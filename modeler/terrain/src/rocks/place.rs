@@ -344,9 +344,7 @@ fn place(at: Placement, v: [f32; 3]) -> (f64, f64) {
     )
 }
 
-/// Stands one rock: its vertices on `ground`, then its normals from its triangles (indices into
-/// its own vertices, so every access stays within a few hundred bytes), summed in triangle
-/// order and normalised.
+/// Stands one rock: its vertices on `ground`, then its normals ([`normals_of`]).
 #[inline]
 fn seat_rock(
     at: Placement,
@@ -373,7 +371,9 @@ fn seat_rock(
 fn normals_of(out: &[[f32; 3]], tris: &[[u16; 3]], norms: &mut [[f32; 3]]) {
     norms.fill([0.0; 3]);
     for t in tris {
-        let [a, b, c] = t.map(usize::from);
+        // Each index loaded on its own: the triangle read whole was unpacked with shifts, a
+        // tenth of the normals' instructions.
+        let (a, b, c) = (usize::from(t[0]), usize::from(t[1]), usize::from(t[2]));
         let (pa, pb, pc) = (out[a], out[b], out[c]);
         let u = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
         let w = [pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]];
@@ -442,8 +442,19 @@ impl<'a> Ground<'a> {
     /// Where `(x, y)` metres reads the heightmap.
     #[inline(always)]
     pub fn sample(&self, x: f64, y: f64) -> Sample {
-        let fx = (x * self.per_metre - 0.5).clamp(0.0, self.last[0]);
-        let fy = (y * self.per_metre - 0.5).clamp(0.0, self.last[1]);
+        // `clamp` without its check that the bounds are in order (they are: `last` ≥ 0), which
+        // it made at every rock vertex; the same value, NaN included.
+        let hold = |f: f64, last: f64| {
+            if f < 0.0 {
+                0.0
+            } else if f > last {
+                last
+            } else {
+                f
+            }
+        };
+        let fx = hold(x * self.per_metre - 0.5, self.last[0]);
+        let fy = hold(y * self.per_metre - 0.5, self.last[1]);
         let (c, r) = ((fx as u32).min(self.max[0]), (fy as u32).min(self.max[1]));
         Sample {
             corner: r * self.cols + c,
@@ -462,10 +473,10 @@ impl<'a> Ground<'a> {
         let i = q.corner as usize;
         let (a, b, d, e) = if self.wide {
             let stride = self.cols as usize;
-            // Two range checks for the square's four corners.
-            match (h.get(i..i + 2), h.get(i + stride..i + stride + 2)) {
-                (Some(&[a, b]), Some(&[d, e])) => (a, b, d, e),
-                _ => (0.0, 0.0, 0.0, 0.0),
+            // One range check for the square's four corners.
+            match h.get(i..i + stride + 2) {
+                Some(s) => (s[0], s[1], s[stride], s[stride + 1]),
+                None => (0.0, 0.0, 0.0, 0.0),
             }
         } else {
             let (cols, rows) = (self.cols, self.rows);
