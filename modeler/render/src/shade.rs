@@ -30,8 +30,12 @@ pub struct Shading<'a> {
     /// The land look's maps of the terrain, this eye's atmosphere and its background when kept
     /// (row-major over the frame: [`crate::atmosphere::Backdrop`]; else computed per pixel that
     /// shows no surface).
-    pub land: Option<(&'a Land, &'a Atmosphere, Option<&'a [[u8; 3]]>)>,
+    pub land: Option<LandShading<'a>>,
 }
+
+/// The land look's part of [`Shading`]: the terrain's maps, the eye's atmosphere, its kept
+/// background if any.
+pub type LandShading<'a> = (&'a Land, &'a Atmosphere, Option<&'a [[u8; 3]]>);
 
 /// A sample's colour before light, for surfaces other than the terrain.
 #[inline]
@@ -90,7 +94,7 @@ fn resolve_land(
     width: usize,
     (x0, x1): (usize, usize),
     y0: usize,
-    (land, air, back): (&Land, &Atmosphere, Option<&[[u8; 3]]>),
+    (land, air, back): LandShading,
     style: &Style,
 ) {
     let step = air.step();
