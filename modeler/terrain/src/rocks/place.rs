@@ -371,8 +371,8 @@ fn seat_rock(
 fn normals_of(out: &[[f32; 3]], tris: &[[u16; 3]], norms: &mut [[f32; 3]]) {
     norms.fill([0.0; 3]);
     for t in tris {
-        // Each index loaded on its own: the triangle read whole was unpacked with shifts, a
-        // tenth of the normals' instructions.
+        // Each index loaded on its own: the triangle read whole was unpacked with shifts, five
+        // instructions more a triangle.
         let (a, b, c) = (usize::from(t[0]), usize::from(t[1]), usize::from(t[2]));
         let (pa, pb, pc) = (out[a], out[b], out[c]);
         let u = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
