@@ -7,7 +7,10 @@
 //! burst is. The end of the sound's flight comes after the emission (up to 1.5 m / c, 4.4 ms),
 //! so emission to frame bounds end of flight to frame from above. The pose was predicted
 //! `prediction_ms` past its burst: the latency less the prediction is what the prediction leaves
-//! uncovered (negative: the pose is predicted past the frame).
+//! uncovered (negative: the pose is predicted past the frame). The host carries each pose on to
+//! the frame's expected end ([`crate::head_prediction`]); with a simulation that knows the head's
+//! true path, each frame also measures how far the pose reported and the pose drawn are from
+//! where the head was when the frame was done.
 
 /// The target: end of flight to frame, ms.
 pub const TARGET_MS: f64 = 20.0;
@@ -21,6 +24,12 @@ pub struct HeadLatency {
     started_us: Vec<u64>,
     /// The prediction of the poses drawn, ms (the latest).
     prediction_ms: u8,
+    /// How far the host carried each frame's pose on past the base station's prediction, µs.
+    leads_us: Vec<u64>,
+    /// Per frame, with the head's true path: the pose reported and the pose drawn less the
+    /// truth when the frame was done, and the pose reported less the truth at its own instant
+    /// (burst + prediction: the tracking's and the base station's prediction's error alone), mm.
+    errors_mm: Vec<[[f64; 3]; 3]>,
 }
 
 /// What [`HeadLatency::summary`] says.
@@ -41,6 +50,47 @@ pub struct LatencySummary {
     pub start_p50_ms: f64,
     /// See [`start_p50_ms`](Self::start_p50_ms).
     pub start_p95_ms: f64,
+    /// How far the host carried the poses on past the base station's prediction, ms: median.
+    pub host_lead_p50_ms: f64,
+    /// With the head's true path: the poses as reported, mm from where the head was when their
+    /// frames were done.
+    pub reported_error: Option<ErrorSummary>,
+    /// The same for the poses drawn (carried on by the host).
+    pub drawn_error: Option<ErrorSummary>,
+    /// The poses as reported, from where the head was at their own instant (burst + the base
+    /// station's prediction): what no prediction by the host can remove.
+    pub tracking_error: Option<ErrorSummary>,
+    /// The mean of the poses reported less the truth at their own instant, mm: an offset
+    /// between the calibrated display frame and the simulator's, the same for every pose and no
+    /// matter of timing, taken out of the three errors above.
+    pub bias_mm: [f64; 3],
+}
+
+/// Distances from the truth, mm.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ErrorSummary {
+    /// Median.
+    pub p50_mm: f64,
+    /// 95th percentile.
+    pub p95_mm: f64,
+    /// Root mean square.
+    pub rms_mm: f64,
+}
+
+impl ErrorSummary {
+    fn of(mm: impl Iterator<Item = f64>) -> Option<ErrorSummary> {
+        let mut v: Vec<f64> = mm.collect();
+        if v.is_empty() {
+            return None;
+        }
+        v.sort_unstable_by(f64::total_cmp);
+        let rank = |q: f64| ((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1;
+        Some(ErrorSummary {
+            p50_mm: v[rank(0.5)],
+            p95_mm: v[rank(0.95)],
+            rms_mm: (v.iter().map(|e| e * e).sum::<f64>() / v.len() as f64).sqrt(),
+        })
+    }
 }
 
 impl LatencySummary {
@@ -57,14 +107,38 @@ impl LatencySummary {
 
 impl HeadLatency {
     /// A frame showing the pose of the head burst at `burst_us`, predicted `prediction_ms`
-    /// ahead, was started at device time `started_us` and produced at `done_us`. A burst after
-    /// the start (a clock restarted by a reattached device) is not a latency: skipped.
-    pub fn frame(&mut self, started_us: u64, done_us: u64, burst_us: u64, prediction_ms: u8) {
+    /// ahead by the base station and `lead_us` further by the host, was started at device time
+    /// `started_us` and produced at `done_us`. A burst after the start (a clock restarted by a
+    /// reattached device) is not a latency: skipped.
+    pub fn frame(&mut self, started_us: u64, done_us: u64, burst_us: u64, prediction_ms: u8, lead_us: u64) {
         if let Some(start) = started_us.checked_sub(burst_us) {
             self.started_us.push(start);
             self.samples_us.push(done_us.saturating_sub(burst_us).max(start));
             self.prediction_ms = prediction_ms;
+            self.leads_us.push(lead_us);
         }
+    }
+
+    /// The last frame's pose as reported less where the head was when the frame was done was
+    /// `reported_mm`, the pose drawn less it `drawn_mm`; the pose reported less where the head
+    /// was at the pose's own instant `tracking_mm`.
+    pub fn error(&mut self, reported_mm: [f64; 3], drawn_mm: [f64; 3], tracking_mm: [f64; 3]) {
+        self.errors_mm.push([reported_mm, drawn_mm, tracking_mm]);
+    }
+
+    /// The mean of the tracking errors ([`LatencySummary::bias_mm`]).
+    fn bias_mm(&self) -> [f64; 3] {
+        let n = self.errors_mm.len().max(1) as f64;
+        std::array::from_fn(|a| self.errors_mm.iter().map(|e| e[2][a]).sum::<f64>() / n)
+    }
+
+    /// The `k`th error of each frame less the bias, mm.
+    fn unbiased(&self, k: usize) -> Option<ErrorSummary> {
+        let b = self.bias_mm();
+        ErrorSummary::of(self.errors_mm.iter().map(|e| {
+            let d = e[k];
+            ((d[0] - b[0]).powi(2) + (d[1] - b[1]).powi(2) + (d[2] - b[2]).powi(2)).sqrt()
+        }))
     }
 
     /// The figures, once a frame was recorded.
@@ -78,6 +152,11 @@ impl HeadLatency {
             prediction_ms: self.prediction_ms,
             start_p50_ms: percentile_ms(&started, 0.5),
             start_p95_ms: percentile_ms(&started, 0.95),
+            host_lead_p50_ms: percentile_ms(&sorted(&self.leads_us), 0.5),
+            reported_error: self.unbiased(0),
+            drawn_error: self.unbiased(1),
+            tracking_error: self.unbiased(2),
+            bias_mm: self.bias_mm(),
         })
     }
 }
@@ -106,9 +185,9 @@ mod tests {
         // Ages 1..=20 ms, given out of order, each drawn in 1 ms; one frame started before its
         // burst is skipped.
         for k in (1..=20u64).rev() {
-            l.frame(100_000 + (k - 1) * 1000, 100_000 + k * 1000, 100_000, 20);
+            l.frame(100_000 + (k - 1) * 1000, 100_000 + k * 1000, 100_000, 20, k * 100);
         }
-        l.frame(5_000, 6_000, 9_000, 20);
+        l.frame(5_000, 6_000, 9_000, 20, 0);
         let s = l.summary().expect("frames");
         assert_eq!(s.frames, 20);
         // 10 of 20 at or below 10 ms; 19 of 20 at or below 19 ms.
@@ -117,5 +196,29 @@ mod tests {
         assert_eq!((s.start_p50_ms, s.start_p95_ms), (9.0, 18.0));
         assert!(s.meets_target());
         assert_eq!(s.uncovered_p95_ms(), -1.0);
+        // Leads of 0.1..=2 ms: 10 of 20 at or below 1 ms.
+        assert_eq!(s.host_lead_p50_ms, 1.0);
+        assert_eq!((s.reported_error, s.drawn_error, s.tracking_error), (None, None, None));
+    }
+
+    #[test]
+    fn errors_by_nearest_rank_and_their_rms() {
+        let mut l = HeadLatency::default();
+        l.frame(0, 1_000, 0, 20, 0);
+        // With a bias of 5 mm along x (the mean of the tracking errors, 3 and 7 mm): reported
+        // 1..=20 mm off along y, drawn 3 mm off along z, tracked 2 mm off along x.
+        for k in 1..=20 {
+            let tracked = if k % 2 == 0 { 3.0 } else { 7.0 };
+            l.error([5.0, f64::from(k), 0.0], [5.0, 0.0, 3.0], [tracked, 0.0, 0.0]);
+        }
+        let s = l.summary().expect("a frame");
+        let r = s.reported_error.expect("errors");
+        assert_eq!((r.p50_mm, r.p95_mm), (10.0, 19.0));
+        let mean_square = (1..=20).map(|k| f64::from(k * k)).sum::<f64>() / 20.0;
+        assert!((r.rms_mm - mean_square.sqrt()).abs() < 1e-12);
+        let d = s.drawn_error.expect("errors");
+        assert_eq!((d.p50_mm, d.p95_mm, d.rms_mm), (3.0, 3.0, 3.0));
+        assert_eq!(s.tracking_error.map(|t| t.p95_mm), Some(2.0));
+        assert_eq!(s.bias_mm, [5.0, 0.0, 0.0]);
     }
 }

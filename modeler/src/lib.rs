@@ -12,6 +12,7 @@
 #![cfg_attr(not(test), warn(clippy::unwrap_used))]
 
 pub mod feed;
+pub mod head_prediction;
 pub mod interaction;
 pub mod keys;
 pub mod latency;

@@ -4,6 +4,7 @@ use pen_host::events::{EventKind, PenEvent};
 use pen_host::transport::sim::DeviceClock;
 
 use crate::feed::{Calibrating, Feed};
+use crate::head_prediction::HeadPredictor;
 use crate::interaction::{Interaction, Tuning, View};
 use crate::latency::{HeadLatency, LatencySummary};
 use penmodel_terrain::document::{Document, Grid};
@@ -41,8 +42,18 @@ pub struct Session {
     state: State,
     events: u64,
     last_event_us: Option<u64>,
-    /// The tracked head's last pose, display-centred metres (issue 16).
-    head_m: Option<[f64; 3]>,
+    /// The tracked head's last pose as reported, display frame mm (issue 16).
+    head_mm: Option<[f64; 3]>,
+    /// The pose the frame being drawn takes: the last one carried on to the frame's expected
+    /// end ([`crate::head_prediction`]), until the next pose comes.
+    head_drawn_mm: Option<[f64; 3]>,
+    /// The host's prediction of the head.
+    predictor: HeadPredictor,
+    /// How far the frame being drawn carried the pose on, µs.
+    head_lead_us: u64,
+    /// The head's true path, device µs to display mm, when the feed is a simulation that knows
+    /// it: how far the poses drawn are from it is measured.
+    head_truth: Option<HeadTruth>,
     /// The device time of that pose's burst, and how far past it the pose was predicted, ms.
     head_burst: Option<(u64, u8)>,
     /// Tracked poses taken.
@@ -53,7 +64,12 @@ pub struct Session {
     latency: HeadLatency,
     /// When the frame being drawn was started, device µs.
     frame_started_us: Option<u64>,
+    /// And on the host's clock: its draw time.
+    frame_started_at: Option<std::time::Instant>,
 }
+
+/// The head's true path: device µs to the emitter's place, display frame mm.
+pub type HeadTruth = Box<dyn Fn(u64) -> [f64; 3] + Send>;
 
 impl Session {
     /// A session on `editor`, shown on a display of `display_mm` fitted to the document's grid.
@@ -67,12 +83,17 @@ impl Session {
             state: State::Running,
             events: 0,
             last_event_us: None,
-            head_m: None,
+            head_mm: None,
+            head_drawn_mm: None,
+            predictor: HeadPredictor::default(),
+            head_lead_us: 0,
+            head_truth: None,
             head_burst: None,
             head_poses: 0,
             clock: None,
             latency: HeadLatency::default(),
             frame_started_us: None,
+            frame_started_at: None,
         }
     }
 
@@ -137,15 +158,15 @@ impl Session {
         self.events += 1;
         if let Some((_, device_us)) = e.seq {
             self.last_event_us = Some(device_us);
+            self.predictor.arrived(device_us, e.t_us);
         }
         if let EventKind::Head(h) = &e.kind
             && let Some(at) = h.at
         {
-            // pend's pose is the last good one when held or refused: always usable. From the
-            // display frame (mm from the lower-left corner) to the camera's (metres from the
-            // centre); the emitter on the bridge stands for the point between the eyes.
-            let [w, hgt] = self.interaction.view().display_mm;
-            self.head_m = Some([(at.u_mm - 0.5 * w) * 1e-3, (at.v_mm - 0.5 * hgt) * 1e-3, at.h_mm * 1e-3]);
+            // pend's pose is the last good one when held or refused: always usable.
+            let mm = [at.u_mm, at.v_mm, at.h_mm];
+            self.head_mm = Some(mm);
+            self.head_drawn_mm = None;
             // A held or refused pose is an older burst's: its age is measured from this report
             // only when the report brought it.
             if h.status == pen_host::events::HeadStatus::Tracked
@@ -153,6 +174,7 @@ impl Session {
             {
                 self.head_burst = Some((device_us, h.prediction_ms));
                 self.head_poses += 1;
+                self.predictor.pose(device_us + u64::from(h.prediction_ms) * 1000, mm);
             }
         }
         self.interaction.handle(&mut self.editor, e);
@@ -161,13 +183,42 @@ impl Session {
     /// Where the tracked head is, once a head event gave a pose: the point between the eyes in
     /// the display's frame, metres from its centre (x right, y up the display, z towards the
     /// viewer), as the camera takes it.
+    /// The pose is the last one reported, or while a frame is drawn, the one it predicted.
     pub fn head_m(&self) -> Option<[f64; 3]> {
-        self.head_m
+        // From the display frame (mm from the lower-left corner) to the camera's (metres from
+        // the centre); the emitter on the bridge stands for the point between the eyes.
+        let [w, hgt] = self.interaction.view().display_mm;
+        self.head_drawn_mm
+            .or(self.head_mm)
+            .map(|p| [(p[0] - 0.5 * w) * 1e-3, (p[1] - 0.5 * hgt) * 1e-3, p[2] * 1e-3])
     }
 
-    /// A frame showing the session is about to be drawn: the device time it starts at.
+    /// The head's true path, for a simulation that knows it: frames then measure how far the
+    /// pose they drew is from where the head was when they were done.
+    pub fn set_head_truth(&mut self, truth: HeadTruth) {
+        self.head_truth = Some(truth);
+    }
+
+    /// A frame showing the session is about to be drawn: the device time it starts at. The
+    /// tracked head's pose is carried on to the frame's expected end: now plus the last frames'
+    /// median draw time ([`crate::head_prediction`]).
     pub fn frame_started(&mut self) {
         self.frame_started_us = self.paced_now_us();
+        self.frame_started_at = Some(std::time::Instant::now());
+        self.head_drawn_mm = None;
+        self.head_lead_us = 0;
+        // An unpaced simulation's device time is not now: nothing to predict to.
+        let now_us = match &self.clock {
+            Some(_) => self.frame_started_us,
+            None => self.predictor.device_at(unix_now_us()),
+        };
+        if let Some(now_us) = now_us.filter(|_| self.head_burst.is_some()) {
+            let end_us = now_us + self.predictor.expected_draw_us();
+            if let Some((mm, lead_us)) = self.predictor.predict(end_us) {
+                self.head_drawn_mm = Some(mm);
+                self.head_lead_us = lead_us;
+            }
+        }
     }
 
     /// A frame showing the session was just produced: with a tracked pose and the clock of a
@@ -177,9 +228,26 @@ impl Session {
     /// time to draw: nothing is measured.
     pub fn frame_produced(&mut self) {
         let started = self.frame_started_us.take();
+        if let Some(at) = self.frame_started_at.take() {
+            self.predictor.drawn(at.elapsed().as_micros() as u64);
+        }
         if let (Some(done_us), Some((burst_us, prediction_ms))) = (self.paced_now_us(), self.head_burst) {
-            self.latency
-                .frame(started.unwrap_or(done_us), done_us, burst_us, prediction_ms);
+            self.latency.frame(
+                started.unwrap_or(done_us),
+                done_us,
+                burst_us,
+                prediction_ms,
+                self.head_lead_us,
+            );
+            // How far the pose reported and the pose drawn are from where the head was.
+            if let (Some(truth), Some(reported)) = (&self.head_truth, self.head_mm) {
+                let true_mm = truth(done_us);
+                let drawn = self.head_drawn_mm.unwrap_or(reported);
+                let own = truth(burst_us + u64::from(prediction_ms) * 1000);
+                let less = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
+                self.latency
+                    .error(less(reported, true_mm), less(drawn, true_mm), less(reported, own));
+            }
         }
     }
 
@@ -245,6 +313,13 @@ impl Session {
     }
 }
 
+/// The host's clock, µs since the Unix epoch (as events are stamped).
+fn unix_now_us() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_micros() as u64)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -291,5 +366,50 @@ mod tests {
         session.event(&head(Some((400.0, 220.0, 650.0)), HeadStatus::Tracked));
         let [x, y, z] = session.head_m().expect("a pose");
         assert!((x - 0.1).abs() < 1e-12 && (y - 0.05).abs() < 1e-12 && (z - 0.65).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_frame_draws_the_head_carried_on_to_its_end() {
+        use pen_host::events::{DisplayPoint, HeadPose, HeadStatus};
+        let editor = Editor::new(blank_document()).expect("a valid document");
+        let mut session = Session::new(editor, [600.0, 340.0], Tuning::default());
+        // A head moving right at 0.1 mm/ms, reported every 15 ms, the last one 40 ms ago on the
+        // host's clock (a real base station: no simulated clock, the events' host stamps).
+        let host_now = unix_now_us();
+        let u_at = |device_us: u64| 300.0 + 1e-4 * device_us as f64;
+        for k in 0..6u16 {
+            let device_us = 1_000_000 + u64::from(k) * 15_000;
+            session.event(&PenEvent {
+                kind: EventKind::Head(HeadPose {
+                    at: Some(DisplayPoint {
+                        u_mm: u_at(device_us + 20_000),
+                        v_mm: 170.0,
+                        h_mm: 650.0,
+                        u_px: 0.0,
+                        v_px: 0.0,
+                    }),
+                    status: HeadStatus::Tracked,
+                    prediction_ms: 20,
+                    refused: 0,
+                    reason: None,
+                }),
+                t_us: host_now - 40_000 - u64::from(5 - k) * 15_000,
+                point: None,
+                sw: None,
+                seq: Some((k, device_us)),
+            });
+        }
+        let reported = session.head_m().expect("a pose")[0];
+        session.frame_started();
+        let drawn = session.head_m().expect("a pose")[0];
+        // The newest pose is for 20 ms past its burst, which was 40 ms ago: the frame's end is
+        // at least 20 ms later, so the pose is carried on along the motion by at least 2 mm, and
+        // by no more than the limit.
+        let ahead_m = drawn - reported;
+        assert!(ahead_m >= 1e-4 * 20_000.0 * 1e-3 - 1e-9, "{ahead_m}");
+        assert!(ahead_m <= 1e-4 * crate::head_prediction::MAX_LEAD_US as f64 * 1e-3 + 1e-9, "{ahead_m}");
+        // The next pose is drawn as reported until the next frame starts.
+        session.frame_produced();
+        assert_eq!(session.head_m().map(|h| h[0]), Some(drawn));
     }
 }

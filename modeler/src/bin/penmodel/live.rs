@@ -319,6 +319,14 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
         signal_hook::flag::register(signal, stop.clone()).context("installing signal handlers")?;
     }
     let demo_us = demo.then(|| (feed::demo_scenario().0.timeline.duration_s() * 1e6) as u64);
+    if let PenSource::Demo { seed, .. } = &source {
+        // The simulator knows where the viewer's head is: frames measure the prediction by it.
+        if let Some(viewer) = pen_sim::Simulation::new(&feed::demo_scenario().0, *seed).viewer() {
+            session.set_head_truth(Box::new(move |device_us| {
+                viewer.emitter_display(device_us as f64 * 1e-6).to_array()
+            }));
+        }
+    }
     // The pen thread is not joined: it notices the closed channel only at its next message, and
     // a silent pen (pend without a device, a base station unplugged) sends none. It ends with
     // the process; it holds nothing that needs closing beyond what the process's end closes.
@@ -475,17 +483,37 @@ fn head_latency_json(session: &Session) -> serde_json::Value {
             "prediction_ms": l.prediction_ms, "uncovered_p95_ms": l.uncovered_p95_ms(),
             "draw_start_p50_ms": l.start_p50_ms, "draw_start_p95_ms": l.start_p95_ms,
             "target_ms": penmodel::latency::TARGET_MS, "meets_target": l.meets_target(),
+            "host_lead_p50_ms": l.host_lead_p50_ms,
+            "reported_error_mm": error_json(l.reported_error), "drawn_error_mm": error_json(l.drawn_error),
+            "tracking_error_mm": error_json(l.tracking_error), "bias_mm": l.bias_mm,
         }),
     }
+}
+
+/// Distances of the poses from the head's true path, or null without it.
+fn error_json(e: Option<penmodel::latency::ErrorSummary>) -> serde_json::Value {
+    e.map_or(
+        serde_json::Value::Null,
+        |e| json!({"p50": e.p50_mm, "p95": e.p95_mm, "rms": e.rms_mm}),
+    )
 }
 
 /// The same for a person: emission to frame against the 20 ms target, and what prediction
 /// leaves uncovered.
 fn head_latency_line(session: &Session) -> Option<String> {
     let l = session.head_latency()?;
+    let truth = match (l.reported_error, l.drawn_error, l.tracking_error) {
+        (Some(r), Some(d), Some(t)) => format!(
+            "; from the true head when the frame was done: as reported p50 {:.1} / p95 {:.1} mm, as drawn p50 {:.1} / \
+             p95 {:.1} mm (at the pose's own instant p50 {:.1} / p95 {:.1} mm)",
+            r.p50_mm, r.p95_mm, d.p50_mm, d.p95_mm, t.p50_mm, t.p95_mm
+        ),
+        _ => String::new(),
+    };
     Some(format!(
         "head: emission to frame on the device's clock p50 {:.1} ms, p95 {:.1} ms, max {:.1} ms over {} \
-         (to the start of drawing p50 {:.1}, p95 {:.1}); target {} ms {}; predicted {} ms ahead, p95 uncovered {:.1} ms",
+         (to the start of drawing p50 {:.1}, p95 {:.1}); target {} ms {}; predicted {} ms ahead, p95 uncovered {:.1} ms, \
+         carried on by the host p50 {:.1} ms{truth}",
         l.p50_ms,
         l.p95_ms,
         l.max_ms,
@@ -496,6 +524,7 @@ fn head_latency_line(session: &Session) -> Option<String> {
         if l.meets_target() { "met" } else { "missed" },
         l.prediction_ms,
         l.uncovered_p95_ms(),
+        l.host_lead_p50_ms,
     ))
 }
 
