@@ -407,7 +407,10 @@ mod tests {
         // by no more than the limit.
         let ahead_m = drawn - reported;
         assert!(ahead_m >= 1e-4 * 20_000.0 * 1e-3 - 1e-9, "{ahead_m}");
-        assert!(ahead_m <= 1e-4 * crate::head_prediction::MAX_LEAD_US as f64 * 1e-3 + 1e-9, "{ahead_m}");
+        assert!(
+            ahead_m <= 1e-4 * crate::head_prediction::MAX_LEAD_US as f64 * 1e-3 + 1e-9,
+            "{ahead_m}"
+        );
         // The next pose is drawn as reported until the next frame starts.
         session.frame_produced();
         assert_eq!(session.head_m().map(|h| h[0]), Some(drawn));
