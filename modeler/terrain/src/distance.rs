@@ -39,81 +39,114 @@ pub(crate) fn on_edge(mask: &Mask, i: usize) -> bool {
     neighbours(mask, i).iter().any(|n| n.is_none_or(|j| !bits[j]))
 }
 
-/// The breadth-first search from the cells queued (each with its box column), which hold 0.
-/// Each queued cell carries its column so that finding its neighbours needs no division.
-fn bfs(mask: &Mask, dist: &mut [u32], queue: &mut Vec<(u32, u32)>) {
+/// A distance as a breadth-first search stores it: `u32` for the public maps, `f32` for the
+/// maps the engine reads (whole numbers, exact in `f32` below 2^24, a bound the grid's cell
+/// limit keeps), so that the engine's maps need no second pass to convert them.
+trait Level: Copy + PartialEq {
+    const ZERO: Self;
+    const UNSEEN: Self;
+    fn next(self) -> Self;
+}
+
+impl Level for u32 {
+    const ZERO: u32 = 0;
+    const UNSEEN: u32 = UNREACHABLE;
+    fn next(self) -> u32 {
+        self + 1
+    }
+}
+
+impl Level for f32 {
+    const ZERO: f32 = 0.0;
+    const UNSEEN: f32 = f32::INFINITY;
+    fn next(self) -> f32 {
+        self + 1.0
+    }
+}
+
+/// The breadth-first search from the cells of `front` (each with its box column), which hold 0,
+/// one layer at a time: each queued cell carries its column so that finding its neighbours needs
+/// no division, and only two layers are held (not every cell of the box), so they stay in the
+/// cache.
+fn bfs<D: Level>(mask: &Mask, dist: &mut [D], mut front: Vec<(u32, u32)>) {
     let bits = mask.bits();
     let (w, n) = (mask.width as usize, bits.len());
-    let mut head = 0;
-    while head < queue.len() {
-        let (i, x) = queue[head];
-        let (i, x) = (i as usize, x as usize);
-        head += 1;
-        let d = dist[i] + 1;
-        let mut visit = |j: usize, xj: usize| {
-            if bits[j] && dist[j] == UNREACHABLE {
-                dist[j] = d;
-                queue.push((j as u32, xj as u32));
+    let mut next = Vec::with_capacity(front.len());
+    let mut d = D::ZERO;
+    while !front.is_empty() {
+        d = d.next();
+        for &(i, x) in &front {
+            let (i, x) = (i as usize, x as usize);
+            let mut visit = |j: usize, xj: usize| {
+                if dist[j] == D::UNSEEN && bits[j] {
+                    dist[j] = d;
+                    next.push((j as u32, xj as u32));
+                }
+            };
+            // The order of `neighbours`: left, right, up, down.
+            if x > 0 {
+                visit(i - 1, x - 1);
             }
-        };
-        // The order of `neighbours`: left, right, up, down.
-        if x > 0 {
-            visit(i - 1, x - 1);
+            if x + 1 < w {
+                visit(i + 1, x + 1);
+            }
+            if i >= w {
+                visit(i - w, x);
+            }
+            if i + w < n {
+                visit(i + w, x);
+            }
         }
-        if x + 1 < w {
-            visit(i + 1, x + 1);
-        }
-        if i >= w {
-            visit(i - w, x);
-        }
-        if i + w < n {
-            visit(i + w, x);
+        front.clear();
+        std::mem::swap(&mut front, &mut next);
+    }
+}
+
+/// [`from_sources`] in either storage.
+fn search_from<D: Level>(mask: &Mask, sources: &[Cell]) -> Vec<D> {
+    let mut dist = vec![D::UNSEEN; mask.box_len()];
+    let mut front = Vec::new();
+    for &s in sources {
+        if let Some(i) = mask.index(s).filter(|&i| mask.bits()[i] && dist[i] != D::ZERO) {
+            dist[i] = D::ZERO;
+            front.push((i as u32, s.0 - mask.c0));
         }
     }
+    bfs(mask, &mut dist, front);
+    dist
+}
+
+/// [`edge_layers`] in either storage.
+fn search_edge<D: Level>(mask: &Mask) -> Vec<D> {
+    let mut dist = vec![D::UNSEEN; mask.box_len()];
+    let mut front = Vec::new();
+    let w = (mask.width as usize).max(1);
+    for (i, &inside) in mask.bits().iter().enumerate() {
+        if inside && on_edge(mask, i) {
+            dist[i] = D::ZERO;
+            front.push((i as u32, (i % w) as u32));
+        }
+    }
+    bfs(mask, &mut dist, front);
+    dist
 }
 
 /// `dp`: the distance of every region cell from the nearest of `sources`, moving through region
 /// cells only. Sources outside the region are ignored.
 pub fn from_sources(mask: &Mask, sources: &[Cell]) -> Vec<u32> {
-    let mut dist = vec![UNREACHABLE; mask.box_len()];
-    let mut queue = Vec::with_capacity(mask.box_len());
-    for &s in sources {
-        if let Some(i) = mask.index(s).filter(|&i| mask.bits()[i] && dist[i] != 0) {
-            dist[i] = 0;
-            queue.push((i as u32, s.0 - mask.c0));
-        }
-    }
-    bfs(mask, &mut dist, &mut queue);
-    dist
+    search_from(mask, sources)
 }
 
 /// `df`: the layer count from the region's edge. Region cells with a 4-neighbour outside the
 /// region (or the grid) are 0, the next layer 1, and so on.
 pub fn edge_layers(mask: &Mask) -> Vec<u32> {
-    let mut dist = vec![UNREACHABLE; mask.box_len()];
-    let mut queue = Vec::with_capacity(mask.box_len());
-    let w = (mask.width as usize).max(1);
-    for (i, &inside) in mask.bits().iter().enumerate() {
-        if inside && on_edge(mask, i) {
-            dist[i] = 0;
-            queue.push((i as u32, (i % w) as u32));
-        }
-    }
-    bfs(mask, &mut dist, &mut queue);
-    dist
-}
-
-/// A taxicab map as the engine reads it: [`UNREACHABLE`] becomes infinite.
-fn real(d: Vec<u32>) -> Vec<f32> {
-    d.into_iter()
-        .map(|d| if d == UNREACHABLE { f32::INFINITY } else { d as f32 })
-        .collect()
+    search_edge(mask)
 }
 
 /// `dp` in `metric`: [`from_sources`] or [`edt::from_sources`].
 pub fn figure_map(metric: Metric, mask: &Mask, sources: &[Cell]) -> Vec<f32> {
     match metric {
-        Metric::Taxicab => real(from_sources(mask, sources)),
+        Metric::Taxicab => search_from(mask, sources),
         Metric::Euclidean => edt::from_sources(mask, sources),
     }
 }
@@ -121,7 +154,7 @@ pub fn figure_map(metric: Metric, mask: &Mask, sources: &[Cell]) -> Vec<f32> {
 /// `df` in `metric`: [`edge_layers`] or [`edt::to_edge`].
 pub fn edge_map(metric: Metric, mask: &Mask) -> Vec<f32> {
     match metric {
-        Metric::Taxicab => real(edge_layers(mask)),
+        Metric::Taxicab => search_edge(mask),
         Metric::Euclidean => edt::to_edge(mask),
     }
 }

@@ -31,6 +31,15 @@ const FAR: u32 = u32::MAX;
 /// Squared Euclidean distance from each cell of a `w × h` box (row-major) to the nearest cell
 /// where `source` is true, or `u64::MAX` when there is no source at all.
 pub fn squared(w: usize, h: usize, source: &[bool]) -> Vec<u64> {
+    let mut out = vec![u64::MAX; w * h];
+    transform(w, h, source, &mut out, |_, d2| d2);
+    out
+}
+
+/// The squared distances of [`squared`] through `f` into `out` (cells of a row without any
+/// source are left as they are): the engine's maps take their square roots as each row is
+/// done, with no squared map in between.
+fn transform<O: Send>(w: usize, h: usize, source: &[bool], out: &mut [O], f: impl Fn(usize, u64) -> O + Sync) {
     debug_assert_eq!(source.len(), w * h);
     // Column pass: vertical distance to the nearest source in the column, two sweeps over rows
     // (row by row rather than column by column, for the cache).
@@ -51,26 +60,29 @@ pub fn squared(w: usize, h: usize, source: &[bool]) -> Vec<u64> {
             }
         }
     }
-    let mut out = vec![u64::MAX; w * h];
     if w.max(h) <= NARROW_SIDE {
-        rows::<i64>(w, &g, &mut out);
+        rows::<i64, O>(w, &g, out, &f);
     } else {
-        rows::<i128>(w, &g, &mut out);
+        rows::<i128, O>(w, &g, out, &f);
     }
-    out
 }
 
 /// The longest box side whose envelope fractions fit `i64`: numerators are at most
 /// `2·side²` (2^41) and denominators `2·side` (2^21), so their cross products stay below 2^62.
 const NARROW_SIDE: usize = 1 << 20;
 
-/// The row pass over `g`'s rows into `out`, rows in parallel, with fractions in `T`.
-fn rows<T: Wide>(w: usize, g: &[u32], out: &mut [u64]) {
+/// The row pass over `g`'s rows into `out` (each squared distance through `f`, with its box
+/// index), rows in parallel, with fractions in `T`.
+fn rows<T: Wide, O: Send>(w: usize, g: &[u32], out: &mut [O], f: &(impl Fn(usize, u64) -> O + Sync)) {
     let w1 = w.max(1);
     g.par_chunks(w1)
         .zip(out.par_chunks_mut(w1))
+        .enumerate()
         .with_min_len(16)
-        .for_each_init(|| Envelope::<T>::with_capacity(w), |env, (row, dst)| env.row(row, dst));
+        .for_each_init(
+            || Envelope::<T>::with_capacity(w),
+            |env, (y, (row, dst))| env.row(row, dst, |x, d2| f(y * w1 + x, d2)),
+        );
 }
 
 /// The integer type of the envelope's fractions: `i64` for boxes up to [`NARROW_SIDE`] a side,
@@ -111,7 +123,7 @@ impl<T: Wide> Envelope<T> {
     }
 
     /// The squared distances of one row from its columns' vertical distances `g`.
-    fn row(&mut self, g: &[u32], out: &mut [u64]) {
+    fn row<O>(&mut self, g: &[u32], out: &mut [O], f: impl Fn(usize, u64) -> O) {
         self.v.clear();
         self.f.clear();
         self.z.clear();
@@ -156,7 +168,7 @@ impl<T: Wide> Envelope<T> {
                 k += 1;
             }
             let dx = x - self.v[k];
-            *d = (dx * dx + self.f[k]) as u64;
+            *d = f(x as usize, (dx * dx + self.f[k]) as u64);
         }
     }
 }
@@ -172,17 +184,15 @@ pub fn from_sources(mask: &Mask, sources: &[Cell]) -> Vec<f32> {
             src[i] = true;
         }
     }
-    let d2 = squared(mask.width as usize, mask.height as usize, &src);
-    bits.iter()
-        .zip(&d2)
-        .map(|(&inside, &d2)| {
-            if inside && d2 != u64::MAX {
-                (d2 as f64).sqrt() as f32
-            } else {
-                f32::INFINITY
-            }
-        })
-        .collect()
+    let mut out = vec![f32::INFINITY; mask.box_len()];
+    transform(mask.width as usize, mask.height as usize, &src, &mut out, |i, d2| {
+        if bits[i] {
+            (d2 as f64).sqrt() as f32
+        } else {
+            f32::INFINITY
+        }
+    });
+    out
 }
 
 /// `df` in the Euclidean metric: for every region cell, the distance to the nearest cell outside
@@ -251,8 +261,8 @@ mod tests {
                 .unwrap_or(FAR);
         }
         let (mut narrow, mut wide) = (vec![u64::MAX; w * h], vec![u64::MAX; w * h]);
-        rows::<i64>(w, &g, &mut narrow);
-        rows::<i128>(w, &g, &mut wide);
+        rows::<i64, u64>(w, &g, &mut narrow, &|_, d2| d2);
+        rows::<i128, u64>(w, &g, &mut wide, &|_, d2| d2);
         assert_eq!(narrow, full);
         assert_eq!(wide, full);
     }

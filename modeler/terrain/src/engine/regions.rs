@@ -28,7 +28,10 @@
 //!   change, and every shape is computed again.
 //!
 //! The per-cell work runs on all cores (rayon), in bands of rows; the figures' distance maps of
-//! a region are computed in parallel.
+//! a region are computed in parallel. Within a row the cells are taken a stretch at a time (an
+//! owned run, or its dirty cells), each step over the whole stretch for one figure, in figure
+//! order: every cell still sees the arithmetic of a cell-by-cell evaluation, and the loops over
+//! the stretch (the sums of a paint, the shares) compile to vector instructions.
 
 use rayon::prelude::*;
 
@@ -127,20 +130,6 @@ fn share_of(norm: f64, dp: f32, inv: impl FnOnce() -> f64) -> f32 {
     }
 }
 
-/// Eq. 3's normaliser of a cell from its figures' distances, in figure order; `inv` gets each
-/// figure's inverse distance when the cell is on none of them (for [`share_of`]).
-fn normaliser(dps: &[&[f32]], i: usize, inv: &mut [f64]) -> f64 {
-    let on = dps.iter().filter(|d| d[i] == 0.0).count();
-    if on > 0 {
-        -(on as f64)
-    } else {
-        for (v, d) in inv.iter_mut().zip(dps) {
-            *v = profile::inverse_distance_real(f64::from(d[i]));
-        }
-        inv.iter().sum()
-    }
-}
-
 /// The sign of a slope, as the kept logarithms are valid for it.
 fn sign(s: f64) -> i8 {
     if s > 0.0 {
@@ -197,6 +186,112 @@ fn dirty_rect(mask: &Mask, dirty: &[bool]) -> Rect {
             height: (r1 - r0 + 1) as u32,
         },
         None => Rect::EMPTY,
+    }
+}
+
+/// The stretches `start..end` of consecutive `true` in `flags`.
+fn stretches(flags: &[bool]) -> impl Iterator<Item = (usize, usize)> + '_ {
+    let mut x = 0;
+    std::iter::from_fn(move || {
+        x += flags.get(x..)?.iter().position(|&f| f)?;
+        let start = x;
+        x += flags[x..].iter().position(|&f| !f).unwrap_or(flags.len() - x);
+        Some((start, x))
+    })
+}
+
+/// What a blend computes, the same for every band.
+#[derive(Clone, Copy)]
+struct Blend<'a> {
+    slopes: &'a [f64],
+    /// Per figure, whether its logarithms are kept.
+    keep: &'a [bool],
+    outer: Option<f64>,
+    shapes: Shapes,
+}
+
+/// One band's slices of the region's and its figures' maps.
+struct Band<'b, 'm> {
+    norm: &'b mut [f64],
+    df: &'b [f32],
+    dps: &'b [&'m [f32]],
+    /// Per figure its shape, coefficient and logarithm.
+    maps: &'b mut [(&'m mut [f32], &'m mut [f32], &'m mut [f32])],
+}
+
+/// Per-stretch working rows of a band: each figure's inverse distances, the cells' sums of them
+/// and counts of figures stood on.
+struct Scratch {
+    inv: Vec<f64>,
+    sum: Vec<f64>,
+    on: Vec<u32>,
+    width: usize,
+}
+
+impl Scratch {
+    fn new(figures: usize, width: usize) -> Scratch {
+        Scratch {
+            inv: vec![0.0; figures * width],
+            sum: vec![0.0; width],
+            on: vec![0; width],
+            width,
+        }
+    }
+}
+
+impl Band<'_, '_> {
+    /// Eq. 3's normaliser, the shapes `how` names and every figure's coefficient on the band's
+    /// cells `cells` (a stretch of one row): each step over the stretch for one figure at a time,
+    /// in figure order, so that each cell sees the arithmetic of a cell-by-cell evaluation.
+    fn blend(self, cells: std::ops::Range<usize>, scratch: &mut Scratch, how: Blend) {
+        let Band { norm, df, dps, maps } = self;
+        let (a, len) = (cells.start, cells.len());
+        let width = scratch.width;
+        let (sum, on) = (&mut scratch.sum[..len], &mut scratch.on[..len]);
+        sum.fill(0.0);
+        on.fill(0);
+        for (dp, inv) in dps.iter().zip(scratch.inv.chunks_mut(width)) {
+            for (((v, s), n), &d) in inv[..len]
+                .iter_mut()
+                .zip(&mut *sum)
+                .zip(&mut *on)
+                .zip(&dp[cells.clone()])
+            {
+                *v = profile::inverse_distance_real(f64::from(d));
+                *s += *v;
+                *n += u32::from(d == 0.0);
+            }
+        }
+        let norm = &mut norm[cells.clone()];
+        for ((out, &s), &n) in norm.iter_mut().zip(&*sum).zip(&*on) {
+            *out = if n > 0 { -f64::from(n) } else { s };
+        }
+        let df = &df[cells.clone()];
+        for (k, ((dp, (shape_k, coef_k, log_k)), inv)) in dps
+            .iter()
+            .zip(maps.iter_mut())
+            .zip(scratch.inv.chunks(width))
+            .enumerate()
+        {
+            let dp = &dp[cells.clone()];
+            let (shape_k, coef_k) = (&mut shape_k[cells.clone()], &mut coef_k[cells.clone()]);
+            if how.shapes.has(k) {
+                let s1 = how.slopes[k];
+                let cells = shape_k.iter_mut().zip(df).zip(dp);
+                if how.keep[k] {
+                    for (((sh, &f), &d), l) in cells.zip(&mut log_k[a..a + len]) {
+                        (*sh, *l) = shape(f, d, s1, how.outer, None);
+                    }
+                } else {
+                    for ((sh, &f), &d) in cells {
+                        *sh = shape(f, d, s1, how.outer, None).0;
+                    }
+                }
+            }
+            for ((((c, &sh), &n), &d), &v) in coef_k.iter_mut().zip(&*shape_k).zip(&*norm).zip(dp).zip(&inv[..len]) {
+                *c = sh * share_of(n, d, || v);
+            }
+        }
     }
 }
 
@@ -493,27 +588,38 @@ impl RegionNode {
             bands.push((b, norm, df, dps, maps));
         }
         let (owned, row_runs) = (&*owned, &*row_runs);
+        let (slopes, keep) = (&slopes[..], &keep[..]);
         bands.into_par_iter().for_each(|(b, norm, df, dps, mut maps)| {
-            let row0 = b * BAND_ROWS;
-            let mut inv = vec![0.0; dps.len()];
-            for r in 0..norm.len() / w {
+            let (row0, rows) = (b * BAND_ROWS, norm.len() / w);
+            let mut scratch = Scratch::new(dps.len(), w);
+            let mut cells = |a: usize, e: usize| {
+                let band = Band {
+                    norm: &mut *norm,
+                    df,
+                    dps: &dps,
+                    maps: &mut maps,
+                };
+                band.blend(
+                    a..e,
+                    &mut scratch,
+                    Blend {
+                        slopes,
+                        keep,
+                        outer,
+                        shapes,
+                    },
+                );
+            };
+            for r in 0..rows {
                 for run in &owned[row_runs[row0 + r]..row_runs[row0 + r + 1]] {
-                    for x in run.start as usize..run.end as usize {
-                        let i = r * w + x;
-                        if dirty.is_some_and(|d| !d[row0 * w + i]) {
-                            continue;
-                        }
-                        let n = normaliser(&dps, i, &mut inv);
-                        norm[i] = n;
-                        for (k, (dp, (shape_k, coef_k, log_k))) in dps.iter().zip(maps.iter_mut()).enumerate() {
-                            if shapes.has(k) {
-                                let (sh, l) = shape(df[i], dp[i], slopes[k], outer, None);
-                                shape_k[i] = sh;
-                                if keep[k] {
-                                    log_k[i] = l;
-                                }
+                    let (a, e) = (r * w + run.start as usize, r * w + run.end as usize);
+                    match dirty {
+                        None => cells(a, e),
+                        // The run's stretches of dirty cells.
+                        Some(d) => {
+                            for (s, t) in stretches(&d[row0 * w + a..row0 * w + e]) {
+                                cells(a + s, a + t);
                             }
-                            coef_k[i] = shape_k[i] * share_of(n, dp[i], || inv[k]);
                         }
                     }
                 }
@@ -549,13 +655,25 @@ impl RegionNode {
             .enumerate()
             .for_each(|(r, ((shape_row, coef_row), log_row))| {
                 for run in &owned[row_runs[r]..row_runs[r + 1]] {
-                    for x in run.start as usize..run.end as usize {
-                        let i = r * w + x;
-                        let (s, l) = shape(df[i], dp[i], s1, outer, reuse.then_some(log_row[x]));
-                        shape_row[x] = s;
-                        coef_row[x] = s * share(norm[i], dp[i]);
-                        if keep {
-                            log_row[x] = l;
+                    let xs = run.start as usize..run.end as usize;
+                    let i0 = r * w + xs.start;
+                    let (df, dp, norm) = (&df[i0..], &dp[i0..], &norm[i0..]);
+                    let cells = shape_row[xs.clone()].iter_mut().zip(&mut coef_row[xs.clone()]);
+                    if reuse && s1 != 0.0 {
+                        // The kept logarithm and the slope make the shape: eq. 1's `w`, which
+                        // `shape_from_log` reads only at slope 0, is not needed.
+                        for ((((sh, c), &l), &d), &n) in cells.zip(&log_row[xs]).zip(dp).zip(norm) {
+                            *sh = profile::shape_from_log(0.0, l, s1) as f32;
+                            *c = *sh * share(n, d);
+                        }
+                    } else {
+                        for (((((sh, c), l), &f), &d), &n) in cells.zip(&mut log_row[xs]).zip(df).zip(dp).zip(norm) {
+                            let (s, kept) = shape(f, d, s1, outer, reuse.then_some(*l));
+                            *sh = s;
+                            *c = s * share(n, d);
+                            if keep {
+                                *l = kept;
+                            }
                         }
                     }
                 }
@@ -578,17 +696,25 @@ impl RegionNode {
             .par_chunks_mut(cols)
             .enumerate()
             .for_each(|(r, line)| {
+                // A stretch of cells, one figure at a time: each cell's sum in figure order.
+                let paint = |a: usize, e: usize, line: &mut [f32]| {
+                    let out = &mut line[c0 + a - r * w..c0 + e - r * w];
+                    out.fill(base);
+                    for (coef, &rel) in coefs.iter().zip(&reliefs) {
+                        for (d, &c) in out.iter_mut().zip(&coef[a..e]) {
+                            *d += rel * c;
+                        }
+                    }
+                };
                 for run in self.runs(r) {
-                    for x in run.start as usize..run.end as usize {
-                        let i = r * w + x;
-                        if dirty.is_some_and(|d| !d[i]) {
-                            continue;
+                    let (a, e) = (r * w + run.start as usize, r * w + run.end as usize);
+                    match dirty {
+                        None => paint(a, e, line),
+                        Some(d) => {
+                            for (s, t) in stretches(&d[a..e]) {
+                                paint(a + s, a + t, line);
+                            }
                         }
-                        let mut d = base;
-                        for (coef, &rel) in coefs.iter().zip(&reliefs) {
-                            d += rel * coef[i];
-                        }
-                        line[c0 + x] = d;
                     }
                 }
             });
