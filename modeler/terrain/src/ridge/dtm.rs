@@ -78,7 +78,8 @@ impl Dtm {
             cell: cell_size,
             filter,
             raw: vec![0.0; n],
-            winner: vec![NONE; n],
+            // Filled on all cores (4 bytes a cell to write and fault in).
+            winner: rayon::iter::repeat_n(NONE, n).collect(),
             hole: vec![false; n],
             out: vec![0.0; n],
             slots: Vec::new(),
