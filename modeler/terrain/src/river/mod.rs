@@ -30,6 +30,7 @@ pub mod morph;
 pub mod near;
 
 use glam::DVec2;
+use rayon::prelude::*;
 
 use crate::document::{Grid, River};
 use course::Sample;
@@ -316,29 +317,64 @@ impl Shape {
     }
 
     /// The cells the next iteration adds to the water (outer banks) and removes from it (inner
-    /// banks), as window indices.
+    /// banks), as window indices in increasing order.
+    ///
+    /// A land cell joins when water is within its sample's reach (`level − 1` city-block steps),
+    /// a water cell leaves when land of the window is: the water and the land are dilated by one
+    /// cross after another on bit-packed images ([`morph::Bits`]), and only the cells within the
+    /// largest reach of the other value (the banks) are looked at.
     fn changes(&self) -> (Vec<usize>, Vec<usize>) {
         let (w, h) = (self.window.width, self.window.height);
-        // Land cells: the distance to the water; water cells: to the land.
-        let to_other = morph::distance_to_other(&self.mask, w, h);
         let (mut add, mut remove) = (Vec::new(), Vec::new());
-        for (i, &o) in self.near.owner.iter().enumerate() {
-            if o == NONE {
-                continue;
+        let most = self.levels.iter().max().map_or(0, |&l| usize::from(l.max(1)) - 1);
+        if most == 0 || w == 0 {
+            return (add, remove);
+        }
+        // `near_water[r]`: the cells within r steps of the water; `near_land[r]`: of the land.
+        let grow = |first: morph::Bits| {
+            let mut all = vec![first];
+            for r in 1..=most {
+                let mut next = morph::Bits::empty(w, h);
+                all[r - 1].cross(&mut next, true);
+                all.push(next);
             }
-            let (reach, turn) = (u16::from(self.levels[o as usize]) - 1, self.turns[o as usize]);
-            let side = self.near.side[i];
-            if reach == 0 || turn == 0 || side == 0 {
-                continue;
-            }
-            // Bending left, the centre of the bend is on the left: the outer bank is the right.
-            let outer = side == -turn;
-            if self.mask[i] == 0 {
-                if outer && to_other[i] <= reach {
-                    add.push(i);
+            all
+        };
+        let water = morph::Bits::of(&self.mask, w, h, true);
+        let mut land = morph::Bits::empty(w, h);
+        water.complement(&mut land);
+        let (near_water, near_land) = (grow(water), grow(land));
+        let (water, land) = (&near_water[0], &near_land[0]);
+        for r in 0..h {
+            let banks = (land.row(r).iter().zip(near_water[most].row(r)))
+                .zip(water.row(r).iter().zip(near_land[most].row(r)))
+                .map(|((l, nw), (wa, nl))| (l & nw) | (wa & nl));
+            for (k, mut word) in banks.enumerate() {
+                while word != 0 {
+                    let c = k * 64 + word.trailing_zeros() as usize;
+                    word &= word - 1;
+                    let i = r * w + c;
+                    let o = self.near.owner[i];
+                    if o == NONE {
+                        continue;
+                    }
+                    let (reach, turn) = (usize::from(self.levels[o as usize]) - 1, self.turns[o as usize]);
+                    let side = self.near.side[i];
+                    if reach == 0 || turn == 0 || side == 0 {
+                        continue;
+                    }
+                    // Bending left, the centre of the bend is on the left: the outer bank is the
+                    // right.
+                    let outer = side == -turn;
+                    let at = |b: &morph::Bits| b.row(r)[k] >> (c % 64) & 1 != 0;
+                    if self.mask[i] == 0 {
+                        if outer && at(&near_water[reach]) {
+                            add.push(i);
+                        }
+                    } else if !outer && at(&near_land[reach]) {
+                        remove.push(i);
+                    }
                 }
-            } else if !outer && to_other[i] <= reach {
-                remove.push(i);
             }
         }
         (add, remove)
@@ -401,14 +437,27 @@ impl Shape {
         // The plug: lake cells next to the river's new course silt up; in the same pass, the
         // river's area and each lake's.
         let mut lake_area = vec![0usize; self.necks.len() + 1];
-        let mut area = 0;
+        let area = self.mask.iter().filter(|&&m| m != 0).count();
         let plug = self.radius + PLUG;
-        for ((l, &m), &d) in self.lakes.iter_mut().zip(&self.mask).zip(&self.near.dist) {
-            if *l != 0 && (f64::from(d) <= plug || m != 0) {
-                *l = 0;
+        // Once a neck has closed, by runs of 64 cells: the lakes are few and small, so most runs
+        // have no lake cell.
+        if !self.necks.is_empty() {
+            let runs = self
+                .lakes
+                .chunks_mut(64)
+                .zip(self.mask.chunks(64))
+                .zip(self.near.dist.chunks(64));
+            for ((lakes, mask), dist) in runs {
+                if lakes.iter().all(|&l| l == 0) {
+                    continue;
+                }
+                for ((l, &m), &d) in lakes.iter_mut().zip(mask).zip(dist) {
+                    if *l != 0 && (f64::from(d) <= plug || m != 0) {
+                        *l = 0;
+                    }
+                    lake_area[*l as usize] += 1;
+                }
             }
-            area += usize::from(m != 0);
-            lake_area[*l as usize] += 1;
         }
         let first_new = self.necks.len() - cuts.len();
         record.oxbows = lake_area[first_new + 1..].to_vec();
@@ -431,7 +480,10 @@ impl Shape {
                 -left * turn * reach
             })
             .collect();
+        // Each sample on its own (the recentring walks across the water), so on the thread pool.
         let moved: Vec<DVec2> = (0..n)
+            .into_par_iter()
+            .with_min_len(256)
             .map(|i| {
                 let (a, b) = (i.saturating_sub(m), (i + m).min(n - 1));
                 let mean = raw[a..=b].iter().sum::<DVec2>() / (b - a + 1) as f64;
@@ -461,7 +513,8 @@ impl Shape {
     fn recentre(&self, p: DVec2, d1: DVec2) -> DVec2 {
         let normal = d1.normalize_or_zero().perp();
         let wet = |t: f64| -> bool {
-            let q = (p + normal * t - self.window.origin()).round();
+            let q = p + normal * t - self.window.origin();
+            let q = DVec2::new(near::round(q.x), near::round(q.y));
             q.x >= 0.0
                 && q.y >= 0.0
                 && (q.x as usize) < self.window.width

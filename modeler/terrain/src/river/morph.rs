@@ -161,21 +161,161 @@ fn separable(d: &mut [u16], width: usize, height: usize) {
     rayon::join(|| columns(left), || columns(right));
 }
 
-/// The image dilated by the diamond of `level` (the cells within `level − 1` of the set).
+/// The image dilated by the diamond of `level` (the cells within `level − 1` of the set): `level − 1`
+/// crosses on the bit-packed image ([`Bits`]).
 pub fn dilate(image: &[u8], width: usize, height: usize, level: u8) -> Vec<u8> {
-    let reach = u16::from(level.max(1)) - 1;
-    distance(image, width, height, true, false)
-        .into_iter()
-        .map(|d| u8::from(d <= reach))
-        .collect()
+    let mut bits = Bits::of(image, width, height, true);
+    let mut spare = Bits::empty(width, height);
+    for _ in 1..level.max(1) {
+        bits.cross(&mut spare, true);
+        std::mem::swap(&mut bits, &mut spare);
+    }
+    bits.to_bytes()
 }
 
 /// The image eroded by the diamond of `level` (the cells farther than `level − 1` from the
-/// complement, the outside counting as complement).
+/// complement, the outside counting as complement): `level − 1` crosses on the bit-packed image
+/// (eroding by a diamond is eroding by its crosses in turn, the outside unset each time).
 pub fn erode(image: &[u8], width: usize, height: usize, level: u8) -> Vec<u8> {
-    let reach = u16::from(level.max(1)) - 1;
-    distance(image, width, height, false, true)
-        .into_iter()
-        .map(|d| u8::from(d > reach))
-        .collect()
+    let mut bits = Bits::of(image, width, height, true);
+    let mut spare = Bits::empty(width, height);
+    for _ in 1..level.max(1) {
+        bits.cross(&mut spare, false);
+        std::mem::swap(&mut bits, &mut spare);
+    }
+    bits.to_bytes()
+}
+
+/// Eight cells (bytes, any non-zero value set) as the low eight bits of a word, the first cell
+/// lowest: each byte's "non-zero" moved to its bit 0, then one multiplication gathers the eight
+/// bits into the top byte (byte `i`'s bit lands at `56 + i`; the other products fall at distinct
+/// places below it or beyond the word, so nothing carries into it).
+fn pack8(eight: &[u8]) -> u64 {
+    let mut b = [0u8; 8];
+    b.copy_from_slice(eight);
+    let x = u64::from_le_bytes(b);
+    const LOW7: u64 = 0x7f7f_7f7f_7f7f_7f7f;
+    let nonzero = (((x & LOW7) + LOW7) | x) >> 7 & 0x0101_0101_0101_0101;
+    nonzero.wrapping_mul(0x0102_0408_1020_4080) >> 56
+}
+
+/// A binary image packed 64 cells to a word, row by row (each row starts a word; the bits past
+/// the width are 0). A cross over it is a few word operations per 64 cells, so the iterated
+/// crosses of a diamond cost less than one pass of a distance transform over bytes.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Bits {
+    width: usize,
+    height: usize,
+    /// Words per row.
+    stride: usize,
+    words: Vec<u64>,
+}
+
+impl Bits {
+    /// All cells unset.
+    pub fn empty(width: usize, height: usize) -> Bits {
+        let stride = width.div_ceil(64);
+        Bits {
+            width,
+            height,
+            stride,
+            words: vec![0; stride * height],
+        }
+    }
+
+    /// The cells of `image` (row-major 0/1) whose value is `value != 0`.
+    pub fn of(image: &[u8], width: usize, height: usize, value: bool) -> Bits {
+        let mut bits = Bits::empty(width, height);
+        bits.set_from(image, value);
+        bits
+    }
+
+    /// Sets the cells of `image` whose value is `value != 0`, the others unset.
+    pub fn set_from(&mut self, image: &[u8], value: bool) {
+        let flip = if value { 0 } else { u64::MAX };
+        if self.width == 0 {
+            return;
+        }
+        for (row, out) in image.chunks(self.width).zip(self.words.chunks_mut(self.stride)) {
+            for (cells, word) in row.chunks(64).zip(out.iter_mut()) {
+                let mut w = 0u64;
+                let mut eights = cells.chunks_exact(8);
+                for (j, eight) in eights.by_ref().enumerate() {
+                    w |= pack8(eight) << (8 * j);
+                }
+                let done = cells.len() / 8 * 8;
+                for (j, &v) in eights.remainder().iter().enumerate() {
+                    w |= u64::from(v != 0) << (done + j);
+                }
+                // The bits past the row's end stay 0 whichever value is asked for.
+                *word = (w ^ flip) & (u64::MAX >> (64 - cells.len()));
+            }
+        }
+    }
+
+    /// The cells of the window that are not set, into `out` (the same size).
+    pub fn complement(&self, out: &mut Bits) {
+        let tail = self.tail();
+        for (dst, src) in out.words.chunks_mut(self.stride).zip(self.words.chunks(self.stride)) {
+            for (k, (d, s)) in dst.iter_mut().zip(src).enumerate() {
+                *d = if k + 1 == self.stride { !s & tail } else { !s };
+            }
+        }
+    }
+
+    /// The bits of a row's last word that are cells.
+    fn tail(&self) -> u64 {
+        match self.width % 64 {
+            0 => u64::MAX,
+            k => u64::MAX >> (64 - k),
+        }
+    }
+
+    /// Whether cell `i` (row-major index) is set.
+    pub fn get(&self, i: usize) -> bool {
+        let (r, c) = (i / self.width, i % self.width);
+        self.words[r * self.stride + c / 64] >> (c % 64) & 1 != 0
+    }
+
+    /// The words of row `r`.
+    pub fn row(&self, r: usize) -> &[u64] {
+        &self.words[r * self.stride..(r + 1) * self.stride]
+    }
+
+    /// Words per row.
+    pub fn stride(&self) -> usize {
+        self.stride
+    }
+
+    /// The image as row-major 0/1 bytes.
+    pub fn to_bytes(&self) -> Vec<u8> {
+        (0..self.width * self.height).map(|i| u8::from(self.get(i))).collect()
+    }
+
+    /// One 4-neighbour cross into `out` (the same size): dilation (a cell or any of its four
+    /// neighbours set) or erosion (the cell and all four set, cells beyond the edge unset).
+    pub fn cross(&self, out: &mut Bits, dilate: bool) {
+        let (s, h) = (self.stride, self.height);
+        let tail = self.tail();
+        let zero = vec![0u64; s];
+        for r in 0..h {
+            let here = self.row(r);
+            let up = if r > 0 { self.row(r - 1) } else { &zero };
+            let down = if r + 1 < h { self.row(r + 1) } else { &zero };
+            let dst = &mut out.words[r * s..(r + 1) * s];
+            for k in 0..s {
+                let x = here[k];
+                // The left neighbour's bit moves up one place (from the word before at bit 0),
+                // the right neighbour's down one (from the word after at bit 63).
+                let left = x << 1 | if k > 0 { here[k - 1] >> 63 } else { 0 };
+                let right = x >> 1 | if k + 1 < s { here[k + 1] << 63 } else { 0 };
+                let w = if dilate {
+                    x | left | right | up[k] | down[k]
+                } else {
+                    x & left & right & up[k] & down[k]
+                };
+                dst[k] = if k + 1 == s { w & tail } else { w };
+            }
+        }
+    }
 }

@@ -118,8 +118,18 @@ fn fill(
         let after = widen((k + 1 < segs).then_some(k));
         let len2 = ab.length_squared();
         slab(win, rows.clone(), a, b, before, after, reach, |i, p| {
+            // `clamp(0, 1)` by hand: the same for a number, without `clamp`'s check of its bounds
+            // (a sixth of the field's instructions).
+            #[allow(clippy::manual_clamp)]
             let t = if len2 > 0.0 {
-                ((p - a).dot(ab) / len2).clamp(0.0, 1.0)
+                let t = (p - a).dot(ab) / len2;
+                if t < 0.0 {
+                    0.0
+                } else if t > 1.0 {
+                    1.0
+                } else {
+                    t
+                }
             } else {
                 0.0
             };
@@ -189,23 +199,35 @@ fn slab(
         return;
     }
     let (r0, r1) = (lo.y.ceil().max(0.0) as usize, hi.y.floor().min(h - 1.0) as usize);
+    // The rows the slab's own corners span (the box above is grown by `reach` both ways: for a
+    // segment along a column, 2·reach rows more than the slab's), and one more each side, so that
+    // the rows left out have no cell whatever the rounding of the bounds below.
+    let v = u.perp();
+    let ys = [lo_t, hi_t].map(|t| a.y + u.y * t);
+    let across = (v.y * reach).abs();
+    let (y0, y1) = (ys[0].min(ys[1]) - across - 1.0, ys[0].max(ys[1]) + across + 1.0);
+    let (r0, r1) = (r0.max(y0.max(0.0) as usize), r1.min(y1.max(0.0) as usize));
     let (cmin, cmax) = (lo.x.ceil().max(0.0), hi.x.floor().min(w - 1.0));
     for r in r0.max(rows.start)..(r1 + 1).min(rows.end) {
         let dy = r as f64 - a.y;
         // Along: s(c) = (c − a.x)·u.x + dy·u.y in [lo_t, hi_t]; across: n(c) = (c − a.x)·u.y − dy·u.x
-        // (up to sign) in [−reach, reach]. Both are linear in c.
-        let (mut c0, mut c1) = (cmin, cmax);
+        // (up to sign) in [−reach, reach]. Both are linear in c. The cells are the integers from
+        // the greatest lower bound to the least upper one: the ceiling of a maximum is the
+        // maximum of the ceilings, so one ceiling and one floor per row, of values held within
+        // a cell of `[cmin, cmax]` (integers), where they are small integers.
+        let (mut low, mut high) = (cmin, cmax);
         for (k, off, range) in [(u.x, dy * u.y, (lo_t, hi_t)), (u.y, -dy * u.x, (-reach, reach))] {
             if k.abs() < 1e-12 {
                 if off < range.0 || off > range.1 {
-                    c1 = c0 - 1.0;
+                    high = low - 1.0;
                 }
             } else {
                 let (x0, x1) = ((range.0 - off) / k + a.x, (range.1 - off) / k + a.x);
-                c0 = c0.max(ceil(x0.min(x1)));
-                c1 = c1.min(floor(x0.max(x1)));
+                low = low.max(x0.min(x1));
+                high = high.min(x0.max(x1));
             }
         }
+        let (c0, c1) = (ceil_small(low.min(cmax + 1.0)), floor_small(high.max(cmin - 1.0)));
         if c1 < c0 {
             continue;
         }
@@ -215,17 +237,30 @@ fn slab(
     }
 }
 
-/// `x.ceil()` up to the sign of a zero, inline: without SSE4.1 `f64::ceil` is a call into libm,
-/// and a slab pays two per row, which made it most of the field's time.
-fn ceil(x: f64) -> f64 {
-    let t = trunc(x);
-    if t < x { t + 1.0 } else { t }
+/// `x.ceil()` for `x` within `i32`'s range, as an integer: a truncation and a compare.
+fn ceil_small(x: f64) -> i32 {
+    let t = x as i32;
+    if f64::from(t) < x { t + 1 } else { t }
 }
 
-/// `x.floor()` up to the sign of a zero, inline (see [`ceil`]).
-fn floor(x: f64) -> f64 {
+/// `x.floor()` for `x` within `i32`'s range, as an integer (see [`ceil_small`]).
+fn floor_small(x: f64) -> i32 {
+    let t = x as i32;
+    if f64::from(t) > x { t - 1 } else { t }
+}
+
+/// `x.round()` (half away from zero) up to the sign of a zero, inline (without SSE4.1
+/// `f64::round` is a call into libm; the river's recentring paid one per step): the fraction `x − trunc(x)` is exact.
+pub(super) fn round(x: f64) -> f64 {
     let t = trunc(x);
-    if t > x { t - 1.0 } else { t }
+    let f = x - t;
+    if f >= 0.5 {
+        t + 1.0
+    } else if f <= -0.5 {
+        t - 1.0
+    } else {
+        t
+    }
 }
 
 /// `x` rounded towards zero; values of 2⁵² and more (and NaN, ∞) are already whole.
