@@ -258,15 +258,14 @@ pub fn draw<S: Sink>(p: &Projected, near: f32, bounds: &Bounds, sink: &mut S) {
             if ch.state == ChunkState::Direct && (span.1 <= bounds.y0 || span.0 >= bounds.y1) {
                 continue;
             }
-            // The row's stitched vertex indices, once per vertex rather than once per quad corner.
-            let (mut top, mut bottom) = ([0usize; PITCH], [0usize; PITCH]);
-            for qc in 0..=ch.nc {
-                top[qc] = ch.index(qc, qr);
-                bottom[qc] = ch.index(qc, qr + 1);
-            }
             for qc in 0..ch.nc {
                 // As the full grid: (a, b, d) and (b, e, d), split along b–d.
-                let (a, bb, d, e) = (top[qc], top[qc + 1], bottom[qc], bottom[qc + 1]);
+                let (a, bb, d, e) = (
+                    ch.index(qc, qr),
+                    ch.index(qc + 1, qr),
+                    ch.index(qc, qr + 1),
+                    ch.index(qc + 1, qr + 1),
+                );
                 if ch.state == ChunkState::Direct {
                     let (va, vb, vd, ve) = (&v[a], &v[bb], &v[d], &v[e]);
                     if rasterise::holds_no_pixel([va, vb, vd, ve], bounds) {
