@@ -3,10 +3,15 @@
 //! 4-neighbour crosses (level 1 is the single cell, the identity).
 //!
 //! Dilating by it keeps every cell within city-block distance `n − 1` of the set; eroding keeps
-//! every cell farther than `n − 1` from the complement. Both read one city-block distance
-//! transform ([`distance`]): two raster passes, exact for the 4-neighbour metric, so the cost is
-//! two sweeps of the image whatever the level. Cells outside the image count as background, as in
-//! `scipy.ndimage.binary_dilation`/`binary_erosion` with their default `border_value=0`.
+//! every cell farther than `n − 1` from the complement. Both are `n − 1` crosses on the image
+//! packed 64 cells to a word ([`Bits`]): a few word operations per 64 cells and cross, so even
+//! the largest diamond costs less than one pass over the bytes. Cells outside the image count as
+//! background, as in `scipy.ndimage.binary_dilation`/`binary_erosion` with their default
+//! `border_value=0`. The river's yearly step uses the same crosses ([`super::Shape`]).
+//!
+//! [`distance`] and [`distance_to_other`] (city-block distance transforms, two raster passes
+//! whatever the level) did both before the crosses; they stay for callers that want the
+//! distances themselves.
 
 /// The largest structuring-element level (the seed's 6: an 11 × 11 diamond).
 pub const MAX_LEVEL: u8 = 6;
