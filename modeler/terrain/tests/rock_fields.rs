@@ -425,3 +425,57 @@ fn a_local_change_of_the_terrain_reseats_the_rocks_over_it_as_a_whole_reseat_wou
     );
     assert_ne!(stale, fresh, "the blocks over the change were skipped");
 }
+
+/// A seated mesh's normals are its triangles' area-weighted normals (summed here in f64 from
+/// its positions), on a slope and at a field cell of 0.7 m away from the origin, moved or not.
+#[test]
+fn seated_rocks_have_their_triangles_area_weighted_normals() {
+    use penmodel_terrain::rocks::place::{Flat, Placement, Samples};
+    use penmodel_terrain::rocks::{Recipe, scatter};
+    let n = 96u32;
+    let s = scatter(&Recipe::figure_1(n, n, 5), None).expect("a valid recipe");
+    let flat = Flat::of(&s);
+    let hill = |x: f64, y: f64| (4.0 * (x / 13.0).sin() * (y / 19.0).cos() + 0.3 * x) as f32;
+    let heights: Vec<f32> = (0..n * n).map(|i| hill(f64::from(i % n), f64::from(i / n))).collect();
+    let map = Heightmap::from_heights(n, n, 1.0, heights).expect("heights");
+    let (mut mesh, mut samples) = (Default::default(), Samples::default());
+    for origin in [[3.0, 5.0], [3.25, 5.5], [3.25, 5.5]] {
+        let at = Placement { origin, cell_size: 0.7 };
+        flat.seat_on(at, &map, &mut samples, &mut mesh);
+        let p: Vec<[f64; 3]> = mesh.positions.iter().map(|p| p.map(f64::from)).collect();
+        let mut sums = vec![[0.0f64; 3]; p.len()];
+        for t in mesh.indices.chunks_exact(3) {
+            let [a, b, c] = [t[0], t[1], t[2]].map(|i| p[i as usize]);
+            let (u, w) = (
+                [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+                [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+            );
+            let cross = [
+                u[1] * w[2] - u[2] * w[1],
+                u[2] * w[0] - u[0] * w[2],
+                u[0] * w[1] - u[1] * w[0],
+            ];
+            for &i in t {
+                for k in 0..3 {
+                    sums[i as usize][k] += cross[k];
+                }
+            }
+        }
+        let mut checked = 0;
+        for (s, m) in sums.iter().zip(&mesh.normals) {
+            let len = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
+            // Sums of area near 0 (a sliver's vertex) leave the direction to rounding.
+            if len < 1e-3 {
+                continue;
+            }
+            let dot = (s[0] * f64::from(m[0]) + s[1] * f64::from(m[1]) + s[2] * f64::from(m[2])) / len;
+            assert!(dot > 1.0 - 1e-4, "normal {m:?} against the sum {s:?} at {origin:?}");
+            checked += 1;
+        }
+        assert!(
+            checked * 100 >= sums.len() * 99,
+            "{checked} of {} normals checked",
+            sums.len()
+        );
+    }
+}

@@ -54,6 +54,13 @@ pub struct Flat {
     /// rocks one by one, each rock's vertices and normals a few hundred bytes in L1: half the
     /// memory of `indices` to read at every re-seat, and no index beyond the rock to check.
     local: Vec<[u16; 3]>,
+    /// Per triangle of `local`, what a seat does not change of its face normal: the edges
+    /// `b − a` and `c − a` across the ground, `[u_x, u_y, w_x, w_y]` in field cells (a seat
+    /// moves every vertex of a field by the same step across the ground and changes heights only).
+    edges: Vec<[f32; 4]>,
+    /// Per vertex, the sum of its triangles' upward components `u_y·w_x − u_x·w_y` (field cells²):
+    /// the same at every seat, so a normal's other two components are all a seat sums.
+    up: Vec<f32>,
 }
 
 /// Vertices per block of rocks for the parallel normals.
@@ -86,6 +93,8 @@ impl Flat {
             boxes: Vec::new(),
             starts: Vec::with_capacity(scatter.rocks.len() + 1),
             local: Vec::with_capacity(t),
+            edges: Vec::with_capacity(t),
+            up: Vec::with_capacity(n),
         };
         for (k, &i) in f.order.iter().enumerate() {
             let Some(rock) = scatter.rocks.get(i as usize) else {
@@ -108,6 +117,18 @@ impl Flat {
                     .iter()
                     .map(|t| t.map(|i| u16::try_from(i).expect("a rock has fewer than 65 536 vertices"))),
             );
+            let verts = &f.vertices[base as usize..];
+            let mut up = vec![0.0f64; verts.len()];
+            for t in rock.mesh.triangles.iter() {
+                let [a, b, c] = t.map(|i| verts[i as usize]);
+                let (u, w) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
+                f.edges.push([u[0], u[1], w[0], w[1]]);
+                let n = f64::from(u[1]) * f64::from(w[0]) - f64::from(u[0]) * f64::from(w[1]);
+                for &i in t {
+                    up[i as usize] += n;
+                }
+            }
+            f.up.extend(up.iter().map(|&n| n as f32));
         }
         f.starts.push((f.vertices.len() as u32, f.local.len() as u32));
         if f.blocks.last() != Some(&(f.vertices.len(), f.order.len())) {
@@ -159,6 +180,7 @@ impl Flat {
             parts.push((w[0], w[1], p, n));
         }
         parts.into_par_iter().for_each(|((v0, k0), (_, k1), out, norms)| {
+            let mut scratch = Scratch::new();
             for w in self.starts[k0..=k1].windows(2) {
                 let ((a, t0), (b, t1)) = (w[0], w[1]);
                 let (a, b) = (a as usize - v0, b as usize - v0);
@@ -167,13 +189,35 @@ impl Flat {
                     at,
                     &ground,
                     verts,
-                    &self.local[t0 as usize..t1 as usize],
+                    self.faces(a + v0..b + v0, t0 as usize..t1 as usize),
                     &mut out[a..b],
                     &mut norms[a..b],
+                    &mut scratch,
                 );
             }
         });
     }
+}
+
+impl Flat {
+    /// One rock's triangles, their edges across the ground and its vertices' upward sums, for
+    /// [`normals_of`].
+    #[inline(always)]
+    fn faces(&self, verts: std::ops::Range<usize>, tris: std::ops::Range<usize>) -> Faces<'_> {
+        Faces {
+            tris: &self.local[tris.clone()],
+            edges: &self.edges[tris],
+            up: &self.up[verts],
+        }
+    }
+}
+
+/// A rock's part of a [`Flat`] for its normals: triangles with indices into its own vertices.
+#[derive(Clone, Copy)]
+struct Faces<'a> {
+    tris: &'a [[u16; 3]],
+    edges: &'a [[f32; 4]],
+    up: &'a [f32],
 }
 
 impl Flat {
@@ -263,6 +307,7 @@ impl Flat {
         parts
             .into_par_iter()
             .for_each(|((v0, k0), (_, k1), out, norms, sampled)| {
+                let mut scratch = Scratch::new();
                 for w in self.starts[k0..=k1].windows(2) {
                     let ((a, t0), (b, t1)) = (w[0], w[1]);
                     let (a, b) = (a as usize - v0, b as usize - v0);
@@ -292,7 +337,13 @@ impl Flat {
                             *o = [x as f32, (g.height(x, y) + f64::from(v[2]) * cell) as f32, y as f32];
                         }
                     }
-                    normals_of(out, &self.local[t0 as usize..t1 as usize], &mut norms[a..b]);
+                    normals_of(
+                        out,
+                        self.faces(a + v0..b + v0, t0 as usize..t1 as usize),
+                        cell,
+                        &mut norms[a..b],
+                        &mut scratch,
+                    );
                 }
             });
         if again || find {
@@ -350,9 +401,10 @@ fn seat_rock(
     at: Placement,
     ground: &impl Fn(f64, f64) -> f64,
     verts: &[[f32; 3]],
-    tris: &[[u16; 3]],
+    faces: Faces<'_>,
     out: &mut [[f32; 3]],
     norms: &mut [[f32; 3]],
+    scratch: &mut Scratch,
 ) {
     for (o, v) in out.iter_mut().zip(verts) {
         let (x, y) = place(at, *v);
@@ -362,34 +414,77 @@ fn seat_rock(
             y as f32,
         ];
     }
-    normals_of(out, tris, norms);
+    normals_of(out, faces, at.cell_size, norms, scratch);
 }
 
-/// A rock's normals from its positions and its triangles (indices into its own vertices, so
-/// every access stays within a few hundred bytes): summed in triangle order and normalised.
-#[inline(always)]
-fn normals_of(out: &[[f32; 3]], tris: &[[u16; 3]], norms: &mut [[f32; 3]]) {
-    norms.fill([0.0; 3]);
-    for t in tris {
-        // Each index loaded on its own: the triangle read whole was unpacked with shifts, five
-        // instructions more a triangle.
-        let (a, b, c) = (usize::from(t[0]), usize::from(t[1]), usize::from(t[2]));
-        let (pa, pb, pc) = (out[a], out[b], out[c]);
-        let u = [pb[0] - pa[0], pb[1] - pa[1], pb[2] - pa[2]];
-        let w = [pc[0] - pa[0], pc[1] - pa[1], pc[2] - pa[2]];
-        let n = [
-            u[1] * w[2] - u[2] * w[1],
-            u[2] * w[0] - u[0] * w[2],
-            u[0] * w[1] - u[1] * w[0],
-        ];
-        for k in [a, b, c] {
-            let s = &mut norms[k];
-            *s = [s[0] + n[0], s[1] + n[1], s[2] + n[2]];
+/// Vertices a rock may have for [`normals_of`]'s fixed arrays (more take the general way).
+const SCRATCH: usize = 256;
+
+/// [`normals_of`]'s working memory, one per block of rocks: fixed arrays, so that a triangle's
+/// indices taken as bytes need no range checks (they were a fifth of the normals' instructions).
+struct Scratch {
+    heights: [f32; SCRATCH],
+    sums: [[f32; 2]; SCRATCH],
+}
+
+impl Scratch {
+    fn new() -> Scratch {
+        Scratch {
+            heights: [0.0; SCRATCH],
+            sums: [[0.0; 2]; SCRATCH],
         }
     }
-    for s in norms.iter_mut() {
+}
+
+/// A rock's normals from its heights (`out[k][1]`, metres) and its faces at `cell` metres a
+/// field cell: each triangle's normal `(b − a) × (c − a)` divided by `cell`, summed in triangle
+/// order and normalised. Its upward part is the precomputed [`Faces::up`]; the other two are
+/// linear in the heights over the precomputed edges across the ground (every access within
+/// the rock's few hundred bytes).
+#[inline(always)]
+fn normals_of(out: &[[f32; 3]], faces: Faces<'_>, cell: f64, norms: &mut [[f32; 3]], scratch: &mut Scratch) {
+    let n = out.len();
+    if n <= SCRATCH {
+        for (h, o) in scratch.heights.iter_mut().zip(out) {
+            *h = o[1];
+        }
+        let sums = &mut scratch.sums[..n];
+        sums.fill([0.0; 2]);
+        // Below `SCRATCH` vertices an index is its low byte.
+        sum_faces(&scratch.heights, &mut scratch.sums, faces, |i| usize::from(i as u8));
+    } else {
+        let heights: Vec<f32> = out.iter().map(|o| o[1]).collect();
+        let mut sums = vec![[0.0; 2]; n];
+        sum_faces(&heights, &mut sums, faces, usize::from);
+        return finish_normals(&sums, faces.up, cell, norms);
+    }
+    finish_normals(&scratch.sums[..n], faces.up, cell, norms);
+}
+
+/// The sums of [`normals_of`] across the ground, each face's added to its three vertices.
+#[inline(always)]
+fn sum_faces(heights: &[f32], sums: &mut [[f32; 2]], faces: Faces<'_>, index: impl Fn(u16) -> usize) {
+    for (t, e) in faces.tris.iter().zip(faces.edges) {
+        let (a, b, c) = (index(t[0]), index(t[1]), index(t[2]));
+        let ha = heights[a];
+        let (du, dw) = (heights[b] - ha, heights[c] - ha);
+        // `u × w` with `u = (e0·cell, du, e1·cell)`, `w = (e2·cell, dw, e3·cell)`, over `cell`.
+        let (nx, nz) = (du * e[3] - e[1] * dw, e[0] * dw - du * e[2]);
+        for k in [a, b, c] {
+            let s = &mut sums[k];
+            *s = [s[0] + nx, s[1] + nz];
+        }
+    }
+}
+
+/// [`normals_of`]'s normals from the sums across the ground and the upward ones, normalised.
+#[inline(always)]
+fn finish_normals(sums: &[[f32; 2]], up: &[f32], cell: f64, norms: &mut [[f32; 3]]) {
+    let cell = cell as f32;
+    for ((s, &up), o) in sums.iter().zip(up).zip(norms) {
+        let s = [s[0], up * cell, s[1]];
         let len = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
-        *s = if len > 0.0 {
+        *o = if len > 0.0 {
             // One division, not three (a re-seat waits on them).
             let inv = 1.0 / len;
             [s[0] * inv, s[1] * inv, s[2] * inv]
