@@ -54,10 +54,6 @@ pub struct Flat {
     /// rocks one by one, each rock's vertices and normals a few hundred bytes in L1: half the
     /// memory of `indices` to read at every re-seat, and no index beyond the rock to check.
     local: Vec<[u16; 3]>,
-    /// Per triangle of `local`, what a seat does not change of its face normal: the edges
-    /// `b − a` and `c − a` across the ground, `[u_x, u_y, w_x, w_y]` in field cells (a seat
-    /// moves every vertex of a field by the same step across the ground and changes heights only).
-    edges: Vec<[f32; 4]>,
     /// Per vertex, the sum of its triangles' upward components `u_y·w_x − u_x·w_y` (field cells²):
     /// the same at every seat, so a normal's other two components are all a seat sums.
     up: Vec<f32>,
@@ -93,9 +89,10 @@ impl Flat {
             boxes: Vec::new(),
             starts: Vec::with_capacity(scatter.rocks.len() + 1),
             local: Vec::with_capacity(t),
-            edges: Vec::with_capacity(t),
             up: Vec::with_capacity(n),
         };
+        // One rock's upward sums, in f64 (memory reused from rock to rock).
+        let mut up: Vec<f64> = Vec::new();
         for (k, &i) in f.order.iter().enumerate() {
             let Some(rock) = scatter.rocks.get(i as usize) else {
                 continue;
@@ -118,11 +115,11 @@ impl Flat {
                     .map(|t| t.map(|i| u16::try_from(i).expect("a rock has fewer than 65 536 vertices"))),
             );
             let verts = &f.vertices[base as usize..];
-            let mut up = vec![0.0f64; verts.len()];
+            up.clear();
+            up.resize(verts.len(), 0.0);
             for t in rock.mesh.triangles.iter() {
                 let [a, b, c] = t.map(|i| verts[i as usize]);
                 let (u, w) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
-                f.edges.push([u[0], u[1], w[0], w[1]]);
                 let n = f64::from(u[1]) * f64::from(w[0]) - f64::from(u[0]) * f64::from(w[1]);
                 for &i in t {
                     up[i as usize] += n;
@@ -200,13 +197,12 @@ impl Flat {
 }
 
 impl Flat {
-    /// One rock's triangles, their edges across the ground and its vertices' upward sums, for
-    /// [`normals_of`].
+    /// One rock's triangles, its vertices and their upward sums, for [`normals_of`].
     #[inline(always)]
     fn faces(&self, verts: std::ops::Range<usize>, tris: std::ops::Range<usize>) -> Faces<'_> {
         Faces {
-            tris: &self.local[tris.clone()],
-            edges: &self.edges[tris],
+            tris: &self.local[tris],
+            verts: &self.vertices[verts.clone()],
             up: &self.up[verts],
         }
     }
@@ -216,7 +212,9 @@ impl Flat {
 #[derive(Clone, Copy)]
 struct Faces<'a> {
     tris: &'a [[u16; 3]],
-    edges: &'a [[f32; 4]],
+    /// In field cells: a seat moves every vertex of a field by the same step across the ground
+    /// and changes only heights, so a face's edges across the ground are the same at every seat.
+    verts: &'a [[f32; 3]],
     up: &'a [f32],
 }
 
@@ -424,6 +422,8 @@ const SCRATCH: usize = 256;
 /// indices taken as bytes need no range checks (they were a fifth of the normals' instructions).
 struct Scratch {
     heights: [f32; SCRATCH],
+    /// The vertices' `(x, y)`, field cells.
+    across: [[f32; 2]; SCRATCH],
     sums: [[f32; 2]; SCRATCH],
 }
 
@@ -431,6 +431,7 @@ impl Scratch {
     fn new() -> Scratch {
         Scratch {
             heights: [0.0; SCRATCH],
+            across: [[0.0; 2]; SCRATCH],
             sums: [[0.0; 2]; SCRATCH],
         }
     }
@@ -439,23 +440,33 @@ impl Scratch {
 /// A rock's normals from its heights (`out[k][1]`, metres) and its faces at `cell` metres a
 /// field cell: each triangle's normal `(b − a) × (c − a)` divided by `cell`, summed in triangle
 /// order and normalised. Its upward part is the precomputed [`Faces::up`]; the other two are
-/// linear in the heights over the precomputed edges across the ground (every access within
+/// linear in the heights over the faces' edges across the ground (every access within
 /// the rock's few hundred bytes).
 #[inline(always)]
 fn normals_of(out: &[[f32; 3]], faces: Faces<'_>, cell: f64, norms: &mut [[f32; 3]], scratch: &mut Scratch) {
     let n = out.len();
     if n <= SCRATCH {
-        for (h, o) in scratch.heights.iter_mut().zip(out) {
+        for (((h, xy), o), v) in scratch
+            .heights
+            .iter_mut()
+            .zip(&mut scratch.across)
+            .zip(out)
+            .zip(faces.verts)
+        {
             *h = o[1];
+            *xy = [v[0], v[1]];
         }
         let sums = &mut scratch.sums[..n];
         sums.fill([0.0; 2]);
         // Below `SCRATCH` vertices an index is its low byte.
-        sum_faces(&scratch.heights, &mut scratch.sums, faces, |i| usize::from(i as u8));
+        sum_faces(&scratch.heights, &scratch.across, &mut scratch.sums, faces.tris, |i| {
+            usize::from(i as u8)
+        });
     } else {
         let heights: Vec<f32> = out.iter().map(|o| o[1]).collect();
+        let across: Vec<[f32; 2]> = faces.verts.iter().map(|v| [v[0], v[1]]).collect();
         let mut sums = vec![[0.0; 2]; n];
-        sum_faces(&heights, &mut sums, faces, usize::from);
+        sum_faces(&heights, &across, &mut sums, faces.tris, usize::from);
         return finish_normals(&sums, faces.up, cell, norms);
     }
     finish_normals(&scratch.sums[..n], faces.up, cell, norms);
@@ -463,11 +474,19 @@ fn normals_of(out: &[[f32; 3]], faces: Faces<'_>, cell: f64, norms: &mut [[f32; 
 
 /// The sums of [`normals_of`] across the ground, each face's added to its three vertices.
 #[inline(always)]
-fn sum_faces(heights: &[f32], sums: &mut [[f32; 2]], faces: Faces<'_>, index: impl Fn(u16) -> usize) {
-    for (t, e) in faces.tris.iter().zip(faces.edges) {
+fn sum_faces(
+    heights: &[f32],
+    across: &[[f32; 2]],
+    sums: &mut [[f32; 2]],
+    tris: &[[u16; 3]],
+    index: impl Fn(u16) -> usize,
+) {
+    for t in tris {
         let (a, b, c) = (index(t[0]), index(t[1]), index(t[2]));
         let ha = heights[a];
         let (du, dw) = (heights[b] - ha, heights[c] - ha);
+        let (pa, pb, pc) = (across[a], across[b], across[c]);
+        let e = [pb[0] - pa[0], pb[1] - pa[1], pc[0] - pa[0], pc[1] - pa[1]];
         // `u × w` with `u = (e0·cell, du, e1·cell)`, `w = (e2·cell, dw, e3·cell)`, over `cell`.
         let (nx, nz) = (du * e[3] - e[1] * dw, e[0] * dw - du * e[2]);
         for k in [a, b, c] {
