@@ -115,13 +115,18 @@ impl Pen {
         self.set(switch, true).hold(0.1).set(switch, false)
     }
 
-    fn stroke(&mut self, points: &[(f64, f64)]) -> &mut Self {
+    /// Draws `points` on the surface and lifts the tip (no SW3: a tool that ends on lifting).
+    fn trace(&mut self, points: &[(f64, f64)]) -> &mut Self {
         let (u, v) = points[0];
         self.hover(u, v).touch();
         for &(u, v) in &points[1..] {
             self.drag_to(u, v);
         }
-        self.lift(HOVER).click(2)
+        self.lift(HOVER)
+    }
+
+    fn stroke(&mut self, points: &[(f64, f64)]) -> &mut Self {
+        self.trace(points).click(2)
     }
 
     fn closed(&mut self, points: &[(f64, f64)]) -> &mut Self {
@@ -500,11 +505,7 @@ fn the_tree_tool_plants_moves_and_sizes_trees_and_groves() {
         (300.0, 200.0),
         (300.0, 100.0),
     ];
-    pen.hover(outline[0].0, outline[0].1).touch();
-    for &(u, v) in &outline[1..] {
-        pen.drag_to(u, v);
-    }
-    pen.lift(HOVER);
+    pen.trace(&outline);
     assert_eq!(pen.doc().groves.len(), 1, "{:?}", pen.ui.take_messages());
     assert_eq!(pen.doc().trees.len(), 2, "the outline planted no single tree");
     let grove = pen.doc().groves[0].clone();
@@ -676,11 +677,7 @@ fn a_tree_pull_shows_as_it_goes_and_records_one_edit() {
         (300.0, 200.0),
         (300.0, 100.0),
     ];
-    pen.hover(outline[0].0, outline[0].1).touch();
-    for &(u, v) in &outline[1..] {
-        pen.drag_to(u, v);
-    }
-    pen.lift(HOVER);
+    pen.trace(&outline);
     assert_eq!(pen.doc().groves.len(), 1, "{:?}", pen.ui.take_messages());
     pen.grab(360.0, 150.0).pull_to(30.0);
     let mean = pen.doc().groves[0].height;
