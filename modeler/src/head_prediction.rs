@@ -57,7 +57,15 @@ impl HeadPredictor {
     /// An event stamped `device_us` on the device's clock reached the host at `host_us` (µs
     /// since the Unix epoch): the clocks' offset.
     pub fn arrived(&mut self, device_us: u64, host_us: u64) {
-        let offset = host_us as i64 - device_us as i64;
+        // Both stamps come from outside (the device's report, pend's line): a pair whose
+        // difference does not fit is skipped, not wrapped.
+        let Some(offset) = i64::try_from(host_us)
+            .ok()
+            .zip(i64::try_from(device_us).ok())
+            .and_then(|(h, d)| h.checked_sub(d))
+        else {
+            return;
+        };
         self.offset = match self.offset {
             Some((from, least, before)) if device_us >= from && device_us - from < OFFSET_WINDOW_US => {
                 Some((from, least.min(offset), before))
@@ -72,7 +80,7 @@ impl HeadPredictor {
     pub fn device_at(&self, host_us: u64) -> Option<u64> {
         let (_, least, before) = self.offset?;
         let offset = before.map_or(least, |b| b.min(least));
-        u64::try_from(host_us as i64 - offset).ok()
+        u64::try_from(i64::try_from(host_us).ok()?.checked_sub(offset)?).ok()
     }
 
     /// A frame took `draw_us` to draw.
@@ -188,5 +196,16 @@ mod tests {
         // A later window keeps the earlier one's least until it ends.
         p.arrived(2_500_000, base + 2_500_000 + 4_000);
         assert_eq!(p.device_at(base + 2_600_000), Some(2_599_000));
+    }
+
+    #[test]
+    fn stamps_whose_difference_does_not_fit_are_skipped() {
+        let mut p = HeadPredictor::default();
+        // A device stamp beyond i64 (a corrupt line) gives no offset and takes nothing.
+        p.arrived(1 << 63, 1_700_000_000_000_000);
+        assert_eq!(p.device_at(1_700_000_000_000_000), None);
+        p.arrived(10_000, 11_000);
+        assert_eq!(p.device_at(1 << 63), None, "a host time beyond i64 has no device time");
+        assert_eq!(p.device_at(21_000), Some(20_000));
     }
 }

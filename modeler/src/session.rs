@@ -174,7 +174,8 @@ impl Session {
             {
                 self.head_burst = Some((device_us, h.prediction_ms));
                 self.head_poses += 1;
-                self.predictor.pose(device_us + u64::from(h.prediction_ms) * 1000, mm);
+                self.predictor
+                    .pose(device_us.saturating_add(u64::from(h.prediction_ms) * 1000), mm);
             }
         }
         self.interaction.handle(&mut self.editor, e);
@@ -213,7 +214,7 @@ impl Session {
             None => self.predictor.device_at(unix_now_us()),
         };
         if let Some(now_us) = now_us.filter(|_| self.head_burst.is_some()) {
-            let end_us = now_us + self.predictor.expected_draw_us();
+            let end_us = now_us.saturating_add(self.predictor.expected_draw_us());
             if let Some((mm, lead_us)) = self.predictor.predict(end_us) {
                 self.head_drawn_mm = Some(mm);
                 self.head_lead_us = lead_us;
@@ -243,7 +244,7 @@ impl Session {
             if let (Some(truth), Some(reported)) = (&self.head_truth, self.head_mm) {
                 let true_mm = truth(done_us);
                 let drawn = self.head_drawn_mm.unwrap_or(reported);
-                let own = truth(burst_us + u64::from(prediction_ms) * 1000);
+                let own = truth(burst_us.saturating_add(u64::from(prediction_ms) * 1000));
                 let less = |a: [f64; 3], b: [f64; 3]| [a[0] - b[0], a[1] - b[1], a[2] - b[2]];
                 self.latency
                     .error(less(reported, true_mm), less(drawn, true_mm), less(reported, own));
