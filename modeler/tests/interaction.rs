@@ -182,6 +182,15 @@ fn blank() -> Document {
 
 const REGION: [(f64, f64); 4] = [(60.0, 40.0), (540.0, 40.0), (540.0, 300.0), (60.0, 300.0)];
 
+/// A grove's outline for the tree tool, back to its start (mm on the display).
+const GROVE_OUTLINE: [(f64, f64); 5] = [
+    (300.0, 100.0),
+    (420.0, 100.0),
+    (420.0, 200.0),
+    (300.0, 200.0),
+    (300.0, 100.0),
+];
+
 fn near(a: Point, b: Point, metres: f64) -> bool {
     (a[0] - b[0]).hypot(a[1] - b[1]) <= metres
 }
@@ -498,13 +507,7 @@ fn the_tree_tool_plants_moves_and_sizes_trees_and_groves() {
     assert_eq!(pen.ui.stats().trees, 2);
 
     // An outline back to its start plants a grove; lifting the tip ends it (no SW3).
-    let outline = [
-        (300.0, 100.0),
-        (420.0, 100.0),
-        (420.0, 200.0),
-        (300.0, 200.0),
-        (300.0, 100.0),
-    ];
+    let outline = GROVE_OUTLINE;
     pen.trace(&outline);
     assert_eq!(pen.doc().groves.len(), 1, "{:?}", pen.ui.take_messages());
     assert_eq!(pen.doc().trees.len(), 2, "the outline planted no single tree");
@@ -670,13 +673,7 @@ fn a_tree_pull_shows_as_it_goes_and_records_one_edit() {
     assert_eq!(pen.doc().trees[0].height, set);
 
     // A grove's pull: its standing trees are scattered again at the height shown, 0.8 to 1.2 of it.
-    let outline = [
-        (300.0, 100.0),
-        (420.0, 100.0),
-        (420.0, 200.0),
-        (300.0, 200.0),
-        (300.0, 100.0),
-    ];
+    let outline = GROVE_OUTLINE;
     pen.trace(&outline);
     assert_eq!(pen.doc().groves.len(), 1, "{:?}", pen.ui.take_messages());
     pen.grab(360.0, 150.0).pull_to(30.0);

@@ -408,30 +408,28 @@ fn parent(h: &[f32], cols: usize, a: &Area, kids: &Level, (i, j): (usize, usize)
     let s = a.step;
     let at = |c: usize, r: usize| h[r * cols + c];
     for r in a.r0..=a.r1 {
-        let ra = a.r0 + (r - a.r0) / s * s;
-        let rb = (ra + s).min(a.r1);
-        let v = if rb > ra {
-            (r - ra) as f32 / (rb - ra) as f32
-        } else {
-            0.0
-        };
+        let (ra, rb, v) = coarse_span(r, a.r0, a.r1, s);
         for c in a.c0..=a.c1 {
             let z = at(c, r);
             if !z.is_finite() {
                 n.error = f32::INFINITY;
                 return n;
             }
-            let ca = a.c0 + (c - a.c0) / s * s;
-            let cb = (ca + s).min(a.c1);
-            let u = if cb > ca {
-                (c - ca) as f32 / (cb - ca) as f32
-            } else {
-                0.0
-            };
+            let (ca, cb, u) = coarse_span(c, a.c0, a.c1, s);
             n.error = n.error.max((z - surface(at, (ca, cb, ra, rb), u, v)).abs());
         }
     }
     n
+}
+
+/// The coarse span at stride `s` (clipped to `hi`) that holds index `i` of a node from `lo`, and
+/// `i`'s fraction across it (0 on a span of no length).
+#[inline]
+fn coarse_span(i: usize, lo: usize, hi: usize, s: usize) -> (usize, usize, f32) {
+    let a = lo + (i - lo) / s * s;
+    let b = (a + s).min(hi);
+    let t = if b > a { (i - a) as f32 / (b - a) as f32 } else { 0.0 };
+    (a, b, t)
 }
 
 /// The height of the coarse quad with corners at columns `ca`, `cb` and rows `ra`, `rb`, at

@@ -152,10 +152,12 @@ fn an_update_over_the_changed_rectangle_equals_a_rebuild() {
     );
 }
 
-fn frame(scene: &Scene, (w, h): (u32, u32)) -> Frame {
+/// A frame of `scene` from a fresh renderer, and the renderer (its LOD picks).
+fn frame(scene: &Scene, (w, h): (u32, u32)) -> (Frame, Renderer) {
     let mut f = Frame::new(w, h).unwrap();
-    Renderer::new().render(scene, &mut f).unwrap();
-    f
+    let mut r = Renderer::new();
+    r.render(scene, &mut f).unwrap();
+    (f, r)
 }
 
 /// Mean absolute difference per channel, and the fraction of pixels whose largest channel
@@ -186,11 +188,9 @@ fn a_frame_at_one_pixel_of_error_differs_from_full_detail_less_than_a_one_pixel_
         scene.style = style.clone();
         scene.vertical_scale = 1.5;
         scene.terrain_lod = 0.0;
-        let full = frame(&scene, (480, 270));
+        let (full, _) = frame(&scene, (480, 270));
         scene.terrain_lod = 1.0;
-        let mut r = Renderer::new();
-        let mut lod = Frame::new(480, 270).unwrap();
-        r.render(&scene, &mut lod).unwrap();
+        let (lod, r) = frame(&scene, (480, 270));
         let picks = r.lod_picks();
         assert!(picks.iter().any(|p| p.level >= 2), "the view uses coarse levels");
         let (mad, frac) = compare(&full, &lod, 0, 24);
@@ -271,11 +271,9 @@ fn a_grazing_view_shows_no_background_through_the_terrain() {
         ..Style::default()
     };
     scene.terrain_lod = 0.0;
-    let full = frame(&scene, (480, 270));
+    let (full, _) = frame(&scene, (480, 270));
     scene.terrain_lod = 2.0;
-    let mut r = Renderer::new();
-    let mut lod = Frame::new(480, 270).unwrap();
-    r.render(&scene, &mut lod).unwrap();
+    let (lod, r) = frame(&scene, (480, 270));
     assert!(r.lod_picks().iter().any(|p| p.level >= 2), "the view mixes levels");
     let w = 480usize;
     let (f, l) = (full.pixels(), lod.pixels());
