@@ -141,11 +141,9 @@ pub struct Editor {
     redo: Vec<UndoStep>,
     store: Option<Store>,
     preview: Option<Preview>,
-    /// The `ridges` entry from before an unrecorded ridge preview ([`Editor::preview_ridges`]).
-    ridge_preview: Option<Option<crate::document::Ridges>>,
-    /// The edit restoring a tree or grove from before an unrecorded preview
-    /// ([`Editor::preview_tree`]).
-    tree_preview: Option<Edit>,
+    /// The edit restoring a whole element — the `ridges` entry, a tree or a grove — from before
+    /// an unrecorded preview of it ([`Editor::preview_ridges`], [`Editor::preview_tree`]).
+    shown: Option<Edit>,
     /// The rock fields standing on the terrain, following every change.
     rocks: Seated,
     /// The trees and groves standing on the terrain, following every change.
@@ -190,11 +188,20 @@ fn preview_target(edit: &Edit) -> Option<(FigurePath, Property, f64)> {
     }
 }
 
-/// What a tree preview replaces: `(is a grove, index)`.
-fn tree_target(edit: &Edit) -> Option<(bool, usize)> {
+/// A whole element an unrecorded preview replaces ([`Editor::preview_ridges`],
+/// [`Editor::preview_tree`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Element {
+    Ridges,
+    Tree(usize),
+    Grove(usize),
+}
+
+fn element_of(edit: &Edit) -> Option<Element> {
     match edit {
-        Edit::ReplaceTree { index, .. } => Some((false, *index)),
-        Edit::ReplaceGrove { index, .. } => Some((true, *index)),
+        Edit::SetRidges { .. } => Some(Element::Ridges),
+        Edit::ReplaceTree { index, .. } => Some(Element::Tree(*index)),
+        Edit::ReplaceGrove { index, .. } => Some(Element::Grove(*index)),
         _ => None,
     }
 }
@@ -219,8 +226,7 @@ impl Editor {
             redo: Vec::new(),
             store: None,
             preview: None,
-            ridge_preview: None,
-            tree_preview: None,
+            shown: None,
             revisions: Revisions::new(),
         })
     }
@@ -420,7 +426,7 @@ impl Editor {
 
     /// Applies `edit`, journals it and makes it undoable.
     pub fn apply(&mut self, edit: Edit) -> Result<Outcome, EditorError> {
-        if self.ridge_preview.is_some() || self.tree_preview.is_some() {
+        if self.shown.is_some() {
             self.cancel_preview()?;
         }
         // Committing the previewed property: undo returns to the value before the preview.
@@ -538,7 +544,7 @@ impl Editor {
     /// first restores them.
     pub fn preview(&mut self, edit: &Edit) -> Result<Outcome, EditorError> {
         let (at, property, _) = preview_target(edit).ok_or(EditorError::NotPreviewable)?;
-        if self.ridge_preview.is_some() || self.tree_preview.is_some() {
+        if self.shown.is_some() {
             self.cancel_preview()?;
         }
         if self.preview.as_ref().is_some_and(|p| p.at != at) {
@@ -565,7 +571,7 @@ impl Editor {
 
     /// Whether a preview is showing.
     pub fn previewing(&self) -> bool {
-        self.preview.is_some() || self.ridge_preview.is_some() || self.tree_preview.is_some()
+        self.preview.is_some() || self.shown.is_some()
     }
 
     /// Shows `ridges` as the `ridges` entry at once without recording it: the frames of a
@@ -574,30 +580,14 @@ impl Editor {
     /// undo returns to the entry from before the preview; any other operation, or
     /// [`Editor::cancel_preview`], first restores it.
     pub fn preview_ridges(&mut self, ridges: Option<crate::document::Ridges>) -> Result<Outcome, EditorError> {
-        if self.preview.is_some() || self.tree_preview.is_some() {
-            self.cancel_preview()?;
-        }
-        let outcome = self.change(&Edit::SetRidges { ridges })?;
-        if self.ridge_preview.is_none()
-            && let Edit::SetRidges { ridges: old } = &outcome.inverse
-        {
-            self.ridge_preview = Some(old.clone());
-        }
-        Ok(outcome)
+        self.preview_element(&Edit::SetRidges { ridges })
     }
 
     /// Records the previewed `ridges` entry as one undoable `set_ridges` step and returns it;
     /// `None` when no ridge preview is showing. If the journal cannot be written, the preview is
     /// undone and the error returned.
     pub fn commit_ridges_preview(&mut self) -> Result<Option<Edit>, EditorError> {
-        let Some(old) = self.ridge_preview.take() else {
-            return Ok(None);
-        };
-        let edit = Edit::SetRidges {
-            ridges: self.doc.ridges.clone(),
-        };
-        let inverse = Edit::SetRidges { ridges: old };
-        self.record_previewed(edit, inverse).map(Some)
+        self.commit_element(|e| e == Element::Ridges)
     }
 
     /// Shows a `replace_tree` or `replace_grove` at once without recording it: the frames of a
@@ -606,42 +596,60 @@ impl Editor {
     /// the element from before the preview; a preview of another element, any other operation,
     /// or [`Editor::cancel_preview`], first restores it.
     pub fn preview_tree(&mut self, edit: &Edit) -> Result<Outcome, EditorError> {
-        let target = tree_target(edit).ok_or(EditorError::NotPreviewable)?;
-        let other = self
-            .tree_preview
-            .as_ref()
-            .is_some_and(|old| tree_target(old) != Some(target));
-        if self.preview.is_some() || self.ridge_preview.is_some() || other {
+        match element_of(edit) {
+            Some(Element::Tree(_) | Element::Grove(_)) => self.preview_element(edit),
+            _ => Err(EditorError::NotPreviewable),
+        }
+    }
+
+    /// Shows `edit`, which replaces a whole [`Element`], unrecorded; the restoring edit is kept
+    /// from the first preview of that element (a figure's or another element's preview is
+    /// restored first).
+    fn preview_element(&mut self, edit: &Edit) -> Result<Outcome, EditorError> {
+        let target = element_of(edit);
+        let other = self.shown.as_ref().is_some_and(|old| element_of(old) != target);
+        if self.preview.is_some() || other {
             self.cancel_preview()?;
         }
         let outcome = self.change(edit)?;
-        if self.tree_preview.is_none() {
-            self.tree_preview = Some(outcome.inverse.clone());
+        if self.shown.is_none() {
+            self.shown = Some(outcome.inverse.clone());
         }
         Ok(outcome)
+    }
+
+    /// Records the previewed element, if `wanted` accepts it, as one undoable step whose undo
+    /// restores it from before the preview; `None` when no such preview is showing.
+    fn commit_element(&mut self, wanted: impl Fn(Element) -> bool) -> Result<Option<Edit>, EditorError> {
+        let Some(element) = self.shown.as_ref().and_then(element_of).filter(|&e| wanted(e)) else {
+            return Ok(None);
+        };
+        let edit = match element {
+            Element::Ridges => Some(Edit::SetRidges {
+                ridges: self.doc.ridges.clone(),
+            }),
+            Element::Tree(index) => self
+                .doc
+                .trees
+                .get(index)
+                .map(|t| Edit::ReplaceTree { index, tree: t.clone() }),
+            Element::Grove(index) => self.doc.groves.get(index).map(|g| Edit::ReplaceGrove {
+                index,
+                grove: g.clone(),
+            }),
+        };
+        let Some(inverse) = self.shown.take() else {
+            return Ok(None);
+        };
+        let Some(edit) = edit else { return Ok(None) };
+        self.record_previewed(edit, inverse).map(Some)
     }
 
     /// Records the previewed tree or grove as one undoable `replace_tree` or `replace_grove`
     /// step and returns it; `None` when no tree preview is showing. If the journal cannot be
     /// written, the preview is undone and the error returned.
     pub fn commit_tree_preview(&mut self) -> Result<Option<Edit>, EditorError> {
-        let Some(inverse) = self.tree_preview.take() else {
-            return Ok(None);
-        };
-        let edit = match tree_target(&inverse) {
-            Some((false, index)) => self
-                .doc
-                .trees
-                .get(index)
-                .map(|t| Edit::ReplaceTree { index, tree: t.clone() }),
-            Some((true, index)) => self.doc.groves.get(index).map(|g| Edit::ReplaceGrove {
-                index,
-                grove: g.clone(),
-            }),
-            None => None,
-        };
-        let Some(edit) = edit else { return Ok(None) };
-        self.record_previewed(edit, inverse).map(Some)
+        self.commit_element(|e| matches!(e, Element::Tree(_) | Element::Grove(_)))
     }
 
     /// Records the previewed values as one undoable step (a `set_height`, a `set_slope`, or a
@@ -686,11 +694,8 @@ impl Editor {
 
     /// Restores the values from before an unrecorded preview; `None` when there is none.
     pub fn cancel_preview(&mut self) -> Result<Option<Outcome>, EditorError> {
-        if let Some(restore) = self.tree_preview.take() {
+        if let Some(restore) = self.shown.take() {
             return Ok(Some(self.change(&restore)?));
-        }
-        if let Some(old) = self.ridge_preview.take() {
-            return Ok(Some(self.change(&Edit::SetRidges { ridges: old })?));
         }
         let Some(p) = self.preview.take() else { return Ok(None) };
         let restore = p.restore();
