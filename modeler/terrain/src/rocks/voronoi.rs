@@ -238,32 +238,42 @@ impl CellPixels {
 }
 
 /// Keeps the part of convex polygon `poly` on the seed's side of the bisector of `s` and `q`;
-/// false when the bisector missed it (`poly` unchanged).
-fn clip(poly: &mut Vec<[f64; 2]>, scratch: &mut Vec<[f64; 2]>, s: [f64; 2], q: [f64; 2]) -> bool {
+/// returns the new polygon's reach from `s` (the largest squared distance of a vertex), or
+/// None when the bisector missed it (`poly` unchanged).
+fn clip(poly: &mut Vec<[f64; 2]>, scratch: &mut Vec<[f64; 2]>, s: [f64; 2], q: [f64; 2]) -> Option<f64> {
     let n = [q[0] - s[0], q[1] - s[1]];
     let m = [(s[0] + q[0]) * 0.5, (s[1] + q[1]) * 0.5];
     let side = |p: [f64; 2]| (p[0] - m[0]) * n[0] + (p[1] - m[1]) * n[1];
     if poly.iter().all(|&p| side(p) <= 0.0) {
-        return false;
+        return None;
     }
     scratch.clear();
     let len = poly.len();
     let mut sa = side(poly[0]);
+    // The reach, kept as the vertices are written (rather than a pass over them after).
+    let mut reach2 = 0.0;
+    let mut keep = |p: [f64; 2], scratch: &mut Vec<[f64; 2]>| {
+        let d2 = (p[0] - s[0]).powi(2) + (p[1] - s[1]).powi(2);
+        if d2 > reach2 {
+            reach2 = d2;
+        }
+        scratch.push(p);
+    };
     for i in 0..len {
         // The next vertex without `% len` (a division per edge).
         let (a, b) = (poly[i], poly[if i + 1 == len { 0 } else { i + 1 }]);
         let sb = side(b);
         if sa <= 0.0 {
-            scratch.push(a);
+            keep(a, scratch);
         }
         if (sa <= 0.0) != (sb <= 0.0) {
             let t = sa / (sa - sb);
-            scratch.push([a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t]);
+            keep([a[0] + (b[0] - a[0]) * t, a[1] + (b[1] - a[1]) * t], scratch);
         }
         sa = sb;
     }
     std::mem::swap(poly, scratch);
-    true
+    Some(reach2)
 }
 
 /// The polygon of the cell of `points[cell]` within the `width × height` rectangle, its
@@ -286,7 +296,6 @@ pub(crate) fn cell_polygon(
 struct PolygonScratch {
     poly: Vec<[f64; 2]>,
     scratch: Vec<[f64; 2]>,
-    near: Vec<(f64, [f64; 2])>,
     out: Vec<[f64; 2]>,
 }
 
@@ -305,12 +314,7 @@ fn cell_polygon_with(
 ) {
     let s = points[cell];
     let (w, h) = (f64::from(width), f64::from(height));
-    let PolygonScratch {
-        poly,
-        scratch,
-        near,
-        out,
-    } = work;
+    let PolygonScratch { poly, scratch, out } = work;
     poly.clear();
     poly.extend([[0.0, 0.0], [w, 0.0], [w, h], [0.0, h]]);
     let reach = |poly: &[[f64; 2]]| {
@@ -318,30 +322,29 @@ fn cell_polygon_with(
             .map(|p| (p[0] - s[0]).powi(2) + (p[1] - s[1]).powi(2))
             .fold(0.0, f64::max)
     };
-    // Neighbours: (squared distance, seed). A seed at distance d cuts the polygon only if the
-    // polygon reaches beyond d/2 from `s`, so seeds farther than twice the reach are skipped. Seeds are gathered from a square about `s` of half-side
-    // `want`, first a guess from the bucket size (about the radius: cells of a saturated
-    // diagram reach about r from their seed), widened while the polygon may reach beyond half
-    // of what was gathered; `done`: every seed within it has cut.
+    // A seed at distance d cuts the polygon only if the polygon reaches beyond d/2 from `s`, so
+    // seeds farther than twice the reach are skipped. Seeds are taken from a square about `s`
+    // of half-side `want`, first a guess from the bucket size (about the radius: cells of a
+    // saturated diagram reach about r from their seed), widened while the polygon may reach
+    // beyond half of what was taken; `done`: every seed within it has cut. Each cuts as it is
+    // found, in bucket order (sorting by distance cost more than the cuts it saves).
     let mut reach2 = reach(poly);
     let (mut done, mut want) = (0.0f64, 1.5 * buckets.size + 1.0);
     let far = w.hypot(h);
     loop {
-        near.clear();
         let (done2, want2) = (done * done, want * want);
         buckets.square(s, want, |q, p| {
             let d2 = (p[0] - s[0]).powi(2) + (p[1] - s[1]).powi(2);
-            if q as usize != cell && d2 > done2 && d2 <= want2 {
-                near.push((d2, p));
+            // The reach changes only when the bisector cut (most seeds taken do not).
+            if q as usize != cell
+                && d2 > done2
+                && d2 <= want2
+                && d2 <= 4.0 * reach2
+                && let Some(r2) = clip(poly, scratch, s, p)
+            {
+                reach2 = r2;
             }
         });
-        // In bucket order, not sorted: sorting cost more than the clips it saves.
-        for &(d2, p) in near.iter() {
-            // The reach changes only when the bisector cut (most seeds gathered do not).
-            if d2 <= 4.0 * reach2 && clip(poly, scratch, s, p) {
-                reach2 = reach(poly);
-            }
-        }
         done = want;
         if 4.0 * reach2 <= done * done || done >= far {
             break;
@@ -364,7 +367,12 @@ fn cell_polygon_with(
     let mut i = 0;
     while out.len() > 3 && i < out.len() {
         let n = out.len();
-        let (a, b, c) = (out[(i + n - 1) % n], out[i], out[(i + 1) % n]);
+        // Neighbours without `%` (a division per vertex).
+        let (a, b, c) = (
+            out[if i == 0 { n - 1 } else { i - 1 }],
+            out[i],
+            out[if i + 1 == n { 0 } else { i + 1 }],
+        );
         let cross = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
         if cross.abs() < 1e-9 {
             out.remove(i);
