@@ -382,7 +382,7 @@ pub fn scatter(recipe: &Recipe, inside: Option<&[bool]>) -> Result<Scatter, Reci
             let layer = &recipe.layers[i];
             let t = Instant::now();
             let mut rng = stream(recipe.seed, SEEDS, i, 0);
-            let mut seeds = match recipe.sampler {
+            let seeds = match recipe.sampler {
                 Sampler::Saturate => poisson::saturate(width, height, layer.radius, &mut rng),
                 Sampler::Darts { fill } => {
                     let throws = poisson::seed_throws(width, height, layer.radius, fill);
@@ -392,7 +392,7 @@ pub fn scatter(recipe: &Recipe, inside: Option<&[bool]>) -> Result<Scatter, Reci
             // Numbered in pixel order, so the stages after read the image and the seeds in step
             // (painting labels and cutting polygons in random order cost twice the time in
             // cache misses).
-            seeds.sort_unstable();
+            let seeds = poisson::in_pixel_order(&seeds, pixels);
             let seeds_ms = ms(t);
             let t = Instant::now();
             let labels = voronoi::label(width, height, &seeds, layer.radius);

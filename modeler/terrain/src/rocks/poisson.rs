@@ -14,18 +14,38 @@
 
 use rand::{Rng, RngExt};
 
-/// Pixel offsets `(dx, dy)` with `dx² + dy² ≤ r²`, row by row.
-pub(crate) fn disk(radius: f64) -> Vec<(i32, i32)> {
+/// The disk of pixels within `r` of a pixel, row by row: `(dy, half)` for the pixels `(dx, dy)`
+/// with `|dx| ≤ half` (`dx² + dy² ≤ r²`). Rows, not offsets, so that flagging and painting run
+/// along a row of the image with one range check a row.
+pub(crate) fn disk_rows(radius: f64) -> Vec<(i32, i32)> {
     let reach = radius.floor() as i32;
     let r2 = radius * radius;
-    let mut out = Vec::new();
-    for dy in -reach..=reach {
-        for dx in -reach..=reach {
-            if f64::from(dx * dx + dy * dy) <= r2 {
-                out.push((dx, dy));
-            }
+    (-reach..=reach)
+        .filter_map(|dy| {
+            (0..=reach)
+                .take_while(|&dx| f64::from(dx * dx + dy * dy) <= r2)
+                .last()
+                .map(|half| (dy, half))
+        })
+        .collect()
+}
+
+/// `points`, distinct pixel indices below `n`, in ascending order: marked in a bitmap and read
+/// back word by word (one pass over `n / 64` words instead of a sort).
+pub(crate) fn in_pixel_order(points: &[u32], n: usize) -> Vec<u32> {
+    let mut bits = vec![0u64; n.div_ceil(64)];
+    for &p in points {
+        bits[p as usize / 64] |= 1 << (p % 64);
+    }
+    let mut out = Vec::with_capacity(points.len());
+    for (w, &word) in bits.iter().enumerate() {
+        let mut word = word;
+        while word != 0 {
+            out.push((w * 64) as u32 + word.trailing_zeros());
+            word &= word - 1;
         }
     }
+    debug_assert_eq!(out.len(), points.len(), "pixel indices must be distinct");
     out
 }
 
@@ -35,14 +55,16 @@ pub fn seed_throws(width: u32, height: u32, radius: f64, fill: f64) -> u64 {
     (area * fill / (std::f64::consts::PI * (0.5 * radius).powi(2))).round() as u64
 }
 
-/// Flags the pixels within `r` of `(x, y)`.
-fn flag(flags: &mut [bool], width: u32, height: u32, x: u32, y: u32, offsets: &[(i32, i32)]) {
+/// Flags the pixels within `r` of `(x, y)` (the disk's rows, [`disk_rows`]).
+fn flag(flags: &mut [bool], width: u32, height: u32, x: u32, y: u32, rows: &[(i32, i32)]) {
     let (w, h) = (width as i32, height as i32);
     let (x, y) = (x as i32, y as i32);
-    for &(dx, dy) in offsets {
-        let (px, py) = (x + dx, y + dy);
-        if px >= 0 && py >= 0 && px < w && py < h {
-            flags[(py * w + px) as usize] = true;
+    for &(dy, half) in rows {
+        let py = y + dy;
+        if py >= 0 && py < h {
+            let (x0, x1) = ((x - half).max(0), (x + half).min(w - 1));
+            let row = (py * w) as usize;
+            flags[row + x0 as usize..=row + x1 as usize].fill(true);
         }
     }
 }
@@ -51,7 +73,7 @@ fn flag(flags: &mut [bool], width: u32, height: u32, x: u32, y: u32, offsets: &[
 /// indices `y·width + x`, in the order they were kept (the field sorts them into pixel order).
 pub fn saturate(width: u32, height: u32, radius: f64, rng: &mut impl Rng) -> Vec<u32> {
     let n = width as usize * height as usize;
-    let offsets = disk(radius);
+    let rows = disk_rows(radius);
     let mut flags = vec![false; n];
     let mut order: Vec<u32> = (0..n as u32).collect();
     let mut kept = Vec::new();
@@ -62,7 +84,7 @@ pub fn saturate(width: u32, height: u32, radius: f64, rng: &mut impl Rng) -> Vec
         let p = order[i];
         if !flags[p as usize] {
             kept.push(p);
-            flag(&mut flags, width, height, p % width, p / width, &offsets);
+            flag(&mut flags, width, height, p % width, p / width, &rows);
         }
     }
     kept
@@ -71,14 +93,14 @@ pub fn saturate(width: u32, height: u32, radius: f64, rng: &mut impl Rng) -> Vec
 /// The seed's dart throwing: `throws` darts at uniformly random pixels.
 pub fn darts(width: u32, height: u32, radius: f64, throws: u64, rng: &mut impl Rng) -> Vec<u32> {
     let n = width as usize * height as usize;
-    let offsets = disk(radius);
+    let rows = disk_rows(radius);
     let mut flags = vec![false; n];
     let mut kept = Vec::new();
     for _ in 0..throws {
         let p = rng.random_range(0..n as u32);
         if !flags[p as usize] {
             kept.push(p);
-            flag(&mut flags, width, height, p % width, p / width, &offsets);
+            flag(&mut flags, width, height, p % width, p / width, &rows);
         }
     }
     kept

@@ -115,7 +115,7 @@ pub fn label(width: u32, height: u32, seeds: &[u32], radius: f64) -> Vec<u32> {
     let n = width as usize * height as usize;
     let mut best = vec![u32::MAX; n];
     let mut owner = vec![u32::MAX; n];
-    let offsets = super::poisson::disk(radius);
+    let rows_of_disk = super::poisson::disk_rows(radius);
     // Bands of rows painted in parallel, each by the seeds whose disks reach it, in index order
     // as a whole image would be (so a tie still keeps the lower index): the same labels on any
     // number of threads.
@@ -126,7 +126,7 @@ pub fn label(width: u32, height: u32, seeds: &[u32], radius: f64) -> Vec<u32> {
         .enumerate()
         .for_each(|(b, (best, owner))| {
             let first = (b * rows) as i32;
-            paint(width, first, best, owner, seeds, &offsets);
+            paint(width, first, best, owner, seeds, &rows_of_disk);
         });
     if owner.contains(&u32::MAX) && !seeds.is_empty() {
         fill_holes(width, height, seeds, radius, &mut owner);
@@ -138,26 +138,32 @@ pub fn label(width: u32, height: u32, seeds: &[u32], radius: f64) -> Vec<u32> {
 const LABEL_BANDS: usize = 4;
 
 /// Paints the rows from `first` that `best` and `owner` hold (whole rows of `width`): each pixel
-/// takes the seed nearest its centre, of the seeds (pixel indices, ascending) whose disk of
-/// `offsets` reaches it.
-fn paint(width: u32, first: i32, best: &mut [u32], owner: &mut [u32], seeds: &[u32], offsets: &[(i32, i32)]) {
+/// takes the seed nearest its centre, of the seeds (pixel indices, ascending) whose disk
+/// (`disk`, [`super::poisson::disk_rows`]) reaches it.
+fn paint(width: u32, first: i32, best: &mut [u32], owner: &mut [u32], seeds: &[u32], disk: &[(i32, i32)]) {
     let w = width as i32;
     let last = first + (best.len() / width as usize) as i32;
-    let reach = offsets.iter().map(|o| o.1.abs()).max().unwrap_or(0);
+    let reach = disk.iter().map(|o| o.0.abs()).max().unwrap_or(0);
     // Seeds are in pixel order, so those within `reach` rows of the band are one run.
     let lo = seeds.partition_point(|&p| (p / width) as i32 + reach < first);
     let hi = seeds.partition_point(|&p| ((p / width) as i32) - reach < last);
     for (i, &p) in seeds.iter().enumerate().take(hi).skip(lo) {
         let (x, y) = ((p % width) as i32, (p / width) as i32);
-        for &(dx, dy) in offsets {
-            let (px, py) = (x + dx, y + dy);
-            if px >= 0 && py >= first && px < w && py < last {
-                let at = ((py - first) * w + px) as usize;
-                let d = (dx * dx + dy * dy) as u32;
+        for &(dy, half) in disk {
+            let py = y + dy;
+            if py < first || py >= last {
+                continue;
+            }
+            let (x0, x1) = ((x - half).max(0), (x + half).min(w - 1));
+            let row = ((py - first) * w) as usize;
+            let span = row + x0 as usize..=row + x1 as usize;
+            let dy2 = dy * dy;
+            for (dx, (b, o)) in (x0 - x..).zip(best[span.clone()].iter_mut().zip(&mut owner[span])) {
+                let d = (dx * dx + dy2) as u32;
                 // Seeds are painted in index order, so a tie keeps the lower index.
-                if d < best[at] {
-                    best[at] = d;
-                    owner[at] = i as u32;
+                if d < *b {
+                    *b = d;
+                    *o = i as u32;
                 }
             }
         }
