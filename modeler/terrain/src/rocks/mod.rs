@@ -315,9 +315,11 @@ fn make_block(recipe: &Recipe, made: &Made, i: usize, part: &[(u32, usize)]) -> 
     block.vertices.reserve(2 * corners);
     block.triangles.reserve(3 * corners);
     let layer = &recipe.layers[i];
-    let seeded = ChaCha8Rng::seed_from_u64(recipe.seed);
+    // One generator for the block, set to each rock's stream in turn (a copy per rock cost a
+    // copy of its buffer).
+    let mut rng = ChaCha8Rng::seed_from_u64(recipe.seed);
     for (k, &(cell, _)) in part.iter().enumerate() {
-        let mut rng = stream_of(&seeded, SHAPE, i, u64::from(cell));
+        restream(&mut rng, SHAPE, i, u64::from(cell));
         let list::Block {
             polygons,
             polygon_starts,
@@ -348,16 +350,18 @@ fn ms(since: Instant) -> f64 {
 
 /// A random stream for `purpose` of `layer` (and `cell`) of a field with `seed`.
 fn stream(seed: u64, purpose: u64, layer: usize, cell: u64) -> ChaCha8Rng {
-    stream_of(&ChaCha8Rng::seed_from_u64(seed), purpose, layer, cell)
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    restream(&mut rng, purpose, layer, cell);
+    rng
 }
 
-/// [`stream`] from the field's generator freshly seeded (`seeded`, nothing drawn from it): a
-/// copy with the stream set is the same generator, without expanding the seed again for each
-/// of tens of thousands of rocks.
-fn stream_of(seeded: &ChaCha8Rng, purpose: u64, layer: usize, cell: u64) -> ChaCha8Rng {
-    let mut rng = seeded.clone();
+/// Sets `rng` (seeded with the field's seed) to the start of the stream of [`stream`]: the same
+/// generator as a fresh one, without expanding the seed again for each of tens of thousands of
+/// rocks. Back at word 0 its buffer counts as used up, so the stream's first block is made on
+/// the first draw, as a fresh generator's is.
+fn restream(rng: &mut ChaCha8Rng, purpose: u64, layer: usize, cell: u64) {
+    rng.set_word_pos(0);
     rng.set_stream(purpose << 56 | (layer as u64) << 40 | cell);
-    rng
 }
 
 const SEEDS: u64 = 1;
@@ -455,8 +459,16 @@ pub fn scatter(recipe: &Recipe, inside: Option<&[bool]>) -> Result<Scatter, Reci
                     Goal::Pixels(p) => got.pixels >= p,
                     Goal::Cells(c) => got.cells.len() >= c,
                 };
-                let mut by_place: Vec<(u32, usize)> = got.cells.iter().enumerate().map(|(k, &c)| (c, k)).collect();
-                by_place.sort_unstable_by_key(|m| m.0);
+                // By cell through a table of when each was drawn (kept cells are distinct),
+                // rather than a sort.
+                let mut drawn_at = vec![usize::MAX; made[i].centres.len()];
+                for (k, &c) in got.cells.iter().enumerate() {
+                    drawn_at[c as usize] = k;
+                }
+                let by_place: Vec<(u32, usize)> = (0..drawn_at.len() as u32)
+                    .zip(drawn_at)
+                    .filter(|m| m.1 != usize::MAX)
+                    .collect();
                 let by_place = Arc::new(by_place);
                 selection_ms += ms(t);
                 for b in 0..by_place.len().div_ceil(list::BLOCK) {

@@ -2,7 +2,7 @@
 //! once, kept only if none of their pixels is taken yet, until the diagram's area or count is
 //! reached. Diagrams go largest mean cell first, so the big rocks find room.
 
-use rand::{Rng, RngExt};
+use rand::Rng;
 
 use super::voronoi::CellPixels;
 
@@ -44,7 +44,7 @@ pub fn select(cells: &CellPixels, taken: &mut [bool], goal: Goal, rng: &mut impl
         if done(&out) {
             break;
         }
-        let j = rng.random_range(i..n);
+        let j = super::poisson::below(rng, i, n);
         order.swap(i, j);
         let c = order[i];
         out.tried += 1;
