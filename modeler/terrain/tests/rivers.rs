@@ -553,7 +553,7 @@ fn river_edits_undo_and_recarve_incrementally() {
 #[test]
 fn the_nearest_sample_field_is_the_distance_to_the_course() {
     use penmodel_terrain::river::near::{self, NONE};
-    // The Ω's sampled course (sharp bends and a neck) and a zigzag with 90° corners.
+    // The Ω's sampled course (sharp bends and a neck) and a zigzag with 127° turns.
     let omega: Vec<DVec2> = course::sample(&omega(18.0).iter().map(|p| DVec2::from(*p)).collect::<Vec<_>>(), 1.0)
         .iter()
         .map(|s| s.p)
@@ -567,26 +567,52 @@ fn the_nearest_sample_field_is_the_distance_to_the_course() {
         width: 200,
         height: 200,
     };
-    for (line, reach) in [(omega, 9.0), (zigzag, 7.0)] {
+    // A shallow zigzag: turns of 37°, under the 45° past which a joint's wedge is a rectangle.
+    let shallow: Vec<DVec2> = (0..40)
+        .map(|i| DVec2::new(10.0 + 3.0 * i as f64, 120.0 + (i % 2) as f64))
+        .collect();
+    for (line, reach) in [(omega, 9.0), (zigzag, 7.0), (shallow, 8.0)] {
         let field = near::nearest(&win, &line, reach);
+        // The owner is the nearer end of a nearest segment: within half the longest segment of
+        // the nearest point.
+        let half = line.windows(2).map(|w| w[0].distance(w[1])).fold(0.0, f64::max) / 2.0;
         for i in 0..win.len() {
             let p = DVec2::new((i % 200) as f64, (i / 200) as f64);
-            // Brute force over every segment.
-            let d = line
+            // Brute force over every segment: the distance and the side (the sign of the cross
+            // product) of each.
+            let mut near: Vec<(f64, i8)> = line
                 .windows(2)
                 .map(|w| {
                     let ab = w[1] - w[0];
                     let t = ((p - w[0]).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
-                    p.distance(w[0] + ab * t)
+                    let cross = ab.perp_dot(p - w[0]);
+                    (
+                        p.distance(w[0] + ab * t),
+                        i8::from(cross > 1e-9) - i8::from(cross < -1e-9),
+                    )
                 })
-                .fold(f64::INFINITY, f64::min);
+                .collect();
+            near.sort_by(|a, b| a.0.total_cmp(&b.0));
+            let d = near[0].0;
             if d <= reach - 1e-9 {
-                assert_ne!(field.owner[i], NONE, "{p} at {d} has no sample");
+                let o = field.owner[i];
+                assert_ne!(o, NONE, "{p} at {d} has no sample");
                 assert!(
                     (f64::from(field.dist[i]) - d).abs() < 1e-4,
                     "{p}: {} against {d}",
                     field.dist[i]
                 );
+                let to_owner = p.distance(line[o as usize]);
+                assert!(
+                    to_owner <= (d * d + half * half).sqrt() + 1e-6,
+                    "{p}: sample {o} is {to_owner} away, the line {d}"
+                );
+                // Where one segment is clearly the nearest and the cell is off the line, its side.
+                if d > 1e-3 && near.get(1).is_none_or(|n| n.0 > d + 1e-3 || n.1 == near[0].1) {
+                    assert_eq!(field.side[i], near[0].1, "{p}: the side");
+                }
+            } else if d > reach + 1e-9 {
+                assert_eq!(field.owner[i], NONE, "{p} at {d} is beyond the reach");
             }
         }
     }

@@ -35,18 +35,17 @@ pub struct Cells {
 impl Cells {
     /// The preview of `shape` as grid cells.
     pub fn of(shape: &Shape) -> Cells {
-        let p = shape.preview();
+        // The preview's cells as window indices, in increasing order.
+        let (add, remove) = shape.changes();
         let w = shape.window;
-        let cells = |m: &[u8]| {
-            m.iter()
-                .enumerate()
-                .filter(|(_, v)| **v != 0)
-                .map(|(i, _)| [w.c0 + (i % w.width) as u32, w.r0 + (i / w.width) as u32])
+        let cells = |m: Vec<usize>| {
+            m.into_iter()
+                .map(|i| [w.c0 + (i % w.width) as u32, w.r0 + (i / w.width) as u32])
                 .collect()
         };
         Cells {
-            erosion: cells(&p.erosion),
-            deposition: cells(&p.deposition),
+            erosion: cells(add),
+            deposition: cells(remove),
         }
     }
 }

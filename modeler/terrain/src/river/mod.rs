@@ -343,7 +343,8 @@ impl Shape {
         let water = morph::Bits::of(&self.mask, w, h, true);
         let mut land = morph::Bits::empty(w, h);
         water.complement(&mut land);
-        let (near_water, near_land) = (grow(water), grow(land));
+        // The water's crosses and the land's on a core each.
+        let (near_water, near_land) = rayon::join(|| grow(water), || grow(land));
         let (water, land) = (&near_water[0], &near_land[0]);
         for r in 0..h {
             let banks = (land.row(r).iter().zip(near_water[most].row(r)))
@@ -429,6 +430,8 @@ impl Shape {
             self.mask[i] = 0;
             self.lakes[i] = id;
         }
+        // The buffer back for the new field.
+        self.near.owner = old_owner;
         self.set_line(line);
         for &(_, _, neck) in &cuts {
             near::sweep_segment(&self.window, &mut self.mask, neck.0, neck.1, self.radius);
@@ -437,7 +440,7 @@ impl Shape {
         // The plug: lake cells next to the river's new course silt up; in the same pass, the
         // river's area and each lake's.
         let mut lake_area = vec![0usize; self.necks.len() + 1];
-        let area = self.mask.iter().filter(|&&m| m != 0).count();
+        let area = self.mask.iter().map(|&m| u32::from(m != 0)).sum::<u32>() as usize;
         let plug = self.radius + PLUG;
         // Once a neck has closed, by runs of 64 cells: the lakes are few and small, so most runs
         // have no lake cell.
@@ -512,27 +515,35 @@ impl Shape {
     /// run of water cells along the normal through `p`, or `p` if it is dry.
     fn recentre(&self, p: DVec2, d1: DVec2) -> DVec2 {
         let normal = d1.normalize_or_zero().perp();
-        let wet = |t: f64| -> bool {
-            let q = p + normal * t - self.window.origin();
-            let q = DVec2::new(near::round(q.x), near::round(q.y));
+        // The cell under p + normal · t for t = k/2: the nearest cell centre, as the floor of
+        // the position plus half a cell (a truncation where it is not negative; outside the
+        // window where it is).
+        let w = self.window.width;
+        let size = DVec2::new(w as f64, self.window.height as f64);
+        let base = p - self.window.origin() + DVec2::splat(0.5);
+        let step = normal * 0.5;
+        let wet = |k: f64| -> bool {
+            let q = base + step * k;
+            // In the window (the floor of q is below the size where q is), then whole cells.
             q.x >= 0.0
                 && q.y >= 0.0
-                && (q.x as usize) < self.window.width
-                && (q.y as usize) < self.window.height
-                && self.mask[q.y as usize * self.window.width + q.x as usize] != 0
+                && q.x < size.x
+                && q.y < size.y
+                && self.mask[q.y as u32 as usize * w + q.x as u32 as usize] != 0
         };
         if normal == DVec2::ZERO || !wet(0.0) {
             return p;
         }
-        let limit = self.radius + 2.0 * REACH;
+        // Half-cell steps each way while the water lasts.
+        let limit = 2.0 * (self.radius + 2.0 * REACH);
         let (mut lo, mut hi) = (0.0, 0.0);
-        while lo > -limit && wet(lo - 0.5) {
-            lo -= 0.5;
+        while lo > -limit && wet(lo - 1.0) {
+            lo -= 1.0;
         }
-        while hi < limit && wet(hi + 0.5) {
-            hi += 0.5;
+        while hi < limit && wet(hi + 1.0) {
+            hi += 1.0;
         }
-        p + normal * ((lo + hi) * 0.5)
+        p + normal * ((lo + hi) * 0.25)
     }
 
     /// Closes the necks of `pts`: returns the line with each loop cut out, and per cut the loop's

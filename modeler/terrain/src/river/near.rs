@@ -20,8 +20,8 @@ pub struct Near {
 }
 
 /// The field of the polyline `line` (cell coordinates of the grid: cell centres at integers) over
-/// `win`, for cells within `reach` cells of it. Each segment visits its slab of cells (below),
-/// so the cost is about the band's area × (1 + 2·reach × the bend per sample).
+/// `win`, for cells within `reach` cells of it. Each segment visits the cells it may be nearest
+/// (below): about the band's area × (1 + reach × the turn per sample / 2) cells in all.
 pub fn nearest(win: &Window, line: &[DVec2], reach: f64) -> Near {
     let mut near = Near {
         owner: Vec::new(),
@@ -32,28 +32,34 @@ pub fn nearest(win: &Window, line: &[DVec2], reach: f64) -> Near {
     near
 }
 
+/// A cell no segment has reached yet, as the bits of its squared distance while searching.
+const EMPTY: u32 = u32::MAX;
+
 /// Windows of at least this many cells fill their field on two row bands at once.
 const SPLIT_CELLS: usize = 16_384;
 
+/// How far (cells) each row's cells of a region reach past its exact bounds, so that rounding in
+/// the bounds never leaves out a cell on an edge; far below a cell, so it adds no visits.
+const SLACK: f64 = 1e-6;
+
 /// [`nearest`] into `near`'s buffers (reused from one iteration to the next).
 ///
-/// A large window is filled as two bands of rows on the thread pool: each band runs every
-/// segment over its own rows, in the same order, so each cell sees the same candidates in the
-/// same order as a single pass and the field is the same bit for bit (a test checks).
+/// Each cell's owner is the nearest segment within `reach` (the first of equal squared distances
+/// as `f32`), whichever segments visit it, so a large window is filled as two bands of rows on
+/// the thread pool and the field is the same bit for bit (a test checks).
 pub fn nearest_into(win: &Window, line: &[DVec2], reach: f64, near: &mut Near) {
+    // Sized here, reset by each band (below).
     let n = win.len();
-    near.owner.clear();
     near.owner.resize(n, NONE);
-    near.dist.clear();
     near.dist.resize(n, f32::INFINITY);
-    near.side.clear();
     near.side.resize(n, 0);
     let origin = win.origin();
     let pts: Vec<DVec2> = line.iter().map(|p| *p - origin).collect();
+    let segs = segments(&pts, reach);
     if n < SPLIT_CELLS || win.height < 2 {
         fill(
             win,
-            &pts,
+            &segs,
             reach,
             0..win.height,
             &mut near.owner,
@@ -67,88 +73,239 @@ pub fn nearest_into(win: &Window, line: &[DVec2], reach: f64, near: &mut Near) {
     let (o0, o1) = near.owner.split_at_mut(at);
     let (d0, d1) = near.dist.split_at_mut(at);
     let (s0, s1) = near.side.split_at_mut(at);
-    let pts = &pts;
+    let segs = &segs;
     rayon::join(
-        || fill(win, pts, reach, 0..mid, o0, d0, s0),
-        || fill(win, pts, reach, mid..win.height, o1, d1, s1),
+        || fill(win, segs, reach, 0..mid, o0, d0, s0),
+        || fill(win, segs, reach, mid..win.height, o1, d1, s1),
     );
 }
 
-/// The field of the polyline `pts` (window-local) over the window's rows `rows`, into buffers
-/// that hold those rows only (reset to [`NONE`], ∞, 0).
+/// A segment of the line in its own frame (from `a` along the unit `u` for `len` cells; `s` along
+/// it from `a`, `n` across it, positive on its left) and the cells it may be nearest: the
+/// rectangle `s` in `along`, `|n|` ≤ reach, and the wedge past its end on the outer side of the
+/// bend, if any.
+struct Segment {
+    a: DVec2,
+    u: DVec2,
+    len: f64,
+    along: (f64, f64),
+    /// The outer side (±1) and how far past the end the wedge reaches at `|n|` = reach.
+    wedge: Option<(f64, f64)>,
+}
+
+/// The line's segments (a single point: one of length 0). A cell's nearest point of the line is
+/// inside a segment (then the cell projects onto it, within `reach` across) or at a joint, on
+/// the outer side of the bend, in the wedge between the two segments' normals; the segment before
+/// the joint covers that wedge (a cell at `|n|` across it lies at most `|n| · tan(turn)` past its
+/// end), or, for a turn of 45° or more, a rectangle `reach` long past its end. The course's ends
+/// and segments of length 0 reach `reach` each way (a disc, which also covers the joints next to
+/// a segment of length 0).
+fn segments(pts: &[DVec2], reach: f64) -> Vec<Segment> {
+    let ends: Vec<(DVec2, DVec2)> = match pts {
+        [] => return Vec::new(),
+        [p] => vec![(*p, *p)],
+        _ => pts.windows(2).map(|w| (w[0], w[1])).collect(),
+    };
+    let dir: Vec<Option<DVec2>> = ends
+        .iter()
+        .map(|&(a, b)| {
+            let len = a.distance(b);
+            (len > 0.0).then(|| (b - a) / len)
+        })
+        .collect();
+    let last = ends.len() - 1;
+    ends.iter()
+        .enumerate()
+        .map(|(k, &(a, b))| {
+            let Some(u) = dir[k] else {
+                return Segment {
+                    a,
+                    u: DVec2::X,
+                    len: 0.0,
+                    along: (-reach, reach),
+                    wedge: None,
+                };
+            };
+            let len = a.distance(b);
+            let start = if k == 0 { -reach } else { 0.0 };
+            let (mut end, mut wedge) = (len, None);
+            match dir.get(k + 1).copied().flatten() {
+                _ if k == last => end = len + reach,
+                // A turn of 45° or more: the wedge's cells within reach lie at most `reach` past.
+                Some(q) if u.dot(q) <= u.perp_dot(q).abs() => end = len + reach,
+                Some(q) => {
+                    // Turning left, the outer side is the right (n < 0).
+                    let turn = u.perp_dot(q);
+                    if turn != 0.0 {
+                        wedge = Some((-turn.signum(), reach * turn.abs() / u.dot(q)));
+                    }
+                }
+                None => {}
+            }
+            Segment {
+                a,
+                u,
+                len,
+                along: (start, end),
+                wedge,
+            }
+        })
+        .collect()
+}
+
+/// The field of the segments `segs` (window-local) over the window's rows `rows`, into buffers
+/// that hold those rows only.
 fn fill(
     win: &Window,
-    pts: &[DVec2],
+    segs: &[Segment],
     reach: f64,
     rows: std::ops::Range<usize>,
     owner: &mut [u32],
     dist: &mut [f32],
     side: &mut [i8],
 ) {
+    // While searching, `dist` holds squared distances compared by their bits (the same order for
+    // positive floats) and all-ones bits (a NaN) for none yet: each buffer is reset by a memset.
+    owner.fill(NONE);
+    dist.fill(f32::from_bits(EMPTY));
+    side.fill(0);
     let base = rows.start * win.width;
-    if pts.len() == 1 {
-        // One point: a disc.
-        visit(win, rows.clone(), pts[0], pts[0], reach, |i, p| {
-            let d = p.distance(pts[0]);
-            if (d as f32) < dist[i - base] {
-                dist[i - base] = d as f32;
-                owner[i - base] = 0;
+    let r2 = reach * reach;
+    for (k, seg) in segs.iter().enumerate() {
+        let Segment { a, u, len, .. } = *seg;
+        let k = k as u32;
+        // Its nearer end: `k` before the middle (and for a segment of length 0), `k + 1` from it.
+        let half = if len > 0.0 { 0.5 * len } else { f64::INFINITY };
+        // The side: none for a segment of length 0 (a point has none).
+        let on = if len > 0.0 { 1e-9 } else { f64::INFINITY };
+        regions(win, rows.clone(), seg, reach, |r, c0, c1| {
+            let j0 = r * win.width + c0 - base;
+            let n = c1 - c0 + 1;
+            // Along the segment s = c·u.x + s0, across it (positive on its left) n0 − c·u.y.
+            let dy = r as f64 - a.y;
+            let (s0, n0) = (dy * u.y - a.x * u.x, dy * u.x + a.x * u.y);
+            let cells = (dist[j0..j0 + n].iter_mut())
+                .zip(&mut owner[j0..j0 + n])
+                .zip(&mut side[j0..j0 + n]);
+            let mut x = c0 as f64;
+            for ((d_best, o_best), s_best) in cells {
+                let s = x * u.x + s0;
+                let across = n0 - x * u.y;
+                x += 1.0;
+                // The nearest point is the projection clamped to the segment (by hand: no NaN
+                // here, and `clamp` checks its bounds).
+                #[allow(clippy::manual_clamp)]
+                let sc = if s < 0.0 {
+                    0.0
+                } else if s > len {
+                    len
+                } else {
+                    s
+                };
+                let d = (s - sc) * (s - sc) + across * across;
+                let df = d as f32;
+                // Without a branch: which segment is nearest changes from cell to cell in no
+                // pattern a predictor learns.
+                let better = d <= r2 && df.to_bits() < d_best.to_bits();
+                let o = k + u32::from(s >= half);
+                let sd = i8::from(across > on) - i8::from(across < -on);
+                *d_best = if better { df } else { *d_best };
+                *o_best = if better { o } else { *o_best };
+                *s_best = if better { sd } else { *s_best };
             }
         });
+    }
+    // The roots once at the end.
+    for d in dist.iter_mut() {
+        *d = if d.to_bits() == EMPTY { f32::INFINITY } else { d.sqrt() };
+    }
+}
+
+/// Calls `f(row, first column, last column)` for the cells of rows `rows` in `seg`'s region: its
+/// rectangle with its wedge, as one convex polygon (the wedge's triangle and the rectangle's
+/// hull; a cell of the hull outside both only costs a visit).
+fn regions(
+    win: &Window,
+    rows: std::ops::Range<usize>,
+    seg: &Segment,
+    reach: f64,
+    mut f: impl FnMut(usize, usize, usize),
+) {
+    let at = |s: f64, n: f64| seg.a + seg.u * s + seg.u.perp() * n;
+    let (s0, s1) = seg.along;
+    // Counter-clockwise in (s, n), and so in the window (a rotation keeps the turn).
+    let verts = match seg.wedge {
+        None => [at(s0, -reach), at(s1, -reach), at(s1, reach), at(s0, reach)],
+        Some((side, past)) if side > 0.0 => [at(s0, -reach), at(s1, -reach), at(s1 + past, reach), at(s0, reach)],
+        Some((_, past)) => [at(s0, -reach), at(s1 + past, -reach), at(s1, reach), at(s0, reach)],
+    };
+    convex(win, rows, &verts, &mut f);
+}
+
+/// Calls `f(row, first column, last column)` for each row of `rows` where the window has cells in
+/// the convex polygon `verts` (counter-clockwise, x right and y up; window-local), each row's
+/// bounds widened by [`SLACK`]: a row's cells form one interval, between the greatest of the
+/// left edges' bounds and the least of the right edges' (each edge's line bounds every row).
+fn convex(win: &Window, rows: std::ops::Range<usize>, verts: &[DVec2], f: &mut impl FnMut(usize, usize, usize)) {
+    let (lo, hi) = verts
+        .iter()
+        .fold((DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        });
+    let (w, h) = (win.width as f64, win.height as f64);
+    if hi.x < -SLACK || hi.y < -SLACK || lo.x > w - 1.0 + SLACK || lo.y > h - 1.0 + SLACK {
         return;
     }
-    let segs = pts.len().saturating_sub(1);
-    let dir: Vec<DVec2> = (0..segs).map(|k| (pts[k + 1] - pts[k]).normalize_or_zero()).collect();
-    // The turn at each joint, once (the angle's size does not depend on the order).
-    let bend: Vec<f64> = (1..segs).map(|k| dir[k - 1].angle_to(dir[k]).abs()).collect();
-    for k in 0..segs {
-        let (a, b) = (pts[k], pts[k + 1]);
-        let ab = b - a;
-        // Each segment visits its slab (the cells whose projection falls on it) widened over
-        // the wedge its joints leave on the outer side of a bend: `reach × angle` past each end,
-        // and 0.6 cell more so that neighbouring slabs overlap whatever the rounding; the
-        // course's ends get a cap of `reach`.
-        let widen = |other: Option<usize>| -> f64 {
-            match other {
-                None => reach,
-                Some(j) => reach * bend[j] + 0.6,
-            }
-        };
-        let before = widen(k.checked_sub(1));
-        let after = widen((k + 1 < segs).then_some(k));
-        let len2 = ab.length_squared();
-        slab(win, rows.clone(), a, b, before, after, reach, |i, p| {
-            // `clamp(0, 1)` by hand: the same for a number, without `clamp`'s check of its bounds
-            // (a sixth of the field's instructions).
-            #[allow(clippy::manual_clamp)]
-            let t = if len2 > 0.0 {
-                let t = (p - a).dot(ab) / len2;
-                if t < 0.0 {
-                    0.0
-                } else if t > 1.0 {
-                    1.0
-                } else {
-                    t
-                }
-            } else {
-                0.0
-            };
-            // Squared distances while searching; the roots once at the end.
-            let d = p.distance_squared(a + ab * t) as f32;
-            let j = i - base;
-            // Without a branch: which segment is nearest changes from cell to cell in no
-            // pattern a predictor learns.
-            let better = d < dist[j];
-            let cross = ab.perp_dot(p - a);
-            let s = i8::from(cross > 1e-9) - i8::from(cross < -1e-9);
-            let o = if t < 0.5 { k as u32 } else { k as u32 + 1 };
-            dist[j] = if better { d } else { dist[j] };
-            owner[j] = if better { o } else { owner[j] };
-            side[j] = if better { s } else { side[j] };
-        });
+    let (r0, r1) = (
+        ceil_small((lo.y - SLACK).max(0.0)) as usize,
+        floor_small((hi.y + SLACK).min(h - 1.0)) as usize,
+    );
+    let (cmin, cmax) = ((lo.x - SLACK).max(0.0), (hi.x + SLACK).min(w - 1.0));
+    // Each edge's x at row y: x0 + y·slope; rising edges bound on the right (the inside is on an
+    // edge's left), falling ones on the left. Edges along a row are bounded by the rows.
+    let mut left = [(0.0, 0.0); 4];
+    let mut right = [(0.0, 0.0); 4];
+    let (mut nl, mut nr) = (0, 0);
+    for (i, p) in verts.iter().enumerate() {
+        let q = verts[(i + 1) % verts.len()];
+        let dy = q.y - p.y;
+        if dy.abs() < 1e-12 {
+            continue;
+        }
+        let slope = (q.x - p.x) / dy;
+        let edge = (p.x - p.y * slope, slope);
+        if dy > 0.0 {
+            right[nr] = edge;
+            nr += 1;
+        } else {
+            left[nl] = edge;
+            nl += 1;
+        }
     }
-    for d in dist.iter_mut() {
-        *d = d.sqrt();
+    let (left, right) = (&left[..nl], &right[..nr]);
+    for r in r0.max(rows.start)..(r1 + 1).min(rows.end) {
+        let y = r as f64;
+        // Plain compares: no NaN here, and `max`/`min` handle one.
+        let (mut low, mut high) = (cmin + SLACK, cmax - SLACK);
+        for &(x0, slope) in left {
+            let x = x0 + y * slope;
+            if x > low {
+                low = x;
+            }
+        }
+        for &(x0, slope) in right {
+            let x = x0 + y * slope;
+            if x < high {
+                high = x;
+            }
+        }
+        let (low, high) = (low - SLACK, high + SLACK);
+        // The ceiling of a maximum is the maximum of the ceilings: one ceiling and one floor per
+        // row, of values held within a cell of `[cmin, cmax]`, where they are small integers.
+        let (c0, c1) = (ceil_small(low.min(cmax + 1.0)), floor_small(high.max(cmin - 1.0)));
+        if c1 >= c0 {
+            f(r, c0 as usize, c1 as usize);
+        }
     }
 }
 
@@ -170,73 +327,6 @@ fn visit(win: &Window, rows: std::ops::Range<usize>, a: DVec2, b: DVec2, reach: 
     }
 }
 
-/// Calls `f(index, local position)` for the window's cells within `reach` of the line through
-/// `a`, `b` whose projection on it lies from `before` before `a` to `after` past `b` (distances
-/// along the line), row by row (of `rows` only): each row's cells form one interval.
-#[allow(clippy::too_many_arguments)]
-fn slab(
-    win: &Window,
-    rows: std::ops::Range<usize>,
-    a: DVec2,
-    b: DVec2,
-    before: f64,
-    after: f64,
-    reach: f64,
-    mut f: impl FnMut(usize, DVec2),
-) {
-    let ab = b - a;
-    let len = ab.length();
-    if len == 0.0 {
-        return visit(win, rows, a, b, reach, f);
-    }
-    let u = ab / len;
-    let (lo_t, hi_t) = (-before, len + after);
-    let corners = [a + u * lo_t, a + u * hi_t];
-    let lo = corners[0].min(corners[1]) - DVec2::splat(reach);
-    let hi = corners[0].max(corners[1]) + DVec2::splat(reach);
-    let (w, h) = (win.width as f64, win.height as f64);
-    if hi.x < 0.0 || hi.y < 0.0 || lo.x > w - 1.0 || lo.y > h - 1.0 {
-        return;
-    }
-    let (r0, r1) = (lo.y.ceil().max(0.0) as usize, hi.y.floor().min(h - 1.0) as usize);
-    // The rows the slab's own corners span (the box above is grown by `reach` both ways: for a
-    // segment along a column, 2·reach rows more than the slab's), and one more each side, so that
-    // the rows left out have no cell whatever the rounding of the bounds below.
-    let v = u.perp();
-    let ys = [lo_t, hi_t].map(|t| a.y + u.y * t);
-    let across = (v.y * reach).abs();
-    let (y0, y1) = (ys[0].min(ys[1]) - across - 1.0, ys[0].max(ys[1]) + across + 1.0);
-    let (r0, r1) = (r0.max(y0.max(0.0) as usize), r1.min(y1.max(0.0) as usize));
-    let (cmin, cmax) = (lo.x.ceil().max(0.0), hi.x.floor().min(w - 1.0));
-    for r in r0.max(rows.start)..(r1 + 1).min(rows.end) {
-        let dy = r as f64 - a.y;
-        // Along: s(c) = (c − a.x)·u.x + dy·u.y in [lo_t, hi_t]; across: n(c) = (c − a.x)·u.y − dy·u.x
-        // (up to sign) in [−reach, reach]. Both are linear in c. The cells are the integers from
-        // the greatest lower bound to the least upper one: the ceiling of a maximum is the
-        // maximum of the ceilings, so one ceiling and one floor per row, of values held within
-        // a cell of `[cmin, cmax]` (integers), where they are small integers.
-        let (mut low, mut high) = (cmin, cmax);
-        for (k, off, range) in [(u.x, dy * u.y, (lo_t, hi_t)), (u.y, -dy * u.x, (-reach, reach))] {
-            if k.abs() < 1e-12 {
-                if off < range.0 || off > range.1 {
-                    high = low - 1.0;
-                }
-            } else {
-                let (x0, x1) = ((range.0 - off) / k + a.x, (range.1 - off) / k + a.x);
-                low = low.max(x0.min(x1));
-                high = high.min(x0.max(x1));
-            }
-        }
-        let (c0, c1) = (ceil_small(low.min(cmax + 1.0)), floor_small(high.max(cmin - 1.0)));
-        if c1 < c0 {
-            continue;
-        }
-        for c in c0 as usize..=c1 as usize {
-            f(r * win.width + c, DVec2::new(c as f64, r as f64));
-        }
-    }
-}
-
 /// `x.ceil()` for `x` within `i32`'s range, as an integer: a truncation and a compare.
 fn ceil_small(x: f64) -> i32 {
     let t = x as i32;
@@ -247,29 +337,6 @@ fn ceil_small(x: f64) -> i32 {
 fn floor_small(x: f64) -> i32 {
     let t = x as i32;
     if f64::from(t) > x { t - 1 } else { t }
-}
-
-/// `x.round()` (half away from zero) up to the sign of a zero, inline (without SSE4.1
-/// `f64::round` is a call into libm; the river's recentring paid one per step): the fraction `x − trunc(x)` is exact.
-pub(super) fn round(x: f64) -> f64 {
-    let t = trunc(x);
-    let f = x - t;
-    if f >= 0.5 {
-        t + 1.0
-    } else if f <= -0.5 {
-        t - 1.0
-    } else {
-        t
-    }
-}
-
-/// `x` rounded towards zero; values of 2⁵² and more (and NaN, ∞) are already whole.
-fn trunc(x: f64) -> f64 {
-    if x.abs() < 4_503_599_627_370_496.0 {
-        x as i64 as f64
-    } else {
-        x
-    }
 }
 
 /// Sets `mask` to 1 on the window's cells within `radius` cells of the segment `a`–`b` (grid
