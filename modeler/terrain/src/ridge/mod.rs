@@ -28,6 +28,7 @@ pub mod rain;
 mod sections;
 pub mod sun;
 pub mod tree;
+mod walk;
 
 use thiserror::Error;
 

@@ -54,11 +54,6 @@ impl Sections {
         s
     }
 
-    /// The samples of a line at most: the grid's extent along u.
-    pub fn width(&self) -> usize {
-        self.w
-    }
-
     /// The lines with samples on the grid (some at the ends may have none).
     pub fn lines(&self) -> Range<isize> {
         let (min, max) = self.o.iter().fold((0, 0), |(a, b), &o| (o.min(a), o.max(b)));
@@ -218,44 +213,6 @@ impl Hull {
         }
     }
 
-    /// Both passes of [`Hull::pass`] over `z` in lock-step, this hull for `AHEAD_UP` into `up`
-    /// and `other` for the opposite into `down` (the two walks are independent, so the CPU
-    /// overlaps one's pop tests with the other's), for horizons above the horizontal only (the
-    /// sky view's): a sample at least as high as every sample ahead gets rise 0 instead of its
-    /// (negative) horizon, and the hull is cleared down to it — everything ahead is lower and
-    /// farther from the samples swept later, so it can give none of them a larger positive
-    /// tangent. A fifth of the samples of the bench's terrain are such running maxima, each
-    /// saving a walk.
-    #[inline(always)]
-    pub fn pass_both_positive(
-        &mut self,
-        other: &mut Hull,
-        z: &[f32],
-        up: (&mut [f32], &mut [f32]),
-        down: (&mut [f32], &mut [f32]),
-    ) {
-        let n = z.len();
-        if n == 0 {
-            return;
-        }
-        let (mask, (su, hu)) = self.stacks(n);
-        let (_, (sd, hd)) = other.stacks(n);
-        let (ru, du) = (&mut up.0[..n], &mut up.1[..n]);
-        let (rd, dd) = (&mut down.0[..n], &mut down.1[..n]);
-        (ru[n - 1], du[n - 1], rd[0], dd[0]) = (f32::NAN, 1.0, f32::NAN, 1.0);
-        let (mut tu, mut td) = (1usize, 1usize);
-        let (mut h1u, mut h1d, mut s) = (z[n - 1], z[0], 0.0f32);
-        // The highest sample ahead in each walk.
-        let (mut mu, mut md) = (h1u, h1d);
-        for j in 1..n {
-            s -= 1.0;
-            let (ku, kd) = (n - 1 - j, j);
-            let (hu_, hd_) = (z[ku], z[kd]);
-            (ru[ku], du[ku]) = step_positive(su, hu, mask, &mut tu, &mut h1u, &mut mu, s, hu_);
-            (rd[kd], dd[kd]) = step_positive(sd, hd, mask, &mut td, &mut h1d, &mut md, s, hd_);
-        }
-    }
-
     /// The stacks for a line of n samples, a power of two above n + 1 long (indices masked with
     /// the returned mask need no bounds checks), with the bottom vertex in place.
     #[inline(always)]
@@ -324,30 +281,6 @@ fn step(ss: &mut [f32], hs: &mut [f32], mask: usize, top: &mut usize, h1: &mut f
     *top = t + 1;
     *h1 = h;
     (a, b)
-}
-
-/// [`step`] for horizons above the horizontal only, `max` the highest sample ahead: a sample
-/// at least as high gets rise 0 and empties the stacks (see [`Hull::pass_both_positive`]).
-#[allow(clippy::too_many_arguments)] // one walk's state, kept in registers by inlining.
-#[inline(always)]
-fn step_positive(
-    ss: &mut [f32],
-    hs: &mut [f32],
-    mask: usize,
-    top: &mut usize,
-    h1: &mut f32,
-    max: &mut f32,
-    s: f32,
-    h: f32,
-) -> (f32, f32) {
-    if h >= *max {
-        *max = h;
-        // The bottom vertex only; this sample becomes the previous one.
-        *top = 1;
-        *h1 = h;
-        return (0.0, 1.0);
-    }
-    step(ss, hs, mask, top, h1, s, h)
 }
 
 /// `z` (`cols × rows`, row-major) transposed: `rows × cols`, followed by `pad` zeros. In tiles,

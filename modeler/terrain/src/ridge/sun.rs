@@ -30,6 +30,7 @@ use rayon::prelude::*;
 use super::RidgeError;
 use super::gradient::sobel;
 use super::sections::{Hull, Sections, transpose};
+use super::walk::{LANES, OFF_GRID, Walk};
 use crate::Heightmap;
 
 /// The diffuse share of clear-sky light used by [`insolation`].
@@ -253,18 +254,10 @@ impl Layout {
     }
 }
 
-/// The `sin² H` of a horizon `rise / (steps·spacing)`, 0 for one below the horizontal or none
-/// (a NaN rise); `sp2` is the spacing squared.
-#[inline]
-fn sin2(rise: f32, steps: f32, sp2: f32) -> f32 {
-    let r = if rise > 0.0 { rise } else { 0.0 };
-    r * r / (r * r + steps * steps * sp2)
-}
-
 /// Lines swept as one block: their heights and values laid out column by column, so that
-/// building and spreading them are shifted interpolations of contiguous cells. A block is also
-/// the unit of work the cores share.
-const BLOCK: usize = 32;
+/// building and spreading them are shifted interpolations of contiguous cells and their walks
+/// run side by side ([`Walk`]). A block is also the unit of work the cores share.
+const BLOCK: usize = LANES;
 
 /// Columns of a layout spread as one piece of work.
 const SPREAD_COLUMNS: usize = 16;
@@ -287,8 +280,7 @@ fn sky_sweep(zc: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &m
         .enumerate()
         .for_each_init(Scratch::default, |buf, (k, block)| {
             let b0 = all.start + (k * BLOCK) as isize;
-            let nb = BLOCK.min((all.end - b0) as usize);
-            sweep_block(zc, &lines, (du, both), b0, &mut block[..w * nb], buf);
+            sweep_block(zc, &lines, (du, both), b0, block, buf);
         });
     let values = &values[..];
     layout
@@ -301,7 +293,7 @@ fn sky_sweep(zc: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &m
                 for (k, block) in values.chunks_exact(w * BLOCK).take(blocks).enumerate() {
                     let b0 = all.start + (k * BLOCK) as isize;
                     let nb = BLOCK.min((all.end - b0) as usize);
-                    lines.column_spread(u, b0, &block[u * nb..(u + 1) * nb], col);
+                    lines.column_spread(u, b0, &block[u * BLOCK..u * BLOCK + nb], col);
                 }
             }
         });
@@ -313,74 +305,43 @@ fn sky_sweep(zc: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &m
     layout.inner += passes;
 }
 
-/// The lines `b0..` of `lines` as one block (`block`, laid out like
-/// [`Sections::block_heights`]'s): their heights, then in their place the `sin² H` of each
-/// sample (towards `du`'s sign, and with `both` the opposite way added).
+/// The lines `b0..b0 + BLOCK` of `lines` as one block (`block`, laid out like
+/// [`Sections::block_heights`]'s, [`OFF_GRID`] where a line is off the grid): their heights,
+/// then in their place the `sin² H` of each sample (towards `du`'s sign, and with `both` the
+/// opposite way added).
 fn sweep_block(zc: &[f32], lines: &Sections, (du, both): (f64, bool), b0: isize, block: &mut [f32], buf: &mut Scratch) {
-    let w = lines.width();
-    let nb = block.len() / w;
     let sp2 = lines.spacing * lines.spacing;
-    let Scratch {
-        heights,
-        up,
-        down,
-        hull,
-        other,
-    } = buf;
-    heights.resize(w, 0.0);
-    for v in [&mut up.0, &mut up.1, &mut down.0, &mut down.1] {
-        v.resize(w, 0.0);
+    let Scratch { heights, walk } = buf;
+    // The columns where any of the lines is on the grid: the walks skip the others.
+    let (mut u0, mut u1) = (usize::MAX, 0);
+    for b in b0..b0 + BLOCK as isize {
+        let cols = lines.columns(b);
+        if !cols.is_empty() {
+            (u0, u1) = (u0.min(cols.start), u1.max(cols.end));
+        }
     }
-    lines.block_heights(zc, b0, nb, block);
-    for j in 0..nb {
-        let cols = lines.columns(b0 + j as isize);
-        let n = cols.len();
-        if n == 0 {
-            continue;
+    if u0 >= u1 {
+        return;
+    }
+    heights.resize(block.len(), 0.0);
+    heights[u0 * BLOCK..u1 * BLOCK].fill(OFF_GRID);
+    lines.block_heights(zc, b0, BLOCK, heights);
+    let (z, out) = (&heights[u0 * BLOCK..u1 * BLOCK], &mut block[u0 * BLOCK..u1 * BLOCK]);
+    match (du > 0.0 || both, du < 0.0 || both) {
+        (true, true) => {
+            walk.pass::<true, false>(z, sp2, out);
+            walk.pass::<false, true>(z, sp2, out);
         }
-        // Line j's samples: element j of each column's chunk of the block.
-        let span = cols.start * nb..cols.end * nb;
-        let zs = &mut heights[..n];
-        for (z, c) in zs.iter_mut().zip(block[span.clone()].chunks_exact(nb)) {
-            *z = c[j];
-        }
-        let (ru, su) = (&mut up.0[..n], &mut up.1[..n]);
-        let (rd, dd) = (&mut down.0[..n], &mut down.1[..n]);
-        match (du > 0.0 || both, du < 0.0 || both) {
-            (true, true) => {
-                hull.pass_both_positive(other, zs, (&mut *ru, &mut *su), (&mut *rd, &mut *dd));
-                // sin² H of both, in place of the first's rises (vectorised).
-                for (((r, &d), &r2), &d2) in ru.iter_mut().zip(su.iter()).zip(rd.iter()).zip(dd.iter()) {
-                    *r = sin2(*r, d, sp2) + sin2(r2, d2, sp2);
-                }
-            }
-            (up_only, _) => {
-                if up_only {
-                    hull.pass::<true>(zs, ru, su);
-                } else {
-                    hull.pass::<false>(zs, ru, su);
-                }
-                for (r, &d) in ru.iter_mut().zip(su.iter()) {
-                    *r = sin2(*r, d, sp2);
-                }
-            }
-        }
-        // The values in place of the heights.
-        for (c, &r) in block[span].chunks_exact_mut(nb).zip(ru.iter()) {
-            c[j] = r;
-        }
+        (true, false) => walk.pass::<true, false>(z, sp2, out),
+        _ => walk.pass::<false, false>(z, sp2, out),
     }
 }
 
-/// Buffers reused from line to line: a line's heights, and the rises and steps to the horizon
-/// ahead in both directions.
+/// Buffers reused from block to block: the block's heights and its walks.
 #[derive(Default)]
 struct Scratch {
     heights: Vec<f32>,
-    up: (Vec<f32>, Vec<f32>),
-    down: (Vec<f32>, Vec<f32>),
-    hull: Hull,
-    other: Hull,
+    walk: Walk,
 }
 
 /// The sky-view fraction per cell from `k` azimuths (`2πi/k`): `1 − (1/k)·Σ sin² H_i`.

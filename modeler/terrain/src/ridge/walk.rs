@@ -1,0 +1,304 @@
+//! The sky view's hull walks ([`super::sun::sky_view`]), the [`LANES`] lines of a block side by
+//! side: one walk step for all of them at a time.
+//!
+//! A line's walk ([`super::sections::Hull`]) is bound by its data-dependent branch — how many
+//! vertices a sample pops — not by its instructions. Nine steps in ten pop at most one vertex,
+//! and those need only the top two vertices of the stack: each lane keeps them apart (`s1, h1`
+//! and `s2, h2`) from the rest of its stack, so that the common step is the same branch-free
+//! arithmetic in every lane, eight lanes to a vector. The lanes that push the previous sample (no
+//! pop), pop two or more, or restart (below) are finished one by one afterwards, from bit masks:
+//! a branch per such lane rather than a guess per sample. The arithmetic is [`super::sections::Hull`]'s, operation for operation (positions are
+//! whole steps, exact in `f32`), so the values are the same to the bit; a test compares them.
+//!
+//! Only horizons above the horizontal are wanted (the sky view's `sin² H` is 0 below): a sample
+//! at least as high as every sample ahead gets rise 0 and empties its lane's stack: everything
+//! ahead of it is lower and farther from the samples walked later, so it can give none of them
+//! a larger positive tangent. About a fifth of the bench's samples are such running maxima.
+
+use wide::f32x8;
+
+/// Lines walked side by side: the block of [`super::sun`].
+pub(super) const LANES: usize = 32;
+
+/// The height a lane's samples off the grid get: below any terrain, so the first sample on the
+/// grid is a running maximum and starts the lane afresh; what the walk gives the samples off
+/// the grid is not used.
+pub(super) const OFF_GRID: f32 = -1.0e30;
+
+/// The bottom of every stack: a vertex no line to the next one passes over (infinitely low), so
+/// that the pop tests need no check for an empty stack. Its position only has to be finite.
+const BOTTOM_S: f32 = 1.0;
+const BOTTOM_H: f32 = f32::NEG_INFINITY;
+
+type Lanes<T> = [T; LANES];
+
+/// Lanes a vector holds (explicit SIMD by `wide`: safe, and plain SSE2 pairs on x86-64's
+/// baseline — the compiler did not vectorise the selects and masks of the step on its own).
+const V: usize = 8;
+/// Vectors per block.
+const G: usize = LANES / V;
+
+/// The walks of one block's lines: per lane the top two vertices of its upper hull (`s1, h1`
+/// and `s2, h2`: positions and heights), the previous sample (one step ahead, not yet on the
+/// hull), the highest sample ahead and the vertex count `n`; the vertices under the top two in
+/// memory, `cap` per lane.
+pub(super) struct Walk {
+    s1: Lanes<f32>,
+    h1: Lanes<f32>,
+    s2: Lanes<f32>,
+    h2: Lanes<f32>,
+    prev: Lanes<f32>,
+    max: Lanes<f32>,
+    n: Lanes<u32>,
+    cap: usize,
+    ms: Vec<f32>,
+    mh: Vec<f32>,
+}
+
+impl Default for Walk {
+    fn default() -> Walk {
+        let all = |v: f32| [v; LANES];
+        Walk {
+            s1: all(BOTTOM_S),
+            h1: all(BOTTOM_H),
+            s2: all(BOTTOM_S),
+            h2: all(BOTTOM_H),
+            prev: all(0.0),
+            max: all(f32::NEG_INFINITY),
+            n: [0; LANES],
+            cap: 0,
+            ms: Vec::new(),
+            mh: Vec::new(),
+        }
+    }
+}
+
+/// `sin² H` of a horizon `rise / (steps·spacing)` in every lane, 0 for one at or below the
+/// horizontal; `sp2` is the spacing squared. (The tests' scalar `sin2`, operation for operation.)
+#[inline(always)]
+fn sin2_lanes(rise: f32x8, steps: f32x8, sp2: f32x8) -> f32x8 {
+    let zero = f32x8::ZERO;
+    let r = rise.simd_gt(zero).select(rise, zero);
+    r * r / (r * r + steps * steps * sp2)
+}
+
+/// Vector g of lanes `v`.
+#[inline(always)]
+fn get(v: &Lanes<f32>, g: usize) -> f32x8 {
+    f32x8::new(v.as_chunks::<V>().0[g])
+}
+
+/// Sets vector g of lanes `v`.
+#[inline(always)]
+fn set(v: &mut Lanes<f32>, g: usize, x: f32x8) {
+    v.as_chunks_mut::<V>().0[g] = x.to_array();
+}
+
+impl Walk {
+    /// Walks the lanes of `heights` (`w` columns of [`LANES`] samples: line j's sample at column
+    /// u is `heights[u·LANES + j]`, [`OFF_GRID`] where the line is off the grid) from the far
+    /// end back — from the last column to the first when `AHEAD_UP`, else from the first — and
+    /// stores each sample's `sin² H` in `out` (laid out the same), or adds it with `ADD`.
+    pub fn pass<const AHEAD_UP: bool, const ADD: bool>(&mut self, heights: &[f32], sp2: f32, out: &mut [f32]) {
+        let (columns, _) = heights.as_chunks::<LANES>();
+        let (outs, _) = out.as_chunks_mut::<LANES>();
+        self.reset(columns.len());
+        let sp2 = f32x8::splat(sp2);
+        let mut s = 0.0f32;
+        let mut walk = |h: &Lanes<f32>, o: &mut Lanes<f32>| {
+            self.step::<ADD>(h, s, sp2, o);
+            s -= 1.0;
+        };
+        if AHEAD_UP {
+            columns.iter().zip(outs.iter_mut()).rev().for_each(|(h, o)| walk(h, o));
+        } else {
+            columns.iter().zip(outs.iter_mut()).for_each(|(h, o)| walk(h, o));
+        }
+    }
+
+    /// Every lane empty, with room for `w` vertices.
+    fn reset(&mut self, w: usize) {
+        let cap = w + 1;
+        if self.cap < cap {
+            self.cap = cap;
+            self.ms.resize(cap * LANES, 0.0);
+            self.mh.resize(cap * LANES, 0.0);
+        }
+        self.max = [f32::NEG_INFINITY; LANES];
+        self.n = [0; LANES];
+    }
+
+    /// One sample per lane, `h`, at position `s` (minus the steps walked, so positions grow
+    /// ahead; exact integers in `f32`).
+    #[inline(always)]
+    fn step<const ADD: bool>(&mut self, h: &Lanes<f32>, s: f32, sp2: f32x8, out: &mut Lanes<f32>) {
+        let sv = f32x8::splat(s);
+        let (zero, one) = (f32x8::ZERO, f32x8::ONE);
+        let mut rise = [0.0f32; LANES];
+        let mut steps = [0.0f32; LANES];
+        let (mut push, mut slow, mut highest) = (0u32, 0u32, 0u32);
+        // The common step, the same in every lane: the previous sample tested against the top
+        // vertex (`Hull`'s first test), and, popped, the top vertex against the one under it (its
+        // second). The lanes that need more are bits of `push`, `slow` and `highest`.
+        for g in 0..G {
+            let hl = get(h, g);
+            let a = get(&self.prev, g) - hl;
+            let (c1, d1) = (get(&self.s1, g) - sv, get(&self.h1, g) - hl);
+            let (c2, d2) = (get(&self.s2, g) - sv, get(&self.h2, g) - hl);
+            // The previous sample's `b` is 1: `d1 · 1` is `d1` exactly.
+            let keep_prev = (a * c1).simd_gt(d1);
+            let keep_top = (d1 * c2).simd_gt(d2 * c1);
+            let top = hl.simd_ge(get(&self.max, g));
+            set(&mut rise, g, top.select(zero, keep_prev.select(a, d1)));
+            set(&mut steps, g, (top | keep_prev).select(one, c1));
+            push |= (keep_prev & !top).to_bitmask() << (g * V);
+            slow |= (!(keep_prev | keep_top | top)).to_bitmask() << (g * V);
+            highest |= top.to_bitmask() << (g * V);
+        }
+        // The lanes that push the previous sample, those that pop on, and the running maxima,
+        // which empty their lanes (a branch per such lane, not per lane).
+        while push != 0 {
+            let l = push.trailing_zeros() as usize;
+            push &= push - 1;
+            self.push(l, s + 1.0);
+        }
+        while slow != 0 {
+            let l = slow.trailing_zeros() as usize;
+            slow &= slow - 1;
+            (rise[l], steps[l]) = self.pop_more(l, s, h[l]);
+        }
+        while highest != 0 {
+            let l = highest.trailing_zeros() as usize;
+            highest &= highest - 1;
+            (self.max[l], self.n[l]) = (h[l], 0);
+            (self.s1[l], self.h1[l], self.s2[l], self.h2[l]) = (BOTTOM_S, BOTTOM_H, BOTTOM_S, BOTTOM_H);
+        }
+        // Every sample becomes its lane's previous one.
+        self.prev = *h;
+        for g in 0..G {
+            let v = sin2_lanes(get(&rise, g), get(&steps, g), sp2);
+            let o = if ADD { get(out, g) + v } else { v };
+            set(out, g, o);
+        }
+    }
+
+    /// Lane l's previous sample, at position `s`, onto its hull.
+    #[inline]
+    fn push(&mut self, l: usize, s: f32) {
+        let n = self.n[l] as usize;
+        if n >= 2 {
+            let i = l * self.cap + n - 2;
+            (self.ms[i], self.mh[i]) = (self.s2[l], self.h2[l]);
+        }
+        (self.s2[l], self.h2[l]) = (self.s1[l], self.h1[l]);
+        (self.s1[l], self.h1[l]) = (s, self.prev[l]);
+        self.n[l] += 1;
+    }
+
+    /// Lane l's step when the top vertex is popped too: the walk goes on down the stack in
+    /// memory from the second vertex (the candidate) until the candidate lies above the line to
+    /// the vertex under it. Returns the candidate's rise and steps.
+    #[inline]
+    fn pop_more(&mut self, l: usize, s: f32, h: f32) -> (f32, f32) {
+        let base = l * self.cap;
+        let n = self.n[l] as usize;
+        let (sv, hv) = (self.s2[l], self.h2[l]);
+        // The candidate, vertex i of the stack (from the bottom, the top being n − 1).
+        let (mut a, mut b, mut sv, mut hv) = (hv - h, sv - s, sv, hv);
+        let mut i = n - 2;
+        while i > 0 {
+            let (sk, hk) = (self.ms[base + i - 1], self.mh[base + i - 1]);
+            let (c, d) = (sk - s, hk - h);
+            if a * c > d * b {
+                break;
+            }
+            (a, b, sv, hv) = (d, c, sk, hk);
+            i -= 1;
+        }
+        // The candidate becomes the top, the vertex under it (or the bottom) the second.
+        self.n[l] = (i + 1) as u32;
+        (self.s1[l], self.h1[l]) = (sv, hv);
+        (self.s2[l], self.h2[l]) = if i > 0 {
+            (self.ms[base + i - 1], self.mh[base + i - 1])
+        } else {
+            (BOTTOM_S, BOTTOM_H)
+        };
+        (a, b)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use rand::{RngExt, SeedableRng};
+    use rand_chacha::ChaCha8Rng;
+
+    use super::super::sections::Hull;
+    use super::*;
+
+    /// `sin² H` as `sky_view` computed it line by line before the lanes.
+    fn sin2(rise: f32, steps: f32, sp2: f32) -> f32 {
+        let r = if rise > 0.0 { rise } else { 0.0 };
+        r * r / (r * r + steps * steps * sp2)
+    }
+
+    /// Lanes of random lines, each on the grid over its own span of columns (off it elsewhere),
+    /// with whole-metre heights so that plateaus and collinear vertices (ties) are common.
+    fn lanes(w: usize, seed: u64) -> (Vec<f32>, Vec<std::ops::Range<usize>>) {
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let mut heights = vec![OFF_GRID; w * LANES];
+        let mut spans = Vec::new();
+        for l in 0..LANES {
+            let a = rng.random_range(0..w / 3);
+            let b = rng.random_range(a..=w);
+            let mut z = rng.random_range(0.0f32..20.0).round();
+            for u in a..b {
+                z = (z + rng.random_range(-3.0f32..3.0)).round();
+                heights[u * LANES + l] = z;
+            }
+            spans.push(a..b);
+        }
+        (heights, spans)
+    }
+
+    #[test]
+    fn the_lanes_give_each_lines_walk_to_the_bit_and_the_brute_force_horizon() {
+        let sp2 = 1.7f32;
+        for seed in 0..40 {
+            let w = 5 + (seed as usize * 37) % 300;
+            let (heights, spans) = lanes(w, seed);
+            let mut walk = Walk::default();
+            let mut both = vec![0.0f32; w * LANES];
+            walk.pass::<true, false>(&heights, sp2, &mut both);
+            walk.pass::<false, true>(&heights, sp2, &mut both);
+            let mut hull = Hull::default();
+            for (l, span) in spans.iter().enumerate() {
+                let z: Vec<f32> = span.clone().map(|u| heights[u * LANES + l]).collect();
+                let n = z.len();
+                let (mut ru, mut su, mut rd, mut sd) = (vec![0.0; n], vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+                hull.pass::<true>(&z, &mut ru, &mut su);
+                hull.pass::<false>(&z, &mut rd, &mut sd);
+                for (k, u) in span.clone().enumerate() {
+                    let line = sin2(ru[k], su[k], sp2) + sin2(rd[k], sd[k], sp2);
+                    assert_eq!(
+                        both[u * LANES + l].to_bits(),
+                        line.to_bits(),
+                        "seed {seed}, lane {l}, column {u}"
+                    );
+                    // Brute force: the largest tangent over the samples ahead each way.
+                    let best = |ahead: &mut dyn Iterator<Item = usize>| {
+                        ahead
+                            .map(|q| (f64::from(z[q]) - f64::from(z[k])) / (q.abs_diff(k) as f64))
+                            .fold(0.0f64, f64::max)
+                    };
+                    let s2 = |t: f64| t * t / (t * t + f64::from(sp2));
+                    let brute = s2(best(&mut (k + 1..n))) + s2(best(&mut (0..k)));
+                    assert!(
+                        (f64::from(both[u * LANES + l]) - brute).abs() < 1e-5,
+                        "seed {seed}, lane {l}, column {u}: {} against {brute}",
+                        both[u * LANES + l]
+                    );
+                }
+            }
+        }
+    }
+}
