@@ -325,10 +325,9 @@ impl Shape {
     /// largest reach of the other value (the banks) are looked at.
     fn changes(&self) -> (Vec<usize>, Vec<usize>) {
         let (w, h) = (self.window.width, self.window.height);
-        let (mut add, mut remove) = (Vec::new(), Vec::new());
         let most = self.levels.iter().max().map_or(0, |&l| usize::from(l.max(1)) - 1);
         if most == 0 || w == 0 {
-            return (add, remove);
+            return (Vec::new(), Vec::new());
         }
         // `near_water[r]`: the cells within r steps of the water; `near_land[r]`: of the land.
         let grow = |first: morph::Bits| {
@@ -346,38 +345,47 @@ impl Shape {
         // The water's crosses and the land's on a core each.
         let (near_water, near_land) = rayon::join(|| grow(water), || grow(land));
         let (water, land) = (&near_water[0], &near_land[0]);
-        for r in 0..h {
-            let banks = (land.row(r).iter().zip(near_water[most].row(r)))
-                .zip(water.row(r).iter().zip(near_land[most].row(r)))
-                .map(|((l, nw), (wa, nl))| (l & nw) | (wa & nl));
-            for (k, mut word) in banks.enumerate() {
-                while word != 0 {
-                    let c = k * 64 + word.trailing_zeros() as usize;
-                    word &= word - 1;
-                    let i = r * w + c;
-                    let o = self.near.owner[i];
-                    if o == NONE {
-                        continue;
-                    }
-                    let (reach, turn) = (usize::from(self.levels[o as usize]) - 1, self.turns[o as usize]);
-                    let side = self.near.side[i];
-                    if reach == 0 || turn == 0 || side == 0 {
-                        continue;
-                    }
-                    // Bending left, the centre of the bend is on the left: the outer bank is the
-                    // right.
-                    let outer = side == -turn;
-                    let at = |b: &morph::Bits| b.row(r)[k] >> (c % 64) & 1 != 0;
-                    if self.mask[i] == 0 {
-                        if outer && at(&near_water[reach]) {
-                            add.push(i);
+        // The banks of rows `rows`, in order.
+        let banks = |rows: std::ops::Range<usize>| {
+            let (mut add, mut remove) = (Vec::new(), Vec::new());
+            for r in rows {
+                let banks = (land.row(r).iter().zip(near_water[most].row(r)))
+                    .zip(water.row(r).iter().zip(near_land[most].row(r)))
+                    .map(|((l, nw), (wa, nl))| (l & nw) | (wa & nl));
+                for (k, mut word) in banks.enumerate() {
+                    while word != 0 {
+                        let c = k * 64 + word.trailing_zeros() as usize;
+                        word &= word - 1;
+                        let i = r * w + c;
+                        let o = self.near.owner[i];
+                        if o == NONE {
+                            continue;
                         }
-                    } else if !outer && at(&near_land[reach]) {
-                        remove.push(i);
+                        let (reach, turn) = (usize::from(self.levels[o as usize]) - 1, self.turns[o as usize]);
+                        let side = self.near.side[i];
+                        if reach == 0 || turn == 0 || side == 0 {
+                            continue;
+                        }
+                        // Bending left, the centre of the bend is on the left: the outer bank is
+                        // the right.
+                        let outer = side == -turn;
+                        let at = |b: &morph::Bits| b.row(r)[k] >> (c % 64) & 1 != 0;
+                        if self.mask[i] == 0 {
+                            if outer && at(&near_water[reach]) {
+                                add.push(i);
+                            }
+                        } else if !outer && at(&near_land[reach]) {
+                            remove.push(i);
+                        }
                     }
                 }
             }
-        }
+            (add, remove)
+        };
+        // Two bands of rows on a core each, joined in order.
+        let ((mut add, mut remove), (add1, remove1)) = rayon::join(|| banks(0..h / 2), || banks(h / 2..h));
+        add.extend(add1);
+        remove.extend(remove1);
         (add, remove)
     }
 

@@ -32,9 +32,6 @@ pub fn nearest(win: &Window, line: &[DVec2], reach: f64) -> Near {
     near
 }
 
-/// A cell no segment has reached yet, as the bits of its squared distance while searching.
-const EMPTY: u32 = u32::MAX;
-
 /// Windows of at least this many cells fill their field on two row bands at once.
 const SPLIT_CELLS: usize = 16_384;
 
@@ -164,11 +161,13 @@ fn fill(
     dist: &mut [f32],
     side: &mut [i8],
 ) {
-    // While searching, `dist` holds squared distances compared by their bits (the same order for
-    // positive floats) and all-ones bits (a NaN) for none yet: each buffer is reset by a memset.
+    // While searching, `dist` holds squared distances, compared by their bits (the same order for
+    // positive floats, ∞ above them all).
     owner.fill(NONE);
-    dist.fill(f32::from_bits(EMPTY));
+    dist.fill(f32::INFINITY);
     side.fill(0);
+    // The rows reached, whose distances need their roots.
+    let mut reached = (usize::MAX, 0);
     let base = rows.start * win.width;
     let r2 = reach * reach;
     for (k, seg) in segs.iter().enumerate() {
@@ -179,6 +178,7 @@ fn fill(
         // The side: none for a segment of length 0 (a point has none).
         let on = if len > 0.0 { 1e-9 } else { f64::INFINITY };
         regions(win, rows.clone(), seg, reach, |r, c0, c1| {
+            reached = (reached.0.min(r), reached.1.max(r));
             let j0 = r * win.width + c0 - base;
             let n = c1 - c0 + 1;
             // Along the segment s = c·u.x + s0, across it (positive on its left) n0 − c·u.y.
@@ -215,9 +215,15 @@ fn fill(
             }
         });
     }
-    // The roots once at the end.
-    for d in dist.iter_mut() {
-        *d = if d.to_bits() == EMPTY { f32::INFINITY } else { d.sqrt() };
+    // The roots once at the end (∞ stays ∞).
+    if reached.0 <= reached.1 {
+        let (from, to) = (
+            (reached.0 - rows.start) * win.width,
+            (reached.1 + 1 - rows.start) * win.width,
+        );
+        for d in &mut dist[from..to] {
+            *d = d.sqrt();
+        }
     }
 }
 
