@@ -20,7 +20,7 @@
 //! Run: `cargo bench -p penmodel-terrain --bench ridge` (filter with e.g. `-- sky32`).
 //! `RIDGE_SKY_CALLS=N` runs only N `sky_view(.., 32)` calls on the 1024² DTM and exits, no
 //! criterion: a short run for `valgrind --tool=callgrind` (instruction counts do not depend on
-//! the machine's load).
+//! the machine's load); `RIDGE_DIRECT_CALLS=N` the same for N `direct` calls (the bench's sun).
 
 use std::f64::consts::TAU;
 use std::hint::black_box;
@@ -379,10 +379,9 @@ fn big_scene() -> Vec<Skeleton> {
 criterion_group!(benches, bench);
 
 fn main() {
-    if let Some(calls) = std::env::var("RIDGE_SKY_CALLS")
-        .ok()
-        .and_then(|v| v.parse::<u32>().ok())
-    {
+    let calls = |name: &str| std::env::var(name).ok().and_then(|v| v.parse::<u32>().ok());
+    let (sky, direct) = (calls("RIDGE_SKY_CALLS"), calls("RIDGE_DIRECT_CALLS"));
+    if sky.is_some() || direct.is_some() {
         let z = Dtm::build(1024, 1024, 1.0, Filter::DEFAULT, &ids(&big_scene()))
             .heights()
             .to_vec();
@@ -392,16 +391,27 @@ fn main() {
             rows: 1024,
             cell: 1.0,
         };
-        let mut total = 0.0f64;
-        for _ in 0..calls {
-            total += sun::sky_view(black_box(field), 32)
+        let (n, what) = match (sky, direct) {
+            (Some(n), _) => (n, "sky_view"),
+            (_, n) => (n.unwrap_or(0), "direct"),
+        };
+        let sun = Sun::degrees(135.0, 25.0, "sun").expect("a sun above the horizon");
+        let (mut total, mut bits) = (0.0f64, 0xcbf2_9ce4_8422_2325u64);
+        for _ in 0..n {
+            let map = if sky.is_some() {
+                sun::sky_view(black_box(field), 32)
+            } else {
+                sun::direct(black_box(field), sun)
+            };
+            total += map.iter().map(|&v| f64::from(v)).sum::<f64>();
+            // The map's bits, to compare versions that should agree exactly.
+            bits = map
                 .iter()
-                .map(|&v| f64::from(v))
-                .sum::<f64>();
+                .fold(bits, |h, v| (h ^ u64::from(v.to_bits())).wrapping_mul(0x100_0000_01b3));
         }
         eprintln!(
-            "{calls} sky_view calls, mean sky view {:.6}",
-            total / (f64::from(calls) * 1024.0 * 1024.0)
+            "{n} {what} calls, mean value {:.6}, bits {bits:016x}",
+            total / (f64::from(n.max(1)) * 1024.0 * 1024.0)
         );
         return;
     }

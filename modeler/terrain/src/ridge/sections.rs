@@ -75,42 +75,6 @@ impl Sections {
         start..end.max(start)
     }
 
-    /// Line b's heights over `cols` (from [`Sections::columns`]) into `out` (as long). `z` holds a
-    /// row more than the grid (any finite values), read with weight 0.
-    #[inline]
-    pub fn heights(&self, z: &[f32], b: isize, cols: Range<usize>, out: &mut [f32]) {
-        let (base, w) = (b * self.w as isize, self.w);
-        let taps = self.off[cols.clone()]
-            .iter()
-            .zip(&self.lo[cols.clone()])
-            .zip(&self.hi[cols]);
-        for (o, ((&off, &lo), &hi)) in out.iter_mut().zip(taps) {
-            let i = (base + off) as usize;
-            *o = z[i] * lo + z[i + w] * hi;
-        }
-    }
-
-    /// Adds line b's `values` over `cols` to the cells they were sampled from, weighted like the
-    /// heights, skipping NaN values, with the weights summed into `weight`. `sum` and `weight`
-    /// hold a row more than the grid (they get weight-0 terms).
-    pub fn spread_weighted(&self, b: isize, cols: Range<usize>, values: &[f32], sum: &mut [f32], weight: &mut [f32]) {
-        let (base, w) = (b * self.w as isize, self.w);
-        let taps = self.off[cols.clone()]
-            .iter()
-            .zip(&self.lo[cols.clone()])
-            .zip(&self.hi[cols]);
-        for (&v, ((&off, &lo), &hi)) in values.iter().zip(taps) {
-            if v.is_nan() {
-                continue;
-            }
-            let i = (base + off) as usize;
-            sum[i] += lo * v;
-            weight[i] += lo;
-            sum[i + w] += hi * v;
-            weight[i + w] += hi;
-        }
-    }
-
     /// The lines `b0..b0 + nb` valid at column u, as indices from b0.
     #[inline]
     fn valid(&self, u: usize, b0: isize, nb: usize) -> Range<usize> {
@@ -160,6 +124,30 @@ impl Sections {
         if hi > 0.0 {
             for (d, &v) in col[at + 1..at + 1 + m].iter_mut().zip(src) {
                 *d += hi * v;
+            }
+        }
+    }
+
+    /// [`Sections::column_spread`] with the weights summed into `weights` (as `col`), skipping
+    /// NaN values: the weighted mean of a cell's samples is then `col / weights`.
+    #[inline]
+    pub fn column_spread_weighted(&self, u: usize, b0: isize, src: &[f32], col: &mut [f32], weights: &mut [f32]) {
+        let j = self.valid(u, b0, src.len());
+        if j.is_empty() {
+            return;
+        }
+        let at = (b0 + j.start as isize + self.o[u]) as usize;
+        let (lo, hi) = (self.lo[u], self.hi[u]);
+        for (k, &v) in src[j].iter().enumerate() {
+            if v.is_nan() {
+                continue;
+            }
+            col[at + k] += lo * v;
+            weights[at + k] += lo;
+            // A weight-0 upper row may lie past the column's last cell.
+            if hi > 0.0 {
+                col[at + k + 1] += hi * v;
+                weights[at + k + 1] += hi;
             }
         }
     }

@@ -93,52 +93,114 @@ impl<'a> Field<'a> {
 
 /// Calls `f(cell index, horizon tangent)` for every cell, for azimuth `azimuth` (radians); the
 /// tangent is `-∞` where nothing lies ahead.
+///
+/// On all cores like [`sky_view`]'s sweeps: blocks of lines walked into their own parts of a
+/// buffer, then the columns spread from the blocks in block order. A cell gets two terms (its
+/// two lines), so the sums do not depend on the order either way.
 pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
     let Field { z, cols, rows, cell } = field;
     let (cols, rows) = (cols as usize, rows as usize);
+    if z.is_empty() {
+        return;
+    }
     let (dx, dy) = (azimuth.cos(), azimuth.sin());
     let x_major = dx.abs() >= dy.abs();
-    // The grid with the direction's dominant axis along its rows, and a row more (see
-    // `Sections::heights`).
-    let (grid, w, h, du, dv) = if x_major {
-        let mut g = Vec::with_capacity(z.len() + cols);
-        g.extend_from_slice(z);
-        g.resize(z.len() + cols, 0.0);
-        (g, cols, rows, dx, dy)
+    // The layout (u along its w rows, v across its h) with u's columns contiguous, an element
+    // more (see `Sections::block_heights`): the grid transposed when u runs along the grid's
+    // rows.
+    let (zc, w, h, du, dv) = if x_major {
+        (transpose(z, cols, rows, 1), cols, rows, dx, dy)
     } else {
-        (transpose(z, cols, rows, rows), rows, cols, dy, dx)
+        let mut zp = Vec::with_capacity(z.len() + 1);
+        zp.extend_from_slice(z);
+        zp.push(0.0);
+        (zp, rows, cols, dy, dx)
     };
     let lines = Sections::new(w, h, slope(du, dv), cell);
-    let (mut sum, mut weight) = (vec![0.0f32; (h + 1) * w], vec![0.0f32; (h + 1) * w]);
-    let [mut heights, mut rise, mut steps] = [(); 3].map(|_| vec![0.0f32; w]);
-    let mut hull = Hull::default();
-    let spacing = lines.spacing;
-    for b in lines.lines() {
-        let cols = lines.columns(b);
-        let n = cols.len();
-        let (zs, rs, ds) = (&mut heights[..n], &mut rise[..n], &mut steps[..n]);
-        lines.heights(&grid, b, cols.clone(), zs);
-        if du > 0.0 {
-            hull.pass::<true>(zs, rs, ds);
-        } else {
-            hull.pass::<false>(zs, rs, ds);
-        }
-        // Nothing ahead of the first sample swept: NaN, no value.
-        for (r, &d) in rs.iter_mut().zip(ds.iter()) {
-            *r /= d * spacing;
-        }
-        lines.spread_weighted(b, cols, rs, &mut sum, &mut weight);
-    }
-    sum.truncate(h * w);
-    weight.truncate(h * w);
-    if !x_major {
-        // Back to the grid's layout: the transposed grid is rows wide.
-        sum = transpose(&sum, w, h, 0);
-        weight = transpose(&weight, w, h, 0);
+    let all = lines.lines();
+    let blocks = all.len().div_ceil(BLOCK);
+    let mut values = vec![0.0f32; blocks * w * BLOCK];
+    values
+        .par_chunks_mut(w * BLOCK)
+        .enumerate()
+        .for_each_init(LineScratch::default, |buf, (k, block)| {
+            let b0 = all.start + (k * BLOCK) as isize;
+            let nb = BLOCK.min((all.end - b0) as usize);
+            horizon_block(&zc, &lines, du > 0.0, (b0, nb), &mut block[..w * nb], buf);
+        });
+    // Per cell the sum of its lines' tangents and of their weights, columns contiguous.
+    let (mut sum, mut weight) = (vec![0.0f32; w * h], vec![0.0f32; w * h]);
+    sum.par_chunks_mut(h * SPREAD_COLUMNS)
+        .zip(weight.par_chunks_mut(h * SPREAD_COLUMNS))
+        .enumerate()
+        .for_each(|(piece, (sums, weights))| {
+            for (i, (col, wcol)) in sums.chunks_exact_mut(h).zip(weights.chunks_exact_mut(h)).enumerate() {
+                let u = piece * SPREAD_COLUMNS + i;
+                for (k, block) in values.chunks_exact(w * BLOCK).enumerate() {
+                    let b0 = all.start + (k * BLOCK) as isize;
+                    let nb = BLOCK.min((all.end - b0) as usize);
+                    lines.column_spread_weighted(u, b0, &block[u * nb..(u + 1) * nb], col, wcol);
+                }
+            }
+        });
+    if x_major {
+        // Back to the grid's layout: u ran along the grid's rows.
+        sum = transpose(&sum, rows, cols, 0);
+        weight = transpose(&weight, rows, cols, 0);
     }
     for (i, (&s, &w)) in sum.iter().zip(&weight).enumerate() {
         f(i, if w > 0.0 { f64::from(s / w) } else { f64::NEG_INFINITY });
     }
+}
+
+/// The `nb` lines `b0..` of `lines` as one block (`block`, laid out like
+/// [`Sections::block_heights`]'s): their heights, then in their place each sample's horizon
+/// tangent towards u's sign `up` (NaN with nothing ahead).
+fn horizon_block(
+    zc: &[f32],
+    lines: &Sections,
+    up: bool,
+    (b0, nb): (isize, usize),
+    block: &mut [f32],
+    buf: &mut LineScratch,
+) {
+    lines.block_heights(zc, b0, nb, block);
+    let LineScratch {
+        heights,
+        rise,
+        steps,
+        hull,
+    } = buf;
+    for j in 0..nb {
+        let cols = lines.columns(b0 + j as isize);
+        let n = cols.len();
+        if n == 0 {
+            continue;
+        }
+        // Line j's samples: element j of each column's chunk of the block.
+        let span = cols.start * nb..cols.end * nb;
+        heights.clear();
+        heights.extend(block[span.clone()].chunks_exact(nb).map(|c| c[j]));
+        rise.resize(n, 0.0);
+        steps.resize(n, 0.0);
+        if up {
+            hull.pass::<true>(heights, rise, steps);
+        } else {
+            hull.pass::<false>(heights, rise, steps);
+        }
+        for (c, (&r, &d)) in block[span].chunks_exact_mut(nb).zip(rise.iter().zip(steps.iter())) {
+            c[j] = r / (d * lines.spacing);
+        }
+    }
+}
+
+/// Buffers reused from line to line of [`horizon_block`].
+#[derive(Default)]
+struct LineScratch {
+    heights: Vec<f32>,
+    rise: Vec<f32>,
+    steps: Vec<f32>,
+    hull: Hull,
 }
 
 /// The slope `dv/du` of a direction with `|du| ≥ |dv|`, the axes and diagonals exact: cos 45°
