@@ -73,8 +73,16 @@ impl Default for Walk {
     }
 }
 
-/// `sin² H` of a horizon `rise / (steps·spacing)` in every lane, 0 for one at or below the
-/// horizontal; `sp2` is the spacing squared. (The tests' scalar `sin2`, operation for operation.)
+/// `sin² H` of a horizon `rise / (steps·spacing)`, 0 for one at or below the horizontal;
+/// `sp2` is the spacing squared.
+#[inline]
+fn sin2(rise: f32, steps: f32, sp2: f32) -> f32 {
+    let r = if rise > 0.0 { rise } else { 0.0 };
+    r * r / (r * r + steps * steps * sp2)
+}
+
+/// [`sin2`] in every lane, operation for operation (so a lane's value does not depend on which
+/// path computed it).
 #[inline(always)]
 fn sin2_lanes(rise: f32x8, steps: f32x8, sp2: f32x8) -> f32x8 {
     let zero = f32x8::ZERO;
@@ -134,12 +142,11 @@ impl Walk {
     fn step<const ADD: bool>(&mut self, h: &Lanes<f32>, s: f32, sp2: f32x8, out: &mut Lanes<f32>) {
         let sv = f32x8::splat(s);
         let (zero, one) = (f32x8::ZERO, f32x8::ONE);
-        let mut rise = [0.0f32; LANES];
-        let mut steps = [0.0f32; LANES];
         let (mut push, mut slow, mut highest) = (0u32, 0u32, 0u32);
         // The common step, the same in every lane: the previous sample tested against the top
         // vertex (`Hull`'s first test), and, popped, the top vertex against the one under it (its
-        // second). The lanes that need more are bits of `push`, `slow` and `highest`.
+        // second). The lanes that need more are bits of `push`, `slow` and `highest`; the lanes
+        // of `slow` keep their output for below.
         for g in 0..G {
             let hl = get(h, g);
             let a = get(&self.prev, g) - hl;
@@ -149,37 +156,38 @@ impl Walk {
             let keep_prev = (a * c1).simd_gt(d1);
             let keep_top = (d1 * c2).simd_gt(d2 * c1);
             let top = hl.simd_ge(get(&self.max, g));
-            set(&mut rise, g, top.select(zero, keep_prev.select(a, d1)));
-            set(&mut steps, g, (top | keep_prev).select(one, c1));
+            let more = !(keep_prev | keep_top | top);
+            let rise = top.select(zero, keep_prev.select(a, d1));
+            let steps = (top | keep_prev).select(one, c1);
+            let (old, v) = (get(out, g), sin2_lanes(rise, steps, sp2));
+            set(out, g, more.select(old, if ADD { old + v } else { v }));
             push |= (keep_prev & !top).to_bitmask() << (g * V);
-            slow |= (!(keep_prev | keep_top | top)).to_bitmask() << (g * V);
+            slow |= more.to_bitmask() << (g * V);
             highest |= top.to_bitmask() << (g * V);
         }
         // The lanes that push the previous sample, those that pop on, and the running maxima,
-        // which empty their lanes (a branch per such lane, not per lane).
+        // which empty their lanes (a branch per such lane, not per lane; `& (LANES - 1)` spares
+        // the bounds checks).
         while push != 0 {
-            let l = push.trailing_zeros() as usize;
+            let l = push.trailing_zeros() as usize & (LANES - 1);
             push &= push - 1;
             self.push(l, s + 1.0);
         }
         while slow != 0 {
-            let l = slow.trailing_zeros() as usize;
+            let l = slow.trailing_zeros() as usize & (LANES - 1);
             slow &= slow - 1;
-            (rise[l], steps[l]) = self.pop_more(l, s, h[l]);
+            let (rise, steps) = self.pop_more(l, s, h[l]);
+            let v = sin2(rise, steps, sp2.as_array()[0]);
+            out[l] = if ADD { out[l] + v } else { v };
         }
         while highest != 0 {
-            let l = highest.trailing_zeros() as usize;
+            let l = highest.trailing_zeros() as usize & (LANES - 1);
             highest &= highest - 1;
             (self.max[l], self.n[l]) = (h[l], 0);
             (self.s1[l], self.h1[l], self.s2[l], self.h2[l]) = (BOTTOM_S, BOTTOM_H, BOTTOM_S, BOTTOM_H);
         }
         // Every sample becomes its lane's previous one.
         self.prev = *h;
-        for g in 0..G {
-            let v = sin2_lanes(get(&rise, g), get(&steps, g), sp2);
-            let o = if ADD { get(out, g) + v } else { v };
-            set(out, g, o);
-        }
     }
 
     /// Lane l's previous sample, at position `s`, onto its hull.
@@ -234,12 +242,6 @@ mod tests {
 
     use super::super::sections::Hull;
     use super::*;
-
-    /// `sin² H` as `sky_view` computed it line by line before the lanes.
-    fn sin2(rise: f32, steps: f32, sp2: f32) -> f32 {
-        let r = if rise > 0.0 { rise } else { 0.0 };
-        r * r / (r * r + steps * steps * sp2)
-    }
 
     /// Lanes of random lines, each on the grid over its own span of columns (off it elsewhere),
     /// with whole-metre heights so that plateaus and collinear vertices (ties) are common.
