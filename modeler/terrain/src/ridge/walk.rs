@@ -7,8 +7,9 @@
 //! and `s2, h2`) from the rest of its stack, so that the common step is the same branch-free
 //! arithmetic in every lane, eight lanes to a vector. The lanes that push the previous sample (no
 //! pop), pop two or more, or restart (below) are finished one by one afterwards, from bit masks:
-//! a branch per such lane rather than a guess per sample. The arithmetic is [`super::sections::Hull`]'s, operation for operation (positions are
-//! whole steps, exact in `f32`), so the values are the same to the bit; a test compares them.
+//! a branch per such lane rather than a guess per sample. The arithmetic is `Hull`'s, operation
+//! for operation (positions are whole steps, exact in `f32`), so the values are the same to the
+//! bit; a test compares them.
 //!
 //! Only horizons above the horizontal are wanted (the sky view's `sin² H` is 0 below): a sample
 //! at least as high as every sample ahead gets rise 0 and empties its lane's stack: everything
