@@ -1,5 +1,5 @@
-//! The parallel sections of the horizon sweep ([`super::sun`], Alg. 3.1) and the upper-hull pass
-//! along one.
+//! The parallel sections of the horizon sweep ([`super::sun`], Alg. 3.1), and the upper-hull
+//! pass along one that the tests compare the lanes of [`super::walk`] with.
 //!
 //! For a direction whose dominant axis is u (the grid's columns; a column-major direction works
 //! on the transposed grid) with slope `t = dv/du` in [−1, 1], line b samples column u at row
@@ -172,18 +172,22 @@ fn part(n: usize, f: impl Fn(usize) -> bool) -> usize {
     a
 }
 
-/// The upper hull of the samples swept so far, in two `f32` stacks reused from line to line.
+/// The upper hull of the samples swept so far, in two `f32` stacks reused from line to line:
+/// one line's walk at a time, as the sky view and the direct light walked before their lines
+/// went side by side ([`super::walk`]); kept as the reference the lanes are tested against.
 ///
 /// Two stacks rather than one of `(f32, f32)` pairs: the pop test reads the vertex pushed one
 /// sample earlier, and a pair written as two 4-byte stores and read back as one 8-byte load
 /// cannot be forwarded from the store buffer, a stall on every sample. Same-width stores and
 /// loads forward.
+#[cfg(test)]
 #[derive(Default)]
 pub(super) struct Hull {
     s: Vec<f32>,
     h: Vec<f32>,
 }
 
+#[cfg(test)]
 impl Hull {
     /// Sweeps a line's heights `z` from the far end back — from the last sample to the first
     /// when `AHEAD_UP` (ahead is increasing index), else from the first — keeping the upper
@@ -238,6 +242,7 @@ impl Hull {
 /// One sample of a hull walk: the sample at position s, height h; `h1` the previous sample's
 /// height (one step ahead, not yet on the stacks `ss`, `hs` of `top` vertices). Returns the rise
 /// and the steps to the horizon vertex, and leaves this sample as the previous one.
+#[cfg(test)]
 #[inline(always)]
 fn step(ss: &mut [f32], hs: &mut [f32], mask: usize, top: &mut usize, h1: &mut f32, s: f32, h: f32) -> (f32, f32) {
     // The nearest vertex (the previous sample, one step ahead) relative to this one.

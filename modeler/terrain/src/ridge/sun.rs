@@ -29,7 +29,7 @@ use rayon::prelude::*;
 
 use super::RidgeError;
 use super::gradient::sobel;
-use super::sections::{Hull, Sections, transpose};
+use super::sections::{Sections, transpose};
 use super::walk::{LANES, OFF_GRID, Walk};
 use crate::Heightmap;
 
@@ -123,10 +123,9 @@ pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
     values
         .par_chunks_mut(w * BLOCK)
         .enumerate()
-        .for_each_init(LineScratch::default, |buf, (k, block)| {
+        .for_each_init(Scratch::default, |buf, (k, block)| {
             let b0 = all.start + (k * BLOCK) as isize;
-            let nb = BLOCK.min((all.end - b0) as usize);
-            horizon_block(&zc, &lines, du > 0.0, (b0, nb), &mut block[..w * nb], buf);
+            horizon_block(&zc, &lines, du > 0.0, b0, block, buf);
         });
     // Per cell the sum of its lines' tangents and of their weights, columns contiguous.
     let (mut sum, mut weight) = (vec![0.0f32; w * h], vec![0.0f32; w * h]);
@@ -139,7 +138,7 @@ pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
                 for (k, block) in values.chunks_exact(w * BLOCK).enumerate() {
                     let b0 = all.start + (k * BLOCK) as isize;
                     let nb = BLOCK.min((all.end - b0) as usize);
-                    lines.column_spread_weighted(u, b0, &block[u * nb..(u + 1) * nb], col, wcol);
+                    lines.column_spread_weighted(u, b0, &block[u * BLOCK..u * BLOCK + nb], col, wcol);
                 }
             }
         });
@@ -153,54 +152,19 @@ pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
     }
 }
 
-/// The `nb` lines `b0..` of `lines` as one block (`block`, laid out like
+/// The lines `b0..b0 + BLOCK` of `lines` as one block (`block`, laid out like
 /// [`Sections::block_heights`]'s): their heights, then in their place each sample's horizon
-/// tangent towards u's sign `up` (NaN with nothing ahead).
-fn horizon_block(
-    zc: &[f32],
-    lines: &Sections,
-    up: bool,
-    (b0, nb): (isize, usize),
-    block: &mut [f32],
-    buf: &mut LineScratch,
-) {
-    lines.block_heights(zc, b0, nb, block);
-    let LineScratch {
-        heights,
-        rise,
-        steps,
-        hull,
-    } = buf;
-    for j in 0..nb {
-        let cols = lines.columns(b0 + j as isize);
-        let n = cols.len();
-        if n == 0 {
-            continue;
-        }
-        // Line j's samples: element j of each column's chunk of the block.
-        let span = cols.start * nb..cols.end * nb;
-        heights.clear();
-        heights.extend(block[span.clone()].chunks_exact(nb).map(|c| c[j]));
-        rise.resize(n, 0.0);
-        steps.resize(n, 0.0);
-        if up {
-            hull.pass::<true>(heights, rise, steps);
-        } else {
-            hull.pass::<false>(heights, rise, steps);
-        }
-        for (c, (&r, &d)) in block[span].chunks_exact_mut(nb).zip(rise.iter().zip(steps.iter())) {
-            c[j] = r / (d * lines.spacing);
-        }
+/// tangent towards u's sign `up` (NaN with nothing ahead), walked side by side ([`Walk`]).
+fn horizon_block(zc: &[f32], lines: &Sections, up: bool, b0: isize, block: &mut [f32], buf: &mut Scratch) {
+    let Scratch { heights, walk } = buf;
+    let Some((z, out)) = block_samples(zc, lines, b0, block, heights) else {
+        return;
+    };
+    if up {
+        walk.horizons::<true>(z, lines.spacing, out);
+    } else {
+        walk.horizons::<false>(z, lines.spacing, out);
     }
-}
-
-/// Buffers reused from line to line of [`horizon_block`].
-#[derive(Default)]
-struct LineScratch {
-    heights: Vec<f32>,
-    rise: Vec<f32>,
-    steps: Vec<f32>,
-    hull: Hull,
 }
 
 /// The slope `dv/du` of a direction with `|du| ≥ |dv|`, the axes and diagonals exact: cos 45°
@@ -374,7 +338,30 @@ fn sky_sweep(zc: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &m
 fn sweep_block(zc: &[f32], lines: &Sections, (du, both): (f64, bool), b0: isize, block: &mut [f32], buf: &mut Scratch) {
     let sp2 = lines.spacing * lines.spacing;
     let Scratch { heights, walk } = buf;
-    // The columns where any of the lines is on the grid: the walks skip the others.
+    let Some((z, out)) = block_samples(zc, lines, b0, block, heights) else {
+        return;
+    };
+    match (du > 0.0 || both, du < 0.0 || both) {
+        (true, true) => {
+            walk.sky::<true, false>(z, sp2, out);
+            walk.sky::<false, true>(z, sp2, out);
+        }
+        (true, false) => walk.sky::<true, false>(z, sp2, out),
+        _ => walk.sky::<false, false>(z, sp2, out),
+    }
+}
+
+/// The heights of the lines `b0..b0 + BLOCK` into `heights` ([`OFF_GRID`] where a line is
+/// off the grid), over the columns where any of them is on it: those columns of the heights and
+/// of `block` (laid out alike), or `None` when the lines miss the grid. The walks skip the other
+/// columns.
+fn block_samples<'a>(
+    zc: &[f32],
+    lines: &Sections,
+    b0: isize,
+    block: &'a mut [f32],
+    heights: &'a mut Vec<f32>,
+) -> Option<(&'a [f32], &'a mut [f32])> {
     let (mut u0, mut u1) = (usize::MAX, 0);
     for b in b0..b0 + BLOCK as isize {
         let cols = lines.columns(b);
@@ -383,20 +370,12 @@ fn sweep_block(zc: &[f32], lines: &Sections, (du, both): (f64, bool), b0: isize,
         }
     }
     if u0 >= u1 {
-        return;
+        return None;
     }
     heights.resize(block.len(), 0.0);
     heights[u0 * BLOCK..u1 * BLOCK].fill(OFF_GRID);
     lines.block_heights(zc, b0, BLOCK, heights);
-    let (z, out) = (&heights[u0 * BLOCK..u1 * BLOCK], &mut block[u0 * BLOCK..u1 * BLOCK]);
-    match (du > 0.0 || both, du < 0.0 || both) {
-        (true, true) => {
-            walk.pass::<true, false>(z, sp2, out);
-            walk.pass::<false, true>(z, sp2, out);
-        }
-        (true, false) => walk.pass::<true, false>(z, sp2, out),
-        _ => walk.pass::<false, false>(z, sp2, out),
-    }
+    Some((&heights[u0 * BLOCK..u1 * BLOCK], &mut block[u0 * BLOCK..u1 * BLOCK]))
 }
 
 /// Buffers reused from block to block: the block's heights and its walks.

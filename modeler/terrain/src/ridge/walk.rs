@@ -1,7 +1,7 @@
 //! The sky view's hull walks ([`super::sun::sky_view`]), the [`LANES`] lines of a block side by
 //! side: one walk step for all of them at a time.
 //!
-//! A line's walk ([`super::sections::Hull`]) is bound by its data-dependent branch — how many
+//! A line's walk (the tests' reference, `sections::Hull`) is bound by its data-dependent branch — how many
 //! vertices a sample pops — not by its instructions. Nine steps in ten pop at most one vertex,
 //! and those need only the top two vertices of the stack: each lane keeps them apart (`s1, h1`
 //! and `s2, h2`) from the rest of its stack, so that the common step is the same branch-free
@@ -64,7 +64,7 @@ impl Default for Walk {
             h1: all(BOTTOM_H),
             s2: all(BOTTOM_S),
             h2: all(BOTTOM_H),
-            prev: all(0.0),
+            prev: all(OFF_GRID),
             max: all(f32::NEG_INFINITY),
             n: [0; LANES],
             cap: 0,
@@ -107,15 +107,32 @@ impl Walk {
     /// Walks the lanes of `heights` (`w` columns of [`LANES`] samples: line j's sample at column
     /// u is `heights[u·LANES + j]`, [`OFF_GRID`] where the line is off the grid) from the far
     /// end back — from the last column to the first when `AHEAD_UP`, else from the first — and
-    /// stores each sample's `sin² H` in `out` (laid out the same), or adds it with `ADD`.
-    pub fn pass<const AHEAD_UP: bool, const ADD: bool>(&mut self, heights: &[f32], sp2: f32, out: &mut [f32]) {
+    /// stores each sample's `sin² H` in `out` (laid out the same), or adds it with `ADD`; `sp2`
+    /// is the spacing of the samples squared. Horizons above the horizontal only (below).
+    pub fn sky<const AHEAD_UP: bool, const ADD: bool>(&mut self, heights: &[f32], sp2: f32, out: &mut [f32]) {
+        self.run::<AHEAD_UP, true, ADD>(heights, sp2, out);
+    }
+
+    /// [`Walk::sky`]'s walk for whole horizons: each sample's horizon tangent
+    /// `rise / (steps·spacing)` into `out`, NaN for the first sample on the grid (nothing ahead),
+    /// as a line's walk (`sections::Hull::pass`) gives them. The lanes restart where they are off the
+    /// grid rather than at running maxima.
+    pub fn horizons<const AHEAD_UP: bool>(&mut self, heights: &[f32], spacing: f32, out: &mut [f32]) {
+        self.run::<AHEAD_UP, false, false>(heights, spacing, out);
+    }
+
+    fn run<const AHEAD_UP: bool, const SKY: bool, const ADD: bool>(
+        &mut self,
+        heights: &[f32],
+        k: f32,
+        out: &mut [f32],
+    ) {
         let (columns, _) = heights.as_chunks::<LANES>();
         let (outs, _) = out.as_chunks_mut::<LANES>();
         self.reset(columns.len());
-        let sp2 = f32x8::splat(sp2);
         let mut s = 0.0f32;
         let mut walk = |h: &Lanes<f32>, o: &mut Lanes<f32>| {
-            self.step::<ADD>(h, s, sp2, o);
+            self.step::<SKY, ADD>(h, s, k, o);
             s -= 1.0;
         };
         if AHEAD_UP {
@@ -133,42 +150,59 @@ impl Walk {
             self.ms.resize(cap * LANES, 0.0);
             self.mh.resize(cap * LANES, 0.0);
         }
-        self.max = [f32::NEG_INFINITY; LANES];
-        self.n = [0; LANES];
+        // Nothing behind the first column: no previous sample (off the grid), no vertex.
+        *self = Walk {
+            cap: self.cap,
+            ms: std::mem::take(&mut self.ms),
+            mh: std::mem::take(&mut self.mh),
+            ..Walk::default()
+        };
     }
 
     /// One sample per lane, `h`, at position `s` (minus the steps walked, so positions grow
-    /// ahead; exact integers in `f32`).
+    /// ahead; exact integers in `f32`). With `SKY` the value is `sin² H` (`k` the spacing
+    /// squared), else the tangent (`k` the spacing).
     #[inline(always)]
-    fn step<const ADD: bool>(&mut self, h: &Lanes<f32>, s: f32, sp2: f32x8, out: &mut Lanes<f32>) {
+    fn step<const SKY: bool, const ADD: bool>(&mut self, h: &Lanes<f32>, s: f32, k: f32, out: &mut Lanes<f32>) {
         let sv = f32x8::splat(s);
-        let (zero, one) = (f32x8::ZERO, f32x8::ONE);
-        let (mut push, mut slow, mut highest) = (0u32, 0u32, 0u32);
+        let (zero, one, kv) = (f32x8::ZERO, f32x8::ONE, f32x8::splat(k));
+        let (off, nan) = (f32x8::splat(OFF_GRID), f32x8::splat(f32::NAN));
+        let (mut push, mut slow, mut restart) = (0u32, 0u32, 0u32);
         // The common step, the same in every lane: the previous sample tested against the top
         // vertex (`Hull`'s first test), and, popped, the top vertex against the one under it (its
-        // second). The lanes that need more are bits of `push`, `slow` and `highest`; the lanes
+        // second). The lanes that need more are bits of `push`, `slow` and `restart`; the lanes
         // of `slow` keep their output for below.
         for g in 0..G {
             let hl = get(h, g);
-            let a = get(&self.prev, g) - hl;
+            let prev = get(&self.prev, g);
+            let a = prev - hl;
             let (c1, d1) = (get(&self.s1, g) - sv, get(&self.h1, g) - hl);
             let (c2, d2) = (get(&self.s2, g) - sv, get(&self.h2, g) - hl);
             // The previous sample's `b` is 1: `d1 · 1` is `d1` exactly.
             let keep_prev = (a * c1).simd_gt(d1);
             let keep_top = (d1 * c2).simd_gt(d2 * c1);
-            let top = hl.simd_ge(get(&self.max, g));
+            let top = if SKY {
+                hl.simd_ge(get(&self.max, g))
+            } else {
+                hl.simd_eq(off)
+            };
             let more = !(keep_prev | keep_top | top);
             let rise = top.select(zero, keep_prev.select(a, d1));
             let steps = (top | keep_prev).select(one, c1);
-            let (old, v) = (get(out, g), sin2_lanes(rise, steps, sp2));
+            let v = if SKY {
+                sin2_lanes(rise, steps, kv)
+            } else {
+                // Nothing ahead of the first sample on the grid.
+                prev.simd_eq(off).select(nan, rise / (steps * kv))
+            };
+            let old = get(out, g);
             set(out, g, more.select(old, if ADD { old + v } else { v }));
             push |= (keep_prev & !top).to_bitmask() << (g * V);
             slow |= more.to_bitmask() << (g * V);
-            highest |= top.to_bitmask() << (g * V);
+            restart |= top.to_bitmask() << (g * V);
         }
-        // The lanes that push the previous sample, those that pop on, and the running maxima,
-        // which empty their lanes (a branch per such lane, not per lane; `& (LANES - 1)` spares
-        // the bounds checks).
+        // The lanes that push the previous sample, those that pop on, and those that restart
+        // (a branch per such lane, not per lane; `& (LANES - 1)` spares the bounds checks).
         while push != 0 {
             let l = push.trailing_zeros() as usize & (LANES - 1);
             push &= push - 1;
@@ -178,12 +212,12 @@ impl Walk {
             let l = slow.trailing_zeros() as usize & (LANES - 1);
             slow &= slow - 1;
             let (rise, steps) = self.pop_more(l, s, h[l]);
-            let v = sin2(rise, steps, sp2.as_array()[0]);
+            let v = if SKY { sin2(rise, steps, k) } else { rise / (steps * k) };
             out[l] = if ADD { out[l] + v } else { v };
         }
-        while highest != 0 {
-            let l = highest.trailing_zeros() as usize & (LANES - 1);
-            highest &= highest - 1;
+        while restart != 0 {
+            let l = restart.trailing_zeros() as usize & (LANES - 1);
+            restart &= restart - 1;
             (self.max[l], self.n[l]) = (h[l], 0);
             (self.s1[l], self.h1[l], self.s2[l], self.h2[l]) = (BOTTOM_S, BOTTOM_H, BOTTOM_S, BOTTOM_H);
         }
@@ -265,14 +299,17 @@ mod tests {
 
     #[test]
     fn the_lanes_give_each_lines_walk_to_the_bit_and_the_brute_force_horizon() {
-        let sp2 = 1.7f32;
+        let (sp, sp2) = (1.3f32, 1.69f32);
         for seed in 0..40 {
             let w = 5 + (seed as usize * 37) % 300;
             let (heights, spans) = lanes(w, seed);
             let mut walk = Walk::default();
             let mut both = vec![0.0f32; w * LANES];
-            walk.pass::<true, false>(&heights, sp2, &mut both);
-            walk.pass::<false, true>(&heights, sp2, &mut both);
+            walk.sky::<true, false>(&heights, sp2, &mut both);
+            walk.sky::<false, true>(&heights, sp2, &mut both);
+            let (mut up, mut down) = (vec![0.0f32; w * LANES], vec![0.0f32; w * LANES]);
+            walk.horizons::<true>(&heights, sp, &mut up);
+            walk.horizons::<false>(&heights, sp, &mut down);
             let mut hull = Hull::default();
             for (l, span) in spans.iter().enumerate() {
                 let z: Vec<f32> = span.clone().map(|u| heights[u * LANES + l]).collect();
@@ -281,12 +318,18 @@ mod tests {
                 hull.pass::<true>(&z, &mut ru, &mut su);
                 hull.pass::<false>(&z, &mut rd, &mut sd);
                 for (k, u) in span.clone().enumerate() {
+                    let at = u * LANES + l;
                     let line = sin2(ru[k], su[k], sp2) + sin2(rd[k], sd[k], sp2);
-                    assert_eq!(
-                        both[u * LANES + l].to_bits(),
-                        line.to_bits(),
-                        "seed {seed}, lane {l}, column {u}"
-                    );
+                    assert_eq!(both[at].to_bits(), line.to_bits(), "seed {seed}, lane {l}, column {u}");
+                    // Whole horizons: the line's tangents, NaN (the same bits) with nothing ahead.
+                    for (lanes, r, d) in [(&up, ru[k], su[k]), (&down, rd[k], sd[k])] {
+                        let t = r / (d * sp);
+                        assert!(
+                            lanes[at].to_bits() == t.to_bits() || (lanes[at].is_nan() && t.is_nan()),
+                            "seed {seed}, lane {l}, column {u}: tangent {} against {t}",
+                            lanes[at]
+                        );
+                    }
                     // Brute force: the largest tangent over the samples ahead each way.
                     let best = |ahead: &mut dyn Iterator<Item = usize>| {
                         ahead
@@ -296,9 +339,9 @@ mod tests {
                     let s2 = |t: f64| t * t / (t * t + f64::from(sp2));
                     let brute = s2(best(&mut (k + 1..n))) + s2(best(&mut (0..k)));
                     assert!(
-                        (f64::from(both[u * LANES + l]) - brute).abs() < 1e-5,
+                        (f64::from(both[at]) - brute).abs() < 1e-5,
                         "seed {seed}, lane {l}, column {u}: {} against {brute}",
-                        both[u * LANES + l]
+                        both[at]
                     );
                 }
             }
