@@ -241,21 +241,34 @@ impl Bits {
         if self.width == 0 {
             return;
         }
-        for (row, out) in image.chunks(self.width).zip(self.words.chunks_mut(self.stride)) {
-            for (cells, word) in row.chunks(64).zip(out.iter_mut()) {
-                let mut w = 0u64;
-                let mut eights = cells.chunks_exact(8);
-                for (j, eight) in eights.by_ref().enumerate() {
-                    w |= pack8(eight) << (8 * j);
+        let (width, stride) = (self.width, self.stride);
+        let pack = |image: &[u8], words: &mut [u64]| {
+            for (row, out) in image.chunks(width).zip(words.chunks_mut(stride)) {
+                for (cells, word) in row.chunks(64).zip(out.iter_mut()) {
+                    let mut w = 0u64;
+                    let mut eights = cells.chunks_exact(8);
+                    for (j, eight) in eights.by_ref().enumerate() {
+                        w |= pack8(eight) << (8 * j);
+                    }
+                    let done = cells.len() / 8 * 8;
+                    for (j, &v) in eights.remainder().iter().enumerate() {
+                        w |= u64::from(v != 0) << (done + j);
+                    }
+                    // The bits past the row's end stay 0 whichever value is asked for.
+                    *word = (w ^ flip) & (u64::MAX >> (64 - cells.len()));
                 }
-                let done = cells.len() / 8 * 8;
-                for (j, &v) in eights.remainder().iter().enumerate() {
-                    w |= u64::from(v != 0) << (done + j);
-                }
-                // The bits past the row's end stay 0 whichever value is asked for.
-                *word = (w ^ flip) & (u64::MAX >> (64 - cells.len()));
             }
+        };
+        // Large images in two bands of rows on the thread pool (a river's year packs its mask
+        // on the way to its crosses).
+        let mid = self.height / 2;
+        if self.height < 2 || width * self.height < 1 << 16 {
+            pack(image, &mut self.words);
+            return;
         }
+        let (i0, i1) = image.split_at(mid * width);
+        let (w0, w1) = self.words.split_at_mut(mid * stride);
+        rayon::join(|| pack(i0, w0), || pack(i1, w1));
     }
 
     /// The cells of the window that are not set, into `out` (the same size).
