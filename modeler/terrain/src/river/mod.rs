@@ -286,10 +286,7 @@ impl Shape {
             .iter()
             .map(|p| p.d1.perp_dot(p.d2) / p.d1.length().powi(3).max(1e-12))
             .collect();
-        // Each sample on its own, so on the thread pool.
         let bend: Vec<f64> = (0..line.len())
-            .into_par_iter()
-            .with_min_len(256)
             .map(|i| {
                 let span = &signed[i.saturating_sub(m)..(i + m + 1).min(line.len())];
                 span.iter().sum::<f64>() / span.len() as f64
@@ -299,11 +296,9 @@ impl Shape {
             .iter()
             .map(|&b| if b.abs() < 1e-9 { 0 } else { b.signum() as i8 })
             .collect();
-        let (river, constants, cell) = (&self.river, &self.constants, self.cell_size);
         self.levels = bend
-            .par_iter()
-            .with_min_len(256)
-            .map(|b| level::level(b.abs() / cell, river, cell, constants))
+            .iter()
+            .map(|b| level::level(b.abs() / self.cell_size, &self.river, self.cell_size, &self.constants))
             .collect();
         let pts: Vec<DVec2> = line.iter().map(|p| p.p).collect();
         near::nearest_into(&self.window, &pts, self.radius + REACH, &mut self.near);

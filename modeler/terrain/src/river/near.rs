@@ -2,7 +2,6 @@
 //! line (a polyline through the samples), its distance, and the side of the line the cell is on.
 
 use glam::DVec2;
-use rayon::prelude::*;
 
 use super::Window;
 
@@ -112,10 +111,8 @@ fn segments(pts: &[DVec2], reach: f64) -> Vec<Segment> {
         })
         .collect();
     let last = ends.len() - 1;
-    // Each segment on its own, so on the thread pool.
-    ends.par_iter()
+    ends.iter()
         .enumerate()
-        .with_min_len(256)
         .map(|(k, &(a, b))| {
             let Some(u) = dir[k] else {
                 return Segment {
