@@ -305,6 +305,10 @@ impl Flat {
         parts
             .into_par_iter()
             .for_each(|((v0, k0), (_, k1), out, norms, sampled)| {
+                // The ground and the place as this block's own values, not read through the
+                // closure's references: the compiler could not tell that the writes to the mesh
+                // leave them unchanged, and loaded their fields again at every vertex.
+                let (g, at, cell) = (g, at, cell);
                 let mut scratch = Scratch::new();
                 for w in self.starts[k0..=k1].windows(2) {
                     let ((a, t0), (b, t1)) = (w[0], w[1]);
