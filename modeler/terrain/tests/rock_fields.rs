@@ -479,3 +479,58 @@ fn seated_rocks_have_their_triangles_area_weighted_normals() {
         );
     }
 }
+
+/// A moving field (every seat at a new place) stands where a fresh seat through the ground's
+/// general height puts it, bit for bit, whether its rocks lie wholly within the terrain's squares
+/// (seated without holding each vertex in) or across the terrain's edges; and its rim vertices
+/// within the squares stand on the terrain's triangles.
+#[test]
+fn a_moving_field_seats_as_a_fresh_seat_does_within_the_terrain_and_across_its_edges() {
+    use penmodel_terrain::rocks::place::{self, Flat, Placement, Samples};
+    use penmodel_terrain::rocks::{Recipe, scatter};
+    let n = 96u32;
+    let s = scatter(&Recipe::figure_1(n, n, 7), None).expect("a valid recipe");
+    let flat = Flat::of(&s);
+    let (m, step) = (64u32, 1.5);
+    let hill = |x: f64, y: f64| (6.0 * (x / 11.0).sin() * (y / 7.0).cos() - 0.2 * y) as f32;
+    let heights: Vec<f32> = (0..m * m).map(|i| hill(f64::from(i % m), f64::from(i / m))).collect();
+    let map = Heightmap::from_heights(m, m, step, heights).expect("heights");
+    // The outer centres: beyond them the terrain is held flat.
+    let within = |v: f64| (0.5 * step..=(f64::from(m) - 0.5) * step).contains(&v);
+    let (mut mesh, mut samples) = (Default::default(), Samples::default());
+    let (mut whole, mut across, mut rims) = (0, 0, 0);
+    for origin in [
+        [-9.7, 3.1],
+        [0.0, 0.0],
+        [1.0 / 3.0, 2.0 / 3.0],
+        [30.2, 41.9],
+        [-20.0, -20.0],
+    ] {
+        let at = Placement { origin, cell_size: 0.9 };
+        flat.seat_on(at, &map, &mut samples, &mut mesh);
+        assert_eq!(mesh, flat.seat(at, place::ground(&map).surface()), "at {origin:?}");
+        let mut first = 0;
+        for rock in flat.order.iter().filter_map(|&i| s.rocks.get(i as usize)) {
+            let p = &mesh.positions[first..first + rock.mesh.vertices.len()];
+            let inside = |q: &[f32; 3]| within(f64::from(q[0])) && within(f64::from(q[2]));
+            if p.iter().all(inside) {
+                whole += 1;
+            } else if p.iter().any(inside) {
+                across += 1;
+            }
+            for q in p[..rock.polygon.len()].iter().filter(|q| inside(q)) {
+                let ground = on_terrain(&map, f64::from(q[0]), f64::from(q[2]));
+                assert!(
+                    (f64::from(q[1]) - ground).abs() < 1e-3,
+                    "rim vertex {q:?} on ground {ground}"
+                );
+                rims += 1;
+            }
+            first += rock.mesh.vertices.len();
+        }
+    }
+    assert!(
+        whole > 1000 && across > 20 && rims > 10_000,
+        "{whole} rocks within, {across} across, {rims} rims"
+    );
+}

@@ -50,6 +50,9 @@ pub struct Flat {
     /// Per rock in [`Flat::order`]: its first vertex and its first triangle in `local`; then
     /// the ends.
     starts: Vec<(u32, u32)>,
+    /// Per rock in [`Flat::order`], the box of its vertices in field cells, `[min x, min y, max
+    /// x, max y]`: a rock within the terrain's squares is seated without holding each vertex in.
+    bounds: Vec<[f32; 4]>,
     /// The triangles again, with indices into their own rock's vertices. Seating walks the
     /// rocks one by one, each rock's vertices and normals a few hundred bytes in L1: half the
     /// memory of `indices` to read at every re-seat, and no index beyond the rock to check.
@@ -88,6 +91,7 @@ impl Flat {
             blocks: vec![(0, 0)],
             boxes: Vec::new(),
             starts: Vec::with_capacity(scatter.rocks.len() + 1),
+            bounds: Vec::with_capacity(scatter.rocks.len()),
             local: Vec::with_capacity(t),
             up: Vec::with_capacity(n),
         };
@@ -115,6 +119,7 @@ impl Flat {
                     .map(|t| t.map(|i| u16::try_from(i).expect("a rock has fewer than 65 536 vertices"))),
             );
             let verts = &f.vertices[base as usize..];
+            f.bounds.push(bounds(verts));
             up.clear();
             up.resize(verts.len(), 0.0);
             for t in rock.mesh.triangles.iter() {
@@ -134,12 +139,7 @@ impl Flat {
         f.boxes = f
             .blocks
             .windows(2)
-            .map(|w| {
-                f.vertices[w[0].0..w[1].0].iter().fold(
-                    [f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY],
-                    |b, v| [b[0].min(v[0]), b[1].min(v[1]), b[2].max(v[0]), b[3].max(v[1])],
-                )
-            })
+            .map(|w| bounds(&f.vertices[w[0].0..w[1].0]))
             .collect();
         f
     }
@@ -310,7 +310,7 @@ impl Flat {
                 // leave them unchanged, and loaded their fields again at every vertex.
                 let (g, at, cell) = (g, at, cell);
                 let mut scratch = Scratch::new();
-                for w in self.starts[k0..=k1].windows(2) {
+                for (w, bounds) in self.starts[k0..=k1].windows(2).zip(&self.bounds[k0..k1]) {
                     let ((a, t0), (b, t1)) = (w[0], w[1]);
                     let (a, b) = (a as usize - v0, b as usize - v0);
                     let out = &mut out[a..b];
@@ -334,9 +334,20 @@ impl Flat {
                         // Moving: [`Flat::seat_into`]'s heights, with the ground's code inlined
                         // here rather than called through a closure at every vertex (the call
                         // was a fifth of a move's re-seat).
-                        for (o, v) in out.iter_mut().zip(verts) {
-                            let (x, y) = place(at, *v);
-                            *o = [x as f32, (g.height(x, y) + f64::from(v[2]) * cell) as f32, y as f32];
+                        if g.holds(at, *bounds) {
+                            for (o, v) in out.iter_mut().zip(verts) {
+                                let (x, y) = place(at, *v);
+                                *o = [
+                                    x as f32,
+                                    (g.height_inside(x, y) + f64::from(v[2]) * cell) as f32,
+                                    y as f32,
+                                ];
+                            }
+                        } else {
+                            for (o, v) in out.iter_mut().zip(verts) {
+                                let (x, y) = place(at, *v);
+                                *o = [x as f32, (g.height(x, y) + f64::from(v[2]) * cell) as f32, y as f32];
+                            }
                         }
                     }
                     normals_of(
@@ -386,6 +397,14 @@ pub struct Sample {
     /// one [`Ground::height`] gives).
     u: f64,
     v: f64,
+}
+
+/// The box of `vertices` across the ground, `[min x, min y, max x, max y]`.
+fn bounds(vertices: &[[f32; 3]]) -> [f32; 4] {
+    vertices.iter().fold(
+        [f32::INFINITY, f32::INFINITY, f32::NEG_INFINITY, f32::NEG_INFINITY],
+        |b, v| [b[0].min(v[0]), b[1].min(v[1]), b[2].max(v[0]), b[3].max(v[1])],
+    )
 }
 
 /// Vertex `v`'s `(x, y)` in metres at `at`.
@@ -582,43 +601,82 @@ impl<'a> Ground<'a> {
         }
     }
 
+    /// Whether every point of the box `b` (`[min x, min y, max x, max y]`, field cells) at `at`
+    /// falls in the grid's squares, not beyond its outer centres: there [`Ground::height_inside`]
+    /// gives [`Ground::height`]'s value. Each step from field cells to the heightmap's
+    /// coordinates is a rounded sum or product with a positive factor, so it keeps the order of
+    /// the points, and the box's corners bound its vertices' coordinates as computed.
+    #[inline]
+    pub fn holds(&self, at: Placement, b: [f32; 4]) -> bool {
+        let f = |v: f32, o: f64| (o + f64::from(v) * at.cell_size) * self.per_metre - 0.5;
+        self.wide
+            && at.cell_size > 0.0
+            && self.per_metre > 0.0
+            && f(b[0], at.origin[0]) >= 0.0
+            && f(b[1], at.origin[1]) >= 0.0
+            && f(b[2], at.origin[0]) < self.last[0]
+            && f(b[3], at.origin[1]) < self.last[1]
+    }
+
+    /// [`Ground::height`] at a point [`Ground::holds`] found in the grid's squares: nothing to
+    /// hold in (about a fifth of a moving field's seat went into holding every vertex in).
+    #[inline(always)]
+    pub fn height_inside(&self, x: f64, y: f64) -> f64 {
+        let (fx, fy) = (x * self.per_metre - 0.5, y * self.per_metre - 0.5);
+        let (c, r) = (fx as u32, fy as u32);
+        let (a, b, d, e) = self.corners(r * self.cols + c);
+        blend(a, b, d, e, fx - f64::from(c), fy - f64::from(r))
+    }
+
+    /// The heights at the four centres about corner `i` of a grid two or more cells wide.
+    #[inline(always)]
+    fn corners(&self, i: u32) -> (f32, f32, f32, f32) {
+        let i = i as usize;
+        let stride = self.cols as usize;
+        // One range check for the square's four corners.
+        match self.h.get(i..i + stride + 2) {
+            Some(s) => (s[0], s[1], s[stride], s[stride + 1]),
+            None => (0.0, 0.0, 0.0, 0.0),
+        }
+    }
+
     /// The height at sample `q`.
     // Inlined into the seating loops (called, it took a third of a re-seat, reloading the
     // ground's fields at every vertex).
     #[inline(always)]
     pub fn at(&self, q: Sample) -> f64 {
         let h = self.h;
-        let i = q.corner as usize;
         let (a, b, d, e) = if self.wide {
-            let stride = self.cols as usize;
-            // One range check for the square's four corners.
-            match h.get(i..i + stride + 2) {
-                Some(s) => (s[0], s[1], s[stride], s[stride + 1]),
-                None => (0.0, 0.0, 0.0, 0.0),
-            }
+            self.corners(q.corner)
         } else {
             let (cols, rows) = (self.cols, self.rows);
             let (c, r) = (q.corner % cols, q.corner / cols);
             let at = |c: u32, r: u32| h[(r.min(rows - 1) * cols + c.min(cols - 1)) as usize];
             (at(c, r), at(c + 1, r), at(c, r + 1), at(c + 1, r + 1))
         };
-        let (a, b, d, e) = (f64::from(a), f64::from(b), f64::from(d), f64::from(e));
-        let (u, v) = (q.u, q.v);
-        // The lower triangle `a + u·(b − a) + v·(d − a)` or the upper one, `e + (1 − u)·(d − e)
-        // + (1 − v)·(b − e)` = `(b + d − e) + u·(e − d) + v·(e − b)`, blended by a 0 or 1
-        // rather than branched on: which half a rock vertex falls in is random, and the
-        // mispredicted branch was a tenth of a re-seat.
-        let upper = f64::from(u8::from(u + v > 1.0));
-        let base = a + upper * (b + d - e - a);
-        let along_u = (b - a) + upper * (e - d - (b - a));
-        let along_v = (d - a) + upper * (e - b - (d - a));
-        base + u * along_u + v * along_v
+        blend(a, b, d, e, q.u, q.v)
     }
 
     /// The same as a function of `(x, y)`, for [`Flat::seat_into`] and [`mesh`].
     pub fn surface(self) -> impl Fn(f64, f64) -> f64 + Sync + 'a {
         move |x, y| self.height(x, y)
     }
+}
+
+/// The height at `(u, v)` in a square of the ground with corner heights `a` (upper left), `b`
+/// (right of it), `d` (below it) and `e` (diagonal).
+#[inline(always)]
+fn blend(a: f32, b: f32, d: f32, e: f32, u: f64, v: f64) -> f64 {
+    let (a, b, d, e) = (f64::from(a), f64::from(b), f64::from(d), f64::from(e));
+    // The lower triangle `a + u·(b − a) + v·(d − a)` or the upper one, `e + (1 − u)·(d − e)
+    // + (1 − v)·(b − e)` = `(b + d − e) + u·(e − d) + v·(e − b)`, blended by a 0 or 1
+    // rather than branched on: which half a rock vertex falls in is random, and the
+    // mispredicted branch was a tenth of a re-seat.
+    let upper = f64::from(u8::from(u + v > 1.0));
+    let base = a + upper * (b + d - e - a);
+    let along_u = (b - a) + upper * (e - d - (b - a));
+    let along_v = (d - a) + upper * (e - b - (d - a));
+    base + u * along_u + v * along_v
 }
 
 /// Area-weighted vertex normals of a triangle list (counter-clockwise seen from +Y).
