@@ -25,6 +25,7 @@ pub mod grow;
 pub mod layer;
 pub mod polygon;
 pub mod rain;
+mod scratch;
 mod sections;
 pub mod sun;
 pub mod tree;

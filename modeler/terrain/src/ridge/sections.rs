@@ -282,7 +282,7 @@ fn step(ss: &mut [f32], hs: &mut [f32], mask: usize, top: &mut usize, h1: &mut f
 pub(super) fn transpose(z: &[f32], cols: usize, rows: usize, pad: usize) -> Vec<f32> {
     const TILE: usize = 64;
     let (w, h) = (cols, rows);
-    let mut t = vec![0.0f32; z.len() + pad];
+    let mut t = super::scratch::zeros(z.len() + pad);
     // Each task writes TILE rows of the result (TILE columns of `z`).
     t[..z.len()]
         .par_chunks_mut(h.max(1) * TILE)

@@ -29,6 +29,7 @@ use rayon::prelude::*;
 
 use super::RidgeError;
 use super::gradient::sobel;
+use super::scratch;
 use super::sections::{Sections, transpose};
 use super::walk::{LANES, OFF_GRID, Walk};
 use crate::Heightmap;
@@ -111,15 +112,14 @@ pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
     let (zc, w, h, du, dv) = if x_major {
         (transpose(z, cols, rows, 1), cols, rows, dx, dy)
     } else {
-        let mut zp = Vec::with_capacity(z.len() + 1);
-        zp.extend_from_slice(z);
-        zp.push(0.0);
+        let mut zp = scratch::zeros(z.len() + 1);
+        zp[..z.len()].copy_from_slice(z);
         (zp, rows, cols, dy, dx)
     };
     let lines = Sections::new(w, h, slope(du, dv), cell);
     let all = lines.lines();
     let blocks = all.len().div_ceil(BLOCK);
-    let mut values = vec![0.0f32; blocks * w * BLOCK];
+    let mut values = scratch::zeros(blocks * w * BLOCK);
     values
         .par_chunks_mut(w * BLOCK)
         .enumerate()
@@ -128,7 +128,7 @@ pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
             horizon_block(&zc, &lines, du > 0.0, b0, block, buf);
         });
     // Per cell the sum of its lines' tangents and of their weights, columns contiguous.
-    let (mut sum, mut weight) = (vec![0.0f32; w * h], vec![0.0f32; w * h]);
+    let (mut sum, mut weight) = (scratch::zeros(w * h), scratch::zeros(w * h));
     sum.par_chunks_mut(h * SPREAD_COLUMNS)
         .zip(weight.par_chunks_mut(h * SPREAD_COLUMNS))
         .enumerate()
@@ -144,12 +144,13 @@ pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
         });
     if x_major {
         // Back to the grid's layout: u ran along the grid's rows.
-        sum = transpose(&sum, rows, cols, 0);
-        weight = transpose(&weight, rows, cols, 0);
+        let (s, w) = (transpose(&sum, rows, cols, 0), transpose(&weight, rows, cols, 0));
+        scratch::give([std::mem::replace(&mut sum, s), std::mem::replace(&mut weight, w)]);
     }
     for (i, (&s, &w)) in sum.iter().zip(&weight).enumerate() {
         f(i, if w > 0.0 { f64::from(s / w) } else { f64::NEG_INFINITY });
     }
+    scratch::give([zc, values, sum, weight]);
 }
 
 /// The lines `b0..b0 + BLOCK` of `lines` as one block (`block`, laid out like
@@ -288,7 +289,7 @@ impl Layout {
         Layout {
             w,
             h,
-            sum: vec![0.0; w * h],
+            sum: scratch::zeros(w * h),
             first: vec![0.0; w],
             last: vec![0.0; w],
             inner: 0.0,
@@ -428,9 +429,8 @@ pub fn sky_view(field: Field<'_>, k: u32) -> Vec<f32> {
     }
     let k = k.max(1) as usize;
     // The grid and its transpose, each an element more (see `Sections::block_heights`).
-    let mut zp = Vec::with_capacity(z.len() + 1);
-    zp.extend_from_slice(z);
-    zp.push(0.0);
+    let mut zp = scratch::zeros(z.len() + 1);
+    zp[..z.len()].copy_from_slice(z);
     let zt = transpose(z, cols, rows, 1);
     // Azimuth d with its opposite d + k/2 when k is even.
     let pairs: Vec<(usize, bool)> = if k.is_multiple_of(2) {
@@ -441,7 +441,7 @@ pub fn sky_view(field: Field<'_>, k: u32) -> Vec<f32> {
     // The row-major azimuths' layout (u along the grid's rows, sums transposed) and the
     // column-major ones' (u down the columns, sums in the grid's layout).
     let (mut x, mut y) = (Layout::new(cols, rows), Layout::new(rows, cols));
-    let mut values = Vec::new();
+    let mut values = scratch::zeros(0);
     for (d, both) in pairs {
         let az = TAU * d as f64 / k as f64;
         let (dx, dy) = (az.cos(), az.sin());
@@ -463,6 +463,7 @@ pub fn sky_view(field: Field<'_>, k: u32) -> Vec<f32> {
             *o = if ws > 0.0 { 1.0 - (a[c] + at[c]) / ws } else { 1.0 };
         }
     });
+    scratch::give([zp, zt, x.sum, y.sum, values, along]);
     out
 }
 
