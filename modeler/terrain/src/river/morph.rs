@@ -169,23 +169,23 @@ fn separable(d: &mut [u16], width: usize, height: usize) {
 /// The image dilated by the diamond of `level` (the cells within `level − 1` of the set): `level − 1`
 /// crosses on the bit-packed image ([`Bits`]).
 pub fn dilate(image: &[u8], width: usize, height: usize, level: u8) -> Vec<u8> {
-    let mut bits = Bits::of(image, width, height, true);
-    let mut spare = Bits::empty(width, height);
-    for _ in 1..level.max(1) {
-        bits.cross(&mut spare, true);
-        std::mem::swap(&mut bits, &mut spare);
-    }
-    bits.to_bytes()
+    crosses(image, width, height, level, true)
 }
 
 /// The image eroded by the diamond of `level` (the cells farther than `level − 1` from the
 /// complement, the outside counting as complement): `level − 1` crosses on the bit-packed image
 /// (eroding by a diamond is eroding by its crosses in turn, the outside unset each time).
 pub fn erode(image: &[u8], width: usize, height: usize, level: u8) -> Vec<u8> {
+    crosses(image, width, height, level, false)
+}
+
+/// `level − 1` 4-neighbour crosses on the bit-packed image, growing the set with `grow`, else
+/// shrinking it.
+fn crosses(image: &[u8], width: usize, height: usize, level: u8, grow: bool) -> Vec<u8> {
     let mut bits = Bits::of(image, width, height, true);
     let mut spare = Bits::empty(width, height);
     for _ in 1..level.max(1) {
-        bits.cross(&mut spare, false);
+        bits.cross(&mut spare, grow);
         std::mem::swap(&mut bits, &mut spare);
     }
     bits.to_bytes()
