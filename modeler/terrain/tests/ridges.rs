@@ -369,12 +369,7 @@ fn bumpy(cols: u32, rows: u32) -> Vec<f32> {
 fn horizons_along_grid_lines_equal_a_brute_force_walk() {
     let (cols, rows, cell) = (64u32, 48u32, 2.0);
     let z = bumpy(cols, rows);
-    let field = Field {
-        z: &z,
-        cols,
-        rows,
-        cell,
-    };
+    let field = field_of(&z, cols, rows, cell);
     for k in 0..8 {
         let az = f64::from(k) * PI / 4.0;
         let (dc, dr) = (az.cos().round() as i64, az.sin().round() as i64);
@@ -405,12 +400,7 @@ fn horizons_along_grid_lines_equal_a_brute_force_walk() {
 fn horizons_in_any_azimuth_are_close_to_a_ray_march() {
     let (cols, rows, cell) = (64u32, 48u32, 2.0);
     let z = bumpy(cols, rows);
-    let field = Field {
-        z: &z,
-        cols,
-        rows,
-        cell,
-    };
+    let field = field_of(&z, cols, rows, cell);
     for az_deg in [10.0, 33.0, 71.0, 100.0, 200.0, 287.0, 333.0] {
         let az = f64::to_radians(az_deg);
         let mut got = vec![0.0; z.len()];
@@ -446,12 +436,7 @@ fn horizons_in_any_azimuth_are_close_to_a_ray_march() {
 fn direct_light_is_lambert_in_the_sun_and_exactly_zero_in_shadow() {
     let (cols, rows, cell) = (64u32, 48u32, 2.0);
     let z = bumpy(cols, rows);
-    let field = Field {
-        z: &z,
-        cols,
-        rows,
-        cell,
-    };
+    let field = field_of(&z, cols, rows, cell);
     let sun = Sun::degrees(180.0, 20.0, "sun").expect("a sun above the horizon");
     let light = sun::direct(field, sun);
     let tan = sun.elevation.tan();
@@ -476,12 +461,7 @@ fn direct_light_is_lambert_in_the_sun_and_exactly_zero_in_shadow() {
     assert!(lit > 100 && dark > 20, "lit {lit}, dark {dark}");
     // On open flat ground Lambert is sin(elevation).
     let flat = vec![3.0f32; 30 * 20];
-    let f = Field {
-        z: &flat,
-        cols: 30,
-        rows: 20,
-        cell: 1.0,
-    };
+    let f = field_of(&flat, 30, 20, 1.0);
     for v in sun::direct(f, sun) {
         assert!((f64::from(v) - sun.elevation.sin()).abs() < 1e-6);
     }
@@ -498,12 +478,7 @@ fn sky_view_of_a_pit_is_one_minus_the_mean_squared_sine_of_its_horizons() {
     let z: Vec<f32> = (0..rows)
         .flat_map(|r| (0..cols).map(move |c| (c as f32 - 20.0).hypot(r as f32 - 20.0)))
         .collect();
-    let field = Field {
-        z: &z,
-        cols,
-        rows,
-        cell,
-    };
+    let field = field_of(&z, cols, rows, cell);
     let sky = sun::sky_view(field, 32);
     let centre = f64::from(sky[(20 * cols + 20) as usize]);
     // Along the 8 grid directions the horizon is exactly 45°; between them the digital line
@@ -578,12 +553,7 @@ fn sky_view_has_the_same_bits_on_any_number_of_threads() {
     // must be added in the same order whatever the sharing.
     let (cols, rows, cell) = (150u32, 90u32, 1.5);
     let z = bumpy(cols, rows);
-    let field = Field {
-        z: &z,
-        cols,
-        rows,
-        cell,
-    };
+    let field = field_of(&z, cols, rows, cell);
     let on = |threads: usize| {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -605,12 +575,7 @@ fn sky_view_has_the_same_bits_on_any_number_of_threads() {
 fn sky_view_is_its_definition_computed_naively() {
     let (cols, rows, cell) = (40u32, 28u32, 2.0);
     let z = bumpy(cols, rows);
-    let field = Field {
-        z: &z,
-        cols,
-        rows,
-        cell,
-    };
+    let field = field_of(&z, cols, rows, cell);
     for k in [5, 16, 32] {
         let want = sky_by_definition(&z, cols as usize, rows as usize, cell, k);
         let got = sun::sky_view(field, k as u32);
@@ -874,4 +839,9 @@ fn a_ridge_preview_shows_each_frame_and_records_one_undoable_step() {
     assert!(ed.preview_ridges(Some(bad)).is_err());
     assert_eq!(ed.document().ridges.as_ref(), Some(&r));
     assert!(!ed.previewing());
+}
+
+/// The lighting functions' view of `cols × rows` heights `z` of `cell`-metre cells.
+fn field_of(z: &[f32], cols: u32, rows: u32, cell: f64) -> Field<'_> {
+    Field { z, cols, rows, cell }
 }
