@@ -1,0 +1,159 @@
+//! Digests of the terrain engine's heights, to show that a change to the engine keeps them bit for
+//! bit: run it before and after and compare the lines.
+//!
+//! For each of the modeler's examples 1–5, in both metrics, on its own grid and on 512² (the
+//! bench's scaling: the same square, finer cells): the heights after a full regeneration, then
+//! after each edit of a sequence applied to the same engine — per figure (nested ones too) a
+//! slope change, a slope of the other sign, a pull and a move (a vertex of a curve, a whole
+//! point) — and the heights of a fresh engine for the document at the end. An edit the document
+//! refuses prints `refused` instead of a digest.
+//!
+//! Run: `cargo run --release -p penmodel-terrain --example engine_digest`.
+//!
+//! `engine_digest --full N taxicab|euclidean` instead builds example 1's 512² terrain N times
+//! (for `valgrind --tool=callgrind`: the difference of two counts is the cost of the extra
+//! builds).
+
+use penmodel_terrain::{CurvePath, Document, Edit, Figure, FigureKind, FigurePath, Metric, TerrainEngine};
+
+/// FNV-1a over the heights' bits: stable across builds and Rust versions.
+fn digest(heights: &[f32]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for v in heights {
+        for x in v.to_bits().to_le_bytes() {
+            h = (h ^ u64::from(x)).wrapping_mul(0x0100_0000_01b3);
+        }
+    }
+    h
+}
+
+const EXAMPLES: [(&str, &str); 5] = [
+    ("01", include_str!("../../examples/01-ridges-and-peaks.json")),
+    ("02", include_str!("../../examples/02-twin-hills.json")),
+    ("03", include_str!("../../examples/03-island-with-crater.json")),
+    ("04", include_str!("../../examples/04-volcano.json")),
+    ("05", include_str!("../../examples/05-terraced-mountain.json")),
+];
+
+/// Example `json` in `metric`, on an n × n grid over the same square (its own grid for `None`).
+fn document(json: &str, metric: Metric, n: Option<u32>) -> Result<Document, String> {
+    let mut doc = Document::from_json(json).map_err(|e| e.to_string())?;
+    doc.terrain.metric = metric;
+    if let Some(n) = n {
+        let extent = doc.grid.width();
+        doc.grid.cols = n;
+        doc.grid.rows = n;
+        doc.grid.cell_size = extent / f64::from(n);
+    }
+    Ok(doc)
+}
+
+/// Every figure's path, parents before their nested figures.
+fn paths(doc: &Document) -> Vec<FigurePath> {
+    fn walk(figs: &[Figure], at: Option<&FigurePath>, region: usize, out: &mut Vec<FigurePath>) {
+        for (i, f) in figs.iter().enumerate() {
+            let p = at.map_or_else(|| FigurePath::new(region, i), |p| p.child(i));
+            out.push(p.clone());
+            walk(&f.figures, Some(&p), region, out);
+        }
+    }
+    let mut out = Vec::new();
+    for (r, region) in doc.regions.iter().enumerate() {
+        walk(&region.figures, None, r, &mut out);
+    }
+    out
+}
+
+/// The edits of the sequence for the figure at `p`.
+fn edits(f: &Figure, p: &FigurePath) -> Vec<(String, Edit)> {
+    let mut out = vec![
+        (
+            format!("{p} slope+0.3"),
+            Edit::SetSlope {
+                at: p.clone(),
+                slope: f.slope + 0.3,
+            },
+        ),
+        (
+            format!("{p} slope-sign"),
+            Edit::SetSlope {
+                at: p.clone(),
+                slope: if f.slope > 0.0 { -0.7 } else { 0.9 },
+            },
+        ),
+        (
+            format!("{p} pull"),
+            Edit::SetHeight {
+                at: p.clone(),
+                height: f.height + 3.5,
+            },
+        ),
+    ];
+    let [x, y] = f.points[f.points.len() / 2];
+    let moved = match f.kind {
+        FigureKind::Point => Edit::MoveFigure {
+            at: p.clone(),
+            by: [2.5, -1.5],
+        },
+        _ => Edit::MovePoint {
+            curve: CurvePath::Figure(p.clone()),
+            index: f.points.len() / 2,
+            to: [x + 2.5, y - 1.5],
+        },
+    };
+    out.push((format!("{p} move"), moved));
+    out
+}
+
+fn sequence(name: &str, metric: Metric, n: Option<u32>, json: &str) -> Result<(), String> {
+    let mut doc = document(json, metric, n)?;
+    let grid = format!("{}x{}", doc.grid.cols, doc.grid.rows);
+    let tag = format!("{name} {metric:?} {grid}");
+    let mut engine = TerrainEngine::new(&doc).map_err(|e| e.to_string())?;
+    println!("{tag} full {:016x}", digest(engine.heightmap().heights()));
+    for p in paths(&doc) {
+        let f = p.get(&doc).ok_or("no figure")?.clone();
+        for (label, edit) in edits(&f, &p) {
+            match edit.apply_to(&mut doc) {
+                Ok(applied) => {
+                    engine.update(&doc, &applied.scope);
+                    println!("{tag} {label} {:016x}", digest(engine.heightmap().heights()));
+                }
+                Err(_) => println!("{tag} {label} refused"),
+            }
+        }
+    }
+    let fresh = TerrainEngine::new(&doc).map_err(|e| e.to_string())?;
+    println!("{tag} fresh {:016x}", digest(fresh.heightmap().heights()));
+    Ok(())
+}
+
+fn main() -> Result<(), String> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    if args.first().map(String::as_str) == Some("--full") {
+        let count: usize = args
+            .get(1)
+            .and_then(|a| a.parse().ok())
+            .ok_or("--full N taxicab|euclidean")?;
+        let metric = match args.get(2).map(String::as_str) {
+            Some("euclidean") => Metric::Euclidean,
+            _ => Metric::Taxicab,
+        };
+        let doc = document(EXAMPLES[0].1, metric, Some(512))?;
+        let mut last = 0;
+        for _ in 0..count {
+            let engine = TerrainEngine::new(&doc).map_err(|e| e.to_string())?;
+            last = digest(engine.heightmap().heights());
+        }
+        println!("{last:016x}");
+        return Ok(());
+    }
+    for (name, json) in EXAMPLES {
+        for metric in [Metric::Taxicab, Metric::Euclidean] {
+            for n in [None, Some(512)] {
+                sequence(name, metric, n, json)?;
+            }
+        }
+    }
+    Ok(())
+}
