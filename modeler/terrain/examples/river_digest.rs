@@ -8,6 +8,9 @@
 //! Run: `cargo run --release -p penmodel-terrain --example river_digest [omega.json]` (the
 //! document's first river is added at 5, 12 and 20 years; default
 //! `modeler/examples/rivers/omega.json`).
+//!
+//! `river_digest --drag N` instead runs the river bench's `drag/512/10` preview N times (for
+//! `valgrind --tool=callgrind`: the difference of two counts is the cost of the extra calls).
 
 use penmodel_terrain::river::{self, Constants, Shape, drag};
 use penmodel_terrain::{Document, Grid, River};
@@ -66,9 +69,31 @@ fn grid(n: u32) -> Grid {
     }
 }
 
+/// The bench's `drag/512/10` preview `calls` times.
+fn drag_calls(calls: usize) {
+    let c = Constants::default();
+    let rv = river::meander(512, 14, 4.0, 10);
+    let d = drag::Drag::new(&rv, 20, &grid(512), &c);
+    let mut moved = rv.clone();
+    moved.points[20] = [moved.points[20][0] + 6.0, moved.points[20][1] - 4.0];
+    let mut cells = 0;
+    for _ in 0..calls {
+        let p = d.preview(std::hint::black_box(&moved));
+        cells += p.erosion.len() + p.deposition.len();
+    }
+    println!("{calls} calls, {cells} cells");
+}
+
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let path = std::env::args()
-        .nth(1)
+    let args: Vec<String> = std::env::args().collect();
+    if args.get(1).is_some_and(|a| a == "--drag") {
+        let calls = args.get(2).ok_or("--drag needs a count")?.parse()?;
+        drag_calls(calls);
+        return Ok(());
+    }
+    let path = args
+        .get(1)
+        .cloned()
         .unwrap_or_else(|| "modeler/examples/rivers/omega.json".to_string());
     let doc = Document::load(std::path::Path::new(&path))?;
     let omega = doc.rivers.first().ok_or("the document has no river")?;

@@ -158,6 +158,11 @@ impl Drag {
     /// The next year's erosion and deposition of `moved` (the grabbed river with its held point
     /// moved: the same points otherwise).
     pub fn preview(&self, moved: &River) -> Cells {
+        super::on_pool(|| self.preview_here(moved))
+    }
+
+    /// [`Drag::preview`] on the calling thread.
+    fn preview_here(&self, moved: &River) -> Cells {
         let Some(part) = self.part().filter(|_| moved.points.len() == self.river.points.len()) else {
             return Cells::of(&Shape::process(moved, &self.grid, &self.constants));
         };

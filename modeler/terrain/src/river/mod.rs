@@ -254,11 +254,13 @@ impl Shape {
 
     /// The river after its `iterations` (at most [`MAX_ITERATIONS`]).
     pub fn process(river: &River, grid: &Grid, constants: &Constants) -> Shape {
-        let mut shape = Shape::new(river, grid, constants);
-        for _ in 0..river.iterations.min(MAX_ITERATIONS) {
-            shape.step();
-        }
-        shape
+        on_pool(|| {
+            let mut shape = Shape::new(river, grid, constants);
+            for _ in 0..river.iterations.min(MAX_ITERATIONS) {
+                shape.step_here();
+            }
+            shape
+        })
     }
 
     /// The samples with their curvature, turn and level.
@@ -405,6 +407,11 @@ impl Shape {
 
     /// One iteration (module docs, steps 1–5).
     pub fn step(&mut self) {
+        on_pool(|| self.step_here());
+    }
+
+    /// [`Shape::step`] on the calling thread.
+    fn step_here(&mut self) {
         let (add, remove) = self.changes();
         for &i in &add {
             self.mask[i] = 1;
@@ -602,6 +609,14 @@ impl Shape {
         out.extend_from_slice(&pts[from..]);
         (out, cuts)
     }
+}
+
+/// `f` run on a thread of the pool. A year forks and joins a few times (the field's bands, the
+/// crosses, the banks, the recentring); from a thread outside the pool each `rayon::join` hands
+/// its work to the pool and blocks the caller on a lock until it is done (some 60 hand-overs and
+/// wake-ups per `drag/512/10` call), from a thread of the pool it only queues the second half.
+pub(crate) fn on_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
+    rayon::scope(|_| f())
 }
 
 /// A hasher for small integer keys (bucket coordinates): a multiply and a rotate per word, where
