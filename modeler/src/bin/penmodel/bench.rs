@@ -84,6 +84,14 @@ pub struct Args {
     /// The memory case's number of point figures.
     #[arg(long, value_name = "K", default_value_t = 100, value_parser = clap::value_parser!(u32).range(1..=10000))]
     memory_figures: u32,
+    /// Timed still frames per case (their median is reported); more make a longer profile.
+    #[arg(long, value_name = "N", default_value_t = 9, value_parser = clap::value_parser!(u32).range(1..=100000))]
+    still_frames: u32,
+    /// Write each still case's last frame into this directory as
+    /// `still-<grid>-lod<px>-<eyes>eye.png` (to look at what the level of detail and the shading
+    /// show).
+    #[arg(long, value_name = "DIR")]
+    still_png: Option<std::path::PathBuf>,
 }
 
 /// The memory case: `k` point figures on a lattice in one square region over most of an n × n
@@ -478,15 +486,23 @@ fn still_figures(grids: &[u32], args: &Args) -> Result<Vec<crate::frames::Still>
                 if args.still_lod_only && lod != args.lod_error {
                     continue;
                 }
-                out.push(crate::frames::measure(&map, lod, stereo, args.look, STILL_FRAMES)?);
+                let png = args
+                    .still_png
+                    .as_ref()
+                    .map(|dir| dir.join(format!("still-{n}-lod{lod}-{}eye.png", if stereo { 2 } else { 1 })));
+                out.push(crate::frames::measure(
+                    &map,
+                    lod,
+                    stereo,
+                    args.look,
+                    args.still_frames as usize,
+                    png.as_deref(),
+                )?);
             }
         }
     }
     Ok(out)
 }
-
-/// Timed still frames per grid, LOD setting and eye count.
-const STILL_FRAMES: usize = 9;
 
 fn still_json(still: &[crate::frames::Still]) -> Vec<serde_json::Value> {
     still
@@ -514,7 +530,8 @@ fn print_still(still: &[crate::frames::Still]) -> Result<()> {
             s.levels
         );
     }
-    pen_host::outln!("medians of {STILL_FRAMES} frames, the view turning 0.1° a frame; target: ≤ 16.7 ms");
+    let frames = still[0].frames;
+    pen_host::outln!("medians of {frames} frames, the view turning 0.1° a frame; target: ≤ 16.7 ms");
     Ok(())
 }
 

@@ -27,6 +27,8 @@ pub struct Still {
     pub lod_error: f32,
     pub stereo: bool,
     pub frame_ms: f64,
+    /// Frames timed (the median of them is `frame_ms`).
+    pub frames: usize,
     /// Terrain nodes drawn per level in the last frame (level 0 first); empty at full detail.
     pub levels: Vec<usize>,
 }
@@ -60,13 +62,15 @@ pub fn terrain(n: u32) -> Result<Heightmap> {
     Heightmap::from_heights(n, n, cell, heights).context("the resampled terrain")
 }
 
-/// Times `frames` still frames of `map` at `lod_error` pixels (0: full detail).
+/// Times `frames` still frames of `map` at `lod_error` pixels (0: full detail); the last one is
+/// written to `png` if given.
 pub fn measure(
     map: &Heightmap,
     lod_error: f32,
     stereo: bool,
     look: crate::render::LookArg,
     frames: usize,
+    png: Option<&std::path::Path>,
 ) -> Result<Still> {
     let extent = [
         map.cell_size() * f64::from(map.cols()),
@@ -90,11 +94,15 @@ pub fn measure(
             times.push(t.elapsed().as_secs_f64() * 1e3);
         }
     }
+    if let Some(path) = png {
+        penmodel_render::output::png::write_png(&frame, path).with_context(|| format!("writing {}", path.display()))?;
+    }
     Ok(Still {
         grid: map.cols(),
         lod_error,
         stereo,
         frame_ms: super::bench::median(times),
+        frames,
         levels: renderer.lod_levels(),
     })
 }
