@@ -48,6 +48,7 @@
 use rayon::prelude::*;
 
 use super::light;
+use super::mips::{Level, Mips};
 use super::ramp::{self, WATER};
 use super::scene::{Scene, Style};
 use penmodel_terrain::revision::Mark;
@@ -101,6 +102,8 @@ pub struct Land {
     /// brightness, and that brightness as a factor − 1 (see [`material_parts`]): a pixel fades
     /// it by its footprint ([`Ground::fine_fade`]).
     albedo: Vec<[f32; 4]>,
+    /// The colours' box-filtered levels, for pixels that span many cells.
+    mips: Mips,
     /// The broad and fine noise per cell: they depend on the grid alone.
     noise: Vec<[f32; 2]>,
     /// The grid the noise is for: columns, rows, cell size.
@@ -325,6 +328,8 @@ impl Land {
         }
         self.albedo.resize(cols * rows, [0.0; 4]);
         colours(map, &scene.style, &self.shore, grown, &self.noise, &mut self.albedo);
+        self.mips
+            .update(&self.albedo, (cols, rows), [grown.c0, grown.c1, grown.r0, grown.r1]);
         self.remade.coloured = ((grown.c1 - grown.c0) * (grown.r1 - grown.r0)) as u64;
         // Non-finite heights, counted again in the changed rows.
         self.bad_rows.resize(rows, 0);
@@ -355,6 +360,7 @@ impl Land {
         if self.cols == 0 || self.rows == 0 || self.albedo.len() < self.cols * self.rows {
             return Ground {
                 albedo: &NOTHING,
+                mips: &[],
                 cols: 1,
                 inv: 0.0,
                 last: [0.0, 0.0],
@@ -363,6 +369,7 @@ impl Land {
         }
         Ground {
             albedo: &self.albedo,
+            mips: self.mips.levels(),
             cols: self.cols,
             inv: 1.0 / self.cell,
             last: [(self.cols - 1) as f32, (self.rows - 1) as f32],
@@ -375,6 +382,8 @@ impl Land {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Ground<'a> {
     albedo: &'a [[f32; 4]],
+    /// Levels 1, 2, … of `albedo`, box-filtered ([`crate::mips`]).
+    mips: &'a [Level],
     cols: usize,
     /// 1 / cell size.
     inv: f32,
@@ -411,13 +420,32 @@ impl Ground<'_> {
         )
     }
 
-    /// The ground's colour (sRGB 0–255, before light) of the cell holding world `(x, z)`
-    /// metres, with `fade` of the fine noise: for pixels where a cell is smaller than a pixel,
-    /// where interpolating between cells would show nothing more and costs three times as much.
+    /// The box-filtered levels above the colours ([`crate::mips`]).
     #[inline]
-    pub(crate) fn nearest_at(&self, x: f32, z: f32, fade: f32) -> [f32; 3] {
-        let (u, v) = self.place(x, z, 0.0);
-        let a = self.albedo[v as u32 as usize * self.cols + u as u32 as usize];
+    pub(crate) fn levels(&self) -> usize {
+        self.mips.len()
+    }
+
+    /// The ground's colour (sRGB 0–255, before light) of the cell of `level` (0: the map's own
+    /// cells; `L`: the mean of `2^L × 2^L` of them) holding world `(x, z)` metres, with `fade` of
+    /// the fine noise: for pixels where a cell is smaller than a pixel, where interpolating
+    /// between cells would show nothing more and costs three times as much. A level past the
+    /// last one kept reads the last.
+    #[inline]
+    pub(crate) fn nearest_at(&self, level: usize, x: f32, z: f32, fade: f32) -> [f32; 3] {
+        let a = match level.min(self.mips.len()) {
+            0 => {
+                let (u, v) = self.place(x, z, 0.0);
+                self.albedo[v as u32 as usize * self.cols + u as u32 as usize]
+            }
+            l => {
+                let m = &self.mips[l - 1];
+                let inv = self.inv / (1u32 << l) as f32;
+                let u = (x * inv).max(0.0).min((m.cols - 1) as f32);
+                let v = (z * inv).max(0.0).min((m.rows - 1) as f32);
+                m.cells[v as u32 as usize * m.cols + u as u32 as usize]
+            }
+        };
         let k = 1.0 + fade * a[3];
         [a[0] * k, a[1] * k, a[2] * k]
     }
@@ -965,6 +993,7 @@ mod tests {
     fn ground(albedo: &[[f32; 4]]) -> Ground<'_> {
         Ground {
             albedo,
+            mips: &[],
             cols: 2,
             inv: 0.1,
             last: [1.0, 1.0],
@@ -1000,13 +1029,44 @@ mod tests {
         for (m, (a, b)) in mid.iter().zip(cells[0].iter().zip(&cells[1])) {
             assert!((m - 0.5 * (a + b)).abs() < 1e-3);
         }
-        let near = g.nearest_at(4.0, 4.0, 1.0);
+        let near = g.nearest_at(0, 4.0, 4.0, 1.0);
         for (n, want) in near.iter().zip([105.0, 84.0, 63.0]) {
             assert!((n - want).abs() < 1e-3);
         }
-        assert_eq!(g.nearest_at(4.0, 4.0, 0.0), [100.0, 80.0, 60.0]);
+        assert_eq!(g.nearest_at(0, 4.0, 4.0, 0.0), [100.0, 80.0, 60.0]);
         // A NaN point reads the first cell.
-        assert_eq!(g.nearest_at(f32::NAN, f32::NAN, 0.0), [100.0, 80.0, 60.0]);
+        assert_eq!(g.nearest_at(0, f32::NAN, f32::NAN, 0.0), [100.0, 80.0, 60.0]);
+    }
+
+    #[test]
+    fn a_pixel_spanning_many_cells_reads_their_mean() {
+        let cells = [
+            [100.0, 80.0, 60.0, 0.05],
+            [200.0, 180.0, 160.0, -0.05],
+            [10.0, 20.0, 30.0, 0.0],
+            [50.0, 40.0, 30.0, 0.02],
+        ];
+        let mut mips = Mips::default();
+        mips.update(&cells, (2, 2), [0, 2, 0, 2]);
+        let g = Ground {
+            mips: mips.levels(),
+            ..ground(&cells)
+        };
+        assert_eq!(g.levels(), 1);
+        // Level 0 is the cell itself; level 1 (and any level past the last) the mean of the four.
+        assert_eq!(g.nearest_at(0, 14.0, 4.0, 0.0), [200.0, 180.0, 160.0]);
+        let mean = [90.0, 80.0, 70.0];
+        for level in [1, 5] {
+            for (x, z) in [(4.0, 4.0), (14.0, 14.0), (-3.0, 30.0)] {
+                let got = g.nearest_at(level, x, z, 0.0);
+                for (g, m) in got.iter().zip(mean) {
+                    assert!((g - m).abs() < 1e-3, "level {level} at ({x}, {z}): {got:?}");
+                }
+            }
+        }
+        // The fine noise's factor is averaged too: (0.05 − 0.05 + 0 + 0.02) / 4.
+        let faded = g.nearest_at(1, 4.0, 4.0, 1.0);
+        assert!((faded[0] - 90.0 * 1.005).abs() < 1e-3);
     }
 
     #[test]

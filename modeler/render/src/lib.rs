@@ -36,6 +36,7 @@ pub mod land;
 pub mod light;
 pub mod lod;
 pub mod meshes;
+mod mips;
 pub mod nodes;
 pub mod overlay;
 pub mod ramp;

@@ -14,6 +14,7 @@
 use super::atmosphere::Atmosphere;
 use super::frame::Rgba;
 use super::land::Land;
+use super::mips;
 use super::ramp::Ramp;
 use super::rasterise::{Sample, Surface};
 use super::scene::Style;
@@ -99,6 +100,7 @@ fn resolve_land(
 ) {
     let step = air.step();
     let ground = land.ground();
+    let levels = ground.levels();
     // Pixels a metre spans across the view at `w = 1`.
     let per_metre = air.pixels(1.0, 1.0);
     // Where a cell spans less than a pixel (1/w below this), the nearest cell's colour.
@@ -124,7 +126,10 @@ fn resolve_land(
                 let c = surface_colour(s.surface, style).unwrap_or_else(|| {
                     let fade = ground.fine_fade(per_metre * s.invw, sin);
                     if s.invw < fine {
-                        ground.nearest_at(at[0], at[1], fade)
+                        // The level whose cells are about the pixel's size: `fine / invw` cells
+                        // span a pixel across the view.
+                        let level = mips::level_for(fine / s.invw, levels);
+                        ground.nearest_at(level, at[0], at[1], fade)
                     } else {
                         ground.albedo_at(at[0], at[1], fade)
                     }
