@@ -37,7 +37,8 @@ pub(crate) struct Mips {
 /// the map itself), at most `available`.
 #[inline]
 pub(crate) fn level_for(cells: f32, available: usize) -> usize {
-    if !(cells >= 2.0) {
+    // NaN and anything under 2 cells: the map itself.
+    if cells.is_nan() || cells < 2.0 {
         return 0;
     }
     // The exponent of a finite f32 ≥ 2 is ⌊log₂⌋ (an infinite one saturates to the top).
