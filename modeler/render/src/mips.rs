@@ -198,8 +198,8 @@ mod tests {
         // The corner parent (2, 1) has one child, (4, 2); the edge parent (2, 0) has two.
         assert_eq!(l1.cells[5], base[2 * cols + 4]);
         let two = [base[4], base[cols + 4]];
-        for ch in 0..4 {
-            assert_eq!(l1.cells[2][ch], (two[0][ch] + two[1][ch]) / 2.0);
+        for (got, (a, b)) in l1.cells[2].iter().zip(two[0].iter().zip(&two[1])) {
+            assert_eq!(*got, (a + b) / 2.0);
         }
     }
 
