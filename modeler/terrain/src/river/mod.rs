@@ -236,11 +236,7 @@ impl Shape {
             mask: vec![0; window.len()],
             lakes: vec![0; window.len()],
             necks: Vec::new(),
-            near: Near {
-                owner: Vec::new(),
-                dist: Vec::new(),
-                side: Vec::new(),
-            },
+            near: Near::empty(),
             history: Vec::new(),
             river: river.clone(),
             constants: *constants,

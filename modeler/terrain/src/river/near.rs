@@ -17,17 +17,31 @@ pub struct Near {
     pub dist: Vec<f32>,
     /// +1 left of the line (counter-clockwise of its direction, x right, y up), −1 right, 0 on it.
     pub side: Vec<i8>,
+    /// Per row of the window, the columns the last fill's segments visited (first > last: none);
+    /// every other cell holds [`NONE`], ∞ and 0, so the next fill resets only these.
+    spans: Vec<(u32, u32)>,
 }
+
+impl Near {
+    /// A field of no cells (each fill sizes it to its window).
+    pub fn empty() -> Near {
+        Near {
+            owner: Vec::new(),
+            dist: Vec::new(),
+            side: Vec::new(),
+            spans: Vec::new(),
+        }
+    }
+}
+
+/// A row span of no cells.
+const NO_SPAN: (u32, u32) = (u32::MAX, 0);
 
 /// The field of the polyline `line` (cell coordinates of the grid: cell centres at integers) over
 /// `win`, for cells within `reach` cells of it. Each segment visits the cells it may be nearest
 /// (below): about the band's area × (1 + reach × the turn per sample / 2) cells in all.
 pub fn nearest(win: &Window, line: &[DVec2], reach: f64) -> Near {
-    let mut near = Near {
-        owner: Vec::new(),
-        dist: Vec::new(),
-        side: Vec::new(),
-    };
+    let mut near = Near::empty();
     nearest_into(win, line, reach, &mut near);
     near
 }
@@ -39,42 +53,85 @@ const SPLIT_CELLS: usize = 16_384;
 /// the bounds never leaves out a cell on an edge; far below a cell, so it adds no visits.
 const SLACK: f64 = 1e-6;
 
-/// [`nearest`] into `near`'s buffers (reused from one iteration to the next).
+/// [`nearest`] into `near`'s buffers (reused from one iteration to the next: a field of the same
+/// window is reset only where its segments reached, so its arrays must hold what the last fill
+/// left there).
 ///
 /// Each cell's owner is the nearest segment within `reach` (the first of equal squared distances
 /// as `f32`), whichever segments visit it, so a large window is filled as two bands of rows on
 /// the thread pool and the field is the same bit for bit (a test checks).
 pub fn nearest_into(win: &Window, line: &[DVec2], reach: f64, near: &mut Near) {
-    // Sized here, reset by each band (below).
     let n = win.len();
-    near.owner.resize(n, NONE);
-    near.dist.resize(n, f32::INFINITY);
-    near.side.resize(n, 0);
+    // Another window's buffers (or none yet): every cell unset, no span.
+    if near.owner.len() != n || near.dist.len() != n || near.side.len() != n || near.spans.len() != win.height {
+        near.owner.clear();
+        near.owner.resize(n, NONE);
+        near.dist.clear();
+        near.dist.resize(n, f32::INFINITY);
+        near.side.clear();
+        near.side.resize(n, 0);
+        near.spans.clear();
+        near.spans.resize(win.height, NO_SPAN);
+    }
     let origin = win.origin();
     let pts: Vec<DVec2> = line.iter().map(|p| *p - origin).collect();
     let segs = segments(&pts, reach);
+    let Near {
+        owner,
+        dist,
+        side,
+        spans,
+    } = near;
     if n < SPLIT_CELLS || win.height < 2 {
         fill(
             win,
             &segs,
             reach,
             0..win.height,
-            &mut near.owner,
-            &mut near.dist,
-            &mut near.side,
+            Band {
+                owner,
+                dist,
+                side,
+                spans,
+            },
         );
         return;
     }
     let mid = win.height / 2;
     let at = mid * win.width;
-    let (o0, o1) = near.owner.split_at_mut(at);
-    let (d0, d1) = near.dist.split_at_mut(at);
-    let (s0, s1) = near.side.split_at_mut(at);
+    let (o0, o1) = owner.split_at_mut(at);
+    let (d0, d1) = dist.split_at_mut(at);
+    let (s0, s1) = side.split_at_mut(at);
+    let (p0, p1) = spans.split_at_mut(mid);
     let segs = &segs;
     rayon::join(
-        || fill(win, segs, reach, 0..mid, o0, d0, s0),
-        || fill(win, segs, reach, mid..win.height, o1, d1, s1),
+        || {
+            let band = Band {
+                owner: o0,
+                dist: d0,
+                side: s0,
+                spans: p0,
+            };
+            fill(win, segs, reach, 0..mid, band)
+        },
+        || {
+            let band = Band {
+                owner: o1,
+                dist: d1,
+                side: s1,
+                spans: p1,
+            };
+            fill(win, segs, reach, mid..win.height, band)
+        },
     );
+}
+
+/// A band of rows of a field's buffers.
+struct Band<'a> {
+    owner: &'a mut [u32],
+    dist: &'a mut [f32],
+    side: &'a mut [i8],
+    spans: &'a mut [(u32, u32)],
 }
 
 /// A segment of the line in its own frame (from `a` along the unit `u` for `len` cells; `s` along
@@ -150,156 +207,213 @@ fn segments(pts: &[DVec2], reach: f64) -> Vec<Segment> {
         .collect()
 }
 
-/// The field of the segments `segs` (window-local) over the window's rows `rows`, into buffers
-/// that hold those rows only.
-fn fill(
-    win: &Window,
-    segs: &[Segment],
-    reach: f64,
-    rows: std::ops::Range<usize>,
-    owner: &mut [u32],
-    dist: &mut [f32],
-    side: &mut [i8],
-) {
+/// The field of the segments `segs` (window-local) over the window's rows `rows`, into a band
+/// of buffers that holds those rows only (unset but for the last fill's spans).
+fn fill(win: &Window, segs: &[Segment], reach: f64, rows: std::ops::Range<usize>, band: Band) {
+    let Band {
+        owner,
+        dist,
+        side,
+        spans,
+    } = band;
+    let w = win.width;
+    // The last fill's cells back to unset.
+    for (r, span) in spans.iter_mut().enumerate() {
+        let (c0, c1) = (span.0 as usize, span.1 as usize);
+        if c0 <= c1 {
+            owner[r * w + c0..=r * w + c1].fill(NONE);
+            dist[r * w + c0..=r * w + c1].fill(f32::INFINITY);
+            side[r * w + c0..=r * w + c1].fill(0);
+        }
+        *span = NO_SPAN;
+    }
     // While searching, `dist` holds squared distances, compared by their bits (the same order for
     // positive floats, ∞ above them all).
-    owner.fill(NONE);
-    dist.fill(f32::INFINITY);
-    side.fill(0);
-    // The rows reached, whose distances need their roots.
-    let mut reached = (usize::MAX, 0);
-    let base = rows.start * win.width;
-    let r2 = reach * reach;
-    for (k, seg) in segs.iter().enumerate() {
-        let Segment { a, u, len, .. } = *seg;
-        let k = k as u32;
-        // Its nearer end: `k` before the middle (and for a segment of length 0), `k + 1` from it.
-        let half = if len > 0.0 { 0.5 * len } else { f64::INFINITY };
-        // The side: none for a segment of length 0 (a point has none).
-        let on = if len > 0.0 { 1e-9 } else { f64::INFINITY };
-        regions(win, rows.clone(), seg, reach, |r, c0, c1| {
-            reached = (reached.0.min(r), reached.1.max(r));
-            let j0 = r * win.width + c0 - base;
-            let n = c1 - c0 + 1;
-            // Along the segment s = c·u.x + s0, across it (positive on its left) n0 − c·u.y.
-            let dy = r as f64 - a.y;
-            let (s0, n0) = (dy * u.y - a.x * u.x, dy * u.x + a.x * u.y);
-            let cells = (dist[j0..j0 + n].iter_mut())
-                .zip(&mut owner[j0..j0 + n])
-                .zip(&mut side[j0..j0 + n]);
-            let mut x = c0 as f64;
-            for ((d_best, o_best), s_best) in cells {
-                let s = x * u.x + s0;
-                let across = n0 - x * u.y;
-                x += 1.0;
-                // The nearest point is the projection clamped to the segment (by hand: no NaN
-                // here, and `clamp` checks its bounds).
-                #[allow(clippy::manual_clamp)]
-                let sc = if s < 0.0 {
-                    0.0
-                } else if s > len {
-                    len
-                } else {
-                    s
-                };
-                let d = (s - sc) * (s - sc) + across * across;
-                let df = d as f32;
-                // Without a branch: which segment is nearest changes from cell to cell in no
-                // pattern a predictor learns.
-                let better = d <= r2 && df.to_bits() < d_best.to_bits();
-                let o = k + u32::from(s >= half);
-                let sd = i8::from(across > on) - i8::from(across < -on);
-                *d_best = if better { df } else { *d_best };
-                *o_best = if better { o } else { *o_best };
-                *s_best = if better { sd } else { *s_best };
-            }
-        });
-    }
-    // The roots once at the end (∞ stays ∞).
-    if reached.0 <= reached.1 {
-        let (from, to) = (
-            (reached.0 - rows.start) * win.width,
-            (reached.1 + 1 - rows.start) * win.width,
-        );
-        for d in &mut dist[from..to] {
-            *d = d.sqrt();
-        }
-    }
-}
-
-/// Calls `f(row, first column, last column)` for the cells of rows `rows` in `seg`'s region: its
-/// rectangle with its wedge, as one convex polygon (the wedge's triangle and the rectangle's
-/// hull; a cell of the hull outside both only costs a visit).
-fn regions(
-    win: &Window,
-    rows: std::ops::Range<usize>,
-    seg: &Segment,
-    reach: f64,
-    mut f: impl FnMut(usize, usize, usize),
-) {
-    let at = |s: f64, n: f64| seg.a + seg.u * s + seg.u.perp() * n;
-    let (s0, s1) = seg.along;
-    // Counter-clockwise in (s, n), and so in the window (a rotation keeps the turn).
-    let verts = match seg.wedge {
-        None => [at(s0, -reach), at(s1, -reach), at(s1, reach), at(s0, reach)],
-        Some((side, past)) if side > 0.0 => [at(s0, -reach), at(s1, -reach), at(s1 + past, reach), at(s0, reach)],
-        Some((_, past)) => [at(s0, -reach), at(s1 + past, -reach), at(s1, reach), at(s0, reach)],
+    let mut band = Band {
+        owner,
+        dist,
+        side,
+        spans,
     };
-    convex(win, rows, &verts, &mut f);
+    for (k, seg) in segs.iter().enumerate() {
+        let Some(region) = Region::of(win, seg, reach) else {
+            continue;
+        };
+        // Most regions are rectangles, with two edges each side.
+        if region.edges <= 2 {
+            visit_segment::<2>(&region, seg, k as u32, reach, &rows, w, &mut band);
+        } else {
+            visit_segment::<4>(&region, seg, k as u32, reach, &rows, w, &mut band);
+        }
+    }
+    let Band { dist, spans, .. } = band;
+    // The roots once at the end (∞ stays ∞).
+    for (r, span) in spans.iter().enumerate() {
+        let (c0, c1) = (span.0 as usize, span.1 as usize);
+        if c0 <= c1 {
+            for d in &mut dist[r * w + c0..=r * w + c1] {
+                *d = d.sqrt();
+            }
+        }
+    }
 }
 
-/// Calls `f(row, first column, last column)` for each row of `rows` where the window has cells in
-/// the convex polygon `verts` (counter-clockwise, x right and y up; window-local), each row's
-/// bounds widened by [`SLACK`]: a row's cells form one interval, between the greatest of the
-/// left edges' bounds and the least of the right edges' (each edge's line bounds every row).
-fn convex(win: &Window, rows: std::ops::Range<usize>, verts: &[DVec2], f: &mut impl FnMut(usize, usize, usize)) {
-    let (lo, hi) = verts
-        .iter()
-        .fold((DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)), |(lo, hi), p| {
-            (lo.min(*p), hi.max(*p))
-        });
-    let (w, h) = (win.width as f64, win.height as f64);
-    if hi.x < -SLACK || hi.y < -SLACK || lo.x > w - 1.0 + SLACK || lo.y > h - 1.0 + SLACK {
-        return;
-    }
-    let (r0, r1) = (
-        ceil_small((lo.y - SLACK).max(0.0)) as usize,
-        floor_small((hi.y + SLACK).min(h - 1.0)) as usize,
-    );
-    let (cmin, cmax) = ((lo.x - SLACK).max(0.0), (hi.x + SLACK).min(w - 1.0));
-    // Each edge's x at row y: x0 + y·slope; rising edges bound on the right (the inside is on an
-    // edge's left), falling ones on the left. Edges along a row are bounded by the rows.
-    let mut left = [(0.0, 0.0); 4];
-    let mut right = [(0.0, 0.0); 4];
-    let (mut nl, mut nr) = (0, 0);
-    for (i, p) in verts.iter().enumerate() {
-        let q = verts[(i + 1) % verts.len()];
-        let dy = q.y - p.y;
-        if dy.abs() < 1e-12 {
+/// Segment `k`'s visits of the cells of its region in the band of rows `rows` (the window `w`
+/// cells wide): where it is nearer than the cell's nearest so far, it becomes the cell's owner.
+/// `N`: the region's edges each side that bound its rows (at least [`Region::edges`]).
+#[inline(always)]
+fn visit_segment<const N: usize>(
+    region: &Region,
+    seg: &Segment,
+    k: u32,
+    reach: f64,
+    rows: &std::ops::Range<usize>,
+    w: usize,
+    band: &mut Band,
+) {
+    let Segment { a, u, len, .. } = *seg;
+    let r2 = reach * reach;
+    let base = rows.start * w;
+    // Its nearer end: `k` before the middle (and for a segment of length 0), `k + 1` from it.
+    let half = if len > 0.0 { 0.5 * len } else { f64::INFINITY };
+    // The side: none for a segment of length 0 (a point has none).
+    let on = if len > 0.0 { 1e-9 } else { f64::INFINITY };
+    for r in region.r0.max(rows.start)..(region.r1 + 1).min(rows.end) {
+        let Some((c0, c1)) = region.cols::<N>(r) else {
             continue;
-        }
-        let slope = (q.x - p.x) / dy;
-        let edge = (p.x - p.y * slope, slope);
-        if dy > 0.0 {
-            right[nr] = edge;
-            nr += 1;
-        } else {
-            left[nl] = edge;
-            nl += 1;
+        };
+        let span = &mut band.spans[r - rows.start];
+        *span = (span.0.min(c0 as u32), span.1.max(c1 as u32));
+        let j0 = r * w + c0 - base;
+        let n = c1 - c0 + 1;
+        // Along the segment s = c·u.x + s0, across it (positive on its left) n0 − c·u.y.
+        let dy = r as u32 as f64 - a.y;
+        let (s0, n0) = (dy * u.y - a.x * u.x, dy * u.x + a.x * u.y);
+        let (dist, owner, side) = (
+            &mut band.dist[j0..j0 + n],
+            &mut band.owner[j0..j0 + n],
+            &mut band.side[j0..j0 + n],
+        );
+        let mut x = c0 as u32 as f64;
+        for j in 0..n {
+            let s = x * u.x + s0;
+            let across = n0 - x * u.y;
+            x += 1.0;
+            // The nearest point is the projection clamped to the segment (by hand: no NaN
+            // here, and `clamp` checks its bounds).
+            #[allow(clippy::manual_clamp)]
+            let sc = if s < 0.0 {
+                0.0
+            } else if s > len {
+                len
+            } else {
+                s
+            };
+            let d = (s - sc) * (s - sc) + across * across;
+            let df = d as f32;
+            // Without a branch: which segment is nearest changes from cell to cell in no pattern
+            // a predictor learns.
+            let better = (d <= r2) & (df.to_bits() < dist[j].to_bits());
+            let o = k + u32::from(s >= half);
+            let sd = i8::from(across > on) - i8::from(across < -on);
+            dist[j] = std::hint::select_unpredictable(better, df, dist[j]);
+            owner[j] = std::hint::select_unpredictable(better, o, owner[j]);
+            side[j] = std::hint::select_unpredictable(better, sd, side[j]);
         }
     }
-    let (left, right) = (&left[..nl], &right[..nr]);
-    for r in r0.max(rows.start)..(r1 + 1).min(rows.end) {
-        let y = r as f64;
-        // Plain compares: no NaN here, and `max`/`min` handle one.
-        let (mut low, mut high) = (cmin + SLACK, cmax - SLACK);
-        for &(x0, slope) in left {
+}
+
+/// The cells a segment visits, row by row: its rectangle with its wedge, as one convex polygon
+/// (the wedge's triangle and the rectangle's hull; a cell of the hull outside both only costs a
+/// visit). Each row's cells form one interval, between the greatest of the left edges' bounds
+/// and the least of the right edges' (each edge's line bounds every row), widened by [`SLACK`].
+struct Region {
+    /// The rows that may have cells, `r0..=r1`.
+    r0: usize,
+    r1: usize,
+    /// The columns' bounds, within the window and widened by [`SLACK`].
+    cmin: f64,
+    cmax: f64,
+    /// Each edge's x at row y: x0 + y·slope. Rising edges bound on the right (the inside is on an
+    /// edge's left), falling ones on the left; the arrays are filled up with lines at −∞ (left)
+    /// and +∞ (right), which bound nothing, so each row takes the same steps.
+    left: [(f64, f64); 4],
+    right: [(f64, f64); 4],
+    /// The edges of the side with more of them.
+    edges: usize,
+}
+
+impl Region {
+    /// `seg`'s region in the window (window-local), or `None` if it has no cells there.
+    fn of(win: &Window, seg: &Segment, reach: f64) -> Option<Region> {
+        let at = |s: f64, n: f64| seg.a + seg.u * s + seg.u.perp() * n;
+        let (s0, s1) = seg.along;
+        // Counter-clockwise in (s, n), and so in the window (a rotation keeps the turn).
+        let verts = match seg.wedge {
+            None => [at(s0, -reach), at(s1, -reach), at(s1, reach), at(s0, reach)],
+            Some((side, past)) if side > 0.0 => [at(s0, -reach), at(s1, -reach), at(s1 + past, reach), at(s0, reach)],
+            Some((_, past)) => [at(s0, -reach), at(s1 + past, -reach), at(s1, reach), at(s0, reach)],
+        };
+        Region::convex(win, &verts)
+    }
+
+    /// The convex polygon `verts` (counter-clockwise, x right and y up; window-local).
+    fn convex(win: &Window, verts: &[DVec2; 4]) -> Option<Region> {
+        let (lo, hi) = verts
+            .iter()
+            .fold((DVec2::splat(f64::MAX), DVec2::splat(f64::MIN)), |(lo, hi), p| {
+                (lo.min(*p), hi.max(*p))
+            });
+        let (w, h) = (win.width as f64, win.height as f64);
+        if hi.x < -SLACK || hi.y < -SLACK || lo.x > w - 1.0 + SLACK || lo.y > h - 1.0 + SLACK {
+            return None;
+        }
+        let mut left = [(f64::NEG_INFINITY, 0.0); 4];
+        let mut right = [(f64::INFINITY, 0.0); 4];
+        let (mut nl, mut nr) = (0, 0);
+        for (i, p) in verts.iter().enumerate() {
+            let q = verts[(i + 1) % verts.len()];
+            let dy = q.y - p.y;
+            // Edges along a row are bounded by the rows.
+            if dy.abs() < 1e-12 {
+                continue;
+            }
+            let slope = (q.x - p.x) / dy;
+            let edge = (p.x - p.y * slope, slope);
+            if dy > 0.0 {
+                right[nr] = edge;
+                nr += 1;
+            } else {
+                left[nl] = edge;
+                nl += 1;
+            }
+        }
+        Some(Region {
+            r0: ceil_small((lo.y - SLACK).max(0.0)) as usize,
+            r1: floor_small((hi.y + SLACK).min(h - 1.0)) as usize,
+            cmin: (lo.x - SLACK).max(0.0),
+            cmax: (hi.x + SLACK).min(w - 1.0),
+            left,
+            right,
+            edges: nl.max(nr),
+        })
+    }
+
+    /// The first and last column of row `r`'s cells, if any, from the first `N` edges of each
+    /// side (at least [`Region::edges`]).
+    #[inline(always)]
+    fn cols<const N: usize>(&self, r: usize) -> Option<(usize, usize)> {
+        let y = r as u32 as f64;
+        // Plain compares: no NaN here, and `max`/`min` handle one. The lines at ±∞ give ±∞
+        // (`y · 0` is 0), never beyond the bound.
+        let (mut low, mut high) = (self.cmin + SLACK, self.cmax - SLACK);
+        for &(x0, slope) in &self.left[..N] {
             let x = x0 + y * slope;
             if x > low {
                 low = x;
             }
         }
-        for &(x0, slope) in right {
+        for &(x0, slope) in &self.right[..N] {
             let x = x0 + y * slope;
             if x < high {
                 high = x;
@@ -308,10 +422,10 @@ fn convex(win: &Window, rows: std::ops::Range<usize>, verts: &[DVec2], f: &mut i
         let (low, high) = (low - SLACK, high + SLACK);
         // The ceiling of a maximum is the maximum of the ceilings: one ceiling and one floor per
         // row, of values held within a cell of `[cmin, cmax]`, where they are small integers.
-        let (c0, c1) = (ceil_small(low.min(cmax + 1.0)), floor_small(high.max(cmin - 1.0)));
-        if c1 >= c0 {
-            f(r, c0 as usize, c1 as usize);
-        }
+        let (last, first) = (self.cmax + 1.0, self.cmin - 1.0);
+        let c0 = ceil_small(if low < last { low } else { last });
+        let c1 = floor_small(if high > first { high } else { first });
+        (c1 >= c0).then_some((c0 as usize, c1 as usize))
     }
 }
 
