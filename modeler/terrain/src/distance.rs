@@ -16,6 +16,7 @@
 use crate::cells::{Cell, Mask};
 use crate::document::Metric;
 use crate::edt;
+use crate::pool;
 
 /// Distance of a cell no path within the region reaches (and of cells outside the region).
 pub const UNREACHABLE: u32 = u32::MAX;
@@ -46,6 +47,8 @@ trait Level: Copy + PartialEq {
     const ZERO: Self;
     const UNSEEN: Self;
     fn next(self) -> Self;
+    /// A map of `len` cells, each [`Level::UNSEEN`].
+    fn unseen(len: usize) -> Vec<Self>;
 }
 
 impl Level for u32 {
@@ -54,6 +57,9 @@ impl Level for u32 {
     fn next(self) -> u32 {
         self + 1
     }
+    fn unseen(len: usize) -> Vec<u32> {
+        vec![UNREACHABLE; len]
+    }
 }
 
 impl Level for f32 {
@@ -61,6 +67,10 @@ impl Level for f32 {
     const UNSEEN: f32 = f32::INFINITY;
     fn next(self) -> f32 {
         self + 1.0
+    }
+    /// The engine's maps come from (and go back to) [`pool::MAPS`].
+    fn unseen(len: usize) -> Vec<f32> {
+        pool::MAPS.filled(len, f32::INFINITY)
     }
 }
 
@@ -104,7 +114,7 @@ fn bfs<D: Level>(mask: &Mask, dist: &mut [D], mut front: Vec<(u32, u32)>) {
 
 /// [`from_sources`] in either storage.
 fn search_from<D: Level>(mask: &Mask, sources: &[Cell]) -> Vec<D> {
-    let mut dist = vec![D::UNSEEN; mask.box_len()];
+    let mut dist = D::unseen(mask.box_len());
     let mut front = Vec::new();
     for &s in sources {
         if let Some(i) = mask.index(s).filter(|&i| mask.bits()[i] && dist[i] != D::ZERO) {
@@ -118,7 +128,7 @@ fn search_from<D: Level>(mask: &Mask, sources: &[Cell]) -> Vec<D> {
 
 /// [`edge_layers`] in either storage.
 fn search_edge<D: Level>(mask: &Mask) -> Vec<D> {
-    let mut dist = vec![D::UNSEEN; mask.box_len()];
+    let mut dist = D::unseen(mask.box_len());
     let mut front = Vec::new();
     let w = (mask.width as usize).max(1);
     for (i, &inside) in mask.bits().iter().enumerate() {

@@ -24,6 +24,7 @@ use std::ops::{Mul, Sub};
 use rayon::prelude::*;
 
 use crate::cells::{Cell, Mask};
+use crate::pool::{self, Pool};
 
 /// No source in the column (or the row).
 const FAR: u32 = u32::MAX;
@@ -31,19 +32,25 @@ const FAR: u32 = u32::MAX;
 /// Squared Euclidean distance from each cell of a `w × h` box (row-major) to the nearest cell
 /// where `source` is true, or `u64::MAX` when there is no source at all.
 pub fn squared(w: usize, h: usize, source: &[bool]) -> Vec<u64> {
+    debug_assert_eq!(source.len(), w * h);
     let mut out = vec![u64::MAX; w * h];
-    transform(w, h, source, &mut out, |_, d2| d2);
+    let mut g: Vec<u32> = source.iter().map(|&s| if s { 0 } else { FAR }).collect();
+    transform(w, h, &mut g, &mut out, |_, d2| d2);
     out
 }
 
-/// The squared distances of [`squared`] through `f` into `out` (cells of a row without any
-/// source are left as they are): the engine's maps take their square roots as each row is
-/// done, with no squared map in between.
-fn transform<O: Send>(w: usize, h: usize, source: &[bool], out: &mut [O], f: impl Fn(usize, u64) -> O + Sync) {
-    debug_assert_eq!(source.len(), w * h);
+/// The engine's maps' column distances, kept from call to call ([`crate::pool`]): 16 MB, a
+/// 1024² box's.
+static COLUMNS: Pool<u32> = Pool::new(4 << 20);
+
+/// The squared distances of [`squared`] from `g` (0 at the sources, [`FAR`] elsewhere; the
+/// column distances on return) through `f` into `out` (cells of a row without any source are
+/// left as they are): the engine's maps take their square roots as each row is done, with no
+/// squared map in between.
+fn transform<O: Send>(w: usize, h: usize, g: &mut [u32], out: &mut [O], f: impl Fn(usize, u64) -> O + Sync) {
+    debug_assert_eq!(g.len(), w * h);
     // Column pass: vertical distance to the nearest source in the column, two sweeps over rows
     // (row by row rather than column by column, for the cache).
-    let mut g: Vec<u32> = source.iter().map(|&s| if s { 0 } else { FAR }).collect();
     for y in 1..h {
         let (above, row) = g[(y - 1) * w..(y + 1) * w].split_at_mut(w);
         for (d, &a) in row.iter_mut().zip(above.iter()) {
@@ -61,9 +68,9 @@ fn transform<O: Send>(w: usize, h: usize, source: &[bool], out: &mut [O], f: imp
         }
     }
     if w.max(h) <= NARROW_SIDE {
-        rows::<i64, O>(w, &g, out, &f);
+        rows::<i64, O>(w, g, out, &f);
     } else {
-        rows::<i128, O>(w, &g, out, &f);
+        rows::<i128, O>(w, g, out, &f);
     }
 }
 
@@ -178,20 +185,21 @@ impl<T: Wide> Envelope<T> {
 /// so is every cell when no source lies in the region. Sources outside the region are ignored.
 pub fn from_sources(mask: &Mask, sources: &[Cell]) -> Vec<f32> {
     let bits = mask.bits();
-    let mut src = vec![false; mask.box_len()];
+    let mut g = COLUMNS.filled(mask.box_len(), FAR);
     for &s in sources {
         if let Some(i) = mask.index(s).filter(|&i| bits[i]) {
-            src[i] = true;
+            g[i] = 0;
         }
     }
-    let mut out = vec![f32::INFINITY; mask.box_len()];
-    transform(mask.width as usize, mask.height as usize, &src, &mut out, |i, d2| {
+    let mut out = pool::MAPS.filled(mask.box_len(), f32::INFINITY);
+    transform(mask.width as usize, mask.height as usize, &mut g, &mut out, |i, d2| {
         if bits[i] {
             (d2 as f64).sqrt() as f32
         } else {
             f32::INFINITY
         }
     });
+    COLUMNS.give(g);
     out
 }
 
@@ -203,22 +211,28 @@ pub fn to_edge(mask: &Mask) -> Vec<f32> {
     // The box with a one-cell border of outside cells: every cell beyond the box is outside the
     // region, and the border is the nearest of them along rows and columns.
     let (pw, ph) = (w + 2, h + 2);
-    let mut outside = vec![true; pw * ph];
+    let mut g = COLUMNS.filled(pw * ph, 0);
     for y in 0..h {
         for (x, &inside) in bits[y * w..(y + 1) * w].iter().enumerate() {
-            outside[(y + 1) * pw + x + 1] = !inside;
-        }
-    }
-    let d2 = squared(pw, ph, &outside);
-    let mut out = vec![f32::INFINITY; w * h];
-    for y in 0..h {
-        for x in 0..w {
-            let i = y * w + x;
-            if bits[i] {
-                out[i] = ((d2[(y + 1) * pw + x + 1] as f64).sqrt() - 1.0) as f32;
+            if inside {
+                g[(y + 1) * pw + x + 1] = FAR;
             }
         }
     }
+    // Every row of the bordered box has a source (its border), so each of its cells is written.
+    let mut bordered = pool::MAPS.unfilled(pw * ph, 0.0);
+    transform(pw, ph, &mut g, &mut bordered, |_, d2| ((d2 as f64).sqrt() - 1.0) as f32);
+    COLUMNS.give(g);
+    let mut out = pool::MAPS.filled(w * h, f32::INFINITY);
+    for (y, row) in out.chunks_mut(w.max(1)).enumerate() {
+        let inner = &bordered[(y + 1) * pw + 1..][..w];
+        for ((o, &d), &inside) in row.iter_mut().zip(inner).zip(&bits[y * w..(y + 1) * w]) {
+            if inside {
+                *o = d;
+            }
+        }
+    }
+    pool::MAPS.give(bordered);
     out
 }
 

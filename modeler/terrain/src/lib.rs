@@ -36,6 +36,7 @@ mod heightmap;
 pub mod journal;
 mod json;
 pub mod persist;
+mod pool;
 pub mod profile;
 pub mod rect;
 pub mod revision;

@@ -41,8 +41,13 @@ use crate::detail;
 use crate::distance;
 use crate::document::{Figure, FigureKind, Grid, Metric, Point};
 use crate::heightmap::Heightmap;
+use crate::pool::{MAPS, Pool};
 use crate::profile;
 use crate::rect::Rect;
+
+/// The regions' normalisers of the regions dropped, for the next ones ([`crate::pool`]): 16 MB,
+/// a 1024² region's.
+static NORMS: Pool<f64> = Pool::new(2 << 20);
 
 /// Box rows per band of parallel work: small enough that two cores share the work evenly.
 const BAND_ROWS: usize = 8;
@@ -55,7 +60,8 @@ struct Run {
     end: u32,
 }
 
-/// Per-figure caches, over the owning region's box.
+/// Per-figure caches, over the owning region's box. `shape`, `coef` and `log` hold numbers only on
+/// the owned cells (elsewhere whatever their buffers held before, never read).
 pub(super) struct FigureNode {
     dp: Vec<f32>,
     /// Eq. 2's shape term on the owned cells, rounded to `f32`.
@@ -71,7 +77,7 @@ pub(super) struct FigureNode {
     pub(super) child: Option<Box<RegionNode>>,
 }
 
-/// Per-region caches, over the region's box.
+/// Per-region caches, over the region's box; `norm` holds numbers only on the owned cells.
 pub(super) struct RegionNode {
     pub(super) mask: Mask,
     /// The distances' metric, the region's (its nested regions inherit it).
@@ -304,13 +310,34 @@ impl FigureNode {
         let n = region.box_len();
         FigureNode {
             dp: distance::figure_map(metric, region, &sources(grid, f, child.as_deref())),
-            shape: vec![0.0; n],
-            coef: vec![0.0; n],
-            log: vec![0.0; n],
+            shape: MAPS.unfilled(n, 0.0),
+            coef: MAPS.unfilled(n, 0.0),
+            log: MAPS.unfilled(n, 0.0),
             log_sign: 0,
             child,
         }
     }
+}
+
+/// The maps go back to their pools, for the next regions and figures built.
+impl Drop for FigureNode {
+    fn drop(&mut self) {
+        for v in [&mut self.dp, &mut self.shape, &mut self.coef, &mut self.log] {
+            MAPS.give(std::mem::take(v));
+        }
+    }
+}
+
+impl Drop for RegionNode {
+    fn drop(&mut self) {
+        MAPS.give(std::mem::take(&mut self.df));
+        NORMS.give(std::mem::take(&mut self.norm));
+    }
+}
+
+/// `v` replaced by `new` (its old buffer back to the pool).
+fn replace_map(v: &mut Vec<f32>, new: Vec<f32>) {
+    MAPS.give(std::mem::replace(v, new));
 }
 
 impl RegionNode {
@@ -331,7 +358,7 @@ impl RegionNode {
             df,
             owned: Vec::new(),
             row_runs: Vec::new(),
-            norm: vec![0.0; n],
+            norm: NORMS.unfilled(n, 0.0),
             figures,
         };
         node.owned_runs();
@@ -348,16 +375,17 @@ impl RegionNode {
             || distance::edge_map(metric, mask),
             || {
                 figs.par_iter().zip(&mut self.figures).for_each(|(f, node)| {
-                    node.dp = distance::figure_map(metric, mask, &sources(grid, f, node.child.as_deref()));
-                    node.shape = vec![0.0; n];
-                    node.coef = vec![0.0; n];
-                    node.log = vec![0.0; n];
+                    let dp = distance::figure_map(metric, mask, &sources(grid, f, node.child.as_deref()));
+                    replace_map(&mut node.dp, dp);
+                    for v in [&mut node.shape, &mut node.coef, &mut node.log] {
+                        replace_map(v, MAPS.unfilled(n, 0.0));
+                    }
                     node.log_sign = 0;
                 })
             },
         );
-        self.df = df;
-        self.norm = vec![0.0; n];
+        replace_map(&mut self.df, df);
+        NORMS.give(std::mem::replace(&mut self.norm, NORMS.unfilled(n, 0.0)));
         self.owned_runs();
         self.blend(figs, outer, Shapes::All, None);
     }
@@ -448,7 +476,7 @@ impl RegionNode {
             .zip(&self.figures[k].dp)
             .map(|(a, b)| a.to_bits() != b.to_bits())
             .collect();
-        drop(old);
+        MAPS.give(old);
         self.blend(figs, outer, Shapes::One(k), Some(&dirty));
         self.paint_own(figs, base, map, Some(&dirty));
         if let Some(g) = gate {
@@ -469,7 +497,8 @@ impl RegionNode {
             );
         }
         let node = &mut self.figures[k];
-        node.dp = distance::figure_map(self.metric, &self.mask, &sources(grid, f, node.child.as_deref()));
+        let dp = distance::figure_map(self.metric, &self.mask, &sources(grid, f, node.child.as_deref()));
+        replace_map(&mut node.dp, dp);
     }
 
     /// Figure k's height changed (a pull): the region painted again, and a closed figure's
