@@ -75,7 +75,6 @@ pub fn nearest_into(win: &Window, line: &[DVec2], reach: f64, near: &mut Near) {
     }
     let origin = win.origin();
     let pts: Vec<DVec2> = line.iter().map(|p| *p - origin).collect();
-    let segs = segments(&pts, reach);
     let Near {
         owner,
         dist,
@@ -85,7 +84,7 @@ pub fn nearest_into(win: &Window, line: &[DVec2], reach: f64, near: &mut Near) {
     if n < SPLIT_CELLS || win.height < 2 {
         fill(
             win,
-            &segs,
+            &pts,
             reach,
             0..win.height,
             Band {
@@ -103,7 +102,7 @@ pub fn nearest_into(win: &Window, line: &[DVec2], reach: f64, near: &mut Near) {
     let (d0, d1) = dist.split_at_mut(at);
     let (s0, s1) = side.split_at_mut(at);
     let (p0, p1) = spans.split_at_mut(mid);
-    let segs = &segs;
+    let pts = &pts;
     rayon::join(
         || {
             let band = Band {
@@ -112,7 +111,7 @@ pub fn nearest_into(win: &Window, line: &[DVec2], reach: f64, near: &mut Near) {
                 side: s0,
                 spans: p0,
             };
-            fill(win, segs, reach, 0..mid, band)
+            fill(win, pts, reach, 0..mid, band)
         },
         || {
             let band = Band {
@@ -121,7 +120,7 @@ pub fn nearest_into(win: &Window, line: &[DVec2], reach: f64, near: &mut Near) {
                 side: s1,
                 spans: p1,
             };
-            fill(win, segs, reach, mid..win.height, band)
+            fill(win, pts, reach, mid..win.height, band)
         },
     );
 }
@@ -147,69 +146,67 @@ struct Segment {
     wedge: Option<(f64, f64)>,
 }
 
-/// The line's segments (a single point: one of length 0). A cell's nearest point of the line is
+/// The line's segments: one per pair of points, one of length 0 for a single point.
+fn segment_count(pts: &[DVec2]) -> usize {
+    pts.len().saturating_sub(1).max(pts.len().min(1))
+}
+
+/// The unit direction from `a` to `b`, if they differ.
+fn direction(a: DVec2, b: DVec2) -> Option<DVec2> {
+    let len = a.distance(b);
+    (len > 0.0).then(|| (b - a) / len)
+}
+
+/// Segment `k` of the line `pts` (below [`segment_count`]). A cell's nearest point of the line is
 /// inside a segment (then the cell projects onto it, within `reach` across) or at a joint, on
 /// the outer side of the bend, in the wedge between the two segments' normals; the segment before
 /// the joint covers that wedge (a cell at `|n|` across it lies at most `|n| · tan(turn)` past its
 /// end), or, for a turn of 45° or more, a rectangle `reach` long past its end. The course's ends
 /// and segments of length 0 reach `reach` each way (a disc, which also covers the joints next to
-/// a segment of length 0).
-fn segments(pts: &[DVec2], reach: f64) -> Vec<Segment> {
-    let ends: Vec<(DVec2, DVec2)> = match pts {
-        [] => return Vec::new(),
-        [p] => vec![(*p, *p)],
-        _ => pts.windows(2).map(|w| (w[0], w[1])).collect(),
+/// a segment of length 0). So the region lies within `√2 · reach` of the segment.
+fn segment(pts: &[DVec2], k: usize, reach: f64) -> Segment {
+    let (a, b) = match pts {
+        [p] => (*p, *p),
+        _ => (pts[k], pts[k + 1]),
     };
-    let dir: Vec<Option<DVec2>> = ends
-        .iter()
-        .map(|&(a, b)| {
-            let len = a.distance(b);
-            (len > 0.0).then(|| (b - a) / len)
-        })
-        .collect();
-    let last = ends.len() - 1;
-    ends.iter()
-        .enumerate()
-        .map(|(k, &(a, b))| {
-            let Some(u) = dir[k] else {
-                return Segment {
-                    a,
-                    u: DVec2::X,
-                    len: 0.0,
-                    along: (-reach, reach),
-                    wedge: None,
-                };
-            };
-            let len = a.distance(b);
-            let start = if k == 0 { -reach } else { 0.0 };
-            let (mut end, mut wedge) = (len, None);
-            match dir.get(k + 1).copied().flatten() {
-                _ if k == last => end = len + reach,
-                // A turn of 45° or more: the wedge's cells within reach lie at most `reach` past.
-                Some(q) if u.dot(q) <= u.perp_dot(q).abs() => end = len + reach,
-                Some(q) => {
-                    // Turning left, the outer side is the right (n < 0).
-                    let turn = u.perp_dot(q);
-                    if turn != 0.0 {
-                        wedge = Some((-turn.signum(), reach * turn.abs() / u.dot(q)));
-                    }
-                }
-                None => {}
+    let Some(u) = direction(a, b) else {
+        return Segment {
+            a,
+            u: DVec2::X,
+            len: 0.0,
+            along: (-reach, reach),
+            wedge: None,
+        };
+    };
+    let len = a.distance(b);
+    let start = if k == 0 { -reach } else { 0.0 };
+    let (mut end, mut wedge) = (len, None);
+    let last = segment_count(pts) - 1;
+    match (k < last).then(|| direction(pts[k + 1], pts[k + 2])).flatten() {
+        _ if k == last => end = len + reach,
+        // A turn of 45° or more: the wedge's cells within reach lie at most `reach` past.
+        Some(q) if u.dot(q) <= u.perp_dot(q).abs() => end = len + reach,
+        Some(q) => {
+            // Turning left, the outer side is the right (n < 0).
+            let turn = u.perp_dot(q);
+            if turn != 0.0 {
+                wedge = Some((-turn.signum(), reach * turn.abs() / u.dot(q)));
             }
-            Segment {
-                a,
-                u,
-                len,
-                along: (start, end),
-                wedge,
-            }
-        })
-        .collect()
+        }
+        None => {}
+    }
+    Segment {
+        a,
+        u,
+        len,
+        along: (start, end),
+        wedge,
+    }
 }
 
-/// The field of the segments `segs` (window-local) over the window's rows `rows`, into a band
-/// of buffers that holds those rows only (unset but for the last fill's spans).
-fn fill(win: &Window, segs: &[Segment], reach: f64, rows: std::ops::Range<usize>, band: Band) {
+/// The field of the line `pts` (window-local) over the window's rows `rows`, into a band of
+/// buffers that holds those rows only (unset but for the last fill's spans).
+fn fill(win: &Window, pts: &[DVec2], reach: f64, rows: std::ops::Range<usize>, band: Band) {
     let Band {
         owner,
         dist,
@@ -235,7 +232,15 @@ fn fill(win: &Window, segs: &[Segment], reach: f64, rows: std::ops::Range<usize>
         side,
         spans,
     };
-    for (k, seg) in segs.iter().enumerate() {
+    // A segment's region lies within √2 · reach of it (see `segment`): those of segments further
+    // from the band's rows have none of its cells.
+    let (top, bottom) = (rows.start as f64 - 2.0 * reach - 1.0, rows.end as f64 + 2.0 * reach);
+    for k in 0..segment_count(pts) {
+        let (a, b) = (pts[k], pts[(k + 1).min(pts.len() - 1)]);
+        if a.y.max(b.y) < top || a.y.min(b.y) > bottom {
+            continue;
+        }
+        let seg = &segment(pts, k, reach);
         let Some(region) = Region::of(win, seg, reach) else {
             continue;
         };
@@ -310,13 +315,13 @@ fn visit_segment<const N: usize>(
                 s
             };
             let d = (s - sc) * (s - sc) + across * across;
-            let df = d as f32;
+            let (df, best) = ((d as f32).to_bits(), dist[j].to_bits());
             // Without a branch: which segment is nearest changes from cell to cell in no pattern
-            // a predictor learns.
-            let better = (d <= r2) & (df.to_bits() < dist[j].to_bits());
+            // a predictor learns (the distance chosen as bits: a float's choice is a branch).
+            let better = (d <= r2) & (df < best);
             let o = k + u32::from(s >= half);
             let sd = i8::from(across > on) - i8::from(across < -on);
-            dist[j] = std::hint::select_unpredictable(better, df, dist[j]);
+            dist[j] = f32::from_bits(std::hint::select_unpredictable(better, df, best));
             owner[j] = std::hint::select_unpredictable(better, o, owner[j]);
             side[j] = std::hint::select_unpredictable(better, sd, side[j]);
         }
