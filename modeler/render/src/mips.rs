@@ -9,6 +9,13 @@
 //! the pixel should show: a nearest cell aliases (a pixel picks one of many cells, and the pick
 //! changes as the view moves).
 //!
+//! A level's cell is packed into 4 bytes ([`Packed`]: the colour rounded to whole sRGB steps, the
+//! fine noise's factor in steps of 1/1024), a quarter of the map's 16: the levels are read only
+//! where a cell is under a pixel, where a step of colour does not show, and the smaller levels
+//! stay in the caches (the load was still a third of the shading's time with 16-byte cells).
+//! Each level is made from the one below as stored, so a level's rounding carries into the next
+//! (at most half a step per level).
+//!
 //! The levels follow the map's changes: [`Mips::update`] recomputes only the parents of the
 //! changed cells, level by level, so the levels after any sequence of changes equal fresh ones
 //! to the bit (each parent is a function of its children alone).
@@ -19,12 +26,58 @@ use rayon::prelude::*;
 /// 4096² grid at any view that shows the grid.
 const MAX_LEVELS: usize = 8;
 
+/// Steps of the fine noise's factor per unit in a [`Packed`] cell: its ±0.07 take ±72 of an
+/// `i8`'s ±127.
+const FACTOR_STEPS: f32 = 1024.0;
+
+/// A level's cell: sRGB 0–255 rounded, and the fine noise's factor × [`FACTOR_STEPS`] as an `i8`.
+#[derive(Debug, Default, Clone, Copy, PartialEq, Eq)]
+pub(crate) struct Packed([u8; 4]);
+
+impl Packed {
+    #[inline]
+    fn pack(v: [f32; 4]) -> Packed {
+        let byte = |x: f32| x.round().clamp(0.0, 255.0) as u8;
+        let factor = (v[3] * FACTOR_STEPS).round().clamp(-127.0, 127.0) as i8;
+        Packed([byte(v[0]), byte(v[1]), byte(v[2]), factor as u8])
+    }
+
+    /// The colour (sRGB 0–255) and the fine noise's factor.
+    #[inline]
+    pub(crate) fn unpack(self) -> [f32; 4] {
+        let [r, g, b, k] = self.0;
+        [
+            f32::from(r),
+            f32::from(g),
+            f32::from(b),
+            f32::from(k as i8) / FACTOR_STEPS,
+        ]
+    }
+}
+
 /// One level: `cols × rows` cells, row-major.
 #[derive(Debug, Default, Clone, PartialEq)]
 pub(crate) struct Level {
     pub(crate) cols: usize,
     pub(crate) rows: usize,
-    pub(crate) cells: Vec<[f32; 4]>,
+    pub(crate) cells: Vec<Packed>,
+}
+
+/// What a level is made from: the map itself, or the level below.
+#[derive(Clone, Copy)]
+enum Below<'a> {
+    Map(&'a [[f32; 4]]),
+    Level(&'a [Packed]),
+}
+
+impl Below<'_> {
+    #[inline]
+    fn get(self, i: usize) -> [f32; 4] {
+        match self {
+            Below::Map(m) => m[i],
+            Below::Level(l) => l[i].unpack(),
+        }
+    }
 }
 
 /// Levels 1, 2, … of a `cols × rows` map.
@@ -69,11 +122,11 @@ impl Mips {
                 .map(|&(c, r)| Level {
                     cols: c,
                     rows: r,
-                    cells: vec![[0.0; 4]; c * r],
+                    cells: vec![Packed::default(); c * r],
                 })
                 .collect();
         }
-        let (mut below, mut below_size) = (base, (cols, rows));
+        let (mut below, mut below_size) = (Below::Map(base), (cols, rows));
         for level in &mut self.levels {
             if c1 <= c0 || r1 <= r0 {
                 return;
@@ -81,7 +134,7 @@ impl Mips {
             // The parents of the changed children.
             (c0, c1, r0, r1) = (c0 / 2, c1.div_ceil(2), r0 / 2, r1.div_ceil(2));
             average(below, below_size, level, [c0, c1, r0, r1]);
-            below = &level.cells;
+            below = Below::Level(&level.cells);
             below_size = (level.cols, level.rows);
         }
     }
@@ -101,7 +154,7 @@ fn sizes(cols: usize, rows: usize) -> Vec<(usize, usize)> {
 
 /// `level`'s cells in columns `c0..c1`, rows `r0..r1` as the mean of their children in `below`
 /// (`cols × rows`); a parent on an odd edge has one or two children.
-fn average(below: &[[f32; 4]], (cols, rows): (usize, usize), level: &mut Level, [c0, c1, r0, r1]: [usize; 4]) {
+fn average(below: Below, (cols, rows): (usize, usize), level: &mut Level, [c0, c1, r0, r1]: [usize; 4]) {
     let width = level.cols;
     level.cells[r0 * width..r1 * width]
         .par_chunks_mut(width)
@@ -111,10 +164,10 @@ fn average(below: &[[f32; 4]], (cols, rows): (usize, usize), level: &mut Level, 
             let (ra, rb) = (2 * r, (2 * r + 1).min(rows - 1));
             for (c, out) in line.iter_mut().enumerate().take(c1).skip(c0) {
                 let (ca, cb) = (2 * c, (2 * c + 1).min(cols - 1));
-                let (a, b) = (&below[ra * cols..], &below[rb * cols..]);
+                let (a, b) = (ra * cols, rb * cols);
                 // Children counted once each (an edge parent repeats its only row or column, and
                 // the repeat is not counted twice).
-                let kids = [a[ca], a[cb], b[ca], b[cb]];
+                let kids = [a + ca, a + cb, b + ca, b + cb].map(|i| below.get(i));
                 let n = match (ca == cb, ra == rb) {
                     (false, false) => 4.0,
                     (true, true) => 1.0,
@@ -129,7 +182,7 @@ fn average(below: &[[f32; 4]], (cols, rows): (usize, usize), level: &mut Level, 
                         }
                     }
                 }
-                *out = sum.map(|s| s / n);
+                *out = Packed::pack(sum.map(|s| s / n));
             }
         });
 }
@@ -143,7 +196,7 @@ mod tests {
         (0..cols * rows)
             .map(|i| {
                 let (c, r) = ((i % cols) as f32, (i / cols) as f32);
-                [c + salt, r, (c * 7.0 + r * 3.0 + salt) % 11.0, 0.01 * c]
+                [c + salt, r, (c * 7.0 + r * 3.0 + salt) % 11.0, 0.002 * c - 0.03]
             })
             .collect()
     }
@@ -167,7 +220,7 @@ mod tests {
     #[test]
     fn a_level_is_the_mean_of_its_cells_on_even_grids() {
         // On a power-of-two grid every level's cell covers exactly 4^l cells: the mean of means
-        // is the mean.
+        // is the mean, up to half a packing step per level.
         let (cols, rows) = (32, 16);
         let base = map(cols, rows, 0.0);
         let mut mips = Mips::default();
@@ -179,8 +232,14 @@ mod tests {
             for r in 0..level.rows {
                 for c in 0..level.cols {
                     let want = block_mean(&base, cols, rows, l, (c, r));
-                    for (got, want) in level.cells[r * level.cols + c].iter().zip(want) {
-                        assert!((got - want).abs() <= 1e-4 * want.abs().max(1.0), "level {l} ({c}, {r})");
+                    let got = level.cells[r * level.cols + c].unpack();
+                    let steps = [1.0, 1.0, 1.0, 1.0 / FACTOR_STEPS];
+                    for ((got, want), step) in got.iter().zip(want).zip(steps) {
+                        let slack = 0.5 * step * l as f32 + 1e-4;
+                        assert!(
+                            (got - want).abs() <= slack,
+                            "level {l} ({c}, {r}): {got} against {want}"
+                        );
                     }
                 }
             }
@@ -196,11 +255,13 @@ mod tests {
         let l1 = &mips.levels()[0];
         assert_eq!((l1.cols, l1.rows), (3, 2));
         // The corner parent (2, 1) has one child, (4, 2); the edge parent (2, 0) has two.
-        assert_eq!(l1.cells[5], base[2 * cols + 4]);
-        let two = [base[4], base[cols + 4]];
-        for (got, (a, b)) in l1.cells[2].iter().zip(two[0].iter().zip(&two[1])) {
-            assert_eq!(*got, (a + b) / 2.0);
-        }
+        assert_eq!(l1.cells[5], Packed::pack(base[2 * cols + 4]));
+        let (a, b) = (base[4], base[cols + 4]);
+        assert_eq!(l1.cells[2], Packed::pack([0, 1, 2, 3].map(|i| (a[i] + b[i]) / 2.0)));
+        // A full parent: (0, 0) has four.
+        let four = [base[0], base[1], base[cols], base[cols + 1]];
+        let mean = [0, 1, 2, 3].map(|i| four.iter().map(|v| v[i]).sum::<f32>() / 4.0);
+        assert_eq!(l1.cells[0], Packed::pack(mean));
     }
 
     #[test]
@@ -230,6 +291,25 @@ mod tests {
         let mut fresh = Mips::default();
         fresh.update(&base, (cols, rows), [0, cols, 0, rows]);
         assert_ne!(mips.levels(), fresh.levels());
+    }
+
+    #[test]
+    fn packing_rounds_to_the_nearest_step() {
+        for v in [
+            [0.0, 255.0, 17.4, 0.07],
+            [12.5001, 99.49, 254.6, -0.07],
+            [-3.0, 300.0, 1.0, 0.0],
+        ] {
+            let back = Packed::pack(v).unpack();
+            for (i, (b, v)) in back.iter().zip(v).enumerate() {
+                let (lo, hi, step) = if i < 3 {
+                    (0.0, 255.0, 1.0)
+                } else {
+                    (-1.0, 1.0, 1.0 / FACTOR_STEPS)
+                };
+                assert!((b - v.clamp(lo, hi)).abs() <= 0.5 * step + 1e-6, "{v:?} -> {back:?}");
+            }
+        }
     }
 
     #[test]

@@ -126,9 +126,11 @@ fn resolve_land(
                 let c = surface_colour(s.surface, style).unwrap_or_else(|| {
                     let fade = ground.fine_fade(per_metre * s.invw, sin);
                     if s.invw < fine {
-                        // The level whose cells are about the pixel's size: `fine / invw` cells
-                        // span a pixel across the view.
-                        let level = mips::level_for(fine / s.invw, levels);
+                        // The level whose cells are about the pixel's length: `fine / invw`
+                        // cells span a pixel across the view, that over `sin` along the ray
+                        // (the longer side, as a GPU's mipmaps choose without anisotropic
+                        // filtering: sharper would alias, and read far more cells).
+                        let level = mips::level_for(fine / (s.invw * sin.max(1e-3)), levels);
                         ground.nearest_at(level, at[0], at[1], fade)
                     } else {
                         ground.albedo_at(at[0], at[1], fade)
