@@ -19,7 +19,7 @@
 //! from a figure, is the straight-line distance to its nearest cell, which in a region with a
 //! bay may cross the bay (`docs/modeler.md` says what that does).
 
-use std::ops::{Mul, Sub};
+use std::ops::{Add, Div, Mul, Sub};
 
 use rayon::prelude::*;
 
@@ -50,21 +50,18 @@ static COLUMNS: Pool<u32> = Pool::new(4 << 20);
 fn transform<O: Send>(w: usize, h: usize, g: &mut [u32], out: &mut [O], f: impl Fn(usize, u64) -> O + Sync) {
     debug_assert_eq!(g.len(), w * h);
     // Column pass: vertical distance to the nearest source in the column, two sweeps over rows
-    // (row by row rather than column by column, for the cache).
+    // (row by row rather than column by column, for the cache). `FAR` saturates, so each step is
+    // a minimum without branches, which compiles to vector instructions.
     for y in 1..h {
         let (above, row) = g[(y - 1) * w..(y + 1) * w].split_at_mut(w);
         for (d, &a) in row.iter_mut().zip(above.iter()) {
-            if *d != 0 && a != FAR {
-                *d = a + 1;
-            }
+            *d = (*d).min(a.saturating_add(1));
         }
     }
     for y in (0..h.saturating_sub(1)).rev() {
         let (row, below) = g[y * w..(y + 2) * w].split_at_mut(w);
         for (d, &b) in row.iter_mut().zip(below.iter()) {
-            if b != FAR && b + 1 < *d {
-                *d = b + 1;
-            }
+            *d = (*d).min(b.saturating_add(1));
         }
     }
     if w.max(h) <= NARROW_SIDE {
@@ -94,7 +91,28 @@ fn rows<T: Wide, O: Send>(w: usize, g: &[u32], out: &mut [O], f: &(impl Fn(usize
 
 /// The integer type of the envelope's fractions: `i64` for boxes up to [`NARROW_SIDE`] a side,
 /// `i128` beyond.
-trait Wide: Copy + PartialOrd + From<i64> + Mul<Output = Self> + Sub<Output = Self> + Send {}
+trait Wide:
+    Copy
+    + PartialOrd
+    + From<i64>
+    + TryInto<i64>
+    + Add<Output = Self>
+    + Div<Output = Self>
+    + Mul<Output = Self>
+    + Sub<Output = Self>
+    + Send
+{
+    /// The first whole `x ≥ 0` with `x·den ≥ num` (`den > 0`), or `hi` if that is more.
+    fn first_at_least(num: Self, den: Self, hi: usize) -> usize {
+        let zero = Self::from(0);
+        if num <= zero {
+            return 0;
+        }
+        // ⌈num/den⌉ of positive numbers.
+        let x = (num + den - Self::from(1)) / den;
+        x.try_into().map_or(hi, |x: i64| (x as u64).min(hi as u64) as usize)
+    }
+}
 impl Wide for i64 {}
 impl Wide for i128 {}
 
@@ -164,18 +182,20 @@ impl<T: Wide> Envelope<T> {
         if self.v.is_empty() {
             return;
         }
-        let mut k = 0;
-        for (x, d) in out.iter_mut().enumerate() {
-            let x = x as i64;
-            // Move on while the next vertex's stretch starts at or before x (x·den ≥ num).
-            while k + 1 < self.v.len() && {
-                let (num, den) = self.z[k + 1];
-                T::from(x) * den >= num
-            } {
-                k += 1;
+        // Each vertex's columns: from where the last one's ended to where the next one's stretch
+        // starts (the first x with x·den ≥ num), in one tight loop.
+        let (v, fs, z) = (&self.v[..], &self.f[..], &self.z[..]);
+        let w = out.len();
+        let mut start = 0;
+        for (k, (&vk, &fk)) in v.iter().zip(fs).enumerate() {
+            let end = z.get(k + 1).map_or(w, |&(num, den)| T::first_at_least(num, den, w));
+            if end > start {
+                for (x, d) in (start..end).zip(&mut out[start..end]) {
+                    let dx = x as i64 - vk;
+                    *d = f(x, (dx * dx + fk) as u64);
+                }
+                start = end;
             }
-            let dx = x - self.v[k];
-            *d = f(x as usize, (dx * dx + self.f[k]) as u64);
         }
     }
 }
