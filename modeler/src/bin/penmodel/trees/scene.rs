@@ -41,6 +41,10 @@ pub struct SceneArgs {
     /// Time frames: LOD off and on mono, LOD on in stereo (otherwise one frame each, untimed).
     #[arg(long)]
     bench: bool,
+    /// With --bench, draw the full-detail frame once, untimed (for the image difference): a
+    /// profile of the LOD frames.
+    #[arg(long)]
+    lod_only: bool,
     /// Timed frames per case with --bench (the median is reported).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     frames: u32,
@@ -160,7 +164,7 @@ pub fn run(args: &SceneArgs) -> Result<()> {
     let mut on = Frame::new(args.width, args.height)?;
 
     scene.tree_lod = None;
-    let ms_full = time(&mut renderer, &scene, &mut full, frames)?;
+    let ms_full = time(&mut renderer, &scene, &mut full, frames.filter(|_| !args.lod_only))?;
     let stats_full = renderer.tree_stats();
     scene.tree_lod = lod;
     let ms_lod = time(&mut renderer, &scene, &mut on, frames)?;
