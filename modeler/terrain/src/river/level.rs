@@ -43,10 +43,37 @@ pub fn max_level(river: &River, cell_size: f64, c: &Constants) -> u8 {
 
 /// The level at a sample of curvature `kappa` (1/m).
 pub fn level(kappa: f64, river: &River, cell_size: f64, c: &Constants) -> u8 {
-    let n_max = max_level(river, cell_size, c);
-    let flow = river.width * river.depth * river.water / c.flow_reference;
-    let drive = c.curvature_gain * kappa * river.width * flow / river.hardness;
-    let grow = 1.0 - (-drive.max(0.0)).exp();
-    let n = 1.0 + (f64::from(n_max - 1) * grow).round();
-    n.clamp(1.0, f64::from(n_max)) as u8
+    Levels::new(river, cell_size, c).at(kappa)
+}
+
+/// [`level`] of one river at many samples: its terms that do not depend on the curvature worked
+/// out once.
+#[derive(Debug, Clone, Copy)]
+pub struct Levels {
+    n_max: u8,
+    flow: f64,
+    curvature_gain: f64,
+    width: f64,
+    hardness: f64,
+}
+
+impl Levels {
+    /// The levels of `river` on cells of `cell_size` metres.
+    pub fn new(river: &River, cell_size: f64, c: &Constants) -> Levels {
+        Levels {
+            n_max: max_level(river, cell_size, c),
+            flow: river.width * river.depth * river.water / c.flow_reference,
+            curvature_gain: c.curvature_gain,
+            width: river.width,
+            hardness: river.hardness,
+        }
+    }
+
+    /// The level at a sample of curvature `kappa` (1/m).
+    pub fn at(&self, kappa: f64) -> u8 {
+        let drive = self.curvature_gain * kappa * self.width * self.flow / self.hardness;
+        let grow = 1.0 - (-drive.max(0.0)).exp();
+        let n = 1.0 + (f64::from(self.n_max - 1) * grow).round();
+        n.clamp(1.0, f64::from(self.n_max)) as u8
+    }
 }

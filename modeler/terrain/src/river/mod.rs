@@ -276,30 +276,19 @@ impl Shape {
 
     /// Takes `line` as the centre line: levels, turns and the nearest-sample field.
     fn set_line(&mut self, line: Vec<Sample>) {
-        // A bend is read over `BEND_SPAN` widths of the course each way: the seed's κ with its
-        // sign, averaged, so a wiggle shorter than a bend neither swaps the banks nor makes a
-        // level of its own.
-        let m = self.span();
-        let signed: Vec<f64> = line
-            .iter()
-            .map(|p| p.d1.perp_dot(p.d2) / p.d1.length().powi(3).max(1e-12))
-            .collect();
-        let bend: Vec<f64> = (0..line.len())
-            .map(|i| {
-                let span = &signed[i.saturating_sub(m)..(i + m + 1).min(line.len())];
-                span.iter().sum::<f64>() / span.len() as f64
-            })
-            .collect();
-        self.turns = bend
-            .iter()
-            .map(|&b| if b.abs() < 1e-9 { 0 } else { b.signum() as i8 })
-            .collect();
-        self.levels = bend
-            .iter()
-            .map(|b| level::level(b.abs() / self.cell_size, &self.river, self.cell_size, &self.constants))
-            .collect();
         let pts: Vec<DVec2> = line.iter().map(|p| p.p).collect();
-        near::nearest_into(&self.window, &pts, self.radius + REACH, &mut self.near);
+        let (window, reach) = (self.window, self.radius + REACH);
+        let (m, cell) = (self.span(), self.cell_size);
+        let levels = level::Levels::new(&self.river, cell, &self.constants);
+        let near = &mut self.near;
+        // The bends and levels while the other core starts on the field (which does not read
+        // them).
+        let ((turns, levels), ()) = rayon::join(
+            || bends(&line, m, cell, &levels),
+            || near::nearest_into(&window, &pts, reach, near),
+        );
+        self.turns = turns;
+        self.levels = levels;
         self.line = line;
     }
 
@@ -451,7 +440,10 @@ impl Shape {
         // The plug: lake cells next to the river's new course silt up; in the same pass, the
         // river's area and each lake's.
         let mut lake_area = vec![0usize; self.necks.len() + 1];
-        let area = self.mask.iter().map(|&m| u32::from(m != 0)).sum::<u32>() as usize;
+        // Counted in bytes by runs of 255 (a byte per lane, 16 lanes to a vector).
+        let area: usize = (self.mask.chunks(255))
+            .map(|run| usize::from(run.iter().map(|&m| u8::from(m != 0)).sum::<u8>()))
+            .sum();
         let plug = self.radius + PLUG;
         // Once a neck has closed, by runs of 64 cells: the lakes are few and small, so most runs
         // have no lake cell.
@@ -566,22 +558,61 @@ impl Shape {
         let n = pts.len();
         // Buckets of `reach` cells: a close pair is in the same or neighbouring buckets.
         let b = reach.max(1.0);
-        let key = |p: DVec2| ((p.x / b).floor() as i64, (p.y / b).floor() as i64);
-        let mut buckets: std::collections::HashMap<(i64, i64), Vec<usize>, CellHash> = Default::default();
-        for (i, p) in pts.iter().enumerate() {
-            buckets.entry(key(*p)).or_default().push(i);
+        let keys: Vec<(i64, i64)> = pts
+            .iter()
+            .map(|p| ((p.x / b).floor() as i64, (p.y / b).floor() as i64))
+            .collect();
+        // The samples by bucket in a table of `slots` (a power of two) hashed from the bucket's
+        // key, each slot's in order along the line: slot `h`'s are `order[start[h]..start[h + 1]]`
+        // (a slot may hold more than one bucket's samples: a lookup checks the key).
+        let slots = (2 * n).next_power_of_two().max(16);
+        let slot = |(kx, ky): (i64, i64)| {
+            let h = (kx as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ (ky as u64).wrapping_mul(0xc2b2_ae3d_27d4_eb4f);
+            (h >> 32) as usize & (slots - 1)
+        };
+        let mut start = vec![0u32; slots + 1];
+        for &k in &keys {
+            start[slot(k) + 1] += 1;
         }
+        for h in 0..slots {
+            start[h + 1] += start[h];
+        }
+        let mut order = vec![0u32; n];
+        let mut next = start.clone();
+        for (i, &k) in keys.iter().enumerate() {
+            let h = slot(k);
+            order[next[h] as usize] = i as u32;
+            next[h] += 1;
+        }
+        let samples = |k: (i64, i64)| {
+            let h = slot(k);
+            &order[start[h] as usize..start[h + 1] as usize]
+        };
         let mut cuts = Vec::new();
+        // The samples of the buckets around `around` (those of the last sample, mostly).
+        let (mut near, mut around): ([&[u32]; 9], Option<(i64, i64)>) = ([&[]; 9], None);
         let mut i = 0;
         while i < n {
-            let (kx, ky) = key(pts[i]);
+            let (kx, ky) = keys[i];
+            if around != Some((kx, ky)) {
+                for (m, bucket) in near.iter_mut().enumerate() {
+                    *bucket = samples((kx + m as i64 / 3 - 1, ky + m as i64 % 3 - 1));
+                }
+                around = Some((kx, ky));
+            }
+            // The farthest sample along the line beyond the gap within reach: in each bucket the
+            // last one that is (slots are in order along the line too).
             let mut far = None;
-            for dx in -1..=1 {
-                for dy in -1..=1 {
-                    for &j in buckets.get(&(kx + dx, ky + dy)).map(Vec::as_slice).unwrap_or(&[]) {
-                        if j > i + gap && pts[i].distance(pts[j]) < reach && far.is_none_or(|f| j > f) {
-                            far = Some(j);
-                        }
+            for (m, bucket) in near.iter().enumerate() {
+                let k = (kx + m as i64 / 3 - 1, ky + m as i64 % 3 - 1);
+                for &j in bucket.iter().rev() {
+                    let j = j as usize;
+                    if j <= i + gap {
+                        break;
+                    }
+                    if keys[j] == k && pts[i].distance(pts[j]) < reach {
+                        far = far.max(Some(j));
+                        break;
                     }
                 }
             }
@@ -607,6 +638,24 @@ impl Shape {
     }
 }
 
+/// Each sample's turn sign and level (cells of `cell` metres). A bend is read over `m` samples
+/// ([`BEND_SPAN`] widths of the course) each way: the seed's κ with its sign, averaged, so a
+/// wiggle shorter than a bend neither swaps the banks nor makes a level of its own.
+fn bends(line: &[Sample], m: usize, cell: f64, levels: &level::Levels) -> (Vec<i8>, Vec<u8>) {
+    let signed: Vec<f64> = line
+        .iter()
+        .map(|p| p.d1.perp_dot(p.d2) / p.d1.length().powi(3).max(1e-12))
+        .collect();
+    (0..line.len())
+        .map(|i| {
+            let span = &signed[i.saturating_sub(m)..(i + m + 1).min(line.len())];
+            let b = span.iter().sum::<f64>() / span.len() as f64;
+            let turn = if b.abs() < 1e-9 { 0 } else { b.signum() as i8 };
+            (turn, levels.at(b.abs() / cell))
+        })
+        .unzip()
+}
+
 /// `f` run on a thread of the pool. A year forks and joins a few times (the field's bands, the
 /// crosses, the banks, the recentring); from a thread outside the pool each `rayon::join` hands
 /// its work to the pool and blocks the caller on a lock until it is done (some 60 hand-overs and
@@ -614,30 +663,3 @@ impl Shape {
 pub(crate) fn on_pool<R: Send>(f: impl FnOnce() -> R + Send) -> R {
     rayon::scope(|_| f())
 }
-
-/// A hasher for small integer keys (bucket coordinates): a multiply and a rotate per word, where
-/// the default SipHash was a tenth of a step. No key comes from outside.
-#[derive(Default)]
-struct CellHasher(u64);
-
-impl std::hash::Hasher for CellHasher {
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(u64::from(b));
-        }
-    }
-
-    fn write_u64(&mut self, n: u64) {
-        self.0 = (self.0.rotate_left(5) ^ n).wrapping_mul(0x517c_c1b7_2722_0a95);
-    }
-
-    fn write_i64(&mut self, n: i64) {
-        self.write_u64(n as u64);
-    }
-
-    fn finish(&self) -> u64 {
-        self.0
-    }
-}
-
-type CellHash = std::hash::BuildHasherDefault<CellHasher>;

@@ -204,6 +204,15 @@ fn pack8(eight: &[u8]) -> u64 {
     nonzero.wrapping_mul(0x0102_0408_1020_4080) >> 56
 }
 
+/// Sixteen cells (bytes, any non-zero value set) as the low sixteen bits of a word, the first
+/// cell lowest: one compare with zero and one gather of the bytes' top bits.
+fn pack16(sixteen: &[u8]) -> u64 {
+    let mut b = [0u8; 16];
+    b.copy_from_slice(sixteen);
+    let zero = wide::u8x16::new(b).simd_eq(wide::u8x16::ZERO).to_bitmask();
+    u64::from(!zero & 0xffff)
+}
+
 /// A binary image packed 64 cells to a word, row by row (each row starts a word; the bits past
 /// the width are 0). A cross over it is a few word operations per 64 cells, so the iterated
 /// crosses of a diamond cost less than one pass of a distance transform over bytes.
@@ -246,11 +255,16 @@ impl Bits {
             for (row, out) in image.chunks(width).zip(words.chunks_mut(stride)) {
                 for (cells, word) in row.chunks(64).zip(out.iter_mut()) {
                     let mut w = 0u64;
-                    let mut eights = cells.chunks_exact(8);
-                    for (j, eight) in eights.by_ref().enumerate() {
-                        w |= pack8(eight) << (8 * j);
+                    let mut sixteens = cells.chunks_exact(16);
+                    for (j, sixteen) in sixteens.by_ref().enumerate() {
+                        w |= pack16(sixteen) << (16 * j);
                     }
-                    let done = cells.len() / 8 * 8;
+                    let mut done = cells.len() / 16 * 16;
+                    let mut eights = sixteens.remainder().chunks_exact(8);
+                    for eight in eights.by_ref() {
+                        w |= pack8(eight) << done;
+                        done += 8;
+                    }
                     for (j, &v) in eights.remainder().iter().enumerate() {
                         w |= u64::from(v != 0) << (done + j);
                     }
