@@ -214,6 +214,8 @@ struct Blend<'a> {
     keep: &'a [bool],
     outer: Option<f64>,
     shapes: Shapes,
+    /// Per figure, whether its shapes were computed before the bands ([`FigureNode::shapes_by_pairs`]).
+    done: &'a [bool],
 }
 
 /// One band's slices of the region's and its figures' maps.
@@ -281,7 +283,7 @@ impl Band<'_, '_> {
         {
             let dp = &dp[cells.clone()];
             let (shape_k, coef_k) = (&mut shape_k[cells.clone()], &mut coef_k[cells.clone()]);
-            if how.shapes.has(k) {
+            if how.shapes.has(k) && !how.done[k] {
                 let s1 = how.slopes[k];
                 let cells = shape_k.iter_mut().zip(df).zip(dp);
                 if how.keep[k] {
@@ -316,6 +318,72 @@ impl FigureNode {
             log_sign: 0,
             child,
         }
+    }
+}
+
+impl FigureNode {
+    /// The shapes (and, with `keep`, the logarithms) on the owned cells `owned` of a box `w`
+    /// wide, for slope `s1` (nested in a figure of slope `outer`), through a table of the
+    /// (df, dp) pairs: with the taxicab metric's whole distances a cell's shape is a function of
+    /// the pair, and a 512² region of 150 000 cells has some 60 000 pairs per figure, so most
+    /// cells read their numbers, computed by the same [`shape`], instead of taking a logarithm
+    /// and an exponential. `false` (nothing done) when a distance is infinite or the table would
+    /// be large.
+    fn shapes_by_pairs(
+        &mut self,
+        df: &[f32],
+        owned: &[Run],
+        w: usize,
+        (s1, outer): (f64, Option<f64>),
+        keep: bool,
+    ) -> bool {
+        let FigureNode { dp, shape: sh, log, .. } = self;
+        let ranges = || {
+            owned.iter().map(move |run| {
+                let r = run.row as usize * w;
+                r + run.start as usize..r + run.end as usize
+            })
+        };
+        // The table's size: the largest distances (taxicab ones are whole numbers, or infinite
+        // where the figure cannot reach, which leaves this path).
+        let (mut hi_f, mut hi_d, mut count) = (0f32, 0f32, 0usize);
+        for r in ranges() {
+            count += r.len();
+            for &d in &dp[r.clone()] {
+                hi_d = if d > hi_d { d } else { hi_d };
+            }
+            for &f in &df[r] {
+                hi_f = if f > hi_f { f } else { hi_f };
+            }
+        }
+        if !hi_d.is_finite() || !hi_f.is_finite() {
+            return false;
+        }
+        // A table of at most two entries per cell, its indices exact in `f32` (computed from the
+        // distances as `df·stride + dp` with one conversion).
+        let stride = hi_d + 1.0;
+        let size = (hi_f + 1.0) * stride;
+        if size > (2 * count) as f32 || size >= (1u32 << 24) as f32 {
+            return false;
+        }
+        // Per pair its shape and logarithm; NaN: not yet computed.
+        let (mut shapes, mut logs) = (MAPS.filled(size as usize, f32::NAN), MAPS.unfilled(size as usize, 0.0));
+        for r in ranges() {
+            let cells = df[r.clone()].iter().zip(&dp[r.clone()]).zip(&mut sh[r.clone()]);
+            for (((&f, &d), out), l) in cells.zip(&mut log[r]) {
+                let at = (f * stride + d) as usize;
+                if shapes[at].is_nan() {
+                    (shapes[at], logs[at]) = shape(f, d, s1, outer, None);
+                }
+                *out = shapes[at];
+                if keep {
+                    *l = logs[at];
+                }
+            }
+        }
+        MAPS.give(shapes);
+        MAPS.give(logs);
+        true
     }
 }
 
@@ -585,6 +653,7 @@ impl RegionNode {
             row_runs,
             norm,
             figures,
+            metric,
             ..
         } = self;
         // The logarithms are kept for top-level figures of nonzero slope.
@@ -597,6 +666,18 @@ impl RegionNode {
                 _ => 0,
             };
         }
+        // In the taxicab metric a full blend computes the shapes a figure at a time, each (df, dp)
+        // pair once; figures on all cores.
+        let done: Vec<bool> = if dirty.is_none() && *metric == Metric::Taxicab {
+            let (df, owned) = (&*df, &*owned);
+            figures
+                .par_iter_mut()
+                .enumerate()
+                .map(|(k, f)| shapes.has(k) && f.shapes_by_pairs(df, owned, w, (slopes[k], outer), keep[k]))
+                .collect()
+        } else {
+            vec![false; figures.len()]
+        };
         // Each band's slices of every figure's maps, so that bands can be written in parallel.
         let mut per_figure: Vec<_> = figures
             .iter_mut()
@@ -617,7 +698,7 @@ impl RegionNode {
             bands.push((b, norm, df, dps, maps));
         }
         let (owned, row_runs) = (&*owned, &*row_runs);
-        let (slopes, keep) = (&slopes[..], &keep[..]);
+        let (slopes, keep, done) = (&slopes[..], &keep[..], &done[..]);
         bands.into_par_iter().for_each(|(b, norm, df, dps, mut maps)| {
             let (row0, rows) = (b * BAND_ROWS, norm.len() / w);
             let mut scratch = Scratch::new(dps.len(), w);
@@ -636,6 +717,7 @@ impl RegionNode {
                         keep,
                         outer,
                         shapes,
+                        done,
                     },
                 );
             };
