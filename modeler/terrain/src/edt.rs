@@ -35,7 +35,7 @@ pub fn squared(w: usize, h: usize, source: &[bool]) -> Vec<u64> {
     debug_assert_eq!(source.len(), w * h);
     let mut out = vec![u64::MAX; w * h];
     let mut g: Vec<u32> = source.iter().map(|&s| if s { 0 } else { FAR }).collect();
-    transform(w, h, &mut g, &mut out, |_, d2| d2);
+    transform(w, h, &mut g, &mut out, |_, d2| d2 as u64);
     out
 }
 
@@ -46,8 +46,9 @@ static COLUMNS: Pool<u32> = Pool::new(4 << 20);
 /// The squared distances of [`squared`] from `g` (0 at the sources, [`FAR`] elsewhere; the
 /// column distances on return) through `f` into `out` (cells of a row without any source are
 /// left as they are): the engine's maps take their square roots as each row is done, with no
-/// squared map in between.
-fn transform<O: Send>(w: usize, h: usize, g: &mut [u32], out: &mut [O], f: impl Fn(usize, u64) -> O + Sync) {
+/// squared map in between. `f` takes them as `i64`, which becomes an `f64` in one instruction
+/// (a `u64` takes several).
+fn transform<O: Send>(w: usize, h: usize, g: &mut [u32], out: &mut [O], f: impl Fn(usize, i64) -> O + Sync) {
     debug_assert_eq!(g.len(), w * h);
     // Column pass: vertical distance to the nearest source in the column, two sweeps over rows
     // (row by row rather than column by column, for the cache). `FAR` saturates, so each step is
@@ -77,7 +78,7 @@ const NARROW_SIDE: usize = 1 << 20;
 
 /// The row pass over `g`'s rows into `out` (each squared distance through `f`, with its box
 /// index), rows in parallel, with fractions in `T`.
-fn rows<T: Wide, O: Send>(w: usize, g: &[u32], out: &mut [O], f: &(impl Fn(usize, u64) -> O + Sync)) {
+fn rows<T: Wide, O: Send>(w: usize, g: &[u32], out: &mut [O], f: &(impl Fn(usize, i64) -> O + Sync)) {
     let w1 = w.max(1);
     g.par_chunks(w1)
         .zip(out.par_chunks_mut(w1))
@@ -148,7 +149,7 @@ impl<T: Wide> Envelope<T> {
     }
 
     /// The squared distances of one row from its columns' vertical distances `g`.
-    fn row<O>(&mut self, g: &[u32], out: &mut [O], f: impl Fn(usize, u64) -> O) {
+    fn row<O>(&mut self, g: &[u32], out: &mut [O], f: impl Fn(usize, i64) -> O) {
         self.v.clear();
         self.f.clear();
         self.z.clear();
@@ -192,7 +193,7 @@ impl<T: Wide> Envelope<T> {
             if end > start {
                 for (x, d) in (start..end).zip(&mut out[start..end]) {
                     let dx = x as i64 - vk;
-                    *d = f(x, (dx * dx + fk) as u64);
+                    *d = f(x, dx * dx + fk);
                 }
                 start = end;
             }
@@ -295,8 +296,8 @@ mod tests {
                 .unwrap_or(FAR);
         }
         let (mut narrow, mut wide) = (vec![u64::MAX; w * h], vec![u64::MAX; w * h]);
-        rows::<i64, u64>(w, &g, &mut narrow, &|_, d2| d2);
-        rows::<i128, u64>(w, &g, &mut wide, &|_, d2| d2);
+        rows::<i64, u64>(w, &g, &mut narrow, &|_, d2| d2 as u64);
+        rows::<i128, u64>(w, &g, &mut wide, &|_, d2| d2 as u64);
         assert_eq!(narrow, full);
         assert_eq!(wide, full);
     }
