@@ -236,10 +236,11 @@ pub fn closed_mask(grid: &Grid, ring: &[Point]) -> Mask {
             // cell anyway.
             let first = (pair[0] - 0.5).ceil().max(f64::from(mask.c0));
             let last = (pair[1] - 0.5).floor().min(f64::from(mask.c0 + mask.width) - 1.0);
-            let mut c = first;
-            while c <= last {
-                mask.insert((c as u32, mask.r0 + lr));
-                c += 1.0;
+            // The columns first..=last, all in the box: one fill of the row's flags.
+            if first <= last {
+                let row = lr as usize * mask.width as usize;
+                let (a, b) = ((first as u32 - mask.c0) as usize, (last as u32 - mask.c0) as usize);
+                mask.bits[row + a..=row + b].fill(true);
             }
         }
     }
