@@ -164,7 +164,10 @@ impl Drag {
     /// [`Drag::preview`] on the calling thread.
     fn preview_here(&self, moved: &River) -> Cells {
         let Some(part) = self.part().filter(|_| moved.points.len() == self.river.points.len()) else {
-            return Cells::of(&Shape::process(moved, &self.grid, &self.constants));
+            let shape = Shape::process(moved, &self.grid, &self.constants);
+            let cells = Cells::of(&shape);
+            shape.recycle();
+            return cells;
         };
         let sub_river = River {
             points: moved.points[part.first..=part.last].to_vec(),
@@ -200,6 +203,7 @@ impl Drag {
         out.erosion.extend(self.base_cells.erosion.iter().filter(from_base));
         out.deposition
             .extend(self.base_cells.deposition.iter().filter(from_base));
+        sub.recycle();
         out
     }
 }

@@ -20,6 +20,7 @@
 //! The processed shape is derived from the document's [`River`] entry, not stored: it regenerates
 //! in milliseconds, and it needs no randomness. Carving it into a heightmap is [`carve`].
 
+mod buffers;
 pub mod carve;
 pub mod course;
 pub mod drag;
@@ -233,10 +234,14 @@ impl Shape {
             line: Vec::new(),
             levels: Vec::new(),
             turns: Vec::new(),
-            mask: vec![0; window.len()],
-            lakes: vec![0; window.len()],
+            mask: buffers::MASKS.filled(window.len(), 0),
+            lakes: buffers::LAKES.filled(window.len(), 0),
             necks: Vec::new(),
-            near: Near::empty(),
+            near: Near::in_buffers(
+                buffers::OWNERS.unfilled(0, NONE),
+                buffers::DISTS.unfilled(0, 0.0),
+                buffers::SIDES.unfilled(0, 0),
+            ),
             history: Vec::new(),
             river: river.clone(),
             constants: *constants,
@@ -257,6 +262,17 @@ impl Shape {
             }
             shape
         })
+    }
+
+    /// Gives its per-cell buffers back for the next shape (a river processed again and again, as
+    /// in a drag's preview, then reuses them).
+    pub fn recycle(self) {
+        buffers::MASKS.give(self.mask);
+        buffers::LAKES.give(self.lakes);
+        let (owner, dist, side) = self.near.into_buffers();
+        buffers::OWNERS.give(owner);
+        buffers::DISTS.give(dist);
+        buffers::SIDES.give(side);
     }
 
     /// The samples with their curvature, turn and level.
@@ -486,13 +502,14 @@ impl Shape {
                 -left * turn * reach
             })
             .collect();
+        let sums = window_sums(&raw, m, DVec2::ZERO);
         // Each sample on its own (the recentring walks across the water), so on the thread pool.
         let moved: Vec<DVec2> = (0..n)
             .into_par_iter()
             .with_min_len(256)
             .map(|i| {
                 let (a, b) = (i.saturating_sub(m), (i + m).min(n - 1));
-                let mean = raw[a..=b].iter().sum::<DVec2>() / (b - a + 1) as f64;
+                let mean = sums[i] / (b - a + 1) as f64;
                 let taper = (i.min(n - 1 - i) as f64 / m as f64).min(1.0);
                 let p = self.line[i].p + mean * taper;
                 if taper < 1.0 {
@@ -646,14 +663,44 @@ fn bends(line: &[Sample], m: usize, cell: f64, levels: &level::Levels) -> (Vec<i
         .iter()
         .map(|p| p.d1.perp_dot(p.d2) / p.d1.length().powi(3).max(1e-12))
         .collect();
+    // Summed as `Iterator::sum` does: from its neutral element, in order.
+    let sums = window_sums(&signed, m, std::iter::empty::<f64>().sum());
     (0..line.len())
         .map(|i| {
-            let span = &signed[i.saturating_sub(m)..(i + m + 1).min(line.len())];
-            let b = span.iter().sum::<f64>() / span.len() as f64;
+            let span = (i + m).min(line.len() - 1) + 1 - i.saturating_sub(m);
+            let b = sums[i] / span as f64;
             let turn = if b.abs() < 1e-9 { 0 } else { b.signum() as i8 };
             (turn, levels.at(b.abs() / cell))
         })
         .unzip()
+}
+
+/// Each element's sum over the elements within `m` of it (clipped to the slice), in order from
+/// the first, starting at `zero`: `zero + v[a] + … + v[b]`. Each sum is a chain of dependent
+/// additions, so four are run side by side (one at a time waits out each addition's latency).
+fn window_sums<T: Copy + std::ops::Add<Output = T>>(v: &[T], m: usize, zero: T) -> Vec<T> {
+    let n = v.len();
+    let mut out = Vec::with_capacity(n);
+    let mut i = 0;
+    while i < n {
+        if i >= m && i + 3 + m < n {
+            // Four whole windows, `i − m ..= i + m` to `i + 3 − m ..= i + 3 + m`.
+            let mut acc = [zero; 4];
+            for j in i - m..=i + m {
+                let four = &v[j..j + 4];
+                for (a, &x) in acc.iter_mut().zip(four) {
+                    *a = *a + x;
+                }
+            }
+            out.extend_from_slice(&acc);
+            i += 4;
+        } else {
+            let (a, b) = (i.saturating_sub(m), (i + m).min(n - 1));
+            out.push(v[a..=b].iter().fold(zero, |s, &x| s + x));
+            i += 1;
+        }
+    }
+    out
 }
 
 /// `f` run on a thread of the pool. A year forks and joins a few times (the field's bands, the

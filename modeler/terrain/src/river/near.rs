@@ -25,12 +25,22 @@ pub struct Near {
 impl Near {
     /// A field of no cells (each fill sizes it to its window).
     pub fn empty() -> Near {
+        Near::in_buffers(Vec::new(), Vec::new(), Vec::new())
+    }
+
+    /// A field that has not been filled, in these buffers (the first fill sets all their cells).
+    pub(super) fn in_buffers(owner: Vec<u32>, dist: Vec<f32>, side: Vec<i8>) -> Near {
         Near {
-            owner: Vec::new(),
-            dist: Vec::new(),
-            side: Vec::new(),
+            owner,
+            dist,
+            side,
             spans: Vec::new(),
         }
+    }
+
+    /// Its buffers.
+    pub(super) fn into_buffers(self) -> (Vec<u32>, Vec<f32>, Vec<i8>) {
+        (self.owner, self.dist, self.side)
     }
 }
 
