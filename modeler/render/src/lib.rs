@@ -376,9 +376,11 @@ impl Renderer {
         meshes.add(trees, Paint::Own, &affine, cell, near, &scene.style);
         let textured = &mut self.eye.textured;
         textured.clear((height as usize, self.tile_rows));
-        textured.add(scene.polygons, 0, &affine, cell, near);
+        // The scene's textures, then the simplified shapes' (as `eye` gives them to the tiles).
+        let textures: Vec<&textured::Texture> = scene.textures.iter().chain(self.trees.cache().textures()).collect();
+        textured.add(scene.polygons, 0, &textures, &affine, cell, near);
         let first = scene.textures.len() as u32;
-        textured.add(self.trees.quads(), first, &affine, cell, near);
+        textured.add(self.trees.quads(), first, &textures, &affine, cell, near);
         (affine, near, projection)
     }
 

@@ -14,6 +14,14 @@
 //!   polygons are drawn does not matter.
 //! - Texels are lit already (rendered with the light, [`crate::impostor::bake`]): a drawn texel
 //!   is [`Surface::Colour`] at full light.
+//! - **Levels** (mipmaps): a texture keeps box-filtered halvings of itself, each texel the mean
+//!   of four (colour weighted by alpha, so transparent texels do not darken the edge), and a quad
+//!   drawn smaller than its texels reads the level whose texels are about a pixel
+//!   ([`Texture::level_for`], chosen per quad when it is projected). A tree's simplified shapes are
+//!   tens of pixels across with 64-texel images: read at level 0, neighbouring pixels fetched
+//!   texels rows apart, and that load was 47 % of the textured triangles' time, a third of the
+//!   30-tree frame (`perf`, issue 14). The alpha test applies to the mean alpha: a texel of a
+//!   level is drawn where at least half of what it covers is.
 //! - Quads are drawn from both windings, like the meshes; triangles are binned by bands of rows
 //!   as the meshes are.
 
@@ -23,23 +31,84 @@ use super::frame::Rgba;
 use super::rasterise::{Bounds, Sample, Sink, Surface};
 use super::transform::Affine;
 
-/// An RGBA image, row 0 at the top.
+/// An RGBA image, row 0 at the top, and its box-filtered levels.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct Texture {
     width: u32,
     height: u32,
     texels: Vec<Rgba>,
+    /// Levels 1, 2, …: `(width, height, texels)`, each half the one before (rounding up), down to
+    /// a texel a side.
+    levels: Vec<(u32, u32, Vec<Rgba>)>,
+}
+
+/// The level below `(w, h, texels)`: each texel the mean of the (up to) four it covers, colour
+/// weighted by alpha.
+fn halve(w: u32, h: u32, texels: &[Rgba]) -> (u32, u32, Vec<Rgba>) {
+    let (hw, hh) = (w.div_ceil(2), h.div_ceil(2));
+    let mut out = Vec::with_capacity(hw as usize * hh as usize);
+    for y in 0..hh {
+        for x in 0..hw {
+            let mut sum = [0u32; 4];
+            let mut n = 0;
+            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
+                let (sx, sy) = (2 * x + dx, 2 * y + dy);
+                if sx < w && sy < h {
+                    let t = texels[(sy * w + sx) as usize];
+                    let a = u32::from(t[3]);
+                    for (s, c) in sum.iter_mut().zip(&t[..3]) {
+                        *s += u32::from(*c) * a;
+                    }
+                    sum[3] += a;
+                    n += 1;
+                }
+            }
+            let colour = |s: u32| (s + sum[3] / 2).checked_div(sum[3]).map_or(0, |c| c as u8);
+            out.push([
+                colour(sum[0]),
+                colour(sum[1]),
+                colour(sum[2]),
+                ((sum[3] + n / 2) / n) as u8,
+            ]);
+        }
+    }
+    (hw, hh, out)
 }
 
 impl Texture {
     /// A texture of `width × height` texels, row-major from the top; `None` unless the sizes
     /// agree and neither side is zero.
     pub fn new(width: u32, height: u32, texels: Vec<Rgba>) -> Option<Texture> {
-        (width > 0 && height > 0 && texels.len() == width as usize * height as usize).then_some(Texture {
+        if width == 0 || height == 0 || texels.len() != width as usize * height as usize {
+            return None;
+        }
+        let mut levels: Vec<(u32, u32, Vec<Rgba>)> = Vec::new();
+        let (mut w, mut h) = (width, height);
+        while w > 1 || h > 1 {
+            let next = halve(w, h, levels.last().map_or(&texels, |l| &l.2));
+            (w, h) = (next.0, next.1);
+            levels.push(next);
+        }
+        Some(Texture {
             width,
             height,
             texels,
+            levels,
         })
+    }
+
+    /// How many levels above the image it keeps.
+    pub fn levels(&self) -> usize {
+        self.levels.len()
+    }
+
+    /// The level to read where a pixel spans `texels` texels: `⌊log₂ texels⌋` (0 below 2),
+    /// at most the last.
+    pub fn level_for(&self, texels: f32) -> u8 {
+        if texels.is_nan() || texels < 2.0 {
+            return 0;
+        }
+        (texels.log2().floor() as usize).min(self.levels.len()) as u8
     }
 
     /// Width in texels.
@@ -60,9 +129,22 @@ impl Texture {
     /// The texel nearest `(u, v)`, both 0 to 1 across the texture (v down), clamped at the edges.
     #[inline]
     pub fn nearest(&self, u: f32, v: f32) -> Rgba {
-        let x = ((u * self.width as f32) as i32).clamp(0, self.width as i32 - 1);
-        let y = ((v * self.height as f32) as i32).clamp(0, self.height as i32 - 1);
-        self.texels[y as usize * self.width as usize + x as usize]
+        self.nearest_in(0, u, v)
+    }
+
+    /// [`Texture::nearest`] in `level` (0: the image; past the last: the last).
+    #[inline]
+    pub fn nearest_in(&self, level: u8, u: f32, v: f32) -> Rgba {
+        let (w, h, texels) = match (level as usize).min(self.levels.len()) {
+            0 => (self.width, self.height, &self.texels),
+            l => {
+                let (w, h, t) = &self.levels[l - 1];
+                (*w, *h, t)
+            }
+        };
+        let x = ((u * w as f32) as i32).clamp(0, w as i32 - 1);
+        let y = ((v * h as f32) as i32).clamp(0, h as i32 - 1);
+        texels[y as usize * w as usize + x as usize]
     }
 }
 
@@ -79,9 +161,9 @@ pub struct Quad {
     pub texture: u32,
 }
 
-/// One eye's projected quads: two triangles each, tagged with their texture's index.
+/// One eye's projected quads: two triangles each, tagged with their texture's index and level.
 #[derive(Debug, Default)]
-pub struct Projected(Binned<u32>);
+pub struct Projected(Binned<(u32, u8)>);
 
 impl Projected {
     /// Forgets the last frame's quads, for a frame `frame_height` rows tall drawn in bands of
@@ -91,26 +173,47 @@ impl Projected {
     }
 
     /// Projects `quads` for one eye (with the terrain's `affine` map and `cell_size`) and bins
-    /// their triangles; their texture indices are offset by `first_texture`.
-    pub fn add(&mut self, quads: &[Quad], first_texture: u32, affine: &Affine, cell_size: f64, near: f32) {
+    /// their triangles; their texture indices (into `textures`, which [`Projected::draw`] will
+    /// be given) are offset by `first_texture`, and each quad reads the level of its texture
+    /// whose texels are about its pixels.
+    #[allow(clippy::too_many_arguments)]
+    pub fn add(
+        &mut self,
+        quads: &[Quad],
+        first_texture: u32,
+        textures: &[&Texture],
+        affine: &Affine,
+        cell_size: f64,
+        near: f32,
+    ) {
         let first = self.0.triangles();
         let s = cell_size as f32;
         for q in quads {
             let base = self.0.vertices();
-            for (p, uv) in q.corners.iter().zip(&q.uv) {
+            let mut corners = [ClipVertex {
+                x: 0.0,
+                y: 0.0,
+                w: 0.0,
+                h: 0.0,
+                l: 0.0,
+            }; 4];
+            for ((p, uv), corner) in q.corners.iter().zip(&q.uv).zip(&mut corners) {
                 // u and v ride in the height and light slots: interpolated as u/w, v/w.
                 let v = affine.clip_point(p[0] / s - 0.5, p[2] / s - 0.5, p[1], 0.0);
-                let v = ClipVertex {
+                *corner = ClipVertex {
                     h: uv[0],
                     l: uv[1],
                     ..v
                 };
-                self.0.vertex(v, near);
+                self.0.vertex(*corner, near);
             }
             let texture = q.texture.saturating_add(first_texture);
+            let level = textures
+                .get(texture as usize)
+                .map_or(0, |t| t.level_for(texels_per_pixel(&corners, t, near)));
             self.0.extend([
-                ([base, base + 1, base + 2], texture),
-                ([base, base + 2, base + 3], texture),
+                ([base, base + 1, base + 2], (texture, level)),
+                ([base, base + 2, base + 3], (texture, level)),
             ]);
         }
         self.0.bin(first);
@@ -132,16 +235,43 @@ impl Projected {
             width,
             y0: bounds.y0,
             texture: first,
+            level: 0,
         };
-        self.0
-            .draw(bounds, near, &mut sink, |sink, k| match textures.get(k as usize) {
+        self.0.draw(bounds, near, &mut sink, |sink, (k, level)| {
+            match textures.get(k as usize) {
                 Some(&texture) => {
                     sink.texture = texture;
+                    sink.level = level;
                     true
                 }
                 None => false,
-            });
+            }
+        });
     }
+}
+
+/// Texels of `texture` per pixel across the quad `corners` (its longer side's ratio, as GPUs
+/// choose a level without anisotropic filtering): the texels its sides span over the pixels they
+/// span on screen, from the corners' pixel positions. 0 (level 0) when a corner is at or behind
+/// the near plane, where the quad is large on screen anyway.
+fn texels_per_pixel(corners: &[ClipVertex; 4], texture: &Texture, near: f32) -> f32 {
+    // A NaN depth counts as behind.
+    if corners.iter().any(|c| c.w.is_nan() || c.w <= near) {
+        return 0.0;
+    }
+    let px = corners.map(|c| [c.x / c.w, c.y / c.w]);
+    let (tw, th) = (texture.width as f32, texture.height as f32);
+    let mut most = 0.0f32;
+    for i in 0..4 {
+        let (a, b) = (i, (i + 1) % 4);
+        let screen = ((px[b][0] - px[a][0]).powi(2) + (px[b][1] - px[a][1]).powi(2)).sqrt();
+        let texels =
+            (((corners[b].h - corners[a].h) * tw).powi(2) + ((corners[b].l - corners[a].l) * th).powi(2)).sqrt();
+        if screen > 0.0 {
+            most = most.max(texels / screen);
+        }
+    }
+    most
 }
 
 /// The depth test for textured triangles: the interpolated "height" and "light" are `u/w` and
@@ -151,6 +281,7 @@ struct TexelSink<'a> {
     width: usize,
     y0: i32,
     texture: &'a Texture,
+    level: u8,
 }
 
 impl Sink for TexelSink<'_> {
@@ -162,7 +293,7 @@ impl Sink for TexelSink<'_> {
             return;
         }
         let w = 1.0 / invw;
-        let [r, g, b, a] = self.texture.nearest(uw * w, vw * w);
+        let [r, g, b, a] = self.texture.nearest_in(self.level, uw * w, vw * w);
         if a < 128 {
             return;
         }
@@ -174,5 +305,75 @@ impl Sink for TexelSink<'_> {
             lw: 2.0 * invw,
             surface: Surface::Colour([r, g, b]),
         };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_level_weights_colour_by_alpha_and_averages_alpha() {
+        // One opaque red texel and three transparent black ones: the mean is red, a quarter
+        // covered (the black of empty texels does not darken it).
+        let t = Texture::new(2, 2, vec![[255, 0, 0, 255], [0, 0, 0, 0], [0, 0, 0, 0], [0, 0, 0, 0]]).expect("texture");
+        assert_eq!(t.levels(), 1);
+        assert_eq!(t.nearest_in(1, 0.9, 0.9), [255, 0, 0, 64]);
+        // Two opaque texels of different colours: their mean, opaque.
+        let t = Texture::new(2, 1, vec![[200, 100, 0, 255], [100, 0, 50, 255]]).expect("texture");
+        assert_eq!(t.nearest_in(1, 0.0, 0.0), [150, 50, 25, 255]);
+        // Level 0 is the image; a level past the last reads the last.
+        assert_eq!(t.nearest_in(0, 0.9, 0.0), [100, 0, 50, 255]);
+        assert_eq!(t.nearest_in(9, 0.9, 0.0), [150, 50, 25, 255]);
+    }
+
+    #[test]
+    fn levels_halve_down_to_one_texel() {
+        let t = Texture::new(5, 3, vec![[1, 2, 3, 255]; 15]).expect("texture");
+        let sizes: Vec<(u32, u32)> = t.levels.iter().map(|l| (l.0, l.1)).collect();
+        assert_eq!(sizes, [(3, 2), (2, 1), (1, 1)]);
+        // A uniform image stays uniform at every level, edges included.
+        assert!(t.levels.iter().all(|l| l.2.iter().all(|&x| x == [1, 2, 3, 255])));
+        let t = Texture::new(64, 64, vec![[0; 4]; 64 * 64]).expect("texture");
+        assert_eq!(t.levels(), 6);
+    }
+
+    #[test]
+    fn a_quad_drawn_smaller_than_its_texels_reads_a_coarser_level() {
+        let t = Texture::new(64, 64, vec![[0; 4]; 64 * 64]).expect("texture");
+        // A square quad of `px` pixels at depth 2, the whole texture across it.
+        let quad = |px: f32| {
+            let corner = |x: f32, y: f32, u: f32, v: f32| ClipVertex {
+                x: 2.0 * x,
+                y: 2.0 * y,
+                w: 2.0,
+                h: u,
+                l: v,
+            };
+            [
+                corner(100.0, 100.0, 0.0, 0.0),
+                corner(100.0 + px, 100.0, 1.0, 0.0),
+                corner(100.0 + px, 100.0 + px, 1.0, 1.0),
+                corner(100.0, 100.0 + px, 0.0, 1.0),
+            ]
+        };
+        for (px, level) in [
+            (128.0, 0),
+            (64.0, 0),
+            (33.0, 0),
+            (32.0, 1),
+            (16.0, 2),
+            (9.0, 2),
+            (1.0, 6),
+            (0.1, 6),
+        ] {
+            let tpp = texels_per_pixel(&quad(px), &t, 0.1);
+            assert!((tpp - 64.0 / px).abs() < 1e-3 * tpp, "{px} px: {tpp}");
+            assert_eq!(t.level_for(tpp), level, "{px} px");
+        }
+        // A corner behind the near plane: level 0.
+        let mut q = quad(4.0);
+        q[2].w = 0.05;
+        assert_eq!(texels_per_pixel(&q, &t, 0.1), 0.0);
     }
 }
