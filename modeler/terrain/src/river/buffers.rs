@@ -5,7 +5,7 @@
 //! allocated again each time, and the allocator handed the freed pages back to the kernel often
 //! enough that they were faulted in and zeroed again (some 480 page faults a call).
 //! [`Shape::recycle`](super::Shape::recycle) gives them back here and [`Shape::new`](super::Shape::new)
-//! takes them.
+//! takes them. A year's bit-packed crosses (some dozen images) are kept here too.
 
 use crate::pool::Pool;
 
@@ -22,3 +22,5 @@ pub(super) static OWNERS: Pool<u32> = Pool::new(KEEP);
 pub(super) static DISTS: Pool<f32> = Pool::new(KEEP);
 /// The field's sides.
 pub(super) static SIDES: Pool<i8> = Pool::new(KEEP);
+/// Bit-packed images (a year's crosses of the water and the land).
+pub(super) static WORDS: Pool<u64> = Pool::new(KEEP);

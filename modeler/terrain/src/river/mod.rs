@@ -332,18 +332,21 @@ impl Shape {
         if most == 0 || w == 0 {
             return (Vec::new(), Vec::new());
         }
+        // Images from kept buffers (each written whole before it is read).
+        let image = || morph::Bits::in_buffer(w, h, buffers::WORDS.unfilled(w.div_ceil(64) * h, 0));
         // `near_water[r]`: the cells within r steps of the water; `near_land[r]`: of the land.
         let grow = |first: morph::Bits| {
             let mut all = vec![first];
             for r in 1..=most {
-                let mut next = morph::Bits::empty(w, h);
+                let mut next = image();
                 all[r - 1].cross(&mut next, true);
                 all.push(next);
             }
             all
         };
-        let water = morph::Bits::of(&self.mask, w, h, true);
-        let mut land = morph::Bits::empty(w, h);
+        let mut water = image();
+        water.set_from(&self.mask, true);
+        let mut land = image();
         water.complement(&mut land);
         // The water's crosses and the land's on a core each.
         let (near_water, near_land) = rayon::join(|| grow(water), || grow(land));
@@ -389,6 +392,9 @@ impl Shape {
         let ((mut add, mut remove), (add1, remove1)) = rayon::join(|| banks(0..h / 2), || banks(h / 2..h));
         add.extend(add1);
         remove.extend(remove1);
+        for bits in near_water.into_iter().chain(near_land) {
+            buffers::WORDS.give(bits.into_buffer());
+        }
         (add, remove)
     }
 

@@ -237,6 +237,25 @@ impl Bits {
         }
     }
 
+    /// An image of `width × height` cells in `words`, resized to fit. Its cells are whatever the
+    /// buffer held: for a caller that sets every word before it reads one ([`Bits::set_from`],
+    /// [`Bits::complement`] and [`Bits::cross`] do).
+    pub fn in_buffer(width: usize, height: usize, mut words: Vec<u64>) -> Bits {
+        let stride = width.div_ceil(64);
+        words.resize(stride * height, 0);
+        Bits {
+            width,
+            height,
+            stride,
+            words,
+        }
+    }
+
+    /// Its buffer of words.
+    pub fn into_buffer(self) -> Vec<u64> {
+        self.words
+    }
+
     /// The cells of `image` (row-major 0/1) whose value is `value != 0`.
     pub fn of(image: &[u8], width: usize, height: usize, value: bool) -> Bits {
         let mut bits = Bits::empty(width, height);
