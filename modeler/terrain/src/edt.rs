@@ -207,12 +207,20 @@ impl<T: Wide> Envelope<T> {
 pub fn from_sources(mask: &Mask, sources: &[Cell]) -> Vec<f32> {
     let bits = mask.bits();
     let mut g = COLUMNS.filled(mask.box_len(), FAR);
+    let mut any = false;
     for &s in sources {
         if let Some(i) = mask.index(s).filter(|&i| bits[i]) {
             g[i] = 0;
+            any = true;
         }
     }
-    let mut out = pool::MAPS.filled(mask.box_len(), f32::INFINITY);
+    // With a source, the column pass gives every row of the box a finite distance (the source's
+    // column), so the row pass writes every cell; without, no cell is written.
+    let mut out = if any {
+        pool::MAPS.unfilled(mask.box_len(), f32::INFINITY)
+    } else {
+        pool::MAPS.filled(mask.box_len(), f32::INFINITY)
+    };
     transform(mask.width as usize, mask.height as usize, &mut g, &mut out, |i, d2| {
         if bits[i] {
             (d2 as f64).sqrt() as f32
