@@ -206,27 +206,51 @@ impl<T: Wide> Envelope<T> {
 /// so is every cell when no source lies in the region. Sources outside the region are ignored.
 pub fn from_sources(mask: &Mask, sources: &[Cell]) -> Vec<f32> {
     let bits = mask.bits();
-    let mut g = COLUMNS.filled(mask.box_len(), FAR);
-    let mut any = false;
-    for &s in sources {
-        if let Some(i) = mask.index(s).filter(|&i| bits[i]) {
-            g[i] = 0;
-            any = true;
-        }
-    }
-    // With a source, the column pass gives every row of the box a finite distance (the source's
-    // column), so the row pass writes every cell; without, no cell is written.
-    let mut out = if any {
-        pool::MAPS.unfilled(mask.box_len(), f32::INFINITY)
-    } else {
-        pool::MAPS.filled(mask.box_len(), f32::INFINITY)
-    };
-    transform(mask.width as usize, mask.height as usize, &mut g, &mut out, |i, d2| {
-        if bits[i] {
+    let inside: Vec<usize> = sources
+        .iter()
+        .filter_map(|&s| mask.index(s).filter(|&i| bits[i]))
+        .collect();
+    // The distance as the engine's maps hold it: the square root of the exact squared distance.
+    let dist = |inside: bool, d2: i64| {
+        if inside {
             (d2 as f64).sqrt() as f32
         } else {
             f32::INFINITY
         }
+    };
+    let w = (mask.width as usize).max(1);
+    if let Some(&first) = inside.first()
+        && inside.iter().all(|&i| i == first)
+    {
+        // One source cell (a point figure): the squared distances directly, those the transform
+        // would find (its one parabola per row), with no transform.
+        let (sx, sy) = ((first % w) as i64, (first / w) as i64);
+        let mut out = pool::MAPS.unfilled(mask.box_len(), f32::INFINITY);
+        out.par_chunks_mut(w)
+            .zip(bits.par_chunks(w))
+            .enumerate()
+            .for_each(|(y, (row, flags))| {
+                let dy = y as i64 - sy;
+                for (x, (o, &b)) in row.iter_mut().zip(flags).enumerate() {
+                    let dx = x as i64 - sx;
+                    *o = dist(b, dx * dx + dy * dy);
+                }
+            });
+        return out;
+    }
+    let mut g = COLUMNS.filled(mask.box_len(), FAR);
+    for &i in &inside {
+        g[i] = 0;
+    }
+    // With a source, the column pass gives every row of the box a finite distance (the source's
+    // column), so the row pass writes every cell; without, no cell is written.
+    let mut out = if inside.is_empty() {
+        pool::MAPS.filled(mask.box_len(), f32::INFINITY)
+    } else {
+        pool::MAPS.unfilled(mask.box_len(), f32::INFINITY)
+    };
+    transform(mask.width as usize, mask.height as usize, &mut g, &mut out, |i, d2| {
+        dist(bits[i], d2)
     });
     COLUMNS.give(g);
     out
@@ -308,6 +332,33 @@ mod tests {
         rows::<i128, u64>(w, &g, &mut wide, &|_, d2| d2 as u64);
         assert_eq!(narrow, full);
         assert_eq!(wide, full);
+    }
+
+    #[test]
+    fn one_source_cell_gives_the_straight_line_distances_of_the_transform() {
+        // A 9 × 7 box with holes, the source given twice, and a second source elsewhere.
+        let cells: Vec<Cell> = (0..63u32)
+            .filter(|i| i % 5 != 3)
+            .map(|i| (10 + i % 9, 20 + i / 9))
+            .collect();
+        let mask = Mask::from_cells(&cells);
+        let (w, h) = (mask.width as usize, mask.height as usize);
+        for sources in [vec![(14, 23)], vec![(14, 23), (14, 23)], vec![(14, 23), (11, 20)]] {
+            let mut source = vec![false; w * h];
+            for &s in &sources {
+                source[mask.index(s).unwrap()] = true;
+            }
+            let want: Vec<f32> = brute(w, h, &source)
+                .iter()
+                .zip(mask.bits())
+                .map(|(&d2, &b)| if b { (d2 as f64).sqrt() as f32 } else { f32::INFINITY })
+                .collect();
+            let got = from_sources(&mask, &sources);
+            assert_eq!(got.len(), want.len());
+            for (i, (g, e)) in got.iter().zip(&want).enumerate() {
+                assert_eq!(g.to_bits(), e.to_bits(), "{sources:?} cell {i}");
+            }
+        }
     }
 
     #[test]
