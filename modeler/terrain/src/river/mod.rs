@@ -345,7 +345,7 @@ impl Shape {
             all
         };
         let mut water = image();
-        water.set_from(&self.mask, true);
+        water.set_from_here(&self.mask, true);
         let mut land = image();
         water.complement(&mut land);
         // The water's crosses and the land's on a core each.
@@ -509,10 +509,11 @@ impl Shape {
             })
             .collect();
         let sums = window_sums(&raw, m, DVec2::ZERO);
-        // Each sample on its own (the recentring walks across the water), so on the thread pool.
+        // Each sample on its own (the recentring walks across the water), so on the thread pool:
+        // in two halves, one join (each join may wait for the other thread to wake).
         let moved: Vec<DVec2> = (0..n)
             .into_par_iter()
-            .with_min_len(256)
+            .with_min_len(n.div_ceil(2).max(256))
             .map(|i| {
                 let (a, b) = (i.saturating_sub(m), (i + m).min(n - 1));
                 let mean = sums[i] / (b - a + 1) as f64;

@@ -265,6 +265,18 @@ impl Bits {
 
     /// Sets the cells of `image` whose value is `value != 0`, the others unset.
     pub fn set_from(&mut self, image: &[u8], value: bool) {
+        self.pack(image, value, 1 << 16);
+    }
+
+    /// [`Bits::set_from`] on the calling thread: a river's year packs its mask (some 0.4
+    /// instructions a cell) on the way to its crosses, where a fork and join, and waking the
+    /// other thread, would cost more than it saves.
+    pub fn set_from_here(&mut self, image: &[u8], value: bool) {
+        self.pack(image, value, usize::MAX);
+    }
+
+    /// [`Bits::set_from`], in two bands of rows on the thread pool from `split` cells.
+    fn pack(&mut self, image: &[u8], value: bool, split: usize) {
         let flip = if value { 0 } else { u64::MAX };
         if self.width == 0 {
             return;
@@ -292,10 +304,9 @@ impl Bits {
                 }
             }
         };
-        // Large images in two bands of rows on the thread pool (a river's year packs its mask
-        // on the way to its crosses).
+        // Large images in two bands of rows on the thread pool.
         let mid = self.height / 2;
-        if self.height < 2 || width * self.height < 1 << 16 {
+        if self.height < 2 || width * self.height < split {
             pack(image, &mut self.words);
             return;
         }
