@@ -61,7 +61,9 @@ impl<T: Clone> Pool<T> {
         }
     }
 
-    /// Keeps `v` while the pool has room (else frees it).
+    /// Keeps `v` while the pool has room (else frees it). Room is made by freeing kept buffers
+    /// bigger than `v`, the biggest first: after a big terrain (the bench's memory case, a big
+    /// document closed) the buffers of the smaller ones that follow are kept, not its.
     pub(crate) fn give(&self, v: Vec<T>) {
         if v.capacity() == 0 {
             return;
@@ -69,7 +71,16 @@ impl<T: Clone> Pool<T> {
         let Ok(mut kept) = self.kept.lock() else {
             return;
         };
-        let held: usize = kept.iter().map(Vec::capacity).sum();
+        let mut held: usize = kept.iter().map(Vec::capacity).sum();
+        while held + v.capacity() > self.cap {
+            let bigger = (0..kept.len())
+                .filter(|&i| kept[i].capacity() > v.capacity())
+                .max_by_key(|&i| kept[i].capacity());
+            let Some(i) = bigger else {
+                break;
+            };
+            held -= kept.swap_remove(i).capacity();
+        }
         if held + v.capacity() <= self.cap {
             kept.push(v);
         }
@@ -106,5 +117,17 @@ mod tests {
         assert_eq!(pool.unfilled(5, 9), vec![2; 5]);
         assert_eq!(pool.unfilled(5, 9), vec![0; 5]);
         assert_eq!(pool.unfilled(5, 9), vec![9; 5], "the second 20 was not kept");
+    }
+
+    #[test]
+    fn a_full_pool_frees_bigger_buffers_for_a_smaller_one() {
+        let pool = Pool::<u8>::new(30);
+        pool.give(vec![0; 25]);
+        pool.give(vec![1; 5]);
+        // 25 + 5 + 10 > 30: the 25 goes.
+        pool.give(vec![2; 10]);
+        assert_eq!(pool.unfilled(4, 9), vec![1; 4]);
+        assert_eq!(pool.unfilled(4, 9), vec![2; 4]);
+        assert_eq!(pool.unfilled(4, 9), vec![9; 4], "the 25 was freed");
     }
 }
