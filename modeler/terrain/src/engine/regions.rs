@@ -28,7 +28,9 @@
 //!   change, and every shape is computed again.
 //!
 //! The per-cell work runs on all cores (rayon), in bands of rows; the figures' distance maps of
-//! a region are computed in parallel. Within a row the cells are taken a stretch at a time (an
+//! a region are computed in parallel, and in the taxicab metric a full blend's shapes a figure at
+//! a time through a table of its (df, dp) pairs ([`FigureNode::shapes_by_pairs`]). The maps come
+//! from and go back to [`crate::pool::MAPS`], so that a new engine does not fault in fresh pages. Within a row the cells are taken a stretch at a time (an
 //! owned run, or its dirty cells), each step over the whole stretch for one figure, in figure
 //! order: every cell still sees the arithmetic of a cell-by-cell evaluation, and the loops over
 //! the stretch (the sums of a paint, the shares) compile to vector instructions.
