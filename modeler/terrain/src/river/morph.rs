@@ -268,7 +268,7 @@ impl Bits {
         self.pack(image, value, 1 << 16);
     }
 
-    /// [`Bits::set_from`] on the calling thread: a river's year packs its mask (some 0.4
+    /// [`Bits::set_from`] on the calling thread: a river's year packs its mask (about 1.3
     /// instructions a cell) on the way to its crosses, where a fork and join, and waking the
     /// other thread, would cost more than it saves.
     pub fn set_from_here(&mut self, image: &[u8], value: bool) {
@@ -284,23 +284,30 @@ impl Bits {
         let (width, stride) = (self.width, self.stride);
         let pack = |image: &[u8], words: &mut [u64]| {
             for (row, out) in image.chunks(width).zip(words.chunks_mut(stride)) {
-                for (cells, word) in row.chunks(64).zip(out.iter_mut()) {
-                    let mut w = 0u64;
-                    let mut sixteens = cells.chunks_exact(16);
-                    for (j, sixteen) in sixteens.by_ref().enumerate() {
-                        w |= pack16(sixteen) << (16 * j);
+                // Sixteen cells at a time, four to a word.
+                let mut w = 0u64;
+                let mut sixteens = row.chunks_exact(16);
+                for (g, sixteen) in sixteens.by_ref().enumerate() {
+                    w |= pack16(sixteen) << (16 * (g % 4));
+                    if g % 4 == 3 {
+                        out[g / 4] = w ^ flip;
+                        w = 0;
                     }
-                    let mut done = cells.len() / 16 * 16;
+                }
+                // The last word, if the groups did not fill it: the cells left, and the bits past
+                // the row's end 0 whichever value is asked for.
+                let mut done = row.len() / 16 * 16;
+                if done % 64 != 0 || done < row.len() {
+                    let last = done / 64;
                     let mut eights = sixteens.remainder().chunks_exact(8);
                     for eight in eights.by_ref() {
-                        w |= pack8(eight) << done;
+                        w |= pack8(eight) << (done % 64);
                         done += 8;
                     }
                     for (j, &v) in eights.remainder().iter().enumerate() {
-                        w |= u64::from(v != 0) << (done + j);
+                        w |= u64::from(v != 0) << (done % 64 + j);
                     }
-                    // The bits past the row's end stay 0 whichever value is asked for.
-                    *word = (w ^ flip) & (u64::MAX >> (64 - cells.len()));
+                    out[last] = (w ^ flip) & (u64::MAX >> (64 - (row.len() - last * 64)));
                 }
             }
         };
