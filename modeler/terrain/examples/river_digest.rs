@@ -9,8 +9,9 @@
 //! document's first river is added at 5, 12 and 20 years; default
 //! `modeler/examples/rivers/omega.json`).
 //!
-//! `river_digest --drag N` instead runs the river bench's `drag/512/10` preview N times (for
-//! `valgrind --tool=callgrind`: the difference of two counts is the cost of the extra calls).
+//! `river_digest --drag N [YEARS]` instead runs the river bench's `drag/512/YEARS` preview (10
+//! years unless given) N times (for `valgrind --tool=callgrind`: the difference of two counts is
+//! the cost of the extra calls).
 
 use penmodel_terrain::river::{self, Constants, Shape, drag};
 use penmodel_terrain::{Document, Grid, River};
@@ -69,10 +70,10 @@ fn grid(n: u32) -> Grid {
     }
 }
 
-/// The bench's `drag/512/10` preview `calls` times.
-fn drag_calls(calls: usize) {
+/// The bench's `drag/512/YEARS` preview `calls` times.
+fn drag_calls(calls: usize, years: u32) {
     let c = Constants::default();
-    let rv = river::meander(512, 14, 4.0, 10);
+    let rv = river::meander(512, 14, 4.0, years);
     let d = drag::Drag::new(&rv, 20, &grid(512), &c);
     let mut moved = rv.clone();
     moved.points[20] = [moved.points[20][0] + 6.0, moved.points[20][1] - 4.0];
@@ -88,7 +89,8 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let args: Vec<String> = std::env::args().collect();
     if args.get(1).is_some_and(|a| a == "--drag") {
         let calls = args.get(2).ok_or("--drag needs a count")?.parse()?;
-        drag_calls(calls);
+        let years = args.get(3).map_or(Ok(10), |y| y.parse())?;
+        drag_calls(calls, years);
         return Ok(());
     }
     let path = args
