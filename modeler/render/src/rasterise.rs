@@ -175,6 +175,24 @@ impl Edge {
 /// their triangle's attributes are set up ([`triangle`]).
 const SMALL_BOX: i32 = 4;
 
+/// Boxes at least this many pixels wide find each row's covered run from the edge functions
+/// ([`run`]) instead of testing every pixel of the box: a big triangle leaves about half its box
+/// empty, and the test's branch misses twice a row.
+const SPAN_BOX: i32 = 16;
+
+/// Narrows the run `lo..=hi` (pixel offsets along a row) to where the edge function `w + k·step`
+/// is ≥ 0; an empty run comes back with `lo > hi`.
+#[inline]
+fn run(w: i64, step: i64, lo: i64, hi: i64) -> (i64, i64) {
+    match step.signum() {
+        // Growing along the row: from the first k with w + k·step ≥ 0.
+        1 => (if w < 0 { lo.max((-w + step - 1) / step) } else { lo }, hi),
+        // Falling: up to the last such k (none if it starts below 0).
+        -1 => (lo, if w < 0 { -1 } else { hi.min(w / -step) }),
+        _ => (lo, if w < 0 { -1 } else { hi }),
+    }
+}
+
 /// Whether the edges `es` (started at the box's first centre) cover a centre of the box of
 /// `dx + 1` × `dy + 1` pixels: the same test as [`triangle`]'s loop.
 #[inline]
@@ -268,19 +286,41 @@ pub fn triangle<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut 
 
     let (mut r0, mut r1, mut r2) = (e0.start, e1.start, e2.start);
     let (mut riw, mut rh, mut rl) = (iw0, h0, l0);
+    let wide = px1 - px0 >= SPAN_BOX;
     for y in py0..=py1 {
         let (mut w0, mut w1, mut w2) = (r0, r1, r2);
         let (mut iw, mut h, mut l) = (riw, rh, rl);
-        for x in px0..=px1 {
-            if (w0 | w1 | w2) >= 0 {
-                sink.pixel(x, y, iw, h, l);
+        if wide {
+            // The row's covered pixels are one run: find it from the edge functions (exact
+            // integers, so the same pixels as testing each), and step the attributes over the
+            // pixels before it one addition at a time, as the loop below does (the same bits).
+            let last = i64::from(px1 - px0);
+            let (first, end) = [(r0, e0.step_x), (r1, e1.step_x), (r2, e2.step_x)]
+                .into_iter()
+                .fold((0, last), |(lo, hi), (w, step)| run(w, step, lo, hi));
+            for _ in 0..first.min(last + 1) {
+                iw += iwx;
+                h += hx;
+                l += lx;
             }
-            w0 += e0.step_x;
-            w1 += e1.step_x;
-            w2 += e2.step_x;
-            iw += iwx;
-            h += hx;
-            l += lx;
+            for x in first..=end {
+                sink.pixel(px0 + x as i32, y, iw, h, l);
+                iw += iwx;
+                h += hx;
+                l += lx;
+            }
+        } else {
+            for x in px0..=px1 {
+                if (w0 | w1 | w2) >= 0 {
+                    sink.pixel(x, y, iw, h, l);
+                }
+                w0 += e0.step_x;
+                w1 += e1.step_x;
+                w2 += e2.step_x;
+                iw += iwx;
+                h += hx;
+                l += lx;
+            }
         }
         r0 += e0.step_y;
         r1 += e1.step_y;

@@ -285,7 +285,7 @@ struct TexelSink<'a> {
 }
 
 impl Sink for TexelSink<'_> {
-    #[inline]
+    #[inline(always)]
     fn pixel(&mut self, x: i32, y: i32, invw: f32, uw: f32, vw: f32) {
         let i = (y - self.y0) as usize * self.width + x as usize;
         let s = &mut self.samples[i];
