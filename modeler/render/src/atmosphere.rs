@@ -7,7 +7,7 @@
 //!   normals' cross product, `r₀×r₁ + x·(r₁×r₂) + y·(r₂×r₀)`: affine in the pixel, a step per
 //!   pixel. Along it `w` grows by `r₂·(r₀×r₁)` (the determinant) per unit, so a sample of depth `w`
 //!   is at `eye + dir·w/det` — the world point a terrain pixel shows, whose ground colour
-//!   [`crate::land::Land::albedo_at`] gives, and its distance from the eye.
+//!   the ground's `albedo_at` ([`crate::land`]) gives, and its distance from the eye.
 //! - **Sky**: a gradient by the ray's elevation, from [`Style::sky_bottom`] at the horizon to
 //!   [`Style::sky_top`] at the zenith (`√sin` of the elevation: the pale band stays near the
 //!   horizon), instead of a gradient down the screen.
