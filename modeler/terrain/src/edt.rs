@@ -8,7 +8,7 @@
 //! Intersections of parabolas are compared as exact fractions (integer cross products), not as
 //! floating-point numbers, so the squared distances are exact integers; the distance is their
 //! square root rounded once to `f32`. The cross products fit 64 bits for boxes up to 2^20 cells a
-//! side ([`Wide`]), which is every box a usual grid has; a longer box (a grid may be 2^24 × 1)
+//! side (`Wide`), which is every box a usual grid has; a longer box (a grid may be 2^24 × 1)
 //! uses 128 bits. Rows are independent, so the row pass runs on all cores.
 //!
 //! `df` is the distance to the nearest cell outside the region, less one (so that a cell with a

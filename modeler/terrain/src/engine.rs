@@ -8,11 +8,11 @@
 //! figures `k`:
 //!
 //! - `dp_k(x)`: distance from figure k's cells; `df(x)`: distance from the region's edge, in the
-//!   region's metric ([`distance::figure_map`], [`distance::edge_map`]): `taxicab`, seed 000's
+//!   region's metric ([`crate::distance::figure_map`], [`crate::distance::edge_map`]): `taxicab`, seed 000's
 //!   4-neighbour path through the region's cells and layer count, or `euclidean`, the exact
 //!   Euclidean transforms of [`crate::edt`].
 //! - eq. 1 `w_k = df/(df + dp_k)`, 1 on the figure; eq. 2 `shape(w_k, s_k)`
-//!   ([`profile::shape`]), with `s_k` the figure's slope, or for a nested figure eq. 4
+//!   ([`crate::profile::shape`]), with `s_k` the figure's slope, or for a nested figure eq. 4
 //!   `(s_k + s0)·w_k − s0` where `s0` is the enclosing figure's slope.
 //! - eq. 3: on one or more figures, the mean of their reliefs; elsewhere the inverse-distance
 //!   blend `Σ(relief_k·shape_k/dp_k) / Σ(1/dp_k)`.

@@ -23,9 +23,9 @@
 //! Errors stop at the first problem, in document order (the memory check comes last).
 //!
 //! The curve checks are linear in the number of vertices for drawn curves: a curve's segments go
-//! into a grid of buckets about one segment long ([`SegmentIndex`]) and each segment is tested only
+//! into a grid of buckets about one segment long (`SegmentIndex`) and each segment is tested only
 //! against those in its neighbouring buckets; points are located against their region's edge
-//! through bands of rows ([`Bands`]).
+//! through bands of rows (`Bands`).
 
 use std::collections::HashMap;
 use std::fmt;
@@ -1082,7 +1082,7 @@ fn figure(grid: &Grid, f: &Figure, edge: &mut Edge<'_>, path: &str, depth: usize
 }
 
 /// Checks every tree: on the grid, a height in (0, [`crate::trees::MAX_HEIGHT`]] m, a known
-/// preset or its own maps ([`species`]), and its wind ([`wind`]).
+/// preset or its own maps ([`species`]), and its wind (`wind`).
 pub fn trees(doc: &Document) -> Result<(), ValidationError> {
     for (i, t) in doc.trees.iter().enumerate() {
         let path = format!("trees[{i}]");

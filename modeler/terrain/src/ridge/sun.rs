@@ -419,7 +419,7 @@ struct Scratch {
 /// the mean over all directions is the weighted mean, every cell getting weight 1 per azimuth
 /// but on the grid's edge rows across a direction's lines, where the weights are known in closed
 /// form (`Sections::weight`). Opposite azimuths share their lines and are swept together. The
-/// azimuths are swept one after another, each on all cores ([`sky_sweep`]); the result does not
+/// azimuths are swept one after another, each on all cores (`sky_sweep`); the result does not
 /// depend on the number of threads.
 pub fn sky_view(field: Field<'_>, k: u32) -> Vec<f32> {
     let Field { z, cols, rows, cell } = field;

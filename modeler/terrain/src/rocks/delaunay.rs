@@ -9,13 +9,13 @@
 //! last new triangle to the one holding the point, splitting it in three, and flipping the edges
 //! facing the point while they are not locally Delaunay — in memory reused from rock to rock
 //! (`cargo bench -p penmodel-terrain --bench rocks -- delaunay`). Orientation is `robust`'s
-//! exact `orient2d`; the incircle test is its filter ([`super::predicates`]): an edge is flipped
+//! exact `orient2d`; the incircle test is its filter (`super::predicates`): an edge is flipped
 //! only when that is certain, so the flips end and the result is Delaunay to within rounding,
 //! cocircular cells included.
 //!
 //! Each neighbour link names the triangle across an edge and that edge's index in it
 //! (`4·triangle + edge`), so a flip finds its way back without searching. A rock of up to
-//! [`SMALL`] triangles (hulls of up to 22 vertices with as many points inside: every rock of
+//! `SMALL` triangles (hulls of up to 22 vertices with as many points inside: every rock of
 //! the seed's figures) is triangulated in fixed arrays whose indices are masked to their size,
 //! so no access is range-checked; larger ones run the same steps on growable lists.
 

@@ -2,7 +2,7 @@
 //! of rocks each in one list, a rock being ranges in them.
 //!
 //! Why: a rock owning four vectors made fig. 1 allocate and free about 194 000 of them, some
-//! 15 % of a scatter's time. Blocks of [`BLOCK`] rocks in the order they are made (a fixed
+//! 15 % of a scatter's time. Blocks of `BLOCK` rocks in the order they are made (a fixed
 //! split, so the same on any number of threads) are filled on all cores without sharing.
 
 use super::shape::RockMesh;

@@ -140,7 +140,7 @@ fn nodes_of(built: &mut Vec<(Vec<IfsMap>, Arc<NodeTree>)>, species: &Species) ->
     n
 }
 
-/// Terrain cells per side of a [`Buckets`] square: a local change of the terrain looks at a few
+/// Terrain cells per side of a `Buckets` square: a local change of the terrain looks at a few
 /// squares, and a grid of 512² has 1024 of them.
 pub const BUCKET_CELLS: f64 = 16.0;
 
