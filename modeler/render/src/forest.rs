@@ -13,10 +13,15 @@
 //! - **LOD off** ([`Scene::tree_lod`] `None`) draws every tree at [`STOP`], the full model.
 //! - Both eyes see the same `Q` per tree, so a stereo pair never shows a group as geometry in one
 //!   eye and as a shape in the other.
+//! - The trees are walked in parallel, each into its own buffers (kept from frame to frame), and
+//!   handed on in the scene's order, so the frame is the same as from one walk: the walk was a
+//!   serial part of the 30-tree frame. The simplified shapes' groups are then looked up (and
+//!   baked the first time) in order, on one thread.
 
 use glam::{DMat3, DVec3};
 use penmodel_terrain::trees::nodes::STOP;
 use penmodel_terrain::trees::{Drawn, Roughness};
+use rayon::prelude::*;
 
 use super::camera::Eye;
 use super::impostor::Cache;
@@ -46,7 +51,8 @@ impl TreeStats {
 /// The trees' per-frame buffers and the simplified shapes' textures.
 #[derive(Debug, Default)]
 pub struct Trees {
-    drawn: Drawn,
+    /// Per tree of the scene, in its order, what it drew this frame.
+    drawn: Vec<Drawn>,
     quads: Vec<Quad>,
     cache: Cache,
     stats: TreeStats,
@@ -88,13 +94,15 @@ pub fn roughness(lod: &Roughness, eye: DVec3, gaze: DVec3, middle: DVec3, height
 impl Trees {
     /// Draws `scene`'s trees for this frame (both eyes), seen from a frame of `aspect`.
     pub fn prepare(&mut self, scene: &Scene, aspect: f64) {
-        let d = &mut self.drawn;
-        d.mesh.positions.clear();
-        d.mesh.normals.clear();
-        d.mesh.colors.clear();
-        d.mesh.indices.clear();
-        d.impostors.clear();
-        (d.nodes, d.polygons, d.leaves) = (0, 0, 0);
+        self.drawn.resize_with(scene.trees.len(), Drawn::default);
+        for d in &mut self.drawn {
+            d.mesh.positions.clear();
+            d.mesh.normals.clear();
+            d.mesh.colors.clear();
+            d.mesh.indices.clear();
+            d.impostors.clear();
+            (d.nodes, d.polygons, d.leaves) = (0, 0, 0);
+        }
         self.quads.clear();
         if scene.trees.is_empty() {
             self.stats = TreeStats {
@@ -104,32 +112,37 @@ impl Trees {
             return;
         }
         let (eye, gaze) = eye_and_gaze(scene, aspect);
-        for tree in scene.trees {
-            let q = match &scene.tree_lod {
-                None => STOP,
-                Some(lod) => {
-                    let middle = DVec3::new(tree.at[0], tree.base + 0.5 * tree.height, tree.at[1]);
-                    roughness(lod, eye, gaze, middle, tree.height)
-                }
-            };
-            let first = self.drawn.impostors.len();
-            tree.draw(q, scene.time, &mut self.drawn);
-            for imp in &self.drawn.impostors[first..] {
+        scene
+            .trees
+            .par_iter()
+            .zip(self.drawn.par_iter_mut())
+            .for_each(|(tree, drawn)| {
+                let q = match &scene.tree_lod {
+                    None => STOP,
+                    Some(lod) => {
+                        let middle = DVec3::new(tree.at[0], tree.base + 0.5 * tree.height, tree.at[1]);
+                        roughness(lod, eye, gaze, middle, tree.height)
+                    }
+                };
+                tree.draw(q, scene.time, drawn);
+            });
+        for (tree, drawn) in scene.trees.iter().zip(&self.drawn) {
+            for imp in &drawn.impostors {
                 let group = self.cache.group(&tree.nodes, imp.node, &scene.style);
                 self.quads.extend(self.cache.quad(group, imp, eye));
             }
         }
         self.stats = TreeStats {
             trees: scene.trees.len(),
-            polygons: self.drawn.polygons,
-            impostors: self.drawn.impostors.len(),
+            polygons: self.drawn.iter().map(|d| d.polygons).sum(),
+            impostors: self.drawn.iter().map(|d| d.impostors.len()).sum(),
             baked: self.cache.groups(),
         };
     }
 
-    /// The copied branches and leaves, coloured.
-    pub fn mesh(&self) -> &penmodel_terrain::export::Mesh {
-        &self.drawn.mesh
+    /// The copied branches and leaves, coloured: a mesh per tree, in the scene's order.
+    pub fn meshes(&self) -> impl Iterator<Item = &penmodel_terrain::export::Mesh> {
+        self.drawn.iter().map(|d| &d.mesh)
     }
 
     /// The simplified shapes' polygons.

@@ -365,22 +365,31 @@ impl Renderer {
             );
         }
         overlay::capsules(scene, &projection, &mut self.eye.capsules);
-        let meshes = &mut self.eye.meshes;
         let cell = scene.terrain.cell_size();
-        meshes.clear((height as usize, self.tile_rows));
-        let rocks = scene.rocks.iter().map(|(_, m)| m);
-        meshes.add(rocks, Paint::Whole(Surface::Rock), &affine, cell, near, &scene.style);
-        let water = scene.water.iter().map(|(_, m)| m);
-        meshes.add(water, Paint::Whole(Surface::Water), &affine, cell, near, &scene.style);
-        let trees = std::iter::once(self.trees.mesh());
-        meshes.add(trees, Paint::Own, &affine, cell, near, &scene.style);
-        let textured = &mut self.eye.textured;
-        textured.clear((height as usize, self.tile_rows));
-        // The scene's textures, then the simplified shapes' (as `eye` gives them to the tiles).
-        let textures: Vec<&textured::Texture> = scene.textures.iter().chain(self.trees.cache().textures()).collect();
-        textured.add(scene.polygons, 0, &textures, &affine, cell, near);
-        let first = scene.textures.len() as u32;
-        textured.add(self.trees.quads(), first, &textures, &affine, cell, near);
+        let bands = (height as usize, self.tile_rows);
+        let (meshes, textured, trees) = (&mut self.eye.meshes, &mut self.eye.textured, &self.trees);
+        // The meshes and the textured polygons side by side: each is projected and binned on one
+        // thread, and the trees' copied polygons and simplified shapes were a serial part of
+        // their frames.
+        rayon::join(
+            || {
+                meshes.clear(bands);
+                let rocks = scene.rocks.iter().map(|(_, m)| m);
+                meshes.add(rocks, Paint::Whole(Surface::Rock), &affine, cell, near, &scene.style);
+                let water = scene.water.iter().map(|(_, m)| m);
+                meshes.add(water, Paint::Whole(Surface::Water), &affine, cell, near, &scene.style);
+                meshes.add(trees.meshes(), Paint::Own, &affine, cell, near, &scene.style);
+            },
+            || {
+                textured.clear(bands);
+                // The scene's textures, then the simplified shapes' (as `eye` gives them to the
+                // tiles).
+                let textures: Vec<&textured::Texture> = scene.textures.iter().chain(trees.cache().textures()).collect();
+                textured.add(scene.polygons, 0, &textures, &affine, cell, near);
+                let first = scene.textures.len() as u32;
+                textured.add(trees.quads(), first, &textures, &affine, cell, near);
+            },
+        );
         (affine, near, projection)
     }
 
