@@ -67,6 +67,12 @@ pub struct RenderStats {
     pub skipped_vertices: usize,
 }
 
+/// The textures the textured polygons name: the scene's, then the trees' simplified shapes' (the
+/// order [`Renderer::project`] offsets their indices by, and the tiles look them up in).
+fn all_textures<'a>(scene: &'a Scene, trees: &'a forest::Trees) -> Vec<&'a textured::Texture> {
+    scene.textures.iter().chain(trees.cache().textures()).collect()
+}
+
 /// The bounds of the whole frame.
 fn whole(frame: &Frame) -> Bounds {
     Bounds {
@@ -382,9 +388,7 @@ impl Renderer {
             },
             || {
                 textured.clear(bands);
-                // The scene's textures, then the simplified shapes' (as `eye` gives them to the
-                // tiles).
-                let textures: Vec<&textured::Texture> = scene.textures.iter().chain(trees.cache().textures()).collect();
+                let textures = all_textures(scene, trees);
                 textured.add(scene.polygons, 0, &textures, &affine, cell, near);
                 let first = scene.textures.len() as u32;
                 textured.add(trees.quads(), first, &textures, &affine, cell, near);
@@ -422,8 +426,7 @@ impl Renderer {
             near,
             viewport,
         };
-        // The scene's textures, then the simplified shapes' (the order `project` offset them by).
-        let textures: Vec<&textured::Texture> = scene.textures.iter().chain(self.trees.cache().textures()).collect();
+        let textures = all_textures(scene, &self.trees);
         tiles::render(
             &pass,
             &self.eye.meshes,

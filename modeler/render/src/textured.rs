@@ -105,10 +105,8 @@ impl Texture {
     /// The level to read where a pixel spans `texels` texels: `⌊log₂ texels⌋` (0 below 2),
     /// at most the last.
     pub fn level_for(&self, texels: f32) -> u8 {
-        if texels.is_nan() || texels < 2.0 {
-            return 0;
-        }
-        (texels.log2().floor() as usize).min(self.levels.len()) as u8
+        // Levels stop at one texel, so there are fewer than 32 of them.
+        super::mips::level_for(texels, self.levels.len()) as u8
     }
 
     /// Width in texels.

@@ -352,7 +352,7 @@ pub fn run(args: &Args) -> Result<()> {
         if args.json {
             pen_host::outln!("{}", serde_json::json!({ "still": still_json(&still) }));
         } else {
-            print_still(&still)?;
+            print_still(&still, args.still_frames)?;
         }
         return Ok(());
     }
@@ -460,7 +460,7 @@ pub fn run(args: &Args) -> Result<()> {
         pen_host::outln!(
             "terrain engine: medians of {FULLS} regenerations, {EDITS} moves and {EDITS} slope changes; targets at 512×512: ≤ 10 ms, ≤ 4 ms, ≤ 1 ms"
         );
-        print_still(&still)?;
+        print_still(&still, args.still_frames)?;
         let show = |v: Option<u64>| v.map_or("unknown".to_owned(), |b| format!("{} MB", mb(b)));
         pen_host::outln!(
             "memory: {} figures on {}×{}: peak resident {} (before building {}), bound {} MB (limit {} MB)",
@@ -514,7 +514,7 @@ fn still_json(still: &[crate::frames::Still]) -> Vec<serde_json::Value> {
         .collect()
 }
 
-fn print_still(still: &[crate::frames::Still]) -> Result<()> {
+fn print_still(still: &[crate::frames::Still], frames: u32) -> Result<()> {
     if still.is_empty() {
         return Ok(());
     }
@@ -530,7 +530,6 @@ fn print_still(still: &[crate::frames::Still]) -> Result<()> {
             s.levels
         );
     }
-    let frames = still[0].frames;
     pen_host::outln!("medians of {frames} frames, the view turning 0.1° a frame; target: ≤ 16.7 ms");
     Ok(())
 }

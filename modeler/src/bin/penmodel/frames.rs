@@ -27,8 +27,6 @@ pub struct Still {
     pub lod_error: f32,
     pub stereo: bool,
     pub frame_ms: f64,
-    /// Frames timed (the median of them is `frame_ms`).
-    pub frames: usize,
     /// Terrain nodes drawn per level in the last frame (level 0 first); empty at full detail.
     pub levels: Vec<usize>,
 }
@@ -102,7 +100,6 @@ pub fn measure(
         lod_error,
         stereo,
         frame_ms: super::bench::median(times),
-        frames,
         levels: renderer.lod_levels(),
     })
 }
