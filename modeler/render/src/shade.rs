@@ -144,7 +144,9 @@ fn resolve_land(
             } else {
                 air.background_bytes(ray)
             };
-            *p = [c[0], c[1], c[2], 255];
+            // One 32-bit store (the array literal was written a byte at a time).
+            let rgba = u32::from(c[0]) | u32::from(c[1]) << 8 | u32::from(c[2]) << 16 | 0xff00_0000;
+            *p = rgba.to_le_bytes();
             ray = [ray[0] + step[0], ray[1] + step[1], ray[2] + step[2]];
             sin += d_sin;
         }

@@ -31,6 +31,9 @@ use super::frame::Rgba;
 use super::rasterise::{Bounds, Sample, Sink, Surface};
 use super::transform::Affine;
 
+/// Most texels a side of a [`Texture`] has (the texel lookup indexes a side in 16 bits).
+pub const MAX_SIDE: u32 = 1 << 16;
+
 /// An RGBA image, row 0 at the top, and its box-filtered levels.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
 pub struct Texture {
@@ -77,9 +80,10 @@ fn halve(w: u32, h: u32, texels: &[Rgba]) -> (u32, u32, Vec<Rgba>) {
 
 impl Texture {
     /// A texture of `width × height` texels, row-major from the top; `None` unless the sizes
-    /// agree and neither side is zero.
+    /// agree and each side is 1 to [`MAX_SIDE`] texels.
     pub fn new(width: u32, height: u32, texels: Vec<Rgba>) -> Option<Texture> {
-        if width == 0 || height == 0 || texels.len() != width as usize * height as usize {
+        let sides = 1..=MAX_SIDE;
+        if !sides.contains(&width) || !sides.contains(&height) || texels.len() != width as usize * height as usize {
             return None;
         }
         let mut levels: Vec<(u32, u32, Vec<Rgba>)> = Vec::new();
@@ -133,6 +137,12 @@ impl Texture {
     /// [`Texture::nearest`] in `level` (0: the image; past the last: the last).
     #[inline]
     pub fn nearest_in(&self, level: u8, u: f32, v: f32) -> Rgba {
+        self.level(level).nearest(u, v)
+    }
+
+    /// `level` (0: the image; past the last: the last) as a pixel reads it.
+    #[inline]
+    fn level(&self, level: u8) -> Level<'_> {
         let (w, h, texels) = match (level as usize).min(self.levels.len()) {
             0 => (self.width, self.height, &self.texels),
             l => {
@@ -140,9 +150,38 @@ impl Texture {
                 (*w, *h, t)
             }
         };
-        let x = ((u * w as f32) as i32).clamp(0, w as i32 - 1);
-        let y = ((v * h as f32) as i32).clamp(0, h as i32 - 1);
-        texels[y as usize * w as usize + x as usize]
+        Level {
+            texels,
+            size: [w as f32, h as f32],
+            // Sides are at most `MAX_SIDE`, so the last texel's index fits.
+            last: [(w - 1) as u16, (h - 1) as u16],
+            stride: w as usize,
+        }
+    }
+}
+
+/// One level of a [`Texture`], its sizes kept as the texel lookup uses them: a textured
+/// triangle's pixels all read the same level, so it is looked up once per triangle
+/// ([`TexelSink`]), not per pixel (that match and the conversions were a fifth of the textured
+/// pixels' instructions).
+#[derive(Clone, Copy)]
+struct Level<'a> {
+    texels: &'a [Rgba],
+    size: [f32; 2],
+    last: [u16; 2],
+    stride: usize,
+}
+
+impl Level<'_> {
+    /// The texel nearest `(u, v)`, both 0 to 1 across the texture (v down), clamped at the edges.
+    #[inline(always)]
+    fn nearest(&self, u: f32, v: f32) -> Rgba {
+        // Truncated towards zero and clamped, as `as i32` then `clamp(0, last)` would (below 0
+        // and NaN: 0; past the last: the last, which is under `u16::MAX`): a cast to 16 bits
+        // saturates in floating point, three instructions where 32 bits took a dozen.
+        let x = ((u * self.size[0]) as u16).min(self.last[0]);
+        let y = ((v * self.size[1]) as u16).min(self.last[1]);
+        self.texels[usize::from(y) * self.stride + usize::from(x)]
     }
 }
 
@@ -232,14 +271,12 @@ impl Projected {
             samples,
             width,
             y0: bounds.y0,
-            texture: first,
-            level: 0,
+            level: first.level(0),
         };
         self.0.draw(bounds, near, &mut sink, |sink, (k, level)| {
             match textures.get(k as usize) {
                 Some(&texture) => {
-                    sink.texture = texture;
-                    sink.level = level;
+                    sink.level = texture.level(level);
                     true
                 }
                 None => false,
@@ -278,8 +315,7 @@ struct TexelSink<'a> {
     samples: &'a mut [Sample],
     width: usize,
     y0: i32,
-    texture: &'a Texture,
-    level: u8,
+    level: Level<'a>,
 }
 
 impl Sink for TexelSink<'_> {
@@ -291,7 +327,7 @@ impl Sink for TexelSink<'_> {
             return;
         }
         let w = 1.0 / invw;
-        let [r, g, b, a] = self.texture.nearest_in(self.level, uw * w, vw * w);
+        let [r, g, b, a] = self.level.nearest(uw * w, vw * w);
         if a < 128 {
             return;
         }
@@ -323,6 +359,31 @@ mod tests {
         // Level 0 is the image; a level past the last reads the last.
         assert_eq!(t.nearest_in(0, 0.9, 0.0), [100, 0, 50, 255]);
         assert_eq!(t.nearest_in(9, 0.9, 0.0), [150, 50, 25, 255]);
+    }
+
+    #[test]
+    fn lookups_clamp_to_the_edge_texels() {
+        // A 3 × 2 image whose texels are numbered 0..6 in their red channel.
+        let t = Texture::new(3, 2, (0..6).map(|i| [i, 0, 0, 255]).collect()).expect("texture");
+        let red = |u: f32, v: f32| t.nearest(u, v)[0];
+        // Inside: the texel holding (u·3, v·2).
+        assert_eq!(red(0.5, 0.25), 1);
+        assert_eq!(red(0.99, 0.99), 5);
+        // Before the first texel, NaN and past the last: the edge texels.
+        for (u, v, edge) in [
+            (-0.5, 0.0, 0),
+            (-1e30, -1e30, 0),
+            (f32::NAN, f32::NAN, 0),
+            (1.0, 1.0, 5),
+            (7.0, 0.0, 2),
+            (1e30, 1e30, 5),
+            (f32::INFINITY, 0.0, 2),
+            (f32::NEG_INFINITY, 1.0, 3),
+        ] {
+            assert_eq!(red(u, v), edge, "({u}, {v})");
+        }
+        // Sides past MAX_SIDE are refused.
+        assert!(Texture::new(MAX_SIDE + 1, 1, vec![[0; 4]; MAX_SIDE as usize + 1]).is_none());
     }
 
     #[test]

@@ -60,7 +60,8 @@ pub struct SceneArgs {
     /// The look: the land look (what `penmodel render` and the demo show) or the classic one.
     #[arg(long, value_enum, default_value = "land")]
     look: crate::render::LookArg,
-    /// Write the mono frames as DIR/full.png and DIR/lod.png.
+    /// Write the mono frames as DIR/full.png and DIR/lod.png (and with --bench the LOD stereo
+    /// frame as DIR/stereo.png).
     #[arg(long, value_name = "DIR")]
     png: Option<PathBuf>,
 }
@@ -169,21 +170,26 @@ pub fn run(args: &SceneArgs) -> Result<()> {
     scene.tree_lod = lod;
     let ms_lod = time(&mut renderer, &scene, &mut on, frames)?;
     let stats_lod = renderer.tree_stats();
-    let ms_stereo = if args.bench {
+    let (ms_stereo, pair) = if args.bench {
         scene.stereo = Stereo::Anaglyph;
         let mut pair = Frame::new(args.width, args.height)?;
         let ms = time(&mut renderer, &scene, &mut pair, frames)?;
         scene.stereo = Stereo::None;
-        ms
+        (ms, Some(pair))
     } else {
-        None
+        (None, None)
     };
     let Some((mad, psnr)) = full.difference(&on) else {
         bail!("the two frames differ in size");
     };
     if let Some(dir) = &args.png {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-        for (name, f) in [("full.png", &full), ("lod.png", &on)] {
+        let frames = [
+            ("full.png", Some(&full)),
+            ("lod.png", Some(&on)),
+            ("stereo.png", pair.as_ref()),
+        ];
+        for (name, f) in frames.into_iter().filter_map(|(n, f)| Some((n, f?))) {
             let path = dir.join(name);
             penmodel_render::output::write_png(f, &path).with_context(|| format!("cannot write {}", path.display()))?;
         }
