@@ -38,6 +38,8 @@ pub const SIDE: [u8; 3] = [104, 86, 66];
 
 /// Entries of the haze table over `d/L` in `[0, HAZE_SPAN]`.
 const HAZE_ENTRIES: usize = 512;
+// `Atmosphere::fog` indexes the table through a 16-bit cast.
+const _: () = assert!(HAZE_ENTRIES <= 1 << 16);
 const HAZE_SPAN: f32 = 8.0;
 
 fn rgb(c: Rgba) -> [f32; 3] {
@@ -199,8 +201,9 @@ impl Atmosphere {
     fn fog(&self, d: f32) -> f32 {
         let x = d * self.inv_haze * ((HAZE_ENTRIES - 1) as f32 / HAZE_SPAN);
         if x.is_finite() {
-            // A 32-bit cast (saturating, as the 64-bit one did: the same entry, cheaper).
-            self.table[(x as u32 as usize).min(HAZE_ENTRIES - 1)]
+            // A 16-bit cast saturates as the 32- and 64-bit ones did (the table is shorter than
+            // 2¹⁶: the same entry), in three instructions where 32 bits took six.
+            self.table[usize::from(x as u16).min(HAZE_ENTRIES - 1)]
         } else {
             1.0
         }

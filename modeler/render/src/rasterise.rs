@@ -201,9 +201,9 @@ fn run(w: i64, step: i64, lo: i64, hi: i64) -> (i64, i64) {
 #[inline]
 fn covers_a_centre(es: [&Edge; 3], dx: i32, dy: i32) -> bool {
     let (mut r0, mut r1, mut r2) = (es[0].start, es[1].start, es[2].start);
-    for _ in 0..=dy {
+    for _ in 0..dy + 1 {
         let (mut w0, mut w1, mut w2) = (r0, r1, r2);
-        for _ in 0..=dx {
+        for _ in 0..dx + 1 {
             if (w0 | w1 | w2) >= 0 {
                 return true;
             }
@@ -290,7 +290,8 @@ pub fn triangle<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut 
     let (mut r0, mut r1, mut r2) = (e0.start, e1.start, e2.start);
     let (mut riw, mut rh, mut rl) = (iw0, h0, l0);
     let wide = px1 - px0 >= SPAN_BOX;
-    for y in py0..=py1 {
+    // Half-open ranges: an inclusive one costs a compare and a flag per step of these loops.
+    for y in py0..py1 + 1 {
         let (mut w0, mut w1, mut w2) = (r0, r1, r2);
         let (mut iw, mut h, mut l) = (riw, rh, rl);
         if wide {
@@ -306,14 +307,14 @@ pub fn triangle<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut 
                 h += hx;
                 l += lx;
             }
-            for x in first..=end {
+            for x in first..end + 1 {
                 sink.pixel(px0 + x as i32, y, iw, h, l);
                 iw += iwx;
                 h += hx;
                 l += lx;
             }
         } else {
-            for x in px0..=px1 {
+            for x in px0..px1 + 1 {
                 if (w0 | w1 | w2) >= 0 {
                     sink.pixel(x, y, iw, h, l);
                 }
