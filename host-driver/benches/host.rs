@@ -25,6 +25,7 @@ fn bench(c: &mut Criterion) {
         display: DisplaySize::REFERENCE,
         residuals: Vec::new(),
         device: None,
+        tip_offset_mm: None,
     };
     let report = |seq: u16| PenReport {
         sw1: seq % 64 < 32,

@@ -133,7 +133,8 @@ impl Pipeline {
             }
             DeviceEvent::Head(h) => {
                 // Only a device the calibration belongs to gets here (a refused one is detached).
-                let point = self.display_point(h.position_mm, h.display_frame);
+                // The glasses' own emitter: without the pen's emitter-to-tip vector.
+                let point = self.calibration.head_to_display(h.position_mm, h.display_frame);
                 out.push(self.head.on_sample(&h, point, now_us()));
                 None
             }

@@ -3,7 +3,8 @@
 use std::time::Duration;
 
 use glam::{DQuat, DVec2, DVec3};
-use pen_host::calibration::procedure::{Prompt, attach, collect_touches, prepare};
+use pen_host::calibration::pivot::{fit_pivot, tip_offset};
+use pen_host::calibration::procedure::{Prompt, attach, collect_pivot, collect_touches, prepare};
 use pen_host::calibration::{Calibration, CalibrationError, DeviceId, DisplaySize, FitKind, SIMULATED_ID, fit};
 use pen_host::device::Device;
 use pen_host::source::Source;
@@ -21,7 +22,7 @@ fn misaligned() -> (DQuat, DVec3) {
 fn run(targets: &[DVec2], seed: u64) -> Calibration {
     let (rotation, translation) = misaligned();
     let rig = Rig::reference().with_display_pose(rotation, translation);
-    let scenario = pen_sim::scenarios::calibration(targets, rig);
+    let scenario = pen_sim::scenarios::calibration(targets, None, rig);
     let mut device = Device::new(Source::Sim(SimOptions {
         scenario,
         seed,
@@ -53,6 +54,69 @@ fn run(targets: &[DVec2], seed: u64) -> Calibration {
         }
     }
     fit(targets, &touched, FitKind::Similarity, DisplaySize::REFERENCE).expect("fit")
+}
+
+/// The pivot after the touches measures the pen's emitter-to-tip vector, and with it taken out
+/// a point carried by the calibration lands where it is: the fit alone puts it off by that
+/// vector, as the tracked glasses' emitter was (issue 16).
+#[test]
+fn the_pivot_measures_the_vector_the_fit_took_in() {
+    let display = DisplaySize::REFERENCE;
+    let targets = display.targets(9);
+    let at = display.pivot_target();
+    let (rotation, translation) = misaligned();
+    let rig = Rig::reference().with_display_pose(rotation, translation);
+    let scenario = pen_sim::scenarios::calibration(&targets, Some(at), rig.clone());
+    let mut device = Device::new(Source::Sim(SimOptions {
+        scenario,
+        seed: 3,
+        speed: 0.0,
+        plug: Default::default(),
+    }));
+    attach(&mut device, Duration::from_secs(2)).expect("attach");
+    prepare(&mut device).expect("raw tracker frame");
+    let touched = collect_touches(&mut device, &targets, Duration::from_secs(30), |_| {}).expect("touches");
+    let mut prompts = Vec::new();
+    let fixes = collect_pivot(&mut device, at, Duration::from_secs(30), |p| {
+        if !matches!(p, Prompt::Pen { .. }) {
+            prompts.push(p.clone())
+        }
+    })
+    .expect("pivot");
+    assert!(matches!(prompts.first(), Some(Prompt::Pivot { .. })), "{prompts:?}");
+    assert!(matches!(prompts.last(), Some(Prompt::Pivoted { .. })), "{prompts:?}");
+    let mut cal = fit(&targets, &touched, FitKind::Similarity, display).expect("fit");
+    let pivot = fit_pivot(&fixes).expect("pivot fits");
+    // The simulated pen's emitter is 8 mm up the pen from its tip.
+    assert!((pivot.radius_mm - rig.emitter_offset_mm).abs() < 0.5, "{pivot:?}");
+    // The tip is on the target: the pivot's centre in the true display frame.
+    let true_tip = rig.display_to_tracker(at.extend(0.0));
+    assert!(pivot.tip_mm.distance(true_tip) < 0.5, "{} vs {true_tip}", pivot.tip_mm);
+    // The vector the touches' pen (leaning 35° towards the user) put into the translation:
+    // from the emitter to the tip, −8 mm along the pen.
+    let lean = pen_sim::hand::TILT_DEG.to_radians();
+    let expected = -DVec3::new(0.0, -lean.sin(), lean.cos()) * rig.emitter_offset_mm;
+    let offset = tip_offset(&cal, &pivot, at);
+    println!("pivot {pivot:?}; offset {offset} against {expected}");
+    assert!(offset.distance(expected) < 0.8, "{offset} vs {expected}");
+    // A glasses' emitter 60 cm in front of the display: off by about 8 mm through the fit
+    // alone, within a millimetre with the vector taken out.
+    let glasses = DVec3::new(310.0, -250.0, 600.0);
+    let tracker = rig.display_to_tracker(glasses);
+    let at_display = |c: &Calibration| {
+        let p = c.head_to_display(tracker, false);
+        DVec3::new(p.u_mm, p.v_mm, p.h_mm)
+    };
+    assert!(at_display(&cal).distance(glasses) > 6.0);
+    let pen_before = cal.to_display(tracker);
+    cal.tip_offset_mm = Some(offset);
+    assert!(
+        at_display(&cal).distance(glasses) < 1.0,
+        "{}",
+        at_display(&cal) - glasses
+    );
+    // The pen's own positions are still the tip's: the vector stays in for them.
+    assert_eq!(cal.to_display(tracker), pen_before);
 }
 
 #[test]
@@ -145,7 +209,7 @@ fn a_calibration_written_to_the_device_makes_it_report_display_coordinates() {
     let targets = DisplaySize::REFERENCE.targets(5);
     let (rotation, translation) = misaligned();
     let rig = Rig::reference().with_display_pose(rotation, translation);
-    let scenario = pen_sim::scenarios::calibration(&targets, rig);
+    let scenario = pen_sim::scenarios::calibration(&targets, None, rig);
     let timeline = scenario.timeline.clone();
     let mut device = Device::new(Source::Sim(SimOptions {
         scenario,
@@ -312,10 +376,15 @@ fn the_file_records_the_device_and_version_1_is_read_with_a_warning() {
     let touched: Vec<DVec3> = targets.iter().map(|p| r.inverse() * (p.extend(0.0) - t)).collect();
     let mut cal = fit(&targets, &touched, FitKind::Rigid, DisplaySize::REFERENCE).expect("fit");
     cal.device = Some(DeviceId(*b"station-A-id"));
+    cal.tip_offset_mm = Some(DVec3::new(0.25, 4.5, -6.75));
     let text = cal.to_toml();
-    assert!(text.contains("version = 2\n"), "{text}");
+    assert!(text.contains("version = 3\n"), "{text}");
     assert!(
         text.contains("[device]\nunique_id = \"73746174696f6e2d412d6964\""),
+        "{text}"
+    );
+    assert!(
+        text.contains("[pen]\ntip_offset_mm = [\n    0.25,\n    4.5,\n    -6.75,\n]"),
         "{text}"
     );
     let back = Calibration::from_toml(&text, "cal.toml").expect("loads");
@@ -332,12 +401,24 @@ fn the_file_records_the_device_and_version_1_is_read_with_a_warning() {
         bad("unique_id = \"7374", "unique_id = \"zz")
             .contains("`device.unique_id` must be the base station's 24 hex digits")
     );
-    assert!(bad("version = 2", "version = 1").contains("`device` is new in version 2"));
-    assert!(bad("version = 2", "version = 3").contains("`version` is 3; this program reads versions 1 and 2"));
+    assert!(bad("version = 3", "version = 1").contains("`device` is new in version 2"));
+    assert!(bad("version = 3", "version = 2").contains("`pen` is new in version 3"));
+    assert!(bad("version = 3", "version = 4").contains("`version` is 4; this program reads versions 1 to 3"));
+    assert!(bad("    4.5,", "    450.0,").contains("`pen.tip_offset_mm` must be three finite numbers"));
+    assert!(bad("    4.5,", "    nan,").contains("`pen.tip_offset_mm` must be three finite numbers"));
+
+    // A file of version 2, written before the pivot: read, without the pen's vector.
+    let pen = text.find("[pen]").expect("a [pen] table");
+    let pen_end = text[pen..].find("]\n\n").map_or(text.len(), |i| pen + i + 3);
+    let v2 = format!("{}{}", &text[..pen], &text[pen_end..]).replacen("version = 3", "version = 2", 1);
+    let back = Calibration::from_toml(&v2, "v2.toml").expect("version 2 still loads");
+    assert_eq!(back.tip_offset_mm, None);
+    assert_eq!(back.device, cal.device);
+    assert_eq!(back.transform, cal.transform);
 
     // A file of version 1, written before calibrations recorded their device: read, for any
     // base station, with a warning that says how to bind it.
-    let old = text.replacen("version = 2", "version = 1", 1).replacen(
+    let old = v2.replacen("version = 2", "version = 1", 1).replacen(
         "[device]\nunique_id = \"73746174696f6e2d412d6964\"\n",
         "",
         1,

@@ -2,7 +2,8 @@
 //!
 //! - [`PenSource::Demo`]: the built-in demo. The simulated pen (pen-sim: hand, acoustics, the
 //!   real firmware core) on a display that is not where the tracker thinks it is; the host's
-//!   calibration procedure touches nine targets and fits the display's pose; then the hand
+//!   calibration procedure touches nine targets and fits the display's pose, and the pen tilted about
+//!   its tip on the centre (the pivot) says where the tip is from the emitter; then the hand
 //!   performs the seed-like modeling session ([`pen_sim::session`]). Every report goes as bytes
 //!   through the host's decoding, the fitted calibration and the event detector — the chain a
 //!   real pen goes through.
@@ -20,7 +21,8 @@ use std::thread::JoinHandle;
 use std::time::Duration;
 
 use glam::DVec2;
-use pen_host::calibration::procedure::{CalibrateError, Prompt, attach, collect_touches, prepare};
+use pen_host::calibration::pivot::{fit_pivot, tip_offset};
+use pen_host::calibration::procedure::{CalibrateError, Prompt, attach, collect_pivot, collect_touches, prepare};
 use pen_host::calibration::{Calibration, DisplaySize, FitKind, fit};
 use pen_host::client::{Client, ClientError, Line};
 use pen_host::device::Device;
@@ -124,7 +126,7 @@ impl CalibrationPicture {
                 self.state.pen_mm = Some([at.x, at.y]);
                 self.state.pressed = *pressed;
             }
-            Prompt::Lift | Prompt::Again { .. } => return None,
+            Prompt::Lift | Prompt::Again { .. } | Prompt::Pivot { .. } | Prompt::Pivoted { .. } => return None,
         }
         Some(self.state.clone())
     }
@@ -188,7 +190,8 @@ impl PenSource {
 pub fn demo_scenario() -> (Scenario, Vec<DVec2>) {
     let rig = Rig::hand_placed_display();
     let targets = DisplaySize::REFERENCE.targets(9);
-    let calibration = pen_sim::scenarios::calibration(&targets, rig.clone());
+    let calibration =
+        pen_sim::scenarios::calibration(&targets, Some(DisplaySize::REFERENCE.pivot_target()), rig.clone());
     let session = pen_sim::session::timeline(&pen_sim::session::steps(), pen_sim::scenarios::home());
     let timeline = calibration.timeline.then(&session);
     let scenario = pen_sim::session::watched(Scenario::new("demo", rig, Acoustics::clean(), timeline));
@@ -271,15 +274,34 @@ fn run_demo(tx: &SyncSender<Feed>, speed: f64, seed: u64) -> Result<(), Stop> {
     if closed {
         return Err(Stop::Closed);
     }
-    let calibration = fit(&targets, &touched, FitKind::Similarity, DisplaySize::REFERENCE)
+    // The pivot: where the tip is from the emitter, for the glasses' positions (issue 16).
+    let at = DisplaySize::REFERENCE.pivot_target();
+    send(
+        tx,
+        Feed::Status("calibrating: the pen tilts about its tip on the centre".into()),
+    )?;
+    let mut picture_pen = |step: &Prompt| {
+        if let Some(p) = picture.after(step) {
+            closed |= tx.send(Feed::Calibrating(p)).is_err();
+        }
+    };
+    let fixes =
+        collect_pivot(&mut device, at, Duration::from_secs(60), &mut picture_pen).map_err(failed("calibration"))?;
+    if closed {
+        return Err(Stop::Closed);
+    }
+    let pivot = fit_pivot(&fixes).map_err(|e| Stop::Failed(format!("calibration: {e}")))?;
+    let mut calibration = fit(&targets, &touched, FitKind::Similarity, DisplaySize::REFERENCE)
         .map_err(|e| Stop::Failed(format!("calibration: {e}")))?;
+    calibration.tip_offset_mm = Some(tip_offset(&calibration, &pivot, at));
     send(tx, Feed::Display(display_mm(&calibration)))?;
     send(
         tx,
         Feed::Status(format!(
-            "calibrated over {count} targets: RMS {:.2} mm, worst {:.2} mm",
+            "calibrated over {count} targets: RMS {:.2} mm, worst {:.2} mm; the emitter {:.1} mm from the tip",
             calibration.rms_mm(),
-            calibration.max_mm()
+            calibration.max_mm(),
+            pivot.radius_mm
         )),
     )?;
     let mut pipeline = Pipeline::with_device(device, calibration);

@@ -12,6 +12,11 @@ use crate::script::Timeline;
 pub const TREMOR_RMS_MM: f64 = 0.15;
 /// How far the pen leans from the display's normal, degrees.
 pub const TILT_DEG: f64 = 35.0;
+/// A pivot's mean lean and how far it swings about it, degrees (three swings per turn).
+const PIVOT_LEAN_DEG: f64 = 30.0;
+const PIVOT_SWING_DEG: f64 = 18.0;
+/// The fraction of a pivot at each end spent easing from the held lean into the circle.
+const PIVOT_EASE: f64 = 0.12;
 /// The longest a contact bounces after a press or release, ms: well inside the firmware's
 /// default 5 ms debounce time, as real tact switches bounce for 1–3 ms.
 pub const MAX_BOUNCE_MS: f64 = 3.0;
@@ -133,10 +138,22 @@ impl Hand {
     }
 
     /// The pen's axis from tip to emitter in the display frame: leaning towards the user (−y)
-    /// by [`TILT_DEG`], wobbling slowly.
+    /// by [`TILT_DEG`], wobbling slowly; in a pivot ([`crate::script::Script::pivot`]) its top
+    /// circles once about the tip at a lean between 12° and 48°, eased in and out of the
+    /// held lean so the emitter does not jump.
     pub fn axis(&self, t_s: f64) -> DVec3 {
         let lean = TILT_DEG.to_radians() + self.wobble.0 * (std::f64::consts::TAU * self.wobble.1 * t_s).sin();
-        DVec3::new(0.0, -lean.sin(), lean.cos())
+        let held = DVec3::new(0.0, -lean.sin(), lean.cos());
+        let Some(s) = self.timeline.pivot_at(self.script_time(t_s)) else {
+            return held;
+        };
+        let turn = std::f64::consts::TAU;
+        let azimuth = -0.25 * turn + turn * s;
+        let lean = (PIVOT_LEAN_DEG + PIVOT_SWING_DEG * (3.0 * turn * s).sin()).to_radians();
+        let circling = DVec3::new(lean.sin() * azimuth.cos(), lean.sin() * azimuth.sin(), lean.cos());
+        let ease = (s.min(1.0 - s) / PIVOT_EASE).clamp(0.0, 1.0);
+        let w = ease * ease * (3.0 - 2.0 * ease);
+        (held * (1.0 - w) + circling * w).normalize()
     }
 
     /// The emitter in the tracker frame at `t_s`.

@@ -107,15 +107,23 @@ pub fn by_name(name: &str) -> Option<Scenario> {
 }
 
 /// A calibration session: the pen touches each target (display mm) for 0.6 s, lifting in
-/// between. `rig` says where the display really is.
-pub fn calibration(targets_mm: &[DVec2], rig: Rig) -> Scenario {
+/// between; then, with `pivot_mm`, it touches there and tilts about its tip for
+/// [`PIVOT_S`] with SW1 held (the host learns from it where the tip is from the emitter).
+/// `rig` says where the display really is.
+pub fn calibration(targets_mm: &[DVec2], pivot_mm: Option<DVec2>, rig: Rig) -> Scenario {
     let mut s = Script::new(home());
     for t in targets_mm {
         s.hover(*t).touch().hold(0.6).lift(HOVER_MM);
     }
+    if let Some(p) = pivot_mm {
+        s.hover(p).touch().pivot(PIVOT_S).lift(HOVER_MM);
+    }
     s.move_to(home());
     Scenario::new("calibration", rig, Acoustics::clean(), s.build())
 }
+
+/// How long the calibration's pivot lasts, s: the top of the pen circles once.
+pub const PIVOT_S: f64 = 3.0;
 
 /// The transducer-delay procedure (`penctl delays --sim`): the hand holds the pen still with its
 /// emitter at each of `points_mm` (tracker frame; the reference rig, whose display frame is the

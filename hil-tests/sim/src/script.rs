@@ -41,6 +41,8 @@ pub struct SwitchEvent {
 pub struct Timeline {
     segments: Vec<Segment>,
     events: Vec<SwitchEvent>,
+    /// Spans (start, end, s) in which the hand tilts the pen about its still tip.
+    pivots: Vec<(f64, f64)>,
 }
 
 /// The minimum-jerk profile: position fraction at time fraction `s` ∈ [0, 1].
@@ -74,6 +76,15 @@ impl Timeline {
         }
     }
 
+    /// How far through a pivot ([`Script::pivot`]) the hand is at `t_s`, from 0 to 1; `None`
+    /// outside one.
+    pub fn pivot_at(&self, t_s: f64) -> Option<f64> {
+        self.pivots
+            .iter()
+            .find(|(t0, t1)| t_s >= *t0 && t_s <= *t1 && t1 > t0)
+            .map(|(t0, t1)| (t_s - t0) / (t1 - t0))
+    }
+
     /// The switch presses and releases, in time order.
     pub fn events(&self) -> &[SwitchEvent] {
         &self.events
@@ -100,6 +111,8 @@ impl Timeline {
             t_s: e.t_s + offset,
             ..*e
         }));
+        self.pivots
+            .extend(other.pivots.iter().map(|(t0, t1)| (t0 + offset, t1 + offset)));
         self
     }
 }
@@ -269,6 +282,14 @@ impl Script {
     /// Lets go of the grabbed figure.
     pub fn let_go(&mut self) -> &mut Self {
         self.release(SW2)
+    }
+
+    /// Keeps the tip still for `duration_s` while tilting the pen about it, its top circling
+    /// once at a lean that rises and falls (the calibration's pivot: the emitter sweeps part of
+    /// a sphere about the tip; the hand's motion is [`crate::hand::Hand::axis`]).
+    pub fn pivot(&mut self, duration_s: f64) -> &mut Self {
+        self.timeline.pivots.push((self.t, self.t + duration_s));
+        self.hold(duration_s)
     }
 
     /// The finished timeline.

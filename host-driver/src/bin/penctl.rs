@@ -207,6 +207,11 @@ struct CalibrateArgs {
     /// Seconds to wait for each touch.
     #[arg(long, default_value_t = 60.0)]
     patience: f64,
+    /// Skip the pivot: after the targets, the pen's tip held on the display's centre while the
+    /// pen tilts about it, its top circling; it measures where the tip is from the emitter, which
+    /// the tracked glasses' positions need (docs/calibration.md, "The pivot").
+    #[arg(long)]
+    no_pivot: bool,
 }
 
 /// `WIDTHxHEIGHT`, for clap (a usage error otherwise).
@@ -499,16 +504,16 @@ fn config(action: ConfigAction) -> Result<()> {
     }
 }
 
-/// The device to calibrate; the simulated user touches exactly the targets, on a display set up
-/// by hand a little off the tracker frame, as a real one would be.
+/// The device to calibrate; the simulated user touches exactly the targets (and pivots on
+/// `pivot`), on a display set up by hand a little off the tracker frame, as a real one would be.
 #[cfg(feature = "sim")]
-fn calibration_source(device: &DeviceArgs, targets: &[glam::DVec2]) -> Result<Source> {
+fn calibration_source(device: &DeviceArgs, targets: &[glam::DVec2], pivot: Option<glam::DVec2>) -> Result<Source> {
     if !device.is_sim() {
         return Ok(device.source()?);
     }
     let rig = pen_sim::rig::Rig::hand_placed_display();
     Ok(Source::Sim(pen_host::transport::sim::SimOptions {
-        scenario: pen_sim::scenarios::calibration(targets, rig),
+        scenario: pen_sim::scenarios::calibration(targets, pivot, rig),
         seed: 1,
         speed: device.speed(),
         plug: Default::default(),
@@ -517,7 +522,7 @@ fn calibration_source(device: &DeviceArgs, targets: &[glam::DVec2]) -> Result<So
 
 /// The device to calibrate.
 #[cfg(not(feature = "sim"))]
-fn calibration_source(device: &DeviceArgs, _targets: &[glam::DVec2]) -> Result<Source> {
+fn calibration_source(device: &DeviceArgs, _targets: &[glam::DVec2], _pivot: Option<glam::DVec2>) -> Result<Source> {
     Ok(device.source()?)
 }
 
@@ -542,7 +547,8 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
         Fit::Rigid => FitKind::Rigid,
         Fit::Similarity => FitKind::Similarity,
     };
-    let source = calibration_source(&a.device, &targets)?;
+    let pivot_at = (!a.no_pivot).then(|| display.pivot_target());
+    let source = calibration_source(&a.device, &targets, pivot_at)?;
     let mut device = Device::new(source);
     calibrate::attach(&mut device, Duration::from_secs(2))?;
     // The calibration records its base station, and is refused for any other.
@@ -559,7 +565,7 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
     let original = calibrate::prepare(&mut device)?;
     let patience = Duration::from_secs_f64(a.patience.max(1.0));
     let tty = std::io::stderr().is_terminal();
-    let touched = calibrate::collect_touches(&mut device, &targets, patience, |step| match step {
+    let tell = |step: &Prompt| match step {
         Prompt::Touch {
             index,
             count,
@@ -570,16 +576,28 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
             target_mm.x,
             target_mm.y
         ),
+        Prompt::Pivot { at_mm } => eprintln!(
+            "pivot: hold the tip on ({:.0}, {:.0}) mm and press; keep it there while you tilt the pen, its top \
+             circling once, leaning it more and less (about 3 s); then lift",
+            at_mm.x, at_mm.y
+        ),
         Prompt::Pen { .. } => {}
         Prompt::Lift => eprintln!("  lift the pen first"),
         Prompt::Again { fixes } => eprintln!("  too short ({fixes} fixes): touch again and hold a moment"),
-        Prompt::Taken { fixes, .. } => {
+        Prompt::Taken { fixes, .. } | Prompt::Pivoted { fixes } => {
             if tty {
                 eprintln!("  taken ({fixes} fixes)")
             }
         }
+    };
+    let taken = calibrate::collect_touches(&mut device, &targets, patience, tell).and_then(|touched| {
+        let pivot = match pivot_at {
+            Some(at) => Some(take_pivot(&mut device, at, patience, tell)?),
+            None => None,
+        };
+        Ok((touched, pivot))
     });
-    let touched = match touched {
+    let (touched, pivot) = match taken {
         Ok(t) => t,
         Err(e) => {
             // Leave the device as it was.
@@ -591,6 +609,20 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
     };
     let mut cal = calibration::fit(&targets, &touched, kind, display)?;
     cal.device = Some(id);
+    if let (Some(p), Some(at)) = (pivot, pivot_at) {
+        let offset = calibration::pivot::tip_offset(&cal, &p, at);
+        cal.tip_offset_mm = Some(offset);
+        outln!(
+            "pivot: the emitter is {:.1} mm from the tip ({:.0}° of tilt, {:.2} mm RMS off the sphere); the pen's \
+             emitter-to-tip vector ({:.1}, {:.1}, {:.1}) mm is taken out of the glasses' positions",
+            p.radius_mm,
+            p.tilt_deg,
+            p.rms_mm,
+            offset.x,
+            offset.y,
+            offset.z
+        );
+    }
     outln!("target (u, v) mm     residual mm");
     for r in &cal.residuals {
         outln!(
@@ -645,6 +677,27 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
         outln!("written to the device: it now reports display coordinates (`penctl config save` keeps them)");
     }
     Ok(())
+}
+
+/// The pivot's sphere: asked again (up to three times) while its fixes do not make one, with
+/// the reason.
+fn take_pivot(
+    device: &mut Device,
+    at: glam::DVec2,
+    patience: Duration,
+    mut tell: impl FnMut(&Prompt),
+) -> Result<calibration::pivot::Pivot, calibrate::CalibrateError> {
+    const TRIES: usize = 3;
+    let mut tries = 0;
+    loop {
+        let fixes = calibrate::collect_pivot(device, at, patience, &mut tell)?;
+        tries += 1;
+        match calibration::pivot::fit_pivot(&fixes) {
+            Ok(p) => return Ok(p),
+            Err(why) if tries >= TRIES => return Err(calibrate::CalibrateError::Pivot { tries, why }),
+            Err(why) => eprintln!("  {why}"),
+        }
+    }
 }
 
 fn decode(hex_args: &[String], frame: bool) -> Result<()> {

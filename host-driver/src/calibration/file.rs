@@ -9,8 +9,13 @@ use serde::{Deserialize, Serialize};
 use super::fit::compact;
 use super::{Calibration, CalibrationError, DeviceId, DisplaySize, FitKind, TargetResidual, Transform};
 
-/// The calibration file's format version: 2 records the base station (`[device]`).
-pub const FILE_VERSION: u32 = 2;
+/// The calibration file's format version: 3 may record the pen's emitter-to-tip vector
+/// (`[pen]`, from the pivot); 2, still read, records the base station (`[device]`) as 3 does.
+pub const FILE_VERSION: u32 = 3;
+/// The format that recorded the base station but not the pen: read as 3 without `[pen]`.
+pub const FILE_VERSION_BOUND: u32 = 2;
+/// The longest emitter-to-tip vector a file may give, mm: a pen's emitter is in its nose.
+const TIP_OFFSET_MAX_MM: f64 = 100.0;
 /// The format before the base station was recorded: still read, and applied to any base station
 /// with a warning ([`Calibration::unbound_warning`]), so that an existing calibration keeps
 /// working until the user calibrates again.
@@ -59,19 +64,27 @@ struct FileFit {
     targets: Vec<FileTarget>,
 }
 
+#[derive(Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct FilePen {
+    tip_offset_mm: Option<[f64; 3]>,
+}
+
 #[derive(Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 struct File {
     version: Option<u32>,
     device: Option<FileDevice>,
+    pen: Option<FilePen>,
     display: Option<FileDisplay>,
     transform: Option<FileTransform>,
     fit: Option<FileFit>,
 }
 
 impl Calibration {
-    /// The calibration as the text of a TOML file: version 2 with the base station it belongs
-    /// to, or version 1 when it records none.
+    /// The calibration as the text of a TOML file: version 3 with the base station it belongs
+    /// to (and the pen's emitter-to-tip vector when the pivot measured it), or version 1 when it
+    /// records no base station (and then no pen: version 1 has no place for it).
     pub fn to_toml(&self) -> String {
         let q = self.transform.rotation;
         let t = self.transform.translation_mm;
@@ -83,6 +96,9 @@ impl Calibration {
             }),
             device: self.device.map(|d| FileDevice {
                 unique_id: Some(d.to_hex()),
+            }),
+            pen: self.device.and(self.tip_offset_mm).map(|t| FilePen {
+                tip_offset_mm: Some(t.to_array()),
             }),
             display: Some(FileDisplay {
                 width_mm: Some(self.display.width_mm),
@@ -130,18 +146,19 @@ impl Calibration {
             problem: problem.into(),
         };
         let missing = |key: &str| bad(key, "is missing");
+        let bound = |d: FileDevice| -> Result<Option<DeviceId>, CalibrationError> {
+            let id = d.unique_id.ok_or_else(|| missing("device.unique_id"))?;
+            let id = DeviceId::from_hex(&id).ok_or_else(|| {
+                bad(
+                    "device.unique_id",
+                    "must be the base station's 24 hex digits, as `penctl info` shows them",
+                )
+            })?;
+            Ok(Some(id))
+        };
         let device = match (file.version, file.device) {
-            (Some(FILE_VERSION), Some(d)) => {
-                let id = d.unique_id.ok_or_else(|| missing("device.unique_id"))?;
-                let id = DeviceId::from_hex(&id).ok_or_else(|| {
-                    bad(
-                        "device.unique_id",
-                        "must be the base station's 24 hex digits, as `penctl info` shows them",
-                    )
-                })?;
-                Some(id)
-            }
-            (Some(FILE_VERSION), None) => return Err(missing("device")),
+            (Some(FILE_VERSION | FILE_VERSION_BOUND), Some(d)) => bound(d)?,
+            (Some(FILE_VERSION | FILE_VERSION_BOUND), None) => return Err(missing("device")),
             (Some(FILE_VERSION_UNBOUND), None) => None,
             (Some(FILE_VERSION_UNBOUND), Some(_)) => {
                 return Err(bad("device", "is new in version 2: set `version = 2`"));
@@ -149,10 +166,29 @@ impl Calibration {
             (Some(v), _) => {
                 return Err(bad(
                     "version",
-                    &format!("is {v}; this program reads versions {FILE_VERSION_UNBOUND} and {FILE_VERSION}"),
+                    &format!("is {v}; this program reads versions {FILE_VERSION_UNBOUND} to {FILE_VERSION}"),
                 ));
             }
             (None, _) => return Err(missing("version")),
+        };
+        let tip_offset_mm = match (file.version, file.pen) {
+            (_, None) => None,
+            (Some(FILE_VERSION), Some(pen)) => {
+                let t = pen.tip_offset_mm.ok_or_else(|| missing("pen.tip_offset_mm"))?;
+                if t.iter().any(|v| !v.is_finite()) || DVec3::from_array(t).length() > TIP_OFFSET_MAX_MM {
+                    return Err(bad(
+                        "pen.tip_offset_mm",
+                        &format!("must be three finite numbers, at most {TIP_OFFSET_MAX_MM} mm long"),
+                    ));
+                }
+                Some(DVec3::from_array(t))
+            }
+            (_, Some(_)) => {
+                return Err(bad(
+                    "pen",
+                    &format!("is new in version {FILE_VERSION}: set `version = {FILE_VERSION}`"),
+                ));
+            }
         };
         let d = file.display.ok_or_else(|| missing("display"))?;
         let display = DisplaySize {
@@ -228,6 +264,7 @@ impl Calibration {
             display,
             residuals,
             device,
+            tip_offset_mm,
         })
     }
 

@@ -169,6 +169,11 @@ impl DisplaySize {
                 .collect(),
         }
     }
+
+    /// Where the pivot is taken ([`super::pivot`]): the display's centre.
+    pub fn pivot_target(&self) -> DVec2 {
+        DVec2::new(0.5 * self.width_mm, 0.5 * self.height_mm)
+    }
 }
 
 /// A fitted transform, tracker frame → display frame: `p_d = scale · R · p_t + translation`.
@@ -233,6 +238,11 @@ pub struct Calibration {
     /// The base station it was measured with, and the only one it is applied to; `None` for
     /// any (the identity, a fit not yet saved, a file of format version 1).
     pub device: Option<DeviceId>,
+    /// The pen's emitter-to-tip vector in the display frame, mm, as the pen was held for the
+    /// touches: the transform's translation took it in, so it is taken out again for the tracked
+    /// glasses ([`head_to_display`](Self::head_to_display)). Measured by the pivot
+    /// ([`super::pivot`]); `None` without one (older files, `penctl calibrate --no-pivot`).
+    pub tip_offset_mm: Option<DVec3>,
 }
 
 impl Calibration {
@@ -251,6 +261,7 @@ impl Calibration {
             display,
             residuals: Vec::new(),
             device: None,
+            tip_offset_mm: None,
         }
     }
 
@@ -286,6 +297,18 @@ impl Calibration {
     /// A tracker-frame point in the display frame.
     pub fn to_display(&self, tracker_mm: DVec3) -> DisplayPoint {
         self.point(self.transform.apply(tracker_mm))
+    }
+
+    /// The tracked glasses' emitter in the display frame, from the tracker frame or, with
+    /// `display_frame`, from a position the device mapped with this calibration's pose: the
+    /// pen's emitter-to-tip vector, which the pose carries for the pen, taken out.
+    pub fn head_to_display(&self, position_mm: DVec3, display_frame: bool) -> DisplayPoint {
+        let mapped = if display_frame {
+            position_mm
+        } else {
+            self.transform.apply(position_mm)
+        };
+        self.point(mapped - self.tip_offset_mm.unwrap_or(DVec3::ZERO))
     }
 }
 
@@ -445,6 +468,7 @@ pub fn fit(
         display,
         residuals,
         device: None,
+        tip_offset_mm: None,
     })
 }
 

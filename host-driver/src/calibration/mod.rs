@@ -5,7 +5,9 @@
 //! * [`file`]: the calibration file, `~/.config/penscape/calibration.toml`.
 //! * [`device`]: which base station a calibration belongs to (it is refused for any other), and
 //!   where each one's file is kept (the simulated pen's apart from the real one's).
-//! * [`procedure`]: leading the user (or the simulated pen) through the targets.
+//! * [`procedure`]: leading the user (or the simulated pen) through the targets and the pivot.
+//! * [`pivot`]: where the pen's tip is from its emitter, from the pen tilted about its tip; the
+//!   tracked glasses' positions have it taken out.
 //! * [`plot`]: the residuals as a PNG.
 //! * [`delays`]: each receiver's transducer delay from a pen held at surveyed points
 //!   (`penctl delays`).
@@ -14,9 +16,10 @@ pub mod delays;
 pub mod device;
 pub mod file;
 pub mod fit;
+pub mod pivot;
 pub mod plot;
 pub mod procedure;
 
 pub use device::{DeviceId, SIMULATED_ID, default_path, default_path_for, default_path_for_source, default_sim_path};
-pub use file::{FILE_VERSION, FILE_VERSION_UNBOUND};
+pub use file::{FILE_VERSION, FILE_VERSION_BOUND, FILE_VERSION_UNBOUND};
 pub use fit::{Calibration, CalibrationError, DisplaySize, FitKind, MIN_TARGETS, TargetResidual, Transform, fit};

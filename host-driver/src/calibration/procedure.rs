@@ -23,6 +23,10 @@ const SETTLE_US: u64 = 80_000;
 const AVERAGE_US: u64 = 300_000;
 /// Fixes a touch needs.
 const MIN_FIXES: usize = 10;
+/// The longest a pivot is taken, µs of device time (it ends when the pen is lifted).
+const PIVOT_MAX_US: u64 = 10_000_000;
+/// Fixes a pivot needs: the sphere's fit's least.
+const MIN_PIVOT_FIXES: usize = super::pivot::MIN_FIXES;
 
 /// What the procedure tells the user, as it goes.
 #[derive(Debug, Clone, PartialEq)]
@@ -52,6 +56,17 @@ pub enum Prompt {
         /// Device clock, µs.
         device_us: u64,
     },
+    /// Hold the tip on `at_mm` and tilt the pen about it, its top circling once, then lift
+    /// ([`collect_pivot`]).
+    Pivot {
+        /// Where, on the display.
+        at_mm: DVec2,
+    },
+    /// The pivot was taken.
+    Pivoted {
+        /// Fixes taken.
+        fixes: usize,
+    },
     /// Target taken.
     Taken {
         /// Where the pen was, tracker frame.
@@ -73,6 +88,14 @@ pub enum CalibrateError {
     /// The user did not touch a target in time.
     #[error("no touch within {0:?}")]
     Timeout(Duration),
+    /// The pivot's fixes did not make a sphere, try after try.
+    #[error("the pivot failed {tries} times; the last: {why}")]
+    Pivot {
+        /// Tries made.
+        tries: usize,
+        /// The last one's reason.
+        why: super::pivot::PivotError,
+    },
 }
 
 /// Attaches to the device within `timeout`.
@@ -126,73 +149,125 @@ pub fn collect_touches(
             count: targets.len(),
             target_mm,
         });
-        let deadline = Instant::now() + patience;
-        let mut lifted = false;
-        let mut told_lift = false;
-        let mut fixes: Vec<DVec3> = Vec::new();
-        let mut pressed_at: Option<u64> = None;
-        loop {
-            if Instant::now() > deadline {
-                return Err(CalibrateError::Timeout(patience));
-            }
-            let Some(event) = device.next(Duration::from_millis(50)) else {
-                continue;
-            };
-            let s = match event {
-                DeviceEvent::Sample(s, _) => s,
-                DeviceEvent::Lost(why) => return Err(CalibrateError::Device(format!("device lost: {why}"))),
-                _ => continue,
-            };
-            if s.in_range {
-                tell(&Prompt::Pen {
-                    position_mm: s.position_mm,
-                    pressed: s.sw[0],
-                    device_us: s.device_us,
-                });
-            }
-            if !s.sw[0] {
-                if pressed_at.take().is_some() {
-                    if fixes.len() >= MIN_FIXES {
-                        break;
-                    }
-                    tell(&Prompt::Again { fixes: fixes.len() });
-                    fixes.clear();
-                }
-                lifted = true;
-                continue;
-            }
-            if !lifted {
-                if !told_lift {
-                    tell(&Prompt::Lift);
-                    told_lift = true;
-                }
-                continue;
-            }
-            let start = *pressed_at.get_or_insert(s.device_us);
-            let held = s.device_us.saturating_sub(start);
-            // Only fresh fixes: a held position (in range, no receivers used) would weigh the
-            // last fix again.
-            if held >= SETTLE_US && s.in_range && s.quality.receivers_used > 0 {
-                fixes.push(s.position_mm);
-            }
-            if held >= SETTLE_US + AVERAGE_US && fixes.len() >= MIN_FIXES {
-                break;
-            }
-        }
+        let fixes = press(device, patience, &mut tell, Press::TOUCH)?;
         let mean = fixes.iter().sum::<DVec3>() / fixes.len() as f64;
         tell(&Prompt::Taken {
             touched_mm: mean,
             fixes: fixes.len(),
         });
         touched.push(mean);
-        // The next target is shown once the pen is off this one.
-        while Instant::now() < deadline {
-            match device.next(Duration::from_millis(50)) {
-                Some(DeviceEvent::Sample(s, _)) if !s.sw[0] => break,
-                Some(DeviceEvent::Lost(why)) => return Err(CalibrateError::Device(format!("device lost: {why}"))),
-                _ => {}
-            }
-        }
+        wait_for_lift(device, patience)?;
     }
     Ok(touched)
+}
+
+/// The pivot ([`super::pivot`]): the tip held on `at_mm` while the pen tilts about it, its top
+/// circling, SW1 pressed throughout. Returns the emitter's fixes (tracker frame), from
+/// [`SETTLE_US`] after the press to the release (at most [`PIVOT_MAX_US`]).
+pub fn collect_pivot(
+    device: &mut Device,
+    at_mm: DVec2,
+    patience: Duration,
+    mut tell: impl FnMut(&Prompt),
+) -> Result<Vec<DVec3>, CalibrateError> {
+    tell(&Prompt::Pivot { at_mm });
+    let fixes = press(device, patience, &mut tell, Press::PIVOT)?;
+    tell(&Prompt::Pivoted { fixes: fixes.len() });
+    wait_for_lift(device, patience)?;
+    Ok(fixes)
+}
+
+/// What one press takes: fixes from [`SETTLE_US`] after it for at most `hold_us`, and the
+/// fewest it needs (fewer, and the user is asked again).
+struct Press {
+    hold_us: u64,
+    min_fixes: usize,
+}
+
+impl Press {
+    const TOUCH: Press = Press {
+        hold_us: AVERAGE_US,
+        min_fixes: MIN_FIXES,
+    };
+    const PIVOT: Press = Press {
+        hold_us: PIVOT_MAX_US,
+        min_fixes: MIN_PIVOT_FIXES,
+    };
+}
+
+/// The fixes of one press of SW1 after a lift: the pen must first be lifted, then pressed; the
+/// press ends at its release or after `press.hold_us`. Gives up after `patience`.
+fn press(
+    device: &mut Device,
+    patience: Duration,
+    tell: &mut impl FnMut(&Prompt),
+    press: Press,
+) -> Result<Vec<DVec3>, CalibrateError> {
+    let deadline = Instant::now() + patience;
+    let mut lifted = false;
+    let mut told_lift = false;
+    let mut fixes: Vec<DVec3> = Vec::new();
+    let mut pressed_at: Option<u64> = None;
+    loop {
+        if Instant::now() > deadline {
+            return Err(CalibrateError::Timeout(patience));
+        }
+        let Some(event) = device.next(Duration::from_millis(50)) else {
+            continue;
+        };
+        let s = match event {
+            DeviceEvent::Sample(s, _) => s,
+            DeviceEvent::Lost(why) => return Err(CalibrateError::Device(format!("device lost: {why}"))),
+            _ => continue,
+        };
+        if s.in_range {
+            tell(&Prompt::Pen {
+                position_mm: s.position_mm,
+                pressed: s.sw[0],
+                device_us: s.device_us,
+            });
+        }
+        if !s.sw[0] {
+            if pressed_at.take().is_some() {
+                if fixes.len() >= press.min_fixes {
+                    return Ok(fixes);
+                }
+                tell(&Prompt::Again { fixes: fixes.len() });
+                fixes.clear();
+            }
+            lifted = true;
+            continue;
+        }
+        if !lifted {
+            if !told_lift {
+                tell(&Prompt::Lift);
+                told_lift = true;
+            }
+            continue;
+        }
+        let start = *pressed_at.get_or_insert(s.device_us);
+        let held = s.device_us.saturating_sub(start);
+        // Only fresh fixes: a held position (in range, no receivers used) would weigh the
+        // last fix again.
+        if held >= SETTLE_US && s.in_range && s.quality.receivers_used > 0 {
+            fixes.push(s.position_mm);
+        }
+        if held >= SETTLE_US + press.hold_us && fixes.len() >= press.min_fixes {
+            return Ok(fixes);
+        }
+    }
+}
+
+/// Waits until the pen is off the surface (SW1 open), so the next prompt is shown once the pen
+/// has left this one; at most `patience`.
+fn wait_for_lift(device: &mut Device, patience: Duration) -> Result<(), CalibrateError> {
+    let deadline = Instant::now() + patience;
+    while Instant::now() < deadline {
+        match device.next(Duration::from_millis(50)) {
+            Some(DeviceEvent::Sample(s, _)) if !s.sw[0] => break,
+            Some(DeviceEvent::Lost(why)) => return Err(CalibrateError::Device(format!("device lost: {why}"))),
+            _ => {}
+        }
+    }
+    Ok(())
 }
