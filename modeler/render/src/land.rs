@@ -415,8 +415,8 @@ impl Ground<'_> {
     #[inline]
     fn place(&self, x: f32, z: f32, half: f32) -> (f32, f32) {
         (
-            (x * self.inv - half).max(0.0).min(self.last[0]),
-            (z * self.inv - half).max(0.0).min(self.last[1]),
+            within(x * self.inv - half, self.last[0]),
+            within(z * self.inv - half, self.last[1]),
         )
     }
 
@@ -441,8 +441,8 @@ impl Ground<'_> {
             l => {
                 let m = &self.mips[l - 1];
                 let inv = self.inv / (1u32 << l) as f32;
-                let u = (x * inv).max(0.0).min((m.cols - 1) as f32);
-                let v = (z * inv).max(0.0).min((m.rows - 1) as f32);
+                let u = within(x * inv, (m.cols - 1) as f32);
+                let v = within(z * inv, (m.rows - 1) as f32);
                 m.cells[v as u32 as usize * m.cols + u as u32 as usize].unpack()
             }
         };
@@ -467,6 +467,15 @@ impl Ground<'_> {
         let k = 1.0 + fade * p[3];
         [p[0] * k, p[1] * k, p[2] * k]
     }
+}
+
+/// `v` clamped to `[0, last]`, a NaN to 0: `v.max(0.0).min(last)` as two compares (a NaN fails
+/// the first), without the NaN handling `f32::max` and `min` compile to (a tenth of a ground
+/// pixel's instructions). `last` is never NaN.
+#[inline(always)]
+fn within(v: f32, last: f32) -> f32 {
+    let v = if v > 0.0 { v } else { 0.0 };
+    if v < last { v } else { last }
 }
 
 /// `a + t·(b − a)` on four lanes.
