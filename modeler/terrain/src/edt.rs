@@ -24,10 +24,10 @@ use std::ops::{Add, Div, Mul, Sub};
 use rayon::prelude::*;
 
 use crate::cells::{Cell, Mask};
-use crate::pool::{self, Pool};
+use crate::pool::{self, COLUMNS};
 
 /// No source in the column (or the row).
-const FAR: u32 = u32::MAX;
+pub(crate) const FAR: u32 = u32::MAX;
 
 /// Squared Euclidean distance from each cell of a `w × h` box (row-major) to the nearest cell
 /// where `source` is true, or `u64::MAX` when there is no source at all.
@@ -35,24 +35,30 @@ pub fn squared(w: usize, h: usize, source: &[bool]) -> Vec<u64> {
     debug_assert_eq!(source.len(), w * h);
     let mut out = vec![u64::MAX; w * h];
     let mut g: Vec<u32> = source.iter().map(|&s| if s { 0 } else { FAR }).collect();
-    transform(w, h, &mut g, &mut out, |_, d2| d2 as u64);
+    transform(w, h, &mut g, &mut out, |d2| d2 as u64);
     out
 }
-
-/// The engine's maps' column distances, kept from call to call ([`crate::pool`]): 16 MB, a
-/// 1024² box's.
-static COLUMNS: Pool<u32> = Pool::new(4 << 20);
 
 /// The squared distances of [`squared`] from `g` (0 at the sources, [`FAR`] elsewhere; the
 /// column distances on return) through `f` into `out` (cells of a row without any source are
 /// left as they are): the engine's maps take their square roots as each row is done, with no
-/// squared map in between. `f` takes them as `i64`, which becomes an `f64` in one instruction
-/// (a `u64` takes several).
-fn transform<O: Send>(w: usize, h: usize, g: &mut [u32], out: &mut [O], f: impl Fn(usize, i64) -> O + Sync) {
+/// squared map in between. `f` takes them as `f64`s (exact: below 2^53), computed in `f64` from
+/// the start, so that a row's cells take their square roots two at a time (vector instructions).
+fn transform<O: Send>(w: usize, h: usize, g: &mut [u32], out: &mut [O], f: impl Fn(f64) -> O + Sync) {
     debug_assert_eq!(g.len(), w * h);
-    // Column pass: vertical distance to the nearest source in the column, two sweeps over rows
-    // (row by row rather than column by column, for the cache). `FAR` saturates, so each step is
-    // a minimum without branches, which compiles to vector instructions.
+    columns(w, h, g);
+    if w.max(h) <= NARROW_SIDE {
+        rows::<i64, O>(w, g, out, &f);
+    } else {
+        rows::<i128, O>(w, g, out, &f);
+    }
+}
+
+/// The column pass over a `w × h` box: each cell's vertical distance to the nearest cell of its
+/// column that holds 0 in `g` ([`FAR`] where none does), in place. Two sweeps over rows (row by
+/// row rather than column by column, for the cache). `FAR` saturates, so each step is a minimum
+/// without branches, which compiles to vector instructions.
+pub(crate) fn columns(w: usize, h: usize, g: &mut [u32]) {
     for y in 1..h {
         let (above, row) = g[(y - 1) * w..(y + 1) * w].split_at_mut(w);
         for (d, &a) in row.iter_mut().zip(above.iter()) {
@@ -65,28 +71,22 @@ fn transform<O: Send>(w: usize, h: usize, g: &mut [u32], out: &mut [O], f: impl 
             *d = (*d).min(b.saturating_add(1));
         }
     }
-    if w.max(h) <= NARROW_SIDE {
-        rows::<i64, O>(w, g, out, &f);
-    } else {
-        rows::<i128, O>(w, g, out, &f);
-    }
 }
 
 /// The longest box side whose envelope fractions fit `i64`: numerators are at most
 /// `2·side²` (2^41) and denominators `2·side` (2^21), so their cross products stay below 2^62.
 const NARROW_SIDE: usize = 1 << 20;
 
-/// The row pass over `g`'s rows into `out` (each squared distance through `f`, with its box
-/// index), rows in parallel, with fractions in `T`.
-fn rows<T: Wide, O: Send>(w: usize, g: &[u32], out: &mut [O], f: &(impl Fn(usize, i64) -> O + Sync)) {
+/// The row pass over `g`'s rows into `out` (each squared distance through `f`), rows in
+/// parallel, with fractions in `T`.
+fn rows<T: Wide, O: Send>(w: usize, g: &[u32], out: &mut [O], f: &(impl Fn(f64) -> O + Sync)) {
     let w1 = w.max(1);
     g.par_chunks(w1)
         .zip(out.par_chunks_mut(w1))
-        .enumerate()
         .with_min_len(16)
         .for_each_init(
             || Envelope::<T>::with_capacity(w),
-            |env, (y, (row, dst))| env.row(row, dst, |x, d2| f(y * w1 + x, d2)),
+            |env, (row, dst)| env.row(row, dst, f),
         );
 }
 
@@ -149,7 +149,7 @@ impl<T: Wide> Envelope<T> {
     }
 
     /// The squared distances of one row from its columns' vertical distances `g`.
-    fn row<O>(&mut self, g: &[u32], out: &mut [O], f: impl Fn(usize, i64) -> O) {
+    fn row<O>(&mut self, g: &[u32], out: &mut [O], f: impl Fn(f64) -> O) {
         self.v.clear();
         self.f.clear();
         self.z.clear();
@@ -191,9 +191,12 @@ impl<T: Wide> Envelope<T> {
         for (k, (&vk, &fk)) in v.iter().zip(fs).enumerate() {
             let end = z.get(k + 1).map_or(w, |&(num, den)| T::first_at_least(num, den, w));
             if end > start {
-                for (x, d) in (start..end).zip(&mut out[start..end]) {
-                    let dx = x as i64 - vk;
-                    *d = f(x, dx * dx + fk);
+                // Whole numbers below 2^53 in `f64`: the same squared distances, exactly, and a
+                // column as an `i32` (a box is narrower than 2^31) converts two at a time.
+                let (vk, fk) = (vk as f64, fk as f64);
+                for (x, d) in (start as i32..end as i32).zip(&mut out[start..end]) {
+                    let dx = f64::from(x) - vk;
+                    *d = f(dx * dx + fk);
                 }
                 start = end;
             }
@@ -211,12 +214,8 @@ pub fn from_sources(mask: &Mask, sources: &[Cell]) -> Vec<f32> {
         .filter_map(|&s| mask.index(s).filter(|&i| bits[i]))
         .collect();
     // The distance as the engine's maps hold it: the square root of the exact squared distance.
-    let dist = |inside: bool, d2: i64| {
-        if inside {
-            (d2 as f64).sqrt() as f32
-        } else {
-            f32::INFINITY
-        }
+    let dist = |inside: bool, d2: f64| {
+        if inside { d2.sqrt() as f32 } else { f32::INFINITY }
     };
     let w = (mask.width as usize).max(1);
     if let Some(&first) = inside.first()
@@ -233,7 +232,7 @@ pub fn from_sources(mask: &Mask, sources: &[Cell]) -> Vec<f32> {
                 let dy = y as i64 - sy;
                 for (x, (o, &b)) in row.iter_mut().zip(flags).enumerate() {
                     let dx = x as i64 - sx;
-                    *o = dist(b, dx * dx + dy * dy);
+                    *o = dist(b, (dx * dx + dy * dy) as f64);
                 }
             });
         return out;
@@ -249,10 +248,14 @@ pub fn from_sources(mask: &Mask, sources: &[Cell]) -> Vec<f32> {
     } else {
         pool::MAPS.unfilled(mask.box_len(), f32::INFINITY)
     };
-    transform(mask.width as usize, mask.height as usize, &mut g, &mut out, |i, d2| {
-        dist(bits[i], d2)
+    transform(mask.width as usize, mask.height as usize, &mut g, &mut out, |d2| {
+        dist(true, d2)
     });
     COLUMNS.give(g);
+    // The cells outside the region, in a second sweep without branches.
+    for (o, &b) in out.iter_mut().zip(bits) {
+        *o = if b { *o } else { f32::INFINITY };
+    }
     out
 }
 
@@ -274,7 +277,7 @@ pub fn to_edge(mask: &Mask) -> Vec<f32> {
     }
     // Every row of the bordered box has a source (its border), so each of its cells is written.
     let mut bordered = pool::MAPS.unfilled(pw * ph, 0.0);
-    transform(pw, ph, &mut g, &mut bordered, |_, d2| ((d2 as f64).sqrt() - 1.0) as f32);
+    transform(pw, ph, &mut g, &mut bordered, |d2| (d2.sqrt() - 1.0) as f32);
     COLUMNS.give(g);
     let mut out = pool::MAPS.filled(w * h, f32::INFINITY);
     for (y, row) in out.chunks_mut(w.max(1)).enumerate() {
@@ -328,8 +331,8 @@ mod tests {
                 .unwrap_or(FAR);
         }
         let (mut narrow, mut wide) = (vec![u64::MAX; w * h], vec![u64::MAX; w * h]);
-        rows::<i64, u64>(w, &g, &mut narrow, &|_, d2| d2 as u64);
-        rows::<i128, u64>(w, &g, &mut wide, &|_, d2| d2 as u64);
+        rows::<i64, u64>(w, &g, &mut narrow, &|d2| d2 as u64);
+        rows::<i128, u64>(w, &g, &mut wide, &|d2| d2 as u64);
         assert_eq!(narrow, full);
         assert_eq!(wide, full);
     }

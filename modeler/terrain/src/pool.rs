@@ -12,6 +12,10 @@ use std::sync::Mutex;
 /// figures dropped, for the next ones: 64 MB, a 512² region's maps for some fifteen figures.
 pub(crate) static MAPS: Pool<f32> = Pool::new(16 << 20);
 
+/// The distance transforms' integer maps ([`crate::edt`], [`crate::distance`]), kept from call to
+/// call: 16 MB, a 1024² box's.
+pub(crate) static COLUMNS: Pool<u32> = Pool::new(4 << 20);
+
 /// Freed buffers of `T`, at most `cap` elements of capacity in all.
 pub(crate) struct Pool<T> {
     kept: Mutex<Vec<Vec<T>>>,

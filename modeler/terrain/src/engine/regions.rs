@@ -159,6 +159,44 @@ fn shape(df: f32, dp: f32, s1: f64, outer: Option<f64>, log: Option<f32>) -> (f3
     (profile::shape_from_log(w, l, s) as f32, l)
 }
 
+/// Cells per step of [`shapes`]: its working rows live on the stack.
+const STEP: usize = 64;
+
+/// [`shape`] for a stretch of cells (their `df` and `dp`): each cell's shape term into `shape`,
+/// and its logarithm into `log` if given. A step of cells at a time: first every cell's weight and
+/// logarithm, then every cell's power. The numbers are [`shape`]'s, but each loop's cells are
+/// independent of each other and short enough that the processor overlaps several cells' `ln`
+/// (or `exp`), where a cell's `ln` then `exp` made one long chain per cell.
+fn shapes(df: &[f32], dp: &[f32], (s1, outer): (f64, Option<f64>), shape: &mut [f32], mut log: Option<&mut [f32]>) {
+    // A few cells (a moved figure's changed cells come in short stretches) do not pay for
+    // setting up the working rows.
+    if df.len() < STEP / 4 {
+        for (i, ((o, &f), &d)) in shape.iter_mut().zip(df).zip(dp).enumerate() {
+            let l;
+            (*o, l) = self::shape(f, d, s1, outer, None);
+            if let Some(log) = log.as_deref_mut() {
+                log[i] = l;
+            }
+        }
+        return;
+    }
+    for a in (0..df.len()).step_by(STEP) {
+        let e = (a + STEP).min(df.len());
+        let (mut w, mut s, mut l) = ([0.0; STEP], [0.0; STEP], [0.0f32; STEP]);
+        for ((((w, s), l), &f), &d) in w.iter_mut().zip(&mut s).zip(&mut l).zip(&df[a..e]).zip(&dp[a..e]) {
+            *w = profile::weight_real(f64::from(f), f64::from(d));
+            *s = outer.map_or(s1, |s0| profile::nested_slope(s1, s0, *w));
+            *l = profile::shape_log(*w, *s);
+        }
+        for (((o, &w), &s), &l) in shape[a..e].iter_mut().zip(&w).zip(&s).zip(&l) {
+            *o = profile::shape_from_log(w, l, s) as f32;
+        }
+        if let Some(log) = log.as_deref_mut() {
+            log[a..e].copy_from_slice(&l[..e - a]);
+        }
+    }
+}
+
 /// The cells of the nested region a closed curve bounds. Validation keeps a closed figure strictly
 /// inside its region, which puts its cells inside the region's; the intersection only guards
 /// against a rounding tie at a cell border, so that no region paints outside its parent.
@@ -286,17 +324,8 @@ impl Band<'_, '_> {
             let dp = &dp[cells.clone()];
             let (shape_k, coef_k) = (&mut shape_k[cells.clone()], &mut coef_k[cells.clone()]);
             if how.shapes.has(k) && !how.done[k] {
-                let s1 = how.slopes[k];
-                let cells = shape_k.iter_mut().zip(df).zip(dp);
-                if how.keep[k] {
-                    for (((sh, &f), &d), l) in cells.zip(&mut log_k[a..a + len]) {
-                        (*sh, *l) = shape(f, d, s1, how.outer, None);
-                    }
-                } else {
-                    for ((sh, &f), &d) in cells {
-                        *sh = shape(f, d, s1, how.outer, None).0;
-                    }
-                }
+                let log = how.keep[k].then(|| &mut log_k[a..a + len]);
+                shapes(df, dp, (how.slopes[k], how.outer), shape_k, log);
             }
             for ((((c, &sh), &n), &d), &v) in coef_k.iter_mut().zip(&*shape_k).zip(&*norm).zip(dp).zip(&inv[..len]) {
                 *c = sh * share_of(n, d, || v);
