@@ -259,3 +259,61 @@ pub fn edge_map(metric: Metric, mask: &Mask) -> Vec<f32> {
         Metric::Euclidean => edt::to_edge(mask),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The distances through the region by relaxation until nothing changes (no transform, no
+    /// queue), for comparison.
+    fn relaxed(mask: &Mask, sources: &[Cell]) -> Vec<u32> {
+        let (w, h, bits) = (mask.width as usize, mask.height as usize, mask.bits());
+        let mut d = vec![UNREACHABLE; w * h];
+        for &s in sources {
+            d[mask.index(s).unwrap()] = 0;
+        }
+        let mut changed = true;
+        while changed {
+            changed = false;
+            for i in (0..w * h).filter(|&i| bits[i]) {
+                let (x, y) = (i % w, i / w);
+                let near = [
+                    (x > 0).then(|| i - 1),
+                    (x + 1 < w).then(|| i + 1),
+                    (y > 0).then(|| i - w),
+                    (y + 1 < h).then(|| i + w),
+                ];
+                let best = near.into_iter().flatten().filter(|&j| bits[j]).map(|j| d[j]).min();
+                if let Some(b) = best.filter(|&b| b != UNREACHABLE && b + 1 < d[i]) {
+                    d[i] = b + 1;
+                    changed = true;
+                }
+            }
+        }
+        d
+    }
+
+    #[test]
+    fn a_bay_across_the_straight_path_leaves_the_distances_through_the_region() {
+        // A U: two arms 3 wide joined at the bottom, a bay 4 wide between them.
+        let cells: Vec<Cell> = (0..10u32)
+            .flat_map(|x| (0..12u32).map(move |y| (x + 5, y + 7)))
+            .filter(|&(x, y)| !((8..12).contains(&x) && y < 16))
+            .collect();
+        let mask = Mask::from_cells(&cells);
+        let tip = (5, 7);
+        let d = from_sources(&mask, &[tip]);
+        assert_eq!(d, relaxed(&mask, &[tip]));
+        // The other arm's tip, 9 columns across, is reached round the bay: 9 rows down, 9 columns
+        // across, 9 rows up.
+        let other = mask.index((14, 7)).unwrap();
+        assert_eq!(d[other], 27);
+        // Without the bay (a full rectangle) the straight distances.
+        let full: Vec<Cell> = (0..10u32)
+            .flat_map(|x| (0..12u32).map(move |y| (x + 5, y + 7)))
+            .collect();
+        let rect = Mask::from_cells(&full);
+        assert_eq!(from_sources(&rect, &[tip]), relaxed(&rect, &[tip]));
+        assert_eq!(from_sources(&rect, &[tip])[rect.index((14, 7)).unwrap()], 9);
+    }
+}
