@@ -137,8 +137,11 @@ pub fn render(
                 y0: y0 as i32,
                 y1: (y0 + rows) as i32,
             };
+            // Only the depth marks a sample empty: every reader looks at `invw` first, and a
+            // surface that wins a sample writes all of it (one store a sample, where the whole
+            // sample took three).
             for row in smp.chunks_mut(width) {
-                row[x0..x1].fill(Sample::default());
+                row[x0..x1].iter_mut().for_each(|s| s.invw = 0.0);
             }
             let mut sink = rasterise::DepthSink {
                 samples: smp,
