@@ -27,6 +27,8 @@ pub struct Pipeline {
     lost: u64,
     refused: Option<String>,
     notice: Option<String>,
+    /// Whether the glasses were told to lack the pen's vector (once per pipeline).
+    told_no_pivot: bool,
 }
 
 impl Pipeline {
@@ -50,6 +52,7 @@ impl Pipeline {
             lost: 0,
             refused: None,
             notice: None,
+            told_no_pivot: false,
         }
     }
 
@@ -59,7 +62,8 @@ impl Pipeline {
     }
 
     /// What the device session last said while it waits for a device
-    /// ([`DeviceEvent::Waiting`]), once: every tool shows it as it is.
+    /// ([`DeviceEvent::Waiting`]), or that a fitted calibration without the pivot's vector
+    /// carries the glasses' positions, once: every tool shows it as it is.
     pub fn take_notice(&mut self) -> Option<String> {
         self.notice.take()
     }
@@ -135,6 +139,16 @@ impl Pipeline {
                 // Only a device the calibration belongs to gets here (a refused one is detached).
                 // The glasses' own emitter: without the pen's emitter-to-tip vector.
                 let point = self.calibration.head_to_display(h.position_mm, h.display_frame);
+                let fitted = !self.calibration.residuals.is_empty();
+                if fitted && self.calibration.tip_offset_mm.is_none() && !self.told_no_pivot {
+                    self.told_no_pivot = true;
+                    self.notice = Some(
+                        "the calibration has no pen vector (calibrated with --no-pivot, or a file before version 3): \
+                         the glasses' positions are off by the pen's emitter-to-tip vector, about 8 mm; run \
+                         `penctl calibrate` again to take the pivot"
+                            .into(),
+                    );
+                }
                 out.push(self.head.on_sample(&h, point, now_us()));
                 None
             }

@@ -94,6 +94,93 @@ fn pend_publishes_the_head_in_the_display_frame() {
     assert!(tracked >= 280, "{tracked} of 300 tracked");
 }
 
+/// The pivot's vector (calibration file version 3, `[pen] tip_offset_mm`) is taken out of the
+/// glasses' positions in pend: the same device bytes come out moved by exactly minus it.
+#[test]
+fn pend_takes_the_pens_vector_out_of_the_glasses() {
+    let bound = Calibration {
+        device: Some(pen_host::calibration::SIMULATED_ID),
+        ..Calibration::identity(DisplaySize::REFERENCE)
+    };
+    let offset = DVec3::new(0.5, 4.5, -6.5);
+    let with_pen = Calibration {
+        tip_offset_mm: Some(offset),
+        ..bound.clone()
+    };
+    let (_, plain) = head_events(bound, 60);
+    let (_, moved) = head_events(with_pen, 60);
+    let mut compared = 0;
+    for (t, h) in &moved {
+        let (Some(m), Some((_, p))) = (h.at, plain.iter().find(|(u, _)| u == t)) else {
+            continue;
+        };
+        let Some(p) = p.at else { continue };
+        let d = DVec3::new(m.u_mm - p.u_mm, m.v_mm - p.v_mm, m.h_mm - p.h_mm);
+        // pend's lines round to 0.01 mm.
+        assert!(d.distance(-offset) < 0.02, "moved by {d}, not by {}", -offset);
+        compared += 1;
+    }
+    assert!(compared >= 30, "{compared} poses at the same device times");
+}
+
+/// A fitted calibration without the pivot's vector says so once, when the glasses first report;
+/// one with it, or the identity (nothing fitted, nothing taken in), says nothing.
+#[test]
+fn a_calibration_without_the_pens_vector_says_so_once_for_the_glasses() {
+    use pen_host::calibration::{SIMULATED_ID, TargetResidual};
+    use pen_host::pipeline::Pipeline;
+    use pen_host::source::Source;
+    use pen_host::transport::sim::SimOptions;
+    let fitted = Calibration {
+        device: Some(SIMULATED_ID),
+        residuals: vec![TargetResidual {
+            target_mm: glam::DVec2::new(60.0, 34.0),
+            touched_mm: DVec3::new(60.0, 34.0, 0.0),
+            residual_mm: 0.0,
+        }],
+        ..Calibration::identity(DisplaySize::REFERENCE)
+    };
+    let notices = |calibration: Calibration| {
+        let scenario = pen_sim::scenarios::by_name("viewer").expect("the viewer scenario");
+        let source = Source::Sim(SimOptions {
+            scenario,
+            seed: 1,
+            speed: 0.0,
+            plug: Default::default(),
+        });
+        let mut pipeline = Pipeline::new(source, calibration);
+        let (mut events, mut heads, mut said) = (Vec::new(), 0, Vec::new());
+        let end = Instant::now() + GUARD;
+        while heads < 100 && Instant::now() < end {
+            pipeline.poll(std::time::Duration::from_millis(50), &mut events);
+            heads += events
+                .drain(..)
+                .filter(|e| matches!(e.kind, EventKind::Head(_)))
+                .count();
+            said.extend(pipeline.take_notice());
+        }
+        assert!(heads >= 100, "{heads} head events");
+        said
+    };
+    let said = notices(fitted.clone());
+    assert_eq!(said.len(), 1, "{said:?}");
+    assert!(
+        said[0].contains("no pen vector") && said[0].contains("penctl calibrate"),
+        "{}",
+        said[0]
+    );
+    let with_pen = Calibration {
+        tip_offset_mm: Some(DVec3::new(0.0, 4.6, -6.6)),
+        ..fitted
+    };
+    assert_eq!(notices(with_pen), Vec::<String>::new());
+    let identity = Calibration {
+        device: Some(SIMULATED_ID),
+        ..Calibration::identity(DisplaySize::REFERENCE)
+    };
+    assert_eq!(notices(identity), Vec::<String>::new());
+}
+
 #[test]
 fn a_head_behind_the_display_is_refused_and_counted() {
     // A calibration turned over (180° about the display's u axis): every head comes out behind
