@@ -121,6 +121,9 @@ pub struct Renderer {
     /// The terrain's level-of-detail pyramid and the revision it was made for.
     pyramid: lod::Pyramid,
     pyramid_made: Option<penmodel_terrain::revision::Mark>,
+    /// What [`Renderer::prepare_terrain`] prepared for — the terrain's revision, the vertical
+    /// scale and the style — and what it found, for the frame that follows.
+    prepared: Option<(penmodel_terrain::revision::Mark, f32, Style, RenderStats)>,
 }
 
 impl Default for Renderer {
@@ -149,13 +152,14 @@ impl Renderer {
             trees: forest::Trees::default(),
             pyramid: lod::Pyramid::default(),
             pyramid_made: None,
+            prepared: None,
         }
     }
 
     /// Renders `scene` into `frame` (at the frame's size), mono or stereo as the scene asks.
     pub fn render(&mut self, scene: &Scene, frame: &mut Frame) -> Result<RenderStats, RenderError> {
         scene.camera.check()?;
-        let stats = self.prepare(scene);
+        let stats = self.prepare_frame(scene);
         let full = whole(frame);
         self.trees
             .prepare(scene, f64::from(frame.width()) / f64::from(frame.height()));
@@ -195,7 +199,7 @@ impl Renderer {
     /// Renders one eye of `scene` over the whole frame, with the UI, ignoring `scene.stereo`.
     pub fn render_eye(&mut self, scene: &Scene, eye: Eye, frame: &mut Frame) -> Result<RenderStats, RenderError> {
         scene.camera.check()?;
-        let stats = self.prepare(scene);
+        let stats = self.prepare_frame(scene);
         let full = whole(frame);
         self.trees
             .prepare(scene, f64::from(frame.width()) / f64::from(frame.height()));
@@ -277,6 +281,35 @@ impl Renderer {
             None => self.pyramid.build(map),
         }
         self.pyramid_made = scene.revisions.map(|r| r.mark());
+    }
+
+    /// Brings up to date what `scene`'s frames share whatever the camera: the land look's maps
+    /// and light, or the classic light, and the level-of-detail pyramid, for the terrain's
+    /// changes since the last frame. [`render`](Self::render) does it anyway; a frame latched
+    /// to the tracked head's newest pose (issue 16) does it first, before it waits for the
+    /// pose, so that the view drawn after the pose is only what the camera decides.
+    pub fn prepare_terrain(&mut self, scene: &Scene) {
+        let stats = self.prepare(scene);
+        self.prepared = scene
+            .revisions
+            .map(|r| (r.mark(), scene.vertical_scale, scene.style.clone(), stats));
+    }
+
+    /// The frame's [`prepare`](Self::prepare), unless [`prepare_terrain`](Self::prepare_terrain)
+    /// did it for the same terrain and style: a second call would take the still terrain for
+    /// one that stopped moving and remake the maps the land look lets lag a pull, inside the
+    /// latency window.
+    fn prepare_frame(&mut self, scene: &Scene) -> RenderStats {
+        match self.prepared.take() {
+            Some((mark, scale, style, stats))
+                if scene.revisions.map(|r| r.mark()) == Some(mark)
+                    && scale == scene.vertical_scale
+                    && style == scene.style =>
+            {
+                stats
+            }
+            _ => self.prepare(scene),
+        }
     }
 
     /// Per-frame work shared by both eyes: the light.

@@ -511,3 +511,43 @@ fn a_still_views_kept_background_equals_the_one_computed_per_pixel() {
         }
     }
 }
+
+/// A frame latched to the tracked head prepares the terrain before it takes the pose
+/// (`Renderer::prepare_terrain`); its frames and the maps' remakes are those of frames that do
+/// not, through a pull (the maps lag it) and after it stops.
+#[test]
+fn preparing_the_terrain_first_changes_neither_the_frames_nor_the_lag() {
+    use penmodel_terrain::{Edit, Editor, FigurePath};
+    let camera = crate::common::above(240.0);
+    let mut editor = Editor::new(edited_document()).expect("valid");
+    let (mut plain, mut first) = (Renderer::new(), Renderer::new());
+    let (mut a, mut b) = (
+        Frame::new(160, 120).expect("frame"),
+        Frame::new(160, 120).expect("frame"),
+    );
+    fn tracked(editor: &Editor, camera: penmodel_render::Camera) -> Scene<'_> {
+        let mut s = Scene::new(editor.heightmap(), camera);
+        s.style = style();
+        s.revisions = Some(editor.revisions());
+        s
+    }
+    // A pull: the height changes frame after frame, then stands still for a few frames.
+    let heights = [22.0, 26.0, 30.0, 34.0, 38.0, 42.0];
+    for frame in 0..heights.len() + 4 {
+        if let Some(&height) = heights.get(frame) {
+            let at = FigurePath::new(1, 0);
+            editor.apply(Edit::SetHeight { at, height }).expect("applies");
+        }
+        plain.render(&tracked(&editor, camera), &mut a).expect("render");
+        first.prepare_terrain(&tracked(&editor, camera));
+        first.render(&tracked(&editor, camera), &mut b).expect("render");
+        assert!(a.pixels() == b.pixels(), "frame {frame}: the frames differ");
+        assert_eq!(plain.land_remakes(), first.land_remakes(), "frame {frame}");
+    }
+    // The pull lagged: fewer remakes than frames that changed.
+    assert!(
+        plain.land_remakes() < heights.len() as u64 + 1,
+        "{}",
+        plain.land_remakes()
+    );
+}

@@ -664,7 +664,12 @@ impl Painter {
         said: &mut dyn FnMut(Vec<String>),
     ) -> Result<(&Frame, bool)> {
         let revisions = Some(session.editor.revisions());
-        self.insets(&Picture::of(session, look), session.editor.heightmap(), revisions)?;
+        let picture = Picture::of(session, look);
+        self.insets(&picture, session.editor.heightmap(), revisions)?;
+        // The terrain's changes taken in before the pose, not in the view after it: a frame
+        // after a burst of edits spent up to 26 ms on them inside the latency window.
+        self.renderer
+            .prepare_terrain(&scene(&picture, session.editor.heightmap(), revisions));
         let ended = latch_head(rx, session, said, Duration::from_micros(HEAD_WAIT_US));
         if let Some(t) = session.last_event_us().filter(|_| advance) {
             session.interaction.advance(t);
