@@ -4,7 +4,9 @@
 //! For each target the pen must first be lifted (SW1 open), then pressed on the target. While
 //! SW1 stays closed the tracker-frame positions are averaged, skipping the first 80 ms (the tip
 //! settling) and stopping after 300 ms; a touch with fewer than 10 fixes is refused and the user
-//! asked again. During the procedure the device reports raw tracker-frame positions: its
+//! asked again. Then the pivot ([`collect_pivot`]): one press on the display's centre while the
+//! pen tilts about its tip, every fix from 80 ms after the press to the release kept for
+//! [`super::pivot`]'s sphere. During the procedure the device reports raw tracker-frame positions: its
 //! display pose is removed (its tip constraint would project onto an uncalibrated plane) and put
 //! back — or replaced by the new calibration — afterwards.
 
