@@ -330,7 +330,9 @@ fn calibrating_the_simulated_pen_never_writes_the_real_devices_file() {
     );
     let text = std::fs::read_to_string(&sim).expect("read");
     assert!(
-        text.contains("version = 2") && text.contains("unique_id = \"70656e73636170652d73696d\""),
+        text.contains("version = 3")
+            && text.contains("unique_id = \"70656e73636170652d73696d\"")
+            && text.contains("[pen]\ntip_offset_mm"),
         "{text}"
     );
 
