@@ -115,8 +115,7 @@ impl<T: Copy> Binned<T> {
             }
             if t.iter().all(|&k| self.direct[k as usize]) {
                 let [a, b, c] = t.map(|k| &self.screen[k as usize]);
-                rasterise::triangle(a, b, c, bounds, sink);
-                rasterise::triangle(a, c, b, bounds, sink);
+                rasterise::two_sided(a, b, c, bounds, sink);
             } else {
                 let poly = clip::triangle(t.map(|k| self.clip[k as usize]), near);
                 if poly.len < 3 {
@@ -124,8 +123,7 @@ impl<T: Copy> Binned<T> {
                 }
                 let v: Vec<Vtx> = poly.vertices[..poly.len].iter().map(transform::project).collect();
                 for k in 1..poly.len - 1 {
-                    rasterise::triangle(&v[0], &v[k], &v[k + 1], bounds, sink);
-                    rasterise::triangle(&v[0], &v[k + 1], &v[k], bounds, sink);
+                    rasterise::two_sided(&v[0], &v[k], &v[k + 1], bounds, sink);
                 }
             }
         }

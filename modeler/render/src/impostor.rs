@@ -159,8 +159,7 @@ fn image(mesh: &Mesh, lit: &[f32], colours: &[[u8; 3]], bounds: &[Vec3; 2], side
     for (t, c) in mesh.indices.chunks_exact(3).zip(colours) {
         let [a, b, cc] = [0, 1, 2].map(|k| &screen[t[k] as usize]);
         sink.surface = Surface::Colour(*c);
-        rasterise::triangle(a, b, cc, &whole, &mut sink);
-        rasterise::triangle(a, cc, b, &whole, &mut sink);
+        rasterise::two_sided(a, b, cc, &whole, &mut sink);
     }
     let texels = samples
         .iter()

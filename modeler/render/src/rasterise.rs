@@ -242,6 +242,34 @@ pub fn holds_no_pixel(vs: [&Vtx; 4], bounds: &Bounds) -> bool {
 /// culled, as are triangles of zero area.
 #[inline]
 pub fn triangle<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut S) {
+    let Some(tile) = box_in(a, b, c, bounds) else {
+        return;
+    };
+    if area(a, b, c) > 0 {
+        fill(a, b, c, tile, sink);
+    }
+}
+
+/// Draws triangle `(a, b, c)` from whichever side faces the eye: as [`triangle`] of `(a, b, c)`
+/// and then of `(a, c, b)` (one of them is culled; zero area draws nothing), with the box and
+/// the area found once.
+#[inline]
+pub fn two_sided<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut S) {
+    let Some(tile) = box_in(a, b, c, bounds) else {
+        return;
+    };
+    // The box does not depend on the order, and `(a, c, b)`'s area is exactly minus this one.
+    match area(a, b, c) {
+        0 => {}
+        1.. => fill(a, b, c, tile, sink),
+        _ => fill(a, c, b, tile, sink),
+    }
+}
+
+/// The pixels `(px0, px1, py0, py1)` (inclusive) of `bounds` whose centres lie in the bounding
+/// box of `a`, `b`, `c`; `None` if there are none.
+#[inline]
+fn box_in(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds) -> Option<(i32, i32, i32, i32)> {
     let min_x = a.x.min(b.x).min(c.x);
     let max_x = a.x.max(b.x).max(c.x);
     let min_y = a.y.min(b.y).min(c.y);
@@ -251,14 +279,19 @@ pub fn triangle<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut 
     let px1 = ((max_x - HALF) >> SUBPIXEL).min(bounds.x1 - 1);
     let py0 = ((min_y - HALF + ONE - 1) >> SUBPIXEL).max(bounds.y0);
     let py1 = ((max_y - HALF) >> SUBPIXEL).min(bounds.y1 - 1);
-    if px0 > px1 || py0 > py1 {
-        return;
-    }
-    let area = (i64::from(b.x) - i64::from(a.x)) * (i64::from(c.y) - i64::from(a.y))
-        - (i64::from(c.x) - i64::from(a.x)) * (i64::from(b.y) - i64::from(a.y));
-    if area <= 0 {
-        return;
-    }
+    (px0 <= px1 && py0 <= py1).then_some((px0, px1, py0, py1))
+}
+
+/// Twice the signed area of `(a, b, c)` in fixed point: positive when clockwise on screen.
+#[inline]
+fn area(a: &Vtx, b: &Vtx, c: &Vtx) -> i64 {
+    (i64::from(b.x) - i64::from(a.x)) * (i64::from(c.y) - i64::from(a.y))
+        - (i64::from(c.x) - i64::from(a.x)) * (i64::from(b.y) - i64::from(a.y))
+}
+
+/// Draws the front-facing triangle `(a, b, c)` over the pixels `(px0, px1, py0, py1)` of its box.
+#[inline]
+fn fill<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, (px0, px1, py0, py1): (i32, i32, i32, i32), sink: &mut S) {
     let sx = px0 * ONE + HALF;
     let sy = py0 * ONE + HALF;
     let e0 = Edge::new(b, c, sx, sy);

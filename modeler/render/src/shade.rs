@@ -123,7 +123,14 @@ fn resolve_land(
             let c = if s.invw > 0.0 {
                 let w = 1.0 / s.invw;
                 let (at, d) = air.point(ray, w);
-                let c = surface_colour(s.surface, style).unwrap_or_else(|| {
+                // The terrain tested first, by itself: most covered samples are ground, and the
+                // match in `surface_colour` was a jump through a table for every one.
+                let own = if s.surface == Surface::Terrain {
+                    None
+                } else {
+                    surface_colour(s.surface, style)
+                };
+                let c = own.unwrap_or_else(|| {
                     let fade = ground.fine_fade(per_metre * s.invw, sin);
                     if s.invw < fine {
                         // The level whose cells are about the pixel's length: `fine / invw`
