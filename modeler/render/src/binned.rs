@@ -9,6 +9,10 @@ use super::clip::{self, ClipVertex};
 use super::rasterise::{self, Bounds, Sink, Vtx};
 use super::transform;
 
+/// Vertices from which a mesh is projected on the pool's threads ([`Binned::vertices_from`]):
+/// fewer, and a tree's few hundred cost more to hand out than to project.
+const PARALLEL_VERTICES: usize = 4096;
+
 /// One eye's projected triangles, each tagged with a `T` (what it shows).
 #[derive(Debug)]
 pub struct Binned<T> {
@@ -61,6 +65,50 @@ impl<T: Copy> Binned<T> {
         self.screen.push(transform::project(&v));
         self.clip.push(v);
         i
+    }
+
+    /// Adds the `n` vertices `vertex(0)`, …, `vertex(n − 1)`; returns the first one's index.
+    /// A large mesh's (a rock field's 10⁵ triangles) are projected on the pool's threads: it was
+    /// one side of the eye's join, alone, while the textured polygons took the other.
+    pub fn vertices_from(&mut self, n: usize, near: f32, vertex: impl Fn(usize) -> ClipVertex + Sync) -> u32 {
+        use rayon::prelude::*;
+        let first = self.clip.len();
+        let unset = ClipVertex {
+            x: 0.0,
+            y: 0.0,
+            w: 1.0,
+            h: 0.0,
+            l: 0.0,
+        };
+        self.clip.resize(first + n, unset);
+        self.screen.resize(first + n, Vtx::default());
+        self.direct.resize(first + n, false);
+        let fill = |(i, ((c, s), d)): (usize, ((&mut ClipVertex, &mut Vtx), &mut bool))| {
+            let v = vertex(i);
+            *d = v.inside(near);
+            *s = transform::project(&v);
+            *c = v;
+        };
+        let (clip, screen, direct) = (
+            &mut self.clip[first..],
+            &mut self.screen[first..],
+            &mut self.direct[first..],
+        );
+        if n >= PARALLEL_VERTICES {
+            clip.par_iter_mut()
+                .zip(screen.par_iter_mut())
+                .zip(direct.par_iter_mut())
+                .with_min_len(PARALLEL_VERTICES / 4)
+                .enumerate()
+                .for_each(fill);
+        } else {
+            clip.iter_mut()
+                .zip(screen.iter_mut())
+                .zip(direct.iter_mut())
+                .enumerate()
+                .for_each(fill);
+        }
+        first as u32
     }
 
     /// How many vertices were added this frame.

@@ -87,13 +87,13 @@ impl Projected {
         let s = cell_size as f32;
         let first = self.0.triangles();
         for mesh in meshes {
-            let base = self.0.vertices();
-            for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
+            let n = mesh.positions.len().min(mesh.normals.len());
+            let base = self.0.vertices_from(n, near, |i| {
+                let (p, n) = (mesh.positions[i], mesh.normals[i]);
                 let lambert = (n[0] * light[0] + n[1] * light[1] + n[2] * light[2]).abs();
                 let l = ambient + (1.0 - ambient) * lambert;
-                self.0
-                    .vertex(affine.clip_point(p[0] / s - 0.5, p[2] / s - 0.5, p[1], l), near);
-            }
+                affine.clip_point(p[0] / s - 0.5, p[2] / s - 0.5, p[1], l)
+            });
             let coloured = paint == Paint::Own && mesh.colors.len() == mesh.positions.len();
             self.0.extend(mesh.indices.chunks_exact(3).map(|t| {
                 let surface = match paint {
