@@ -10,9 +10,17 @@
 //!
 //! Run: `cargo run --release -p penmodel-terrain --example engine_digest`.
 //!
+//! `engine_digest --dump FILE` also writes every terrain's heights (`f32`, little-endian, in the
+//! order of the lines) to FILE; `engine_digest --compare FILE` reads such a file, written by
+//! another build, and reports the largest difference of a height from that build's, in metres and
+//! relative to the terrain's relief (its highest cell less its lowest), instead of equality.
+//!
 //! `engine_digest --full N taxicab|euclidean` instead builds example 1's 512² terrain N times
 //! (for `valgrind --tool=callgrind`: the difference of two counts is the cost of the extra
 //! builds).
+
+use std::fs::File;
+use std::io::{BufReader, BufWriter, Read, Write};
 
 use penmodel_terrain::{CurvePath, Document, Edit, Figure, FigureKind, FigurePath, Metric, TerrainEngine};
 
@@ -105,12 +113,58 @@ fn edits(f: &Figure, p: &FigurePath) -> Vec<(String, Edit)> {
     out
 }
 
-fn sequence(name: &str, metric: Metric, n: Option<u32>, json: &str) -> Result<(), String> {
+/// Where the heights go besides their digests: nowhere, a file, or a comparison with a file's.
+enum Record {
+    None,
+    Dump(BufWriter<File>),
+    /// The file, and the largest difference so far: metres, relative to the relief, and where.
+    Compare(BufReader<File>, f64, f64, String),
+}
+
+impl Record {
+    fn heights(&mut self, tag: &str, heights: &[f32]) -> Result<(), String> {
+        match self {
+            Record::None => {}
+            Record::Dump(out) => {
+                for v in heights {
+                    out.write_all(&v.to_le_bytes()).map_err(|e| e.to_string())?;
+                }
+            }
+            Record::Compare(input, metres, relative, at) => {
+                let mut bytes = vec![0u8; heights.len() * 4];
+                input.read_exact(&mut bytes).map_err(|e| format!("{tag}: {e}"))?;
+                let old: Vec<f32> = bytes
+                    .chunks_exact(4)
+                    .map(|b| f32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+                    .collect();
+                let (lo, hi) = old
+                    .iter()
+                    .fold((f32::INFINITY, f32::NEG_INFINITY), |(l, h), &v| (l.min(v), h.max(v)));
+                let relief = f64::from(hi - lo);
+                let diff = old
+                    .iter()
+                    .zip(heights)
+                    .map(|(&a, &b)| f64::from((a - b).abs()))
+                    .fold(0.0, f64::max);
+                if diff > *metres {
+                    (*metres, *at) = (diff, tag.to_string());
+                }
+                if relief > 0.0 {
+                    *relative = relative.max(diff / relief);
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+fn sequence(name: &str, metric: Metric, n: Option<u32>, json: &str, record: &mut Record) -> Result<(), String> {
     let mut doc = document(json, metric, n)?;
     let grid = format!("{}x{}", doc.grid.cols, doc.grid.rows);
     let tag = format!("{name} {metric:?} {grid}");
     let mut engine = TerrainEngine::new(&doc).map_err(|e| e.to_string())?;
     println!("{tag} full {:016x}", digest(engine.heightmap().heights()));
+    record.heights(&format!("{tag} full"), engine.heightmap().heights())?;
     for p in paths(&doc) {
         let f = p.get(&doc).ok_or("no figure")?.clone();
         for (label, edit) in edits(&f, &p) {
@@ -118,6 +172,7 @@ fn sequence(name: &str, metric: Metric, n: Option<u32>, json: &str) -> Result<()
                 Ok(applied) => {
                     engine.update(&doc, &applied.scope);
                     println!("{tag} {label} {:016x}", digest(engine.heightmap().heights()));
+                    record.heights(&format!("{tag} {label}"), engine.heightmap().heights())?;
                 }
                 Err(_) => println!("{tag} {label} refused"),
             }
@@ -125,6 +180,7 @@ fn sequence(name: &str, metric: Metric, n: Option<u32>, json: &str) -> Result<()
     }
     let fresh = TerrainEngine::new(&doc).map_err(|e| e.to_string())?;
     println!("{tag} fresh {:016x}", digest(fresh.heightmap().heights()));
+    record.heights(&format!("{tag} fresh"), fresh.heightmap().heights())?;
     Ok(())
 }
 
@@ -148,12 +204,33 @@ fn main() -> Result<(), String> {
         println!("{last:016x}");
         return Ok(());
     }
+    let file = |flag: &str| args.get(1).ok_or(format!("{flag} FILE"));
+    let mut record = match args.first().map(String::as_str) {
+        Some("--dump") => Record::Dump(BufWriter::new(
+            File::create(file("--dump")?).map_err(|e| e.to_string())?,
+        )),
+        Some("--compare") => Record::Compare(
+            BufReader::new(File::open(file("--compare")?).map_err(|e| e.to_string())?),
+            0.0,
+            0.0,
+            String::new(),
+        ),
+        Some(other) => return Err(format!("unknown flag {other}")),
+        None => Record::None,
+    };
     for (name, json) in EXAMPLES {
         for metric in [Metric::Taxicab, Metric::Euclidean] {
             for n in [None, Some(512)] {
-                sequence(name, metric, n, json)?;
+                sequence(name, metric, n, json, &mut record)?;
             }
         }
+    }
+    match record {
+        Record::Dump(mut out) => out.flush().map_err(|e| e.to_string())?,
+        Record::Compare(_, metres, relative, at) => {
+            println!("largest difference {metres:e} m ({relative:e} of the relief), at {at}");
+        }
+        Record::None => {}
     }
     Ok(())
 }

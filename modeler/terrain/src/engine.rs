@@ -13,7 +13,13 @@
 //!   Euclidean transforms of [`crate::edt`].
 //! - eq. 1 `w_k = df/(df + dp_k)`, 1 on the figure; eq. 2 `shape(w_k, s_k)`
 //!   ([`crate::profile::shape`]), with `s_k` the figure's slope, or for a nested figure eq. 4
-//!   `(s_k + s0)·w_k − s0` where `s0` is the enclosing figure's slope.
+//!   `(s_k + s0)·w_k − s0` where `s0` is the enclosing figure's slope. The engine takes eq. 2's
+//!   power as an exponential of a logarithm rounded to `f32` ([`crate::fastmath::shape_log`],
+//!   [`crate::fastmath::shape_from_log`]: polynomials within 2⁻⁴⁶ of `libm`'s, so that cells
+//!   are computed in vector instructions); its heights differ from a `libm` evaluation
+//!   ([`crate::profile::shape_from_log`]) by an `f32` unit of the relief in a few cells, and
+//!   since 24 Nov are no longer bit-identical to earlier builds'. They still equal a full
+//!   rebuild's to the bit after any edit.
 //! - eq. 3: on one or more figures, the mean of their reliefs; elsewhere the inverse-distance
 //!   blend `Σ(relief_k·shape_k/dp_k) / Σ(1/dp_k)`.
 //! - height(x) = base + that blend, for the innermost region containing x; 0 outside every region.

@@ -28,6 +28,7 @@ pub mod edt;
 pub mod engine;
 pub mod erosion;
 pub mod export;
+pub mod fastmath;
 // The fuzz targets' properties, shared with the stable test that replays their corpora.
 #[doc(hidden)]
 pub mod fuzzing;

@@ -8,14 +8,14 @@
 //! would let a value travel several cells in one pass and fix it too early).
 //!
 //! [`generate`] follows the `f32` arithmetic the engine documents (`shape_k` by
-//! `profile::shape_from_log` and `share_k` each rounded to `f32`, `coef_k` their `f32` product, then `base + Σ relief_k·coef_k` in figure
+//! `fastmath::shape_from_log` and `share_k` each rounded to `f32`, `coef_k` their `f32` product, then `base + Σ relief_k·coef_k` in figure
 //! order), so a correct engine matches it to the bit. Also compiled into the `terrain` bench (`#[path]`), hence the
 //! `dead_code` allowance: each user calls only part of it.
 #![allow(dead_code)]
 
 use penmodel_terrain::cells::{self, Cell, Mask};
 use penmodel_terrain::distance::UNREACHABLE;
-use penmodel_terrain::{Document, Figure, FigureKind, Grid, Heightmap, ValidationError, profile, validate};
+use penmodel_terrain::{Document, Figure, FigureKind, Grid, Heightmap, ValidationError, fastmath, profile, validate};
 
 /// The box indices of the 4-neighbours of box index `i` that lie in the box.
 fn neighbours(mask: &Mask, i: usize) -> [Option<usize>; 4] {
@@ -142,7 +142,7 @@ fn region(grid: &Grid, mask: &Mask, figs: &[Figure], base: f64, outer: Option<f6
             // Eq. 1, 2 and 4.
             let w = profile::weight(df[i], d[i]);
             let s = outer.map_or(f.slope, |s0| profile::nested_slope(f.slope, s0, w));
-            let coef = profile::shape_from_log(w, profile::shape_log(w, s), s) as f32 * share;
+            let coef = fastmath::shape_from_log(w, fastmath::shape_log(w, s), s) as f32 * share;
             h += rel * coef;
         }
         let (c, r) = cell;

@@ -4,14 +4,17 @@
 //! minus its nested regions'), and eq. 3's normaliser per cell, `norm`: `−n` on a cell where n
 //! figures stand, else `Σ_j 1/dp_j` in figure order (0 where no figure reaches). Per figure:
 //! its distances `dp`, its shape term `shape = eq. 2(w, s)` (eq. 1's `w`, eq. 4's slope for a
-//! nested figure) evaluated as `profile::shape_from_log` and rounded to `f32`, the logarithm that
-//! takes (`profile::shape_log`, kept for a top-level figure so that a slope change of the same
+//! nested figure) evaluated as `fastmath::shape_from_log` and rounded to `f32`, the logarithm that
+//! takes (`fastmath::shape_log`, kept for a top-level figure so that a slope change of the same
 //! sign is one `exp` per cell), and its coefficient `coef = shape × share` (an `f32` product),
 //! where `share` is eq. 3's weight read from `norm` and `dp` ([`share`]).
 //!
 //! Every path computes a cell's numbers with the same functions, and a cell's height always as
 //! `base + Σ_k relief_k·coef_k` in `f32`, figures in order ([`RegionNode::paint_own`]), so an
-//! updated terrain equals a full regeneration to the bit:
+//! updated terrain equals a full regeneration to the bit. Eq. 2's logarithm and exponential are
+//! [`crate::fastmath`]'s polynomials, not `libm`'s, so that a stretch of cells takes them in
+//! vector instructions (since 24 Nov: heights no longer bit-identical to earlier builds; over
+//! `engine_digest`'s terrains at most 2·10⁻¹⁰ of the relief from the `libm` ones):
 //!
 //! - **a moved figure** (a vertex, the whole figure; not a closed one): its new `dp` in full
 //!   (one breadth-first search or distance transform over the box, linear in its cells),
@@ -28,8 +31,7 @@
 //!   change, and every shape is computed again.
 //!
 //! The per-cell work runs on all cores (rayon), in bands of rows; the figures' distance maps of
-//! a region are computed in parallel, and in the taxicab metric a full blend's shapes a figure at
-//! a time through a table of its (df, dp) pairs ([`FigureNode::shapes_by_pairs`]). The maps come
+//! a region are computed in parallel. The maps come
 //! from and go back to [`crate::pool::MAPS`], so that a new engine does not fault in fresh pages. Within a row the cells are taken a stretch at a time (an
 //! owned run, or its dirty cells), each step over the whole stretch for one figure, in figure
 //! order: every cell still sees the arithmetic of a cell-by-cell evaluation, and the loops over
@@ -42,6 +44,7 @@ use crate::change::ListChange;
 use crate::detail;
 use crate::distance;
 use crate::document::{Figure, FigureKind, Grid, Metric, Point};
+use crate::fastmath;
 use crate::heightmap::Heightmap;
 use crate::pool::{MAPS, Pool};
 use crate::profile;
@@ -155,18 +158,18 @@ fn sign(s: f64) -> i8 {
 fn shape(df: f32, dp: f32, s1: f64, outer: Option<f64>, log: Option<f32>) -> (f32, f32) {
     let w = profile::weight_real(f64::from(df), f64::from(dp));
     let s = outer.map_or(s1, |s0| profile::nested_slope(s1, s0, w));
-    let l = log.unwrap_or_else(|| profile::shape_log(w, s));
-    (profile::shape_from_log(w, l, s) as f32, l)
+    let l = log.unwrap_or_else(|| fastmath::shape_log(w, s));
+    (fastmath::shape_from_log(w, l, s) as f32, l)
 }
 
 /// Cells per step of [`shapes`]: its working rows live on the stack.
 const STEP: usize = 64;
 
 /// [`shape`] for a stretch of cells (their `df` and `dp`): each cell's shape term into `shape`,
-/// and its logarithm into `log` if given. A step of cells at a time: first every cell's weight and
-/// logarithm, then every cell's power. The numbers are [`shape`]'s, but each loop's cells are
-/// independent of each other and short enough that the processor overlaps several cells' `ln`
-/// (or `exp`), where a cell's `ln` then `exp` made one long chain per cell.
+/// and its logarithm into `log` if given. A step of cells at a time: every cell's weight,
+/// logarithm and power, then every cell's exponential, then its shape term. The numbers are
+/// [`shape`]'s (the same operations in the same order), but each loop is free of branches and
+/// calls, and compiles to vector instructions.
 fn shapes(df: &[f32], dp: &[f32], (s1, outer): (f64, Option<f64>), shape: &mut [f32], mut log: Option<&mut [f32]>) {
     // A few cells (a moved figure's changed cells come in short stretches) do not pay for
     // setting up the working rows.
@@ -182,17 +185,41 @@ fn shapes(df: &[f32], dp: &[f32], (s1, outer): (f64, Option<f64>), shape: &mut [
     }
     for a in (0..df.len()).step_by(STEP) {
         let e = (a + STEP).min(df.len());
-        let (mut w, mut s, mut l) = ([0.0; STEP], [0.0; STEP], [0.0f32; STEP]);
-        for ((((w, s), l), &f), &d) in w.iter_mut().zip(&mut s).zip(&mut l).zip(&df[a..e]).zip(&dp[a..e]) {
+        let (mut w, mut s, mut l, mut y) = ([0.0; STEP], [0.0; STEP], [0.0f32; STEP], [0.0; STEP]);
+        let cells = w.iter_mut().zip(&mut s).zip(&mut l).zip(&mut y);
+        for ((((w, s), l), y), (&f, &d)) in cells.zip(df[a..e].iter().zip(&dp[a..e])) {
             *w = profile::weight_real(f64::from(f), f64::from(d));
             *s = outer.map_or(s1, |s0| profile::nested_slope(s1, s0, *w));
-            *l = profile::shape_log(*w, *s);
+            *l = fastmath::shape_log(*w, *s);
+            *y = fastmath::power(*l, *s);
         }
-        for (((o, &w), &s), &l) in shape[a..e].iter_mut().zip(&w).zip(&s).zip(&l) {
-            *o = profile::shape_from_log(w, l, s) as f32;
+        // The exponentials alone in their loop: it compiles to vector instructions.
+        for y in &mut y {
+            *y = fastmath::exp(*y);
+        }
+        for (((o, &w), &s), &e) in shape[a..e].iter_mut().zip(&w).zip(&s).zip(&y) {
+            *o = fastmath::shape_from_exp(w, e, s) as f32;
         }
         if let Some(log) = log.as_deref_mut() {
             log[a..e].copy_from_slice(&l[..e - a]);
+        }
+    }
+}
+
+/// The shape terms of a top-level figure of slope `s ≠ 0` from its kept logarithms `log`:
+/// [`fastmath::shape_from_log`] a step of cells at a time, the exponentials in a loop of their own
+/// (vector instructions).
+fn shapes_from_logs(log: &[f32], s: f64, shape: &mut [f32]) {
+    for (log, shape) in log.chunks(STEP).zip(shape.chunks_mut(STEP)) {
+        let mut y = [0.0; STEP];
+        for (y, &l) in y.iter_mut().zip(log) {
+            *y = fastmath::power(l, s);
+        }
+        for y in &mut y {
+            *y = fastmath::exp(*y);
+        }
+        for (o, &e) in shape.iter_mut().zip(&y) {
+            *o = fastmath::shape_from_exp(0.0, e, s) as f32;
         }
     }
 }
@@ -254,8 +281,6 @@ struct Blend<'a> {
     keep: &'a [bool],
     outer: Option<f64>,
     shapes: Shapes,
-    /// Per figure, whether its shapes were computed before the bands ([`FigureNode::shapes_by_pairs`]).
-    done: &'a [bool],
 }
 
 /// One band's slices of the region's and its figures' maps.
@@ -323,7 +348,7 @@ impl Band<'_, '_> {
         {
             let dp = &dp[cells.clone()];
             let (shape_k, coef_k) = (&mut shape_k[cells.clone()], &mut coef_k[cells.clone()]);
-            if how.shapes.has(k) && !how.done[k] {
+            if how.shapes.has(k) {
                 let log = how.keep[k].then(|| &mut log_k[a..a + len]);
                 shapes(df, dp, (how.slopes[k], how.outer), shape_k, log);
             }
@@ -349,72 +374,6 @@ impl FigureNode {
             log_sign: 0,
             child,
         }
-    }
-}
-
-impl FigureNode {
-    /// The shapes (and, with `keep`, the logarithms) on the owned cells `owned` of a box `w`
-    /// wide, for slope `s1` (nested in a figure of slope `outer`), through a table of the
-    /// (df, dp) pairs: with the taxicab metric's whole distances a cell's shape is a function of
-    /// the pair, and a 512² region of 150 000 cells has some 60 000 pairs per figure, so most
-    /// cells read their numbers, computed by the same [`shape`], instead of taking a logarithm
-    /// and an exponential. `false` (nothing done) when a distance is infinite or the table would
-    /// be large.
-    fn shapes_by_pairs(
-        &mut self,
-        df: &[f32],
-        owned: &[Run],
-        w: usize,
-        (s1, outer): (f64, Option<f64>),
-        keep: bool,
-    ) -> bool {
-        let FigureNode { dp, shape: sh, log, .. } = self;
-        let ranges = || {
-            owned.iter().map(move |run| {
-                let r = run.row as usize * w;
-                r + run.start as usize..r + run.end as usize
-            })
-        };
-        // The table's size: the largest distances (taxicab ones are whole numbers, or infinite
-        // where the figure cannot reach, which leaves this path).
-        let (mut hi_f, mut hi_d, mut count) = (0f32, 0f32, 0usize);
-        for r in ranges() {
-            count += r.len();
-            for &d in &dp[r.clone()] {
-                hi_d = if d > hi_d { d } else { hi_d };
-            }
-            for &f in &df[r] {
-                hi_f = if f > hi_f { f } else { hi_f };
-            }
-        }
-        if !hi_d.is_finite() || !hi_f.is_finite() {
-            return false;
-        }
-        // A table of at most two entries per cell, its indices exact in `f32` (computed from the
-        // distances as `df·stride + dp` with one conversion).
-        let stride = hi_d + 1.0;
-        let size = (hi_f + 1.0) * stride;
-        if size > (2 * count) as f32 || size >= (1u32 << 24) as f32 {
-            return false;
-        }
-        // Per pair its shape and logarithm; NaN: not yet computed.
-        let (mut shapes, mut logs) = (MAPS.filled(size as usize, f32::NAN), MAPS.unfilled(size as usize, 0.0));
-        for r in ranges() {
-            let cells = df[r.clone()].iter().zip(&dp[r.clone()]).zip(&mut sh[r.clone()]);
-            for (((&f, &d), out), l) in cells.zip(&mut log[r]) {
-                let at = (f * stride + d) as usize;
-                if shapes[at].is_nan() {
-                    (shapes[at], logs[at]) = shape(f, d, s1, outer, None);
-                }
-                *out = shapes[at];
-                if keep {
-                    *l = logs[at];
-                }
-            }
-        }
-        MAPS.give(shapes);
-        MAPS.give(logs);
-        true
     }
 }
 
@@ -684,7 +643,6 @@ impl RegionNode {
             row_runs,
             norm,
             figures,
-            metric,
             ..
         } = self;
         // The logarithms are kept for top-level figures of nonzero slope.
@@ -697,18 +655,6 @@ impl RegionNode {
                 _ => 0,
             };
         }
-        // In the taxicab metric a full blend computes the shapes a figure at a time, each (df, dp)
-        // pair once; figures on all cores.
-        let done: Vec<bool> = if dirty.is_none() && *metric == Metric::Taxicab {
-            let (df, owned) = (&*df, &*owned);
-            figures
-                .par_iter_mut()
-                .enumerate()
-                .map(|(k, f)| shapes.has(k) && f.shapes_by_pairs(df, owned, w, (slopes[k], outer), keep[k]))
-                .collect()
-        } else {
-            vec![false; figures.len()]
-        };
         // Each band's slices of every figure's maps, so that bands can be written in parallel.
         let mut per_figure: Vec<_> = figures
             .iter_mut()
@@ -729,7 +675,7 @@ impl RegionNode {
             bands.push((b, norm, df, dps, maps));
         }
         let (owned, row_runs) = (&*owned, &*row_runs);
-        let (slopes, keep, done) = (&slopes[..], &keep[..], &done[..]);
+        let (slopes, keep) = (&slopes[..], &keep[..]);
         bands.into_par_iter().for_each(|(b, norm, df, dps, mut maps)| {
             let (row0, rows) = (b * BAND_ROWS, norm.len() / w);
             let mut scratch = Scratch::new(dps.len(), w);
@@ -748,7 +694,6 @@ impl RegionNode {
                         keep,
                         outer,
                         shapes,
-                        done,
                     },
                 );
             };
@@ -800,23 +745,18 @@ impl RegionNode {
                     let xs = run.start as usize..run.end as usize;
                     let i0 = r * w + xs.start;
                     let (df, dp, norm) = (&df[i0..], &dp[i0..], &norm[i0..]);
-                    let cells = shape_row[xs.clone()].iter_mut().zip(&mut coef_row[xs.clone()]);
+                    let len = xs.len();
+                    let shape_run = &mut shape_row[xs.clone()];
                     if reuse && s1 != 0.0 {
                         // The kept logarithm and the slope make the shape: eq. 1's `w`, which
                         // `shape_from_log` reads only at slope 0, is not needed.
-                        for ((((sh, c), &l), &d), &n) in cells.zip(&log_row[xs]).zip(dp).zip(norm) {
-                            *sh = profile::shape_from_log(0.0, l, s1) as f32;
-                            *c = *sh * share(n, d);
-                        }
+                        shapes_from_logs(&log_row[xs.clone()], s1, shape_run);
                     } else {
-                        for (((((sh, c), l), &f), &d), &n) in cells.zip(&mut log_row[xs]).zip(df).zip(dp).zip(norm) {
-                            let (s, kept) = shape(f, d, s1, outer, reuse.then_some(*l));
-                            *sh = s;
-                            *c = s * share(n, d);
-                            if keep {
-                                *l = kept;
-                            }
-                        }
+                        let log = keep.then(|| &mut log_row[xs.clone()]);
+                        shapes(&df[..len], &dp[..len], (s1, outer), shape_run, log);
+                    }
+                    for (((c, &sh), &d), &n) in coef_row[xs].iter_mut().zip(&*shape_run).zip(dp).zip(norm) {
+                        *c = sh * share(n, d);
                     }
                 }
             });
