@@ -17,7 +17,8 @@
 //!
 //! `engine_digest --full N taxicab|euclidean` instead builds example 1's 512² terrain N times
 //! (for `valgrind --tool=callgrind`: the difference of two counts is the cost of the extra
-//! builds).
+//! builds). `engine_digest --moves N METRIC` and `--slopes N METRIC` build it once, then move
+//! its second figure's middle vertex, or change that figure's slope, N times back and forth.
 
 use std::fs::File;
 use std::io::{BufReader, BufWriter, Read, Write};
@@ -184,18 +185,60 @@ fn sequence(name: &str, metric: Metric, n: Option<u32>, json: &str, record: &mut
     Ok(())
 }
 
+/// The metric a `--full`, `--moves` or `--slopes` run names (taxicab unless `euclidean`).
+fn metric_arg(arg: Option<&String>) -> Metric {
+    match arg.map(String::as_str) {
+        Some("euclidean") => Metric::Euclidean,
+        _ => Metric::Taxicab,
+    }
+}
+
+/// `--moves N METRIC` / `--slopes N METRIC`: example 1's 512² terrain built once, then its
+/// second figure's middle vertex moved (or its slope changed) N times, back and forth.
+fn edits_only(kind: &str, args: &[String]) -> Result<(), String> {
+    let count: usize = args
+        .get(1)
+        .and_then(|a| a.parse().ok())
+        .ok_or(format!("{kind} N taxicab|euclidean"))?;
+    let metric = metric_arg(args.get(2));
+    let mut doc = document(EXAMPLES[0].1, metric, Some(512))?;
+    let mut engine = TerrainEngine::new(&doc).map_err(|e| e.to_string())?;
+    let p = FigurePath::new(0, 1);
+    let f = p.get(&doc).ok_or("no figure")?.clone();
+    let index = f.points.len() / 2;
+    let [x, y] = f.points[index];
+    for i in 0..count {
+        let step = if i % 2 == 0 { 1.0 } else { 0.0 };
+        let edit = if kind == "--moves" {
+            Edit::MovePoint {
+                curve: CurvePath::Figure(p.clone()),
+                index,
+                to: [x + 2.5 * step, y - 1.5 * step],
+            }
+        } else {
+            Edit::SetSlope {
+                at: p.clone(),
+                slope: f.slope + 0.3 * step,
+            }
+        };
+        let applied = edit.apply_to(&mut doc).map_err(|e| e.to_string())?;
+        engine.update(&doc, &applied.scope);
+    }
+    println!("{:016x}", digest(engine.heightmap().heights()));
+    Ok(())
+}
+
 fn main() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
+    if let Some(kind @ ("--moves" | "--slopes")) = args.first().map(String::as_str) {
+        return edits_only(kind, &args);
+    }
     if args.first().map(String::as_str) == Some("--full") {
         let count: usize = args
             .get(1)
             .and_then(|a| a.parse().ok())
             .ok_or("--full N taxicab|euclidean")?;
-        let metric = match args.get(2).map(String::as_str) {
-            Some("euclidean") => Metric::Euclidean,
-            _ => Metric::Taxicab,
-        };
-        let doc = document(EXAMPLES[0].1, metric, Some(512))?;
+        let doc = document(EXAMPLES[0].1, metric_arg(args.get(2)), Some(512))?;
         let mut last = 0;
         for _ in 0..count {
             let engine = TerrainEngine::new(&doc).map_err(|e| e.to_string())?;
