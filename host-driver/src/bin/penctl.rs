@@ -583,7 +583,8 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
         ),
         Prompt::Pen { .. } => {}
         Prompt::Lift => eprintln!("  lift the pen first"),
-        Prompt::Again { fixes } => eprintln!("  too short ({fixes} fixes): touch again and hold a moment"),
+        // After a touch or the pivot alike.
+        Prompt::Again { fixes } => eprintln!("  too short ({fixes} fixes): press again and hold it longer"),
         Prompt::Taken { fixes, .. } | Prompt::Pivoted { fixes } => {
             if tty {
                 eprintln!("  taken ({fixes} fixes)")

@@ -44,7 +44,7 @@ pub enum Prompt {
     },
     /// Lift the pen first.
     Lift,
-    /// The touch was too short or unsteady: touch again.
+    /// The touch or the pivot was too short: press again.
     Again {
         /// Fixes taken.
         fixes: usize,
