@@ -22,6 +22,7 @@ use crate::cells::{Cell, Mask};
 use crate::document::Metric;
 use crate::edt;
 use crate::pool;
+use crate::simd;
 
 /// Distance of a cell no path within the region reaches (and of cells outside the region).
 pub const UNREACHABLE: u32 = u32::MAX;
@@ -72,7 +73,9 @@ impl Level for f32 {
         pool::MAPS.unfilled(len, f32::INFINITY)
     }
     fn of(d: u32) -> f32 {
-        d as f32
+        // Through `i32` (exact: `d` is below 2^24), which converts four or eight at a time; a
+        // `u32` has no vector conversion before AVX-512.
+        d as i32 as f32
     }
 }
 
@@ -118,9 +121,11 @@ fn bfs<D: Level>(mask: &Mask, dist: &mut [D], mut front: Vec<(u32, u32)>) {
 /// cell holding 0 in `g`, over every cell of the box, region or not ([`edt::FAR`] where no cell
 /// holds 0). It is separable, like the Euclidean one: the column pass, then per row the least
 /// column distance plus the horizontal one, by a sweep each way. A few branch-free operations per
-/// cell, against some sixty (and mispredicted branches) for a breadth-first search.
-fn taxicab_transform(w: usize, h: usize, g: &mut [u32]) {
-    edt::columns(w, h, g);
+/// cell, against some sixty (and mispredicted branches) for a breadth-first search. Called
+/// through [`taxicab_transform`].
+#[inline(always)]
+fn taxicab_body(w: usize, h: usize, g: &mut [u32]) {
+    edt::columns_body(w, h, g);
     for row in g.chunks_mut(w.max(1)) {
         let mut run = edt::FAR;
         for d in row.iter_mut() {
@@ -139,8 +144,10 @@ fn taxicab_transform(w: usize, h: usize, g: &mut [u32]) {
 /// [`edt::FAR`] on the border and outside the region) are the distances through the region's
 /// cells: every region cell but a source (0) has a region 4-neighbour one closer, so a path of its
 /// length inside the region leads down to a source, and no path is shorter than the straight
-/// taxicab distance. A bay of the region that a shortest path would cross fails it.
-fn inside_paths(pw: usize, g: &[u32]) -> bool {
+/// taxicab distance. A bay of the region that a shortest path would cross fails it. Called
+/// through [`inside_paths`].
+#[inline(always)]
+fn inside_body(pw: usize, g: &[u32]) -> bool {
     let mut bad = false;
     for y in 1..(g.len() / pw).saturating_sub(1) {
         let i = y * pw;
@@ -154,11 +161,28 @@ fn inside_paths(pw: usize, g: &[u32]) -> bool {
     !bad
 }
 
+simd::twice! {
+    /// [`taxicab_body`], eight `u32` lanes wide where the CPU has AVX2 ([`crate::simd`]).
+    fn taxicab_transform(w: usize, h: usize, g: &mut [u32]) = taxicab_body;
+}
+
+simd::twice! {
+    /// [`inside_body`], eight lanes wide where the CPU has AVX2.
+    fn inside_paths(pw: usize, g: &[u32]) -> bool = inside_body;
+}
+
 /// [`from_sources`] in either storage: the taxicab transform of the box (with a border) when its
 /// distances are those through the region ([`inside_paths`]: no bay of the region in the way),
 /// else the breadth-first search.
 fn search_from<D: Level>(mask: &Mask, sources: &[Cell]) -> Vec<D> {
     let (w, h, bits) = (mask.width as usize, mask.height as usize, mask.bits());
+    let mut inside = sources.iter().filter_map(|&s| mask.index(s).filter(|&i| bits[i]));
+    if let Some(first) = inside.next()
+        && inside.all(|i| i == first)
+        && let Some(out) = from_one(mask, first)
+    {
+        return out;
+    }
     let pw = w + 2;
     let mut g = pool::COLUMNS.filled(pw * (h + 2), edt::FAR);
     let mut any = false;
@@ -204,6 +228,69 @@ fn search_from<D: Level>(mask: &Mask, sources: &[Cell]) -> Vec<D> {
     }
     bfs(mask, &mut dist, front);
     dist
+}
+
+/// The taxicab distances from the one source cell at box index `s` (a point figure), when they
+/// are those through the region: `|x − sx| + |y − sy|` directly, which is what the transform of
+/// [`search_from`] gives for one source, and [`inside_paths`]' test on them by the mask alone —
+/// every region cell but the source has a region neighbour one step toward it (left of it, right,
+/// above or below, as the source lies). `None` when a bay is in the way.
+fn from_one<D: Level>(mask: &Mask, s: usize) -> Option<Vec<D>> {
+    let (w, bits) = ((mask.width as usize).max(1), mask.bits());
+    let (sx, sy) = (s % w, s / w);
+    let ok = bits.chunks(w).enumerate().all(|(y, row)| {
+        // The row toward the source (none on its row): its flags, or no cell.
+        let toward = match y.cmp(&sy) {
+            std::cmp::Ordering::Less => Some(&bits[(y + 1) * w..][..w]),
+            std::cmp::Ordering::Equal => None,
+            std::cmp::Ordering::Greater => Some(&bits[(y - 1) * w..][..w]),
+        };
+        one_row_ok(row, toward, sx)
+    });
+    if !ok {
+        return None;
+    }
+    let mut out = D::blank(mask.box_len());
+    for (y, (line, row)) in out.chunks_mut(w).zip(bits.chunks(w)).enumerate() {
+        let dy = y.abs_diff(sy) as u32;
+        for (x, (o, &b)) in line.iter_mut().zip(row).enumerate() {
+            *o = if b {
+                D::of(x.abs_diff(sx) as u32 + dy)
+            } else {
+                D::UNSEEN
+            };
+        }
+    }
+    Some(out)
+}
+
+/// Whether every region cell of `row` has a region neighbour one step toward the source at column
+/// `sx`: the cell beside it toward `sx`, or the one in the row `toward` (the row nearer the
+/// source's; `None` on the source's row, where the source itself needs none).
+fn one_row_ok(row: &[bool], toward: Option<&[bool]>, sx: usize) -> bool {
+    // The source's column lies in the box: `sx < row.len()`.
+    let w = row.len();
+    let (left, right) = (&row[..sx], &row[sx + 1..]);
+    // Left of the source the neighbour toward it is on the right, right of it on the left.
+    let (beside_left, beside_right) = (&row[1..=sx], &row[sx..w - 1]);
+    let mut bad = false;
+    match toward {
+        Some(t) => {
+            for ((&c, &n), &v) in left.iter().zip(beside_left).zip(t) {
+                bad |= c & !n & !v;
+            }
+            for ((&c, &n), &v) in right.iter().zip(beside_right).zip(&t[sx + 1..]) {
+                bad |= c & !n & !v;
+            }
+            bad |= row[sx] & !t[sx];
+        }
+        None => {
+            for (&c, &n) in left.iter().zip(beside_left).chain(right.iter().zip(beside_right)) {
+                bad |= c & !n;
+            }
+        }
+    }
+    !bad
 }
 
 /// [`edge_layers`] in either storage: the taxicab distance to the nearest cell outside the region
@@ -315,5 +402,39 @@ mod tests {
         let rect = Mask::from_cells(&full);
         assert_eq!(from_sources(&rect, &[tip]), relaxed(&rect, &[tip]));
         assert_eq!(from_sources(&rect, &[tip])[rect.index((14, 7)).unwrap()], 9);
+    }
+
+    /// One source cell (the direct distances and the mask's test, [`from_one`]) gives the
+    /// distances through the region, on regions with and without bays, from sources anywhere in
+    /// them — the same numbers as the transform or the search take for several sources.
+    #[test]
+    fn one_source_gives_the_distances_through_the_region() {
+        let (w, h) = (23u32, 17u32);
+        for seed in 0..40u64 {
+            // A blob of cells: a disc with notches cut by a hash, and a wall with a gap on some.
+            let cells: Vec<Cell> = (0..w * h)
+                .map(|i| (i % w, i / w))
+                .filter(|&(x, y)| {
+                    let (dx, dy) = (f64::from(x) - 11.0, f64::from(y) - 8.0);
+                    let hash = (u64::from(x * 31 + y * 7) + seed).wrapping_mul(0x9e37_79b9_7f4a_7c15) >> 58;
+                    let wall = seed % 3 == 0 && x == 12 && y > 3;
+                    dx * dx / 121.0 + dy * dy / 64.0 <= 1.0 && hash > 3 && !wall
+                })
+                .map(|(x, y)| (x + 3, y + 5))
+                .collect();
+            let mask = Mask::from_cells(&cells);
+            for k in [0, cells.len() / 3, cells.len() / 2, cells.len() - 1] {
+                let source = cells[(k + seed as usize) % cells.len()];
+                let want = relaxed(&mask, &[source]);
+                assert_eq!(from_sources(&mask, &[source]), want, "seed {seed} source {source:?}");
+                // The same source twice is still one cell; an outside one is ignored.
+                assert_eq!(from_sources(&mask, &[source, source, (0, 0)]), want);
+                let engine: Vec<u32> = search_from::<f32>(&mask, &[source])
+                    .iter()
+                    .map(|&d| if d.is_finite() { d as u32 } else { UNREACHABLE })
+                    .collect();
+                assert_eq!(engine, want);
+            }
+        }
     }
 }

@@ -54,11 +54,44 @@ fn transform<O: Send>(w: usize, h: usize, g: &mut [u32], out: &mut [O], f: impl 
     }
 }
 
+/// [`transform`] for the engine's maps: each cell's distance `√d² − less` as an `f32` (`less` 0
+/// for `dp`, 1 for `df`), each row's envelope read out through [`sqrt_row`] (four lanes wide
+/// where the CPU has AVX2).
+fn transform_sqrt(w: usize, h: usize, g: &mut [u32], out: &mut [f32], less: f64) {
+    debug_assert_eq!(g.len(), w * h);
+    columns(w, h, g);
+    if w.max(h) <= NARROW_SIDE {
+        g.par_chunks(w.max(1))
+            .zip(out.par_chunks_mut(w.max(1)))
+            .with_min_len(16)
+            .for_each_init(
+                || Envelope::<i64>::with_capacity(w),
+                |env, (row, dst)| sqrt_row(env, row, dst, less),
+            );
+    } else {
+        rows::<i128, f32>(w, g, out, &|d2| (d2.sqrt() - less) as f32);
+    }
+}
+
+/// One row of [`transform_sqrt`]. Called through [`sqrt_row`].
+#[inline(always)]
+fn sqrt_row_body(env: &mut Envelope<i64>, g: &[u32], out: &mut [f32], less: f64) {
+    // `√d² − 0` is `√d²` (never −0: a square root is +0 or more).
+    env.row(g, out, |d2| (d2.sqrt() - less) as f32);
+}
+
+crate::simd::twice! {
+    /// [`sqrt_row_body`], four lanes wide where the CPU has AVX2 ([`crate::simd`]).
+    fn sqrt_row(env: &mut Envelope<i64>, g: &[u32], out: &mut [f32], less: f64) = sqrt_row_body;
+}
+
 /// The column pass over a `w × h` box: each cell's vertical distance to the nearest cell of its
 /// column that holds 0 in `g` ([`FAR`] where none does), in place. Two sweeps over rows (row by
 /// row rather than column by column, for the cache). `FAR` saturates, so each step is a minimum
-/// without branches, which compiles to vector instructions.
-pub(crate) fn columns(w: usize, h: usize, g: &mut [u32]) {
+/// without branches, which compiles to vector instructions. Called through [`columns`] (or inlined
+/// into another function's copies).
+#[inline(always)]
+pub(crate) fn columns_body(w: usize, h: usize, g: &mut [u32]) {
     for y in 1..h {
         let (above, row) = g[(y - 1) * w..(y + 1) * w].split_at_mut(w);
         for (d, &a) in row.iter_mut().zip(above.iter()) {
@@ -71,6 +104,11 @@ pub(crate) fn columns(w: usize, h: usize, g: &mut [u32]) {
             *d = (*d).min(b.saturating_add(1));
         }
     }
+}
+
+crate::simd::twice! {
+    /// [`columns_body`], eight lanes wide where the CPU has AVX2 ([`crate::simd`]).
+    pub(crate) fn columns(w: usize, h: usize, g: &mut [u32]) = columns_body;
 }
 
 /// The longest box side whose envelope fractions fit `i64`: numerators are at most
@@ -137,6 +175,7 @@ impl<T: Wide> Envelope<T> {
     /// Where the parabola of column `q` (height `fq`) starts to lie below the one of the last
     /// vertex `k`: `((fq + q²) − (fk + vk²)) / (2(q − vk))`, as a fraction with a positive
     /// denominator.
+    #[inline(always)]
     fn meet(&self, k: usize, q: i64, fq: i64) -> (T, T) {
         let (vk, fk) = (self.v[k], self.f[k]);
         // Both terms fit i64 (at most 2·side² each); their difference too.
@@ -144,11 +183,13 @@ impl<T: Wide> Envelope<T> {
     }
 
     /// `a ≤ b` for fractions with positive denominators.
+    #[inline(always)]
     fn at_most(a: (T, T), b: (T, T)) -> bool {
         a.0 * b.1 <= b.0 * a.1
     }
 
     /// The squared distances of one row from its columns' vertical distances `g`.
+    #[inline(always)]
     fn row<O>(&mut self, g: &[u32], out: &mut [O], f: impl Fn(f64) -> O) {
         self.v.clear();
         self.f.clear();
@@ -204,6 +245,28 @@ impl<T: Wide> Envelope<T> {
     }
 }
 
+/// One row of a one-source map: the cells' distances from the source at column `sx`, `dy2` rows'
+/// squares away (infinite outside the region, where `flags` is false). The squared distances are
+/// whole numbers below 2⁵³, exact in `f64`: the transform's numbers. Called through
+/// [`one_source_row`].
+#[inline(always)]
+fn one_source_body(row: &mut [f32], flags: &[bool], sx: i32, dy2: f64) {
+    // Columns as `i32` (a box is narrower than 2³¹) convert to `f64` four at a time.
+    for (x, (o, &b)) in (0..row.len() as i32).zip(row.iter_mut().zip(flags)) {
+        let dx = f64::from(x - sx);
+        *o = if b {
+            (dx * dx + dy2).sqrt() as f32
+        } else {
+            f32::INFINITY
+        };
+    }
+}
+
+crate::simd::twice! {
+    /// [`one_source_body`], four lanes wide where the CPU has AVX2 ([`crate::simd`]).
+    fn one_source_row(row: &mut [f32], flags: &[bool], sx: i32, dy2: f64) = one_source_body;
+}
+
 /// `dp` in the Euclidean metric: the distance of every region cell from the nearest of
 /// `sources` (straight-line), over the mask's box; cells outside the region are infinite, and
 /// so is every cell when no source lies in the region. Sources outside the region are ignored.
@@ -213,27 +276,20 @@ pub fn from_sources(mask: &Mask, sources: &[Cell]) -> Vec<f32> {
         .iter()
         .filter_map(|&s| mask.index(s).filter(|&i| bits[i]))
         .collect();
-    // The distance as the engine's maps hold it: the square root of the exact squared distance.
-    let dist = |inside: bool, d2: f64| {
-        if inside { d2.sqrt() as f32 } else { f32::INFINITY }
-    };
     let w = (mask.width as usize).max(1);
     if let Some(&first) = inside.first()
         && inside.iter().all(|&i| i == first)
     {
         // One source cell (a point figure): the squared distances directly, those the transform
         // would find (its one parabola per row), with no transform.
-        let (sx, sy) = ((first % w) as i64, (first / w) as i64);
+        let (sx, sy) = ((first % w) as i32, (first / w) as f64);
         let mut out = pool::MAPS.unfilled(mask.box_len(), f32::INFINITY);
         out.par_chunks_mut(w)
             .zip(bits.par_chunks(w))
             .enumerate()
             .for_each(|(y, (row, flags))| {
-                let dy = y as i64 - sy;
-                for (x, (o, &b)) in row.iter_mut().zip(flags).enumerate() {
-                    let dx = x as i64 - sx;
-                    *o = dist(b, (dx * dx + dy * dy) as f64);
-                }
+                let dy = y as f64 - sy;
+                one_source_row(row, flags, sx, dy * dy);
             });
         return out;
     }
@@ -248,9 +304,7 @@ pub fn from_sources(mask: &Mask, sources: &[Cell]) -> Vec<f32> {
     } else {
         pool::MAPS.unfilled(mask.box_len(), f32::INFINITY)
     };
-    transform(mask.width as usize, mask.height as usize, &mut g, &mut out, |d2| {
-        dist(true, d2)
-    });
+    transform_sqrt(mask.width as usize, mask.height as usize, &mut g, &mut out, 0.0);
     COLUMNS.give(g);
     // The cells outside the region, in a second sweep without branches.
     for (o, &b) in out.iter_mut().zip(bits) {
@@ -277,7 +331,7 @@ pub fn to_edge(mask: &Mask) -> Vec<f32> {
     }
     // Every row of the bordered box has a source (its border), so each of its cells is written.
     let mut bordered = pool::MAPS.unfilled(pw * ph, 0.0);
-    transform(pw, ph, &mut g, &mut bordered, |d2| (d2.sqrt() - 1.0) as f32);
+    transform_sqrt(pw, ph, &mut g, &mut bordered, 1.0);
     COLUMNS.give(g);
     let mut out = pool::MAPS.filled(w * h, f32::INFINITY);
     for (y, row) in out.chunks_mut(w.max(1)).enumerate() {

@@ -44,6 +44,9 @@ pub mod revision;
 pub mod ridge;
 pub mod river;
 pub mod rocks;
+// Runtime dispatch of the hot loops to AVX2; public only for the tests that compare both copies.
+#[doc(hidden)]
+pub mod simd;
 pub mod trees;
 pub mod validate;
 

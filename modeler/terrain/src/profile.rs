@@ -21,6 +21,7 @@ fn real(d: u32) -> f64 {
 
 /// Eq. 1 for distances of either metric (`dp` infinite where the figure cannot reach): the same
 /// numbers as [`weight`] on whole distances.
+#[inline]
 pub fn weight_real(df: f64, dp: f64) -> f64 {
     if dp == 0.0 {
         1.0
@@ -80,6 +81,7 @@ pub fn profile(h: f64, w: f64, s: f64) -> f64 {
 /// Eq. 4, the slope a nested figure uses at a cell of weight `w`: `(s1 + s0)·w − s0`, where `s1`
 /// is the figure's slope and `s0` the enclosing closed figure's. It is `−s0` at the nested
 /// region's edge, mirroring the parent's slope there so the two slopes join, and `s1` on the figure.
+#[inline]
 pub fn nested_slope(s1: f64, s0: f64, w: f64) -> f64 {
     (s1 + s0) * w - s0
 }
@@ -90,6 +92,7 @@ pub fn inverse_distance(dp: u32) -> f64 {
 }
 
 /// Eq. 3's weight for a distance of either metric: `1/dp`, 0 when infinite.
+#[inline]
 pub fn inverse_distance_real(dp: f64) -> f64 {
     1.0 / dp
 }

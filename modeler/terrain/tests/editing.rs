@@ -34,7 +34,7 @@ fn figure_paths(doc: &Document) -> Vec<FigurePath> {
 }
 
 #[derive(Debug, Clone)]
-enum Op {
+pub(crate) enum Op {
     Height(usize, f64),
     Slope(usize, f64),
     MoveFigure(usize, [f64; 2]),
@@ -48,7 +48,7 @@ enum Op {
     Redo,
 }
 
-fn op() -> impl Strategy<Value = Op> {
+pub(crate) fn op() -> impl Strategy<Value = Op> {
     let d = || [-3.0..3.0f64, -3.0..3.0f64];
     prop_oneof![
         4 => (any::<usize>(), height()).prop_map(|(i, h)| Op::Height(i, h)),
@@ -66,7 +66,7 @@ fn op() -> impl Strategy<Value = Op> {
 }
 
 /// The edit an op stands for on `doc` (None for undo/redo or when there is no figure).
-fn edit_for(doc: &Document, op: &Op) -> Option<Edit> {
+pub(crate) fn edit_for(doc: &Document, op: &Op) -> Option<Edit> {
     let paths = figure_paths(doc);
     let pick = |i: usize| paths.get(i % paths.len().max(1)).cloned();
     let vertex_count = |at: &FigurePath| {
@@ -139,13 +139,13 @@ fn edit_for(doc: &Document, op: &Op) -> Option<Edit> {
     })
 }
 
-fn metric() -> impl Strategy<Value = Metric> {
+pub(crate) fn metric() -> impl Strategy<Value = Metric> {
     prop_oneof![Just(Metric::Taxicab), Just(Metric::Euclidean)]
 }
 
 /// No detail, or detail of a random amount, scale (2 to 40 cells of the 40-cell grid), octaves
 /// and seed.
-fn detail() -> impl Strategy<Value = Option<Detail>> {
+pub(crate) fn detail() -> impl Strategy<Value = Option<Detail>> {
     prop::option::of(
         (0.0..=1.0f64, 2.0..40.0f64, 1u32..=6, any::<u64>()).prop_map(|(amount, scale, octaves, seed)| Detail {
             amount,
@@ -158,7 +158,7 @@ fn detail() -> impl Strategy<Value = Option<Detail>> {
 
 /// The editor's terrain equals a full regeneration of its document to the bit.
 /// No erosion, or erosion of a random talus, 1 to 8 steps and amount.
-fn erosion() -> impl Strategy<Value = Option<Erosion>> {
+pub(crate) fn erosion() -> impl Strategy<Value = Option<Erosion>> {
     prop::option::of(
         (5.0..80.0f64, 1u32..=8, 0.0..=1.0f64).prop_map(|(talus, iterations, amount)| Erosion {
             talus,

@@ -16,6 +16,7 @@ mod ridges;
 mod rivers;
 mod rock_fields;
 mod rocks;
+mod simd;
 mod tree_documents;
 mod trees;
 mod validation;

@@ -49,6 +49,7 @@ use crate::heightmap::Heightmap;
 use crate::pool::{MAPS, Pool};
 use crate::profile;
 use crate::rect::Rect;
+use crate::simd;
 
 /// The regions' normalisers of the regions dropped, for the next ones ([`crate::pool`]): 16 MB,
 /// a 1024² region's.
@@ -126,19 +127,25 @@ impl Shapes {
 
 /// Eq. 3's weight of a figure at distance `dp` on a cell with normaliser `norm`: `1/n` on each
 /// of the n figures a cell stands on, `(1/dp)/Σ(1/dp_j)` elsewhere, 0 where no figure reaches.
+#[inline(always)]
 fn share(norm: f64, dp: f32) -> f32 {
     share_of(norm, dp, || profile::inverse_distance_real(f64::from(dp)))
 }
 
-/// [`share`] with the figure's inverse distance `inv` (computed only when needed).
+/// [`share`] with the figure's inverse distance `inv` (computed only when needed). One division
+/// whichever the case: a loop over cells compiles the cases to selects, which take both sides,
+/// and the divisions are the blend's bottleneck (`x/1` and `0/x` are the `x` and `0` of the
+/// cases without one).
+#[inline(always)]
 fn share_of(norm: f64, dp: f32, inv: impl FnOnce() -> f64) -> f32 {
-    if norm < 0.0 {
-        if dp == 0.0 { (1.0 / -norm) as f32 } else { 0.0 }
+    let (num, den) = if norm < 0.0 {
+        (if dp == 0.0 { 1.0 } else { 0.0 }, -norm)
     } else if norm > 0.0 {
-        (inv() / norm) as f32
+        (inv(), norm)
     } else {
-        0.0
-    }
+        (0.0, 1.0)
+    };
+    (num / den) as f32
 }
 
 /// The sign of a slope, as the kept logarithms are valid for it.
@@ -170,6 +177,7 @@ const STEP: usize = 64;
 /// logarithm and power, then every cell's exponential, then its shape term. The numbers are
 /// [`shape`]'s (the same operations in the same order), but each loop is free of branches and
 /// calls, and compiles to vector instructions.
+#[inline(always)]
 fn shapes(df: &[f32], dp: &[f32], (s1, outer): (f64, Option<f64>), shape: &mut [f32], mut log: Option<&mut [f32]>) {
     // A few cells (a moved figure's changed cells come in short stretches) do not pay for
     // setting up the working rows.
@@ -209,6 +217,7 @@ fn shapes(df: &[f32], dp: &[f32], (s1, outer): (f64, Option<f64>), shape: &mut [
 /// The shape terms of a top-level figure of slope `s ≠ 0` from its kept logarithms `log`:
 /// [`fastmath::shape_from_log`] a step of cells at a time, the exponentials in a loop of their own
 /// (vector instructions).
+#[inline(always)]
 fn shapes_from_logs(log: &[f32], s: f64, shape: &mut [f32]) {
     for (log, shape) in log.chunks(STEP).zip(shape.chunks_mut(STEP)) {
         let mut y = [0.0; STEP];
@@ -316,6 +325,8 @@ impl Band<'_, '_> {
     /// Eq. 3's normaliser, the shapes `how` names and every figure's coefficient on the band's
     /// cells `cells` (a stretch of one row): each step over the stretch for one figure at a time,
     /// in figure order, so that each cell sees the arithmetic of a cell-by-cell evaluation.
+    /// Called through [`blend_stretch`].
+    #[inline(always)]
     fn blend(self, cells: std::ops::Range<usize>, scratch: &mut Scratch, how: Blend) {
         let Band { norm, df, dps, maps } = self;
         let (a, len) = (cells.start, cells.len());
@@ -357,6 +368,69 @@ impl Band<'_, '_> {
             }
         }
     }
+}
+
+simd::twice! {
+    /// [`Band::blend`], four lanes wide where the CPU has AVX2 ([`crate::simd`]).
+    fn blend_stretch(band: Band<'_, '_>, cells: std::ops::Range<usize>, scratch: &mut Scratch, how: Blend<'_>) = Band::blend;
+}
+
+/// Paints a stretch of cells `out`: `base + Σ relief_k·coef_k` in `f32`, figures in order (each
+/// step over the stretch for one figure). Called through [`paint_stretch`].
+#[inline(always)]
+fn paint_body(out: &mut [f32], base: f32, coefs: &[&[f32]], reliefs: &[f32], a: usize) {
+    out.fill(base);
+    let e = a + out.len();
+    for (coef, &rel) in coefs.iter().zip(reliefs) {
+        for (d, &c) in out.iter_mut().zip(&coef[a..e]) {
+            *d += rel * c;
+        }
+    }
+}
+
+simd::twice! {
+    /// [`paint_body`], four lanes wide where the CPU has AVX2.
+    fn paint_stretch(out: &mut [f32], base: f32, coefs: &[&[f32]], reliefs: &[f32], a: usize) = paint_body;
+}
+
+/// A slope's work on one owned run (box columns `xs` of a row, its cells from `i0` on): the shape
+/// terms, from the kept logarithms (`reuse`) or computed (keeping the logarithms in `log_row` when
+/// `keep`), and the coefficients. Called through [`reshape_run`].
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn reshape_body(
+    (df, dp, norm): (&[f32], &[f32], &[f64]),
+    xs: std::ops::Range<usize>,
+    (shape_row, coef_row, log_row): (&mut [f32], &mut [f32], &mut [f32]),
+    (s1, outer): (f64, Option<f64>),
+    reuse: bool,
+    keep: bool,
+) {
+    let len = xs.len();
+    let shape_run = &mut shape_row[xs.clone()];
+    if reuse && s1 != 0.0 {
+        // The kept logarithm and the slope make the shape: eq. 1's `w`, which
+        // `shape_from_log` reads only at slope 0, is not needed.
+        shapes_from_logs(&log_row[xs.clone()], s1, shape_run);
+    } else {
+        let log = keep.then(|| &mut log_row[xs.clone()]);
+        shapes(&df[..len], &dp[..len], (s1, outer), shape_run, log);
+    }
+    for (((c, &sh), &d), &n) in coef_row[xs].iter_mut().zip(&*shape_run).zip(dp).zip(norm) {
+        *c = sh * share(n, d);
+    }
+}
+
+simd::twice! {
+    /// [`reshape_body`], four lanes wide where the CPU has AVX2.
+    fn reshape_run(
+        maps: (&[f32], &[f32], &[f64]),
+        xs: std::ops::Range<usize>,
+        rows: (&mut [f32], &mut [f32], &mut [f32]),
+        slope: (f64, Option<f64>),
+        reuse: bool,
+        keep: bool,
+    ) = reshape_body;
 }
 
 impl FigureNode {
@@ -686,7 +760,8 @@ impl RegionNode {
                     dps: &dps,
                     maps: &mut maps,
                 };
-                band.blend(
+                blend_stretch(
+                    band,
                     a..e,
                     &mut scratch,
                     Blend {
@@ -744,20 +819,14 @@ impl RegionNode {
                 for run in &owned[row_runs[r]..row_runs[r + 1]] {
                     let xs = run.start as usize..run.end as usize;
                     let i0 = r * w + xs.start;
-                    let (df, dp, norm) = (&df[i0..], &dp[i0..], &norm[i0..]);
-                    let len = xs.len();
-                    let shape_run = &mut shape_row[xs.clone()];
-                    if reuse && s1 != 0.0 {
-                        // The kept logarithm and the slope make the shape: eq. 1's `w`, which
-                        // `shape_from_log` reads only at slope 0, is not needed.
-                        shapes_from_logs(&log_row[xs.clone()], s1, shape_run);
-                    } else {
-                        let log = keep.then(|| &mut log_row[xs.clone()]);
-                        shapes(&df[..len], &dp[..len], (s1, outer), shape_run, log);
-                    }
-                    for (((c, &sh), &d), &n) in coef_row[xs].iter_mut().zip(&*shape_run).zip(dp).zip(norm) {
-                        *c = sh * share(n, d);
-                    }
+                    reshape_run(
+                        (&df[i0..], &dp[i0..], &norm[i0..]),
+                        xs,
+                        (&mut *shape_row, &mut *coef_row, &mut *log_row),
+                        (s1, outer),
+                        reuse,
+                        keep,
+                    );
                 }
             });
     }
@@ -781,12 +850,7 @@ impl RegionNode {
                 // A stretch of cells, one figure at a time: each cell's sum in figure order.
                 let paint = |a: usize, e: usize, line: &mut [f32]| {
                     let out = &mut line[c0 + a - r * w..c0 + e - r * w];
-                    out.fill(base);
-                    for (coef, &rel) in coefs.iter().zip(&reliefs) {
-                        for (d, &c) in out.iter_mut().zip(&coef[a..e]) {
-                            *d += rel * c;
-                        }
-                    }
+                    paint_stretch(out, base, &coefs, &reliefs, a);
                 };
                 for run in self.runs(r) {
                     let (a, e) = (r * w + run.start as usize, r * w + run.end as usize);
