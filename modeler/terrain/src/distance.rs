@@ -126,7 +126,34 @@ fn bfs<D: Level>(mask: &Mask, dist: &mut [D], mut front: Vec<(u32, u32)>) {
 #[inline(always)]
 fn taxicab_body(w: usize, h: usize, g: &mut [u32]) {
     edt::columns_body(w, h, g);
-    for row in g.chunks_mut(w.max(1)) {
+    let w = w.max(1);
+    // A sweep is a chain of dependent steps (each a minimum with the last plus one), which waits
+    // on each step's latency; four rows swept together are four chains the core runs side by
+    // side.
+    let mut quads = g.chunks_exact_mut(4 * w);
+    for quad in &mut quads {
+        let (ab, cd) = quad.split_at_mut(2 * w);
+        let ((a, b), (c, d)) = (ab.split_at_mut(w), cd.split_at_mut(w));
+        let step = |run: &mut u32, d: &mut u32| {
+            *run = (*d).min(run.saturating_add(1));
+            *d = *run;
+        };
+        let mut run = [edt::FAR; 4];
+        for (((a, b), c), d) in a.iter_mut().zip(&mut *b).zip(&mut *c).zip(&mut *d) {
+            step(&mut run[0], a);
+            step(&mut run[1], b);
+            step(&mut run[2], c);
+            step(&mut run[3], d);
+        }
+        let mut run = [edt::FAR; 4];
+        for (((a, b), c), d) in a.iter_mut().zip(b).zip(c).zip(d).rev() {
+            step(&mut run[0], a);
+            step(&mut run[1], b);
+            step(&mut run[2], c);
+            step(&mut run[3], d);
+        }
+    }
+    for row in quads.into_remainder().chunks_mut(w) {
         let mut run = edt::FAR;
         for d in row.iter_mut() {
             run = (*d).min(run.saturating_add(1));
@@ -161,13 +188,13 @@ fn inside_body(pw: usize, g: &[u32]) -> bool {
     !bad
 }
 
-simd::twice! {
-    /// [`taxicab_body`], eight `u32` lanes wide where the CPU has AVX2 ([`crate::simd`]).
+simd::copies! {
+    /// [`taxicab_body`], in the widest copy the CPU has ([`crate::simd`]).
     fn taxicab_transform(w: usize, h: usize, g: &mut [u32]) = taxicab_body;
 }
 
-simd::twice! {
-    /// [`inside_body`], eight lanes wide where the CPU has AVX2.
+simd::copies! {
+    /// [`inside_body`], in the widest copy the CPU has.
     fn inside_paths(pw: usize, g: &[u32]) -> bool = inside_body;
 }
 

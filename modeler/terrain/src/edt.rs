@@ -55,8 +55,8 @@ fn transform<O: Send>(w: usize, h: usize, g: &mut [u32], out: &mut [O], f: impl 
 }
 
 /// [`transform`] for the engine's maps: each cell's distance `√d² − less` as an `f32` (`less` 0
-/// for `dp`, 1 for `df`), each row's envelope read out through [`sqrt_row`] (four lanes wide
-/// where the CPU has AVX2).
+/// for `dp`, 1 for `df`), each row's envelope read out through [`sqrt_row`] (in the widest
+/// copy of [`crate::simd`] the CPU has).
 fn transform_sqrt(w: usize, h: usize, g: &mut [u32], out: &mut [f32], less: f64) {
     debug_assert_eq!(g.len(), w * h);
     columns(w, h, g);
@@ -80,8 +80,8 @@ fn sqrt_row_body(env: &mut Envelope<i64>, g: &[u32], out: &mut [f32], less: f64)
     env.row(g, out, |d2| (d2.sqrt() - less) as f32);
 }
 
-crate::simd::twice! {
-    /// [`sqrt_row_body`], four lanes wide where the CPU has AVX2 ([`crate::simd`]).
+crate::simd::copies! {
+    /// [`sqrt_row_body`], in the widest copy the CPU has ([`crate::simd`]).
     fn sqrt_row(env: &mut Envelope<i64>, g: &[u32], out: &mut [f32], less: f64) = sqrt_row_body;
 }
 
@@ -106,8 +106,8 @@ pub(crate) fn columns_body(w: usize, h: usize, g: &mut [u32]) {
     }
 }
 
-crate::simd::twice! {
-    /// [`columns_body`], eight lanes wide where the CPU has AVX2 ([`crate::simd`]).
+crate::simd::copies! {
+    /// [`columns_body`], in the widest copy the CPU has ([`crate::simd`]).
     pub(crate) fn columns(w: usize, h: usize, g: &mut [u32]) = columns_body;
 }
 
@@ -155,31 +155,36 @@ trait Wide:
 impl Wide for i64 {}
 impl Wide for i128 {}
 
-/// The lower envelope of one row's parabolas: their vertices `v` (columns, increasing) and for
-/// each the fraction `z = num/den` where it starts to be the lowest.
+/// A vertex of a row's lower envelope: the parabola's column `v`, its height `f` (the squared
+/// column distance), `f + v²` (what [`Envelope::meet`] reads), and the fraction `z = num/den`
+/// where it starts to be the lowest.
+#[derive(Clone, Copy)]
+struct Vertex<T> {
+    v: i64,
+    f: i64,
+    h: i64,
+    z: (T, T),
+}
+
+/// The lower envelope of one row's parabolas: its vertices, columns increasing, in a buffer as
+/// long as the row (the first `k` of them in use), so that adding and dropping one is an index.
 struct Envelope<T> {
-    v: Vec<i64>,
-    f: Vec<i64>,
-    z: Vec<(T, T)>,
+    verts: Vec<Vertex<T>>,
 }
 
 impl<T: Wide> Envelope<T> {
     fn with_capacity(n: usize) -> Envelope<T> {
         Envelope {
-            v: Vec::with_capacity(n),
-            f: Vec::with_capacity(n),
-            z: Vec::with_capacity(n),
+            verts: Vec::with_capacity(n),
         }
     }
 
-    /// Where the parabola of column `q` (height `fq`) starts to lie below the one of the last
-    /// vertex `k`: `((fq + q²) − (fk + vk²)) / (2(q − vk))`, as a fraction with a positive
-    /// denominator.
+    /// Where the parabola of column `q` (`hq = fq + q²`) starts to lie below the one of vertex
+    /// `a`: `((fq + q²) − (fa + va²)) / (2(q − va))`, as a fraction with a positive denominator.
     #[inline(always)]
-    fn meet(&self, k: usize, q: i64, fq: i64) -> (T, T) {
-        let (vk, fk) = (self.v[k], self.f[k]);
+    fn meet(a: &Vertex<T>, q: i64, hq: i64) -> (T, T) {
         // Both terms fit i64 (at most 2·side² each); their difference too.
-        ((fq + q * q - (fk + vk * vk)).into(), (2 * (q - vk)).into())
+        ((hq - a.h).into(), (2 * (q - a.v)).into())
     }
 
     /// `a ≤ b` for fractions with positive denominators.
@@ -191,50 +196,49 @@ impl<T: Wide> Envelope<T> {
     /// The squared distances of one row from its columns' vertical distances `g`.
     #[inline(always)]
     fn row<O>(&mut self, g: &[u32], out: &mut [O], f: impl Fn(f64) -> O) {
-        self.v.clear();
-        self.f.clear();
-        self.z.clear();
+        let zero = Vertex {
+            v: 0,
+            f: 0,
+            h: 0,
+            z: (T::from(0), T::from(0)),
+        };
+        if self.verts.len() < g.len() {
+            self.verts.resize(g.len(), zero);
+        }
+        let verts = &mut self.verts[..g.len()];
+        let mut k = 0;
         for (q, &gq) in g.iter().enumerate() {
             if gq == FAR {
                 continue;
             }
             let (q, fq) = (q as i64, i64::from(gq) * i64::from(gq));
+            let hq = fq + q * q;
+            // The first vertex's stretch starts at −∞.
+            let mut z = (T::from(-1), T::from(0));
             // Drop the vertices the new parabola hides: those whose own stretch would start
-            // after the new one's.
-            while let Some(k) = self.v.len().checked_sub(1) {
-                let s = self.meet(k, q, fq);
-                if k > 0 && Self::at_most(s, self.z[k]) {
-                    self.v.pop();
-                    self.f.pop();
-                    self.z.pop();
+            // after the new one's (never the first).
+            while k > 0 {
+                z = Self::meet(&verts[k - 1], q, hq);
+                if k > 1 && Self::at_most(z, verts[k - 1].z) {
+                    k -= 1;
                 } else {
-                    self.v.push(q);
-                    self.f.push(fq);
-                    self.z.push(s);
                     break;
                 }
             }
-            if self.v.is_empty() {
-                self.v.push(q);
-                self.f.push(fq);
-                // The first vertex's stretch starts at −∞.
-                self.z.push(((-1).into(), 0.into()));
-            }
-        }
-        if self.v.is_empty() {
-            return;
+            verts[k] = Vertex { v: q, f: fq, h: hq, z };
+            k += 1;
         }
         // Each vertex's columns: from where the last one's ended to where the next one's stretch
         // starts (the first x with x·den ≥ num), in one tight loop.
-        let (v, fs, z) = (&self.v[..], &self.f[..], &self.z[..]);
+        let verts = &verts[..k];
         let w = out.len();
         let mut start = 0;
-        for (k, (&vk, &fk)) in v.iter().zip(fs).enumerate() {
-            let end = z.get(k + 1).map_or(w, |&(num, den)| T::first_at_least(num, den, w));
+        for (i, a) in verts.iter().enumerate() {
+            let end = verts.get(i + 1).map_or(w, |b| T::first_at_least(b.z.0, b.z.1, w));
             if end > start {
                 // Whole numbers below 2^53 in `f64`: the same squared distances, exactly, and a
                 // column as an `i32` (a box is narrower than 2^31) converts two at a time.
-                let (vk, fk) = (vk as f64, fk as f64);
+                let (vk, fk) = (a.v as f64, a.f as f64);
                 for (x, d) in (start as i32..end as i32).zip(&mut out[start..end]) {
                     let dx = f64::from(x) - vk;
                     *d = f(dx * dx + fk);
@@ -262,8 +266,8 @@ fn one_source_body(row: &mut [f32], flags: &[bool], sx: i32, dy2: f64) {
     }
 }
 
-crate::simd::twice! {
-    /// [`one_source_body`], four lanes wide where the CPU has AVX2 ([`crate::simd`]).
+crate::simd::copies! {
+    /// [`one_source_body`], in the widest copy the CPU has ([`crate::simd`]).
     fn one_source_row(row: &mut [f32], flags: &[bool], sx: i32, dy2: f64) = one_source_body;
 }
 

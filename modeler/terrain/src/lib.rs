@@ -44,7 +44,8 @@ pub mod revision;
 pub mod ridge;
 pub mod river;
 pub mod rocks;
-// Runtime dispatch of the hot loops to AVX2; public only for the tests that compare both copies.
+// Runtime dispatch of the hot loops to AVX2 and AVX-512; public only for the tests that compare
+// the copies.
 #[doc(hidden)]
 pub mod simd;
 pub mod trees;

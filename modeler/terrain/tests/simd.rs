@@ -1,7 +1,7 @@
-//! The engine's two copies of its hot loops (`penmodel_terrain::simd`: the baseline x86-64 one
-//! and the AVX2 one the CPU picks at run time) give the same terrain to the bit, so the baseline
-//! copy stays tested on a machine that runs the AVX2 one. On a CPU without AVX2 both runs take
-//! the baseline copy (the tests say so on stderr).
+//! The engine's copies of its hot loops (`penmodel_terrain::simd`: baseline x86-64, AVX2 and
+//! AVX-512, the CPU's widest picked at run time) give the same terrain to the bit, so the
+//! narrower copies stay tested on a machine that runs the widest. A copy the CPU lacks is not
+//! compared (the tests say so on stderr).
 
 use std::path::PathBuf;
 use std::sync::{Mutex, PoisonError};
@@ -9,29 +9,44 @@ use std::sync::{Mutex, PoisonError};
 use crate::common::*;
 use crate::editing::{Op, detail, edit_for, erosion, metric, op};
 use penmodel_terrain::editor::Editor;
-use penmodel_terrain::{Document, Heightmap, Metric, generate, simd};
+use penmodel_terrain::simd::{self, Level};
+use penmodel_terrain::{Document, Heightmap, Metric, generate};
 use proptest::prelude::*;
 
 /// The tests that switch the copies, one at a time (the switch is the whole process's).
 static SWITCH: Mutex<()> = Mutex::new(());
 
-/// Forces the baseline copies while it lives (and holds the switch).
-struct Baseline<'a>(#[allow(dead_code)] std::sync::MutexGuard<'a, ()>);
-
-/// Runs `f` with the baseline copies forced, then with the CPU's choice: the two results.
-fn both<T>(mut f: impl FnMut() -> T) -> (T, T) {
-    let guard = SWITCH.lock().unwrap_or_else(PoisonError::into_inner);
-    simd::force_baseline(true);
-    let on = Baseline(guard);
-    let baseline = f();
-    drop(on);
-    (baseline, f())
+/// The copies this CPU has, narrowest first.
+fn levels() -> Vec<Level> {
+    let all = [Level::Baseline, Level::Avx2, Level::Avx512];
+    let have: Vec<Level> = all.into_iter().filter(|&l| l <= simd::available()).collect();
+    if have.len() < all.len() {
+        eprintln!("this CPU runs only the copies {have:?}: the others are not compared");
+    }
+    have
 }
 
-impl Drop for Baseline<'_> {
+/// Lets the CPU choose its copy again when dropped (after a panic too).
+struct Uncap;
+
+impl Drop for Uncap {
     fn drop(&mut self) {
-        simd::force_baseline(false);
+        simd::force_at_most(Level::Avx512);
     }
+}
+
+/// `f`'s result with each copy the CPU has, narrowest first.
+fn each<T>(mut f: impl FnMut(Level) -> T) -> Vec<(Level, T)> {
+    let _one = SWITCH.lock().unwrap_or_else(PoisonError::into_inner);
+    let _uncap = Uncap;
+    levels()
+        .into_iter()
+        .map(|level| {
+            simd::force_at_most(level);
+            assert_eq!(simd::level(), level);
+            (level, f(level))
+        })
+        .collect()
 }
 
 fn bits(map: &Heightmap) -> Vec<u32> {
@@ -39,10 +54,7 @@ fn bits(map: &Heightmap) -> Vec<u32> {
 }
 
 #[test]
-fn both_copies_give_the_examples_the_same_terrain() {
-    if !simd::has_avx2() {
-        eprintln!("no AVX2 on this CPU: both runs took the baseline copies");
-    }
+fn the_copies_give_the_examples_the_same_terrain() {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples");
     let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()
@@ -62,12 +74,14 @@ fn both_copies_give_the_examples_the_same_terrain() {
                     let extent = doc.grid.width();
                     (doc.grid.cols, doc.grid.rows, doc.grid.cell_size) = (n, n, extent / f64::from(n));
                 }
-                let (baseline, avx2) = both(|| generate(&doc).unwrap());
-                assert!(
-                    bits(&baseline) == bits(&avx2),
-                    "{} {metric:?} {n:?}: the copies differ",
-                    path.display()
-                );
+                let maps = each(|_| bits(&generate(&doc).unwrap()));
+                for (level, map) in &maps[1..] {
+                    assert!(
+                        *map == maps[0].1,
+                        "{} {metric:?} {n:?}: the {level:?} copy differs from the baseline",
+                        path.display()
+                    );
+                }
             }
         }
     }
@@ -76,29 +90,32 @@ fn both_copies_give_the_examples_the_same_terrain() {
 proptest! {
     #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
 
-    /// Two editors, one run with the baseline copies and one with the CPU's choice, given the
-    /// same edits (every kind: pulls, slopes, moves, figures added and deleted, undo, redo) hold
-    /// the same terrain to the bit after each.
+    /// One editor per copy the CPU has, each run with its copy, given the same edits (every
+    /// kind: pulls, slopes, moves, figures added and deleted, undo, redo) hold the same terrain
+    /// to the bit after each.
     #[test]
-    fn both_copies_edit_to_the_same_terrain(mut doc in nested_document(), ops in prop::collection::vec(op(), 1..14), metric in metric(), detail in detail(), erosion in erosion()) {
+    fn the_copies_edit_to_the_same_terrain(mut doc in nested_document(), ops in prop::collection::vec(op(), 1..14), metric in metric(), detail in detail(), erosion in erosion()) {
         doc.terrain.metric = metric;
         doc.terrain.detail = detail;
         doc.terrain.erosion = erosion;
-        let (mut baseline, mut avx2) = both(|| Editor::new(doc.clone()).unwrap());
-        prop_assert!(bits(baseline.heightmap()) == bits(avx2.heightmap()));
+        let mut editors: Vec<(Level, Editor)> = each(|_| Editor::new(doc.clone()).unwrap());
         for op in &ops {
-            let step = |e: &mut Editor| match op {
-                Op::Undo => e.undo().is_ok(),
-                Op::Redo => e.redo().is_ok(),
-                _ => edit_for(e.document(), op).is_some_and(|edit| e.apply(edit).is_ok()),
-            };
-            let mut which = 0;
-            let (a, b) = both(|| {
-                which += 1;
-                step(if which == 1 { &mut baseline } else { &mut avx2 })
-            });
-            prop_assert_eq!(a, b);
-            prop_assert!(bits(baseline.heightmap()) == bits(avx2.heightmap()), "after {:?}", op);
+            let mut results = Vec::new();
+            for (level, editor) in &mut editors {
+                let _one = SWITCH.lock().unwrap_or_else(PoisonError::into_inner);
+                let _uncap = Uncap;
+                simd::force_at_most(*level);
+                results.push(match op {
+                    Op::Undo => editor.undo().is_ok(),
+                    Op::Redo => editor.redo().is_ok(),
+                    _ => edit_for(editor.document(), op).is_some_and(|edit| editor.apply(edit).is_ok()),
+                });
+            }
+            prop_assert!(results.iter().all(|&r| r == results[0]));
+            let first = bits(editors[0].1.heightmap());
+            for (level, editor) in &editors[1..] {
+                prop_assert!(bits(editor.heightmap()) == first, "{:?} copy, after {:?}", level, op);
+            }
         }
     }
 }

@@ -370,8 +370,8 @@ impl Band<'_, '_> {
     }
 }
 
-simd::twice! {
-    /// [`Band::blend`], four lanes wide where the CPU has AVX2 ([`crate::simd`]).
+simd::copies! {
+    /// [`Band::blend`], in the widest copy the CPU has ([`crate::simd`]).
     fn blend_stretch(band: Band<'_, '_>, cells: std::ops::Range<usize>, scratch: &mut Scratch, how: Blend<'_>) = Band::blend;
 }
 
@@ -388,8 +388,8 @@ fn paint_body(out: &mut [f32], base: f32, coefs: &[&[f32]], reliefs: &[f32], a: 
     }
 }
 
-simd::twice! {
-    /// [`paint_body`], four lanes wide where the CPU has AVX2.
+simd::copies! {
+    /// [`paint_body`], in the widest copy the CPU has.
     fn paint_stretch(out: &mut [f32], base: f32, coefs: &[&[f32]], reliefs: &[f32], a: usize) = paint_body;
 }
 
@@ -421,8 +421,8 @@ fn reshape_body(
     }
 }
 
-simd::twice! {
-    /// [`reshape_body`], four lanes wide where the CPU has AVX2.
+simd::copies! {
+    /// [`reshape_body`], in the widest copy the CPU has.
     fn reshape_run(
         maps: (&[f32], &[f32], &[f64]),
         xs: std::ops::Range<usize>,
