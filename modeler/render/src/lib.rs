@@ -41,6 +41,7 @@ pub mod nodes;
 pub mod overlay;
 pub mod ramp;
 pub mod rasterise;
+pub mod rock_lod;
 pub mod scene;
 pub mod shade;
 pub mod stereo;
@@ -414,7 +415,7 @@ impl Renderer {
             || {
                 meshes.clear(bands);
                 let rocks = scene.rocks.iter().map(|(_, m)| m);
-                meshes.add(rocks, Paint::Whole(Surface::Rock), &affine, cell, near, &scene.style);
+                meshes.add_rocks(rocks, scene.terrain_lod, &affine, cell, near, &scene.style);
                 let water = scene.water.iter().map(|(_, m)| m);
                 meshes.add(water, Paint::Whole(Surface::Water), &affine, cell, near, &scene.style);
                 meshes.add(trees.meshes(), Paint::Own, &affine, cell, near, &scene.style);

@@ -17,7 +17,9 @@
 use penmodel_terrain::export::Mesh;
 
 use super::binned::Binned;
+use super::clip::ClipVertex;
 use super::rasterise::{Bounds, DepthSink, Sample, Surface};
+use super::rock_lod;
 use super::scene::Style;
 use super::transform::Affine;
 
@@ -62,7 +64,27 @@ pub fn srgb(linear: [f32; 3]) -> [u8; 3] {
 
 /// One eye's projected meshes.
 #[derive(Debug, Default)]
-pub struct Projected(Binned<Surface>);
+pub struct Projected(Binned<Surface>, PartsCache);
+
+/// The last frames' rock meshes' [`rock_lod::parts`], by their indices: a field's triangles stay
+/// the same while it follows the terrain (only its positions change), and finding its parts
+/// again each frame cost more than comparing the indices.
+#[derive(Debug, Default)]
+struct PartsCache(Vec<(Vec<u32>, usize, Option<Vec<rock_lod::Part>>)>);
+
+impl PartsCache {
+    /// The parts of the `k`-th rock mesh of a frame.
+    fn of(&mut self, k: usize, indices: &[u32], vertices: usize) -> Option<&[rock_lod::Part]> {
+        if self.0.len() <= k {
+            self.0.resize_with(k + 1, Default::default);
+        }
+        let entry = &mut self.0[k];
+        if entry.0 != indices || entry.1 != vertices {
+            *entry = (indices.to_vec(), vertices, rock_lod::parts(indices, vertices));
+        }
+        entry.2.as_deref()
+    }
+}
 
 impl Projected {
     /// Forgets the last frame's meshes, for a frame `frame_height` rows tall drawn in bands of
@@ -82,33 +104,83 @@ impl Projected {
         near: f32,
         style: &Style,
     ) {
-        let light = super::light::world_light(style);
-        let ambient = style.ambient.clamp(0.0, 1.0);
-        let s = cell_size as f32;
-        let first = self.0.triangles();
-        for mesh in meshes {
+        add(&mut self.0, meshes, paint, affine, cell_size, near, style);
+    }
+
+    /// Projects and bins rock fields like [`Projected::add`] with [`Paint::Whole`]`(`[`Surface::Rock`]`)`,
+    /// each rock whose bounding sphere projects within `pixels` of its centre as one quad
+    /// ([`crate::rock_lod`]); `pixels` 0 draws every rock whole.
+    pub fn add_rocks<'m>(
+        &mut self,
+        meshes: impl IntoIterator<Item = &'m Mesh>,
+        pixels: f32,
+        affine: &Affine,
+        cell_size: f64,
+        near: f32,
+        style: &Style,
+    ) {
+        let Projected(binned, cache) = self;
+        for (k, mesh) in meshes.into_iter().enumerate() {
             let n = mesh.positions.len().min(mesh.normals.len());
-            let base = self.0.vertices_from(n, near, |i| {
-                let (p, n) = (mesh.positions[i], mesh.normals[i]);
-                let lambert = (n[0] * light[0] + n[1] * light[1] + n[2] * light[2]).abs();
-                let l = ambient + (1.0 - ambient) * lambert;
-                affine.clip_point(p[0] / s - 0.5, p[2] / s - 0.5, p[1], l)
+            let parts = if pixels > 0.0 {
+                cache.of(k, &mesh.indices, n)
+            } else {
+                None
+            };
+            let Some(parts) = parts else {
+                add(
+                    binned,
+                    [mesh],
+                    Paint::Whole(Surface::Rock),
+                    affine,
+                    cell_size,
+                    near,
+                    style,
+                );
+                continue;
+            };
+            let light = super::light::world_light(style);
+            let ambient = style.ambient.clamp(0.0, 1.0);
+            let s = cell_size as f32;
+            let choices = rock_lod::choose(mesh, parts, affine, s, near, pixels, (light, ambient));
+            // The whole rocks' vertices, packed: `source[i]` is the mesh's vertex of the i-th.
+            let mut source = Vec::new();
+            let mut quads = 0;
+            for (part, choice) in parts.iter().zip(&choices) {
+                match choice {
+                    rock_lod::Choice::Whole => source.extend(part.vertices.clone().map(|v| v as u32)),
+                    rock_lod::Choice::Quad(_) => quads += 1,
+                }
+            }
+            let first = binned.triangles();
+            let base = binned.vertices_from(source.len(), near, |i| {
+                lit(mesh, source[i] as usize, (light, ambient), affine, s)
             });
-            let coloured = paint == Paint::Own && mesh.colors.len() == mesh.positions.len();
-            self.0.extend(mesh.indices.chunks_exact(3).map(|t| {
-                let surface = match paint {
-                    Paint::Whole(s) => s,
-                    Paint::Own if coloured => {
-                        let [a, b, c] = [0, 1, 2].map(|k| mesh.colors[t[k] as usize]);
-                        let third = 1.0 / 3.0;
-                        Surface::Colour(srgb([0, 1, 2].map(|i| (a[i] + b[i] + c[i]) * third)))
+            let mut triangles = Vec::with_capacity(mesh.indices.len() / 3 - quads + 2 * quads);
+            let mut packed = base;
+            for (part, choice) in parts.iter().zip(&choices) {
+                match choice {
+                    rock_lod::Choice::Whole => {
+                        // The part's vertex v is packed at `packed + (v − start)`.
+                        let shift = packed as i64 - part.vertices.start as i64;
+                        let at = |v: u32| (i64::from(v) + shift) as u32;
+                        let tris = &mesh.indices[3 * part.triangles.start..3 * part.triangles.end];
+                        triangles.extend(
+                            tris.chunks_exact(3)
+                                .map(|t| ([at(t[0]), at(t[1]), at(t[2])], Surface::Rock)),
+                        );
+                        packed += part.vertices.len() as u32;
                     }
-                    Paint::Own => Surface::Rock,
-                };
-                ([t[0] + base, t[1] + base, t[2] + base], surface)
-            }));
+                    rock_lod::Choice::Quad(corners) => {
+                        let [a, b, c, d] = corners.map(|v| binned.vertex(v, near));
+                        triangles.push(([a, b, c], Surface::Rock));
+                        triangles.push(([a, c, d], Surface::Rock));
+                    }
+                }
+            }
+            binned.extend(triangles);
+            binned.bin(first);
         }
-        self.0.bin(first);
     }
 
     /// How many triangles were added this frame.
@@ -130,4 +202,48 @@ impl Projected {
             true
         });
     }
+}
+
+/// [`Projected::add`] into `binned`.
+fn add<'m>(
+    binned: &mut Binned<Surface>,
+    meshes: impl IntoIterator<Item = &'m Mesh>,
+    paint: Paint,
+    affine: &Affine,
+    cell_size: f64,
+    near: f32,
+    style: &Style,
+) {
+    let light = super::light::world_light(style);
+    let ambient = style.ambient.clamp(0.0, 1.0);
+    let s = cell_size as f32;
+    let first = binned.triangles();
+    for mesh in meshes {
+        let n = mesh.positions.len().min(mesh.normals.len());
+        let base = binned.vertices_from(n, near, |i| lit(mesh, i, (light, ambient), affine, s));
+        let coloured = paint == Paint::Own && mesh.colors.len() == mesh.positions.len();
+        binned.extend(mesh.indices.chunks_exact(3).map(|t| {
+            let surface = match paint {
+                Paint::Whole(s) => s,
+                Paint::Own if coloured => {
+                    let [a, b, c] = [0, 1, 2].map(|k| mesh.colors[t[k] as usize]);
+                    let third = 1.0 / 3.0;
+                    Surface::Colour(srgb([0, 1, 2].map(|i| (a[i] + b[i] + c[i]) * third)))
+                }
+                Paint::Own => Surface::Rock,
+            };
+            ([t[0] + base, t[1] + base, t[2] + base], surface)
+        }));
+    }
+    binned.bin(first);
+}
+
+/// Vertex `i` of `mesh` in clip space (grid cells of `s` metres), lit two-sided:
+/// `ambient + (1 − ambient)·|n·L|`.
+#[inline]
+fn lit(mesh: &Mesh, i: usize, (light, ambient): ([f32; 3], f32), affine: &Affine, s: f32) -> ClipVertex {
+    let (p, n) = (mesh.positions[i], mesh.normals[i]);
+    let lambert = (n[0] * light[0] + n[1] * light[1] + n[2] * light[2]).abs();
+    let l = ambient + (1.0 - ambient) * lambert;
+    affine.clip_point(p[0] / s - 0.5, p[2] / s - 0.5, p[1], l)
 }
