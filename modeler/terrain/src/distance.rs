@@ -279,10 +279,12 @@ fn from_one<D: Level>(mask: &Mask, s: usize) -> Option<Vec<D>> {
     }
     let mut out = D::blank(mask.box_len());
     for (y, (line, row)) in out.chunks_mut(w).zip(bits.chunks(w)).enumerate() {
-        let dy = y.abs_diff(sy) as u32;
-        for (x, (o, &b)) in line.iter_mut().zip(row).enumerate() {
+        // In `i32` (a box is narrower than 2^31, and distances stay below 2^24), whose
+        // differences and absolute values take vector instructions.
+        let (dy, sx) = (y.abs_diff(sy) as i32, sx as i32);
+        for (x, (o, &b)) in (0..line.len() as i32).zip(line.iter_mut().zip(row)) {
             *o = if b {
-                D::of(x.abs_diff(sx) as u32 + dy)
+                D::of(((x - sx).abs() + dy) as u32)
             } else {
                 D::UNSEEN
             };

@@ -191,9 +191,21 @@ fn shapes(df: &[f32], dp: &[f32], (s1, outer): (f64, Option<f64>), shape: &mut [
         }
         return;
     }
+    if s1 == 0.0 && outer.is_none() {
+        // Eq. 2 at slope 0 is `w` itself: what the steps below give (`shape_log` takes
+        // `ln 1 = 0`, and `shape_from_exp` returns `w`), without a logarithm or an exponential.
+        for ((o, &f), &d) in shape.iter_mut().zip(df).zip(dp) {
+            *o = profile::weight_real(f64::from(f), f64::from(d)) as f32;
+        }
+        if let Some(log) = log {
+            log[..df.len()].fill(0.0);
+        }
+        return;
+    }
+    // The working rows, set up once for all the steps.
+    let (mut w, mut s, mut l, mut y) = ([0.0; STEP], [0.0; STEP], [0.0f32; STEP], [0.0; STEP]);
     for a in (0..df.len()).step_by(STEP) {
         let e = (a + STEP).min(df.len());
-        let (mut w, mut s, mut l, mut y) = ([0.0; STEP], [0.0; STEP], [0.0f32; STEP], [0.0; STEP]);
         let cells = w.iter_mut().zip(&mut s).zip(&mut l).zip(&mut y);
         for ((((w, s), l), y), (&f, &d)) in cells.zip(df[a..e].iter().zip(&dp[a..e])) {
             *w = profile::weight_real(f64::from(f), f64::from(d));
@@ -202,7 +214,7 @@ fn shapes(df: &[f32], dp: &[f32], (s1, outer): (f64, Option<f64>), shape: &mut [
             *y = fastmath::power(*l, *s);
         }
         // The exponentials alone in their loop: it compiles to vector instructions.
-        for y in &mut y {
+        for y in &mut y[..e - a] {
             *y = fastmath::exp(*y);
         }
         for (((o, &w), &s), &e) in shape[a..e].iter_mut().zip(&w).zip(&s).zip(&y) {
