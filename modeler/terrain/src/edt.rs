@@ -167,15 +167,20 @@ struct Vertex<T> {
 }
 
 /// The lower envelope of one row's parabolas: its vertices, columns increasing, in a buffer as
-/// long as the row (the first `k` of them in use), so that adding and dropping one is an index.
+/// long as the row (the first `k` of them in use), so that adding and dropping one is an index;
+/// and per column of the row, the column and height of the vertex whose parabola is lowest there.
 struct Envelope<T> {
     verts: Vec<Vertex<T>>,
+    columns: Vec<f64>,
+    heights: Vec<f64>,
 }
 
 impl<T: Wide> Envelope<T> {
     fn with_capacity(n: usize) -> Envelope<T> {
         Envelope {
             verts: Vec::with_capacity(n),
+            columns: Vec::with_capacity(n),
+            heights: Vec::with_capacity(n),
         }
     }
 
@@ -202,10 +207,15 @@ impl<T: Wide> Envelope<T> {
             h: 0,
             z: (T::from(0), T::from(0)),
         };
-        if self.verts.len() < g.len() {
-            self.verts.resize(g.len(), zero);
+        let Envelope {
+            verts,
+            columns,
+            heights,
+        } = self;
+        if verts.len() < g.len() {
+            verts.resize(g.len(), zero);
         }
-        let verts = &mut self.verts[..g.len()];
+        let verts = &mut verts[..g.len()];
         let mut k = 0;
         for (q, &gq) in g.iter().enumerate() {
             if gq == FAR {
@@ -228,23 +238,36 @@ impl<T: Wide> Envelope<T> {
             verts[k] = Vertex { v: q, f: fq, h: hq, z };
             k += 1;
         }
+        if k == 0 {
+            return;
+        }
         // Each vertex's columns: from where the last one's ended to where the next one's stretch
-        // starts (the first x with x·den ≥ num), in one tight loop.
+        // starts (the first x with x·den ≥ num); the last one's end at the row's end, so every
+        // column gets its vertex.
         let verts = &verts[..k];
         let w = out.len();
+        if columns.len() < w {
+            columns.resize(w, 0.0);
+            heights.resize(w, 0.0);
+        }
+        let (columns, heights) = (&mut columns[..w], &mut heights[..w]);
         let mut start = 0;
         for (i, a) in verts.iter().enumerate() {
             let end = verts.get(i + 1).map_or(w, |b| T::first_at_least(b.z.0, b.z.1, w));
             if end > start {
-                // Whole numbers below 2^53 in `f64`: the same squared distances, exactly, and a
-                // column as an `i32` (a box is narrower than 2^31) converts two at a time.
-                let (vk, fk) = (a.v as f64, a.f as f64);
-                for (x, d) in (start as i32..end as i32).zip(&mut out[start..end]) {
-                    let dx = f64::from(x) - vk;
-                    *d = f(dx * dx + fk);
-                }
+                // Whole numbers below 2^53 in `f64`.
+                columns[start..end].fill(a.v as f64);
+                heights[start..end].fill(a.f as f64);
                 start = end;
             }
+        }
+        // Then the squared distances in one loop over the row, which compiles to vector
+        // instructions (a vertex's stretch is often a column or two): whole numbers below 2^53
+        // in `f64`, so the same numbers exactly; a column as an `i32` (a box is narrower than
+        // 2^31) converts several at a time.
+        for (x, ((d, &v), &h)) in (0..w as i32).zip(out.iter_mut().zip(&*columns).zip(&*heights)) {
+            let dx = f64::from(x) - v;
+            *d = f(dx * dx + h);
         }
     }
 }
