@@ -126,6 +126,13 @@ impl Trees {
                 };
                 tree.draw(q, scene.time, drawn);
             });
+        let wanted: Vec<_> = scene
+            .trees
+            .iter()
+            .zip(&self.drawn)
+            .flat_map(|(tree, drawn)| drawn.impostors.iter().map(move |imp| (&tree.nodes, imp.node)))
+            .collect();
+        self.cache.bake_missing(&wanted, &scene.style);
         for (tree, drawn) in scene.trees.iter().zip(&self.drawn) {
             for imp in &drawn.impostors {
                 let group = self.cache.group(&tree.nodes, imp.node, &scene.style);

@@ -24,6 +24,7 @@ use std::sync::Arc;
 use glam::{DAffine3, DVec3, Vec3};
 use penmodel_terrain::export::Mesh;
 use penmodel_terrain::trees::{Impostor, NodeTree};
+use rayon::prelude::*;
 
 use super::meshes::srgb;
 use super::rasterise::{self, Bounds, DepthSink, Sample, Surface, Vtx};
@@ -264,17 +265,35 @@ pub struct Cache {
 impl Cache {
     /// The group index of `impostor`'s node of `tree`, baked now if it is the first of its scale.
     pub fn group(&mut self, tree: &Arc<NodeTree>, node: u32, style: &Style) -> u32 {
-        let scale = tree.nodes.get(node as usize).map_or(1.0, |n| n.scale);
-        let key = (Arc::as_ptr(tree) as usize, scale.to_bits());
+        let key = key(tree, node);
         if let Some(&g) = self.groups.get(&key) {
             return g;
         }
-        let mesh = if (node as usize) < tree.nodes.len() {
-            tree.subtree(node as usize)
-        } else {
-            Mesh::default()
-        };
-        let baked = bake(&mesh, style, TEXELS);
+        self.insert(key, tree, baked(tree, node, style))
+    }
+
+    /// Bakes the groups of `wanted` (node trees and nodes) not baked yet, on the pool's threads:
+    /// a grove planted, or a head leaning in, asks for tens of new groups in one frame, and
+    /// baking them one by one inside the view took up to 120 ms of a tracked frame (issue 16).
+    pub fn bake_missing(&mut self, wanted: &[(&Arc<NodeTree>, u32)], style: &Style) {
+        let mut missing: Vec<((usize, u64), &Arc<NodeTree>, u32)> = Vec::new();
+        for &(tree, node) in wanted {
+            let k = key(tree, node);
+            if !self.groups.contains_key(&k) && !missing.iter().any(|m| m.0 == k) {
+                missing.push((k, tree, node));
+            }
+        }
+        let made: Vec<Baked> = missing
+            .par_iter()
+            .map(|&(_, tree, node)| baked(tree, node, style))
+            .collect();
+        for ((k, tree, _), b) in missing.into_iter().zip(made) {
+            self.insert(k, tree, b);
+        }
+    }
+
+    /// Adds `baked` as the group of `key`; returns its index.
+    fn insert(&mut self, key: (usize, u64), tree: &Arc<NodeTree>, baked: Baked) -> u32 {
         let g = self.bounds.len() as u32;
         self.bounds.push(baked.bounds);
         self.crops.extend(baked.textures.iter().map(opaque));
@@ -305,4 +324,21 @@ impl Cache {
     pub fn groups(&self) -> usize {
         self.bounds.len()
     }
+}
+
+/// A group's key: its node tree's address and the node's scale (a tree's nodes of one scale
+/// are the same shape).
+fn key(tree: &Arc<NodeTree>, node: u32) -> (usize, u64) {
+    let scale = tree.nodes.get(node as usize).map_or(1.0, |n| n.scale);
+    (Arc::as_ptr(tree) as usize, scale.to_bits())
+}
+
+/// Node `node` of `tree` baked (an empty group for a node it does not have).
+fn baked(tree: &NodeTree, node: u32, style: &Style) -> Baked {
+    let mesh = if (node as usize) < tree.nodes.len() {
+        tree.subtree(node as usize)
+    } else {
+        Mesh::default()
+    };
+    bake(&mesh, style, TEXELS)
 }

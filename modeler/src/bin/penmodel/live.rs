@@ -668,8 +668,11 @@ impl Painter {
         self.insets(&picture, session.editor.heightmap(), revisions)?;
         // The terrain's changes taken in before the pose, not in the view after it: a frame
         // after a burst of edits spent up to 26 ms on them inside the latency window.
+        let before = scene(&picture, session.editor.heightmap(), revisions);
+        self.renderer.prepare_terrain(&before);
+        // The trees' new simplified shapes baked for the last pose, not in the view.
         self.renderer
-            .prepare_terrain(&scene(&picture, session.editor.heightmap(), revisions));
+            .prepare_trees(&before, self.view.width(), self.view.height());
         let ended = latch_head(rx, session, said, Duration::from_micros(HEAD_WAIT_US));
         if let Some(t) = session.last_event_us().filter(|_| advance) {
             session.interaction.advance(t);
