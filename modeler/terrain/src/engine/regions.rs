@@ -35,7 +35,8 @@
 //! from and go back to [`crate::pool::MAPS`], so that a new engine does not fault in fresh pages. Within a row the cells are taken a stretch at a time (an
 //! owned run, or its dirty cells), each step over the whole stretch for one figure, in figure
 //! order: every cell still sees the arithmetic of a cell-by-cell evaluation, and the loops over
-//! the stretch (the sums of a paint, the shares) compile to vector instructions.
+//! the stretch (the sums of a paint, the shares) compile to vector instructions — in the widest
+//! copy the CPU has ([`crate::simd`]: baseline, AVX2 or AVX-512, the same bits from each).
 
 use rayon::prelude::*;
 
