@@ -181,7 +181,7 @@ impl Atmosphere {
     /// The ground position `(x, z)` of the point of depth `w` along `ray`, and its distance from
     /// the eye along the view's axis (the haze's distance: within the 45° of a view it is at most
     /// 8 % short of the distance along the ray, and it costs no square root per pixel).
-    #[inline]
+    #[inline(always)]
     pub fn point(&self, ray: [f32; 3], w: f32) -> ([f32; 2], f32) {
         let k = w * self.inv_det;
         (
@@ -197,22 +197,34 @@ impl Atmosphere {
     }
 
     /// `1 − exp(−d/L)`.
-    #[inline]
+    #[inline(always)]
     fn fog(&self, d: f32) -> f32 {
         let x = d * self.inv_haze * ((HAZE_ENTRIES - 1) as f32 / HAZE_SPAN);
-        if x.is_finite() {
-            // A 16-bit cast saturates as the 32- and 64-bit ones did (the table is shorter than
-            // 2¹⁶: the same entry), in three instructions where 32 bits took six.
-            self.table[usize::from(x as u16).min(HAZE_ENTRIES - 1)]
-        } else {
-            1.0
-        }
+        // A 16-bit cast saturates as the 32- and 64-bit ones did (the table is shorter than 2¹⁶:
+        // the same entry), in three instructions where 32 bits took six. The entry is read
+        // whatever `x` is (a NaN casts to 0) and then chosen: without a branch the resolve's
+        // last pass is vectorised (`shade::resolve_land`).
+        let t = self.table[usize::from(x as u16).min(HAZE_ENTRIES - 1)];
+        if x.is_finite() { t } else { 1.0 }
     }
 
     /// `colour` (lit) seen from `d` metres away.
-    #[inline]
+    #[inline(always)]
     pub fn hazed(&self, colour: [f32; 3], d: f32) -> [f32; 3] {
-        lerp(colour, self.horizon, self.haze * self.fog(d))
+        self.hazed_by(colour, self.haze_at(d))
+    }
+
+    /// How far a surface `d` metres away tends to the horizon's colour: [`Atmosphere::hazed`]
+    /// in two steps, this one a table lookup, the other arithmetic (the resolve vectorises it).
+    #[inline(always)]
+    pub fn haze_at(&self, d: f32) -> f32 {
+        self.haze * self.fog(d)
+    }
+
+    /// `colour` tended to the horizon's by `t` ([`Atmosphere::haze_at`]).
+    #[inline(always)]
+    pub fn hazed_by(&self, colour: [f32; 3], t: f32) -> [f32; 3] {
+        lerp(colour, self.horizon, t)
     }
 
     /// What a pixel that shows no surface sees along `ray`: the table, the model's side, the
@@ -261,7 +273,7 @@ impl Atmosphere {
     }
 
     /// [`Atmosphere::background`] as bytes.
-    #[inline]
+    #[inline(always)]
     pub fn background_bytes(&self, ray: [f32; 3]) -> [u8; 3] {
         let c = self.background(ray);
         [c[0] as u8, c[1] as u8, c[2] as u8]
@@ -269,7 +281,7 @@ impl Atmosphere {
 }
 
 /// `a + t·(b − a)`, spelled out (an array `map` here costs a tenth of the frame).
-#[inline]
+#[inline(always)]
 pub fn lerp(a: [f32; 3], b: [f32; 3], t: f32) -> [f32; 3] {
     [
         a[0] + t * (b[0] - a[0]),

@@ -44,6 +44,8 @@ pub mod rasterise;
 pub mod rock_lod;
 pub mod scene;
 pub mod shade;
+#[doc(hidden)]
+pub mod simd;
 pub mod stereo;
 pub mod text;
 pub mod textured;

@@ -43,7 +43,7 @@ impl Packed {
     }
 
     /// The colour (sRGB 0–255) and the fine noise's factor.
-    #[inline]
+    #[inline(always)]
     pub(crate) fn unpack(self) -> [f32; 4] {
         let [r, g, b, k] = self.0;
         [
@@ -88,7 +88,7 @@ pub(crate) struct Mips {
 
 /// The level a pixel spanning `cells` cells of the map reads: `⌊log₂ cells⌋` (0 below 2 cells,
 /// the map itself), at most `available`.
-#[inline]
+#[inline(always)]
 pub(crate) fn level_for(cells: f32, available: usize) -> usize {
     // NaN and anything under 2 cells: the map itself.
     if cells.is_nan() || cells < 2.0 {

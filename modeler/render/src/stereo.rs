@@ -15,6 +15,7 @@ use rayon::prelude::*;
 use super::frame::{Frame, Rgba};
 
 /// Rec. 601 luminance of a colour.
+#[inline(always)]
 pub fn luma(p: Rgba) -> u8 {
     ((299 * u32::from(p[0]) + 587 * u32::from(p[1]) + 114 * u32::from(p[2]) + 500) / 1000) as u8
 }
@@ -25,9 +26,14 @@ pub fn anaglyph(left: &Frame, right: &mut Frame) {
         .pixels_mut()
         .par_chunks_mut(4096)
         .zip(left.pixels().par_chunks(4096))
-        .for_each(|(r, l)| {
-            for (r, l) in r.iter_mut().zip(l) {
-                r[0] = luma(*l);
-            }
-        });
+        .for_each(|(r, l)| crate::simd::dispatch!(red_from_luma, (r, l)));
+}
+
+/// `right`'s red channels from `left`'s luminance, compiled for the baseline and for AVX2
+/// ([`crate::simd`]: AVX2 multiplies eight 32-bit lanes, which SSE2 cannot).
+#[inline(always)]
+fn red_from_luma(right: &mut [Rgba], left: &[Rgba]) {
+    for (r, l) in right.iter_mut().zip(left) {
+        r[0] = luma(*l);
+    }
 }

@@ -5,5 +5,6 @@ mod lod;
 mod outputs;
 mod render;
 mod rocks;
+mod simd;
 mod trees;
 mod water;
