@@ -49,11 +49,13 @@ pub struct Vtx {
 
 /// Pixel coordinate → fixed point. Deterministic (the same input gives the same bits), which is
 /// all watertightness needs; the offset keeps the truncating conversion rounding to nearest
-/// over the guard band.
+/// over the guard band. A vertex far outside the guard band (behind the eye, say) saturates the
+/// conversion; it is clipped, never drawn from these coordinates, so the subtraction wraps as a
+/// release build's does instead of panicking in a debug one.
 #[inline]
 pub fn snap(p: f32) -> i32 {
     const OFFSET: f32 = 16384.0;
-    ((p + OFFSET) * ONE as f32 + 0.5) as i32 - (OFFSET as i32) * ONE
+    (((p + OFFSET) * ONE as f32 + 0.5) as i32).wrapping_sub((OFFSET as i32) * ONE)
 }
 
 /// A pixel rectangle `[x0, x1) × [y0, y1)`.
