@@ -6,7 +6,8 @@
 //! passes for it) and the anaglyph ([`crate::stereo`]) — are compiled twice: once for the
 //! baseline, once inside a `#[target_feature(enable = "avx2")]` function that calls the same
 //! `#[inline(always)]` body, so that LLVM uses eight lanes in that copy. [`avx2`] picks one at
-//! run time. (The triangles' pixel loops step their attributes one addition after another,
+//! run time, from the terrain engine's choice of copy (`penmodel_terrain::simd`: one detection of
+//! the CPU and one test switch for both crates). (The triangles' pixel loops step their attributes one addition after another,
 //! which no vector width changes, so they are compiled once.)
 //!
 //! The two copies give the same bytes: AVX2 adds no operation the baseline copy lacks, and an
@@ -17,42 +18,34 @@
 //! (`tests/simd.rs`), so the baseline copy stays tested on an AVX2 machine.
 
 use std::sync::OnceLock;
-use std::sync::atomic::{AtomicBool, Ordering};
 
-/// Set while the baseline copies are forced (tests).
-static BASELINE: AtomicBool = AtomicBool::new(false);
+use penmodel_terrain::simd::{Level, available, force_at_most, level};
 
 /// The environment variable that, set to `1`, keeps the baseline copies for the whole process
 /// (to measure what the AVX2 copies bring, or to rule them out).
 pub const BASELINE_VARIABLE: &str = "PENMODEL_RENDER_BASELINE";
 
-/// Whether the AVX2 copies run: the CPU has AVX2, [`BASELINE_VARIABLE`] is not `1` and the
-/// baseline is not forced. Both questions are asked once, so this is two loads.
+/// Whether the AVX2 copies run: the terrain engine's choice of copy ([`penmodel_terrain::simd`]:
+/// the CPU's widest, unless a test capped it) is AVX2 or wider, and [`BASELINE_VARIABLE`] is not
+/// `1` (asked once). A few loads.
 #[inline(always)]
 pub(crate) fn avx2() -> bool {
-    static CHOSEN: OnceLock<bool> = OnceLock::new();
-    !BASELINE.load(Ordering::Relaxed)
-        && *CHOSEN.get_or_init(|| has_avx2() && std::env::var(BASELINE_VARIABLE).as_deref() != Ok("1"))
+    static VARIABLE: OnceLock<bool> = OnceLock::new();
+    level() >= Level::Avx2 && !*VARIABLE.get_or_init(|| std::env::var(BASELINE_VARIABLE).as_deref() == Ok("1"))
 }
 
-/// Forces the baseline copies (`true`) or lets the CPU choose again (`false`), for every thread.
-/// Both copies draw the same bytes, so a frame drawn meanwhile is not disturbed.
+/// Forces the baseline copies (`true`) or lets the CPU choose again (`false`), for every thread
+/// and the terrain engine's copies too (they give the same bits). Both copies draw the same
+/// bytes, so a frame drawn meanwhile is not disturbed.
 #[doc(hidden)]
 pub fn force_baseline(on: bool) {
-    BASELINE.store(on, Ordering::Relaxed);
+    force_at_most(if on { Level::Baseline } else { Level::Avx512 });
 }
 
 /// Whether this CPU runs the AVX2 copies at all (tests say which copies they compared).
 #[doc(hidden)]
 pub fn has_avx2() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    {
-        std::arch::is_x86_feature_detected!("avx2")
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        false
-    }
+    available() >= Level::Avx2
 }
 
 /// Calls `body(args…)`, an `#[inline(always)]` function, compiled for AVX2 when [`avx2`] says
