@@ -7,8 +7,9 @@
 //! baseline, once inside a `#[target_feature(enable = "avx2")]` function that calls the same
 //! `#[inline(always)]` body, so that LLVM uses eight lanes in that copy. [`avx2`] picks one at
 //! run time, from the terrain engine's choice of copy (`penmodel_terrain::simd`: one detection of
-//! the CPU and one test switch for both crates). (The triangles' pixel loops step their attributes one addition after another,
-//! which no vector width changes, so they are compiled once.)
+//! the CPU and one test switch for both crates). (The triangles' pixel loops step their
+//! attributes one addition after another, which no vector width changes, so they are compiled
+//! once.)
 //!
 //! The two copies give the same bytes: AVX2 adds no operation the baseline copy lacks, and an
 //! IEEE addition, multiplication, division, square root or conversion gives the same result in
