@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use penmodel_terrain::{Document, Figure, FigureKind, cells, generate};
 
-fn examples() -> Vec<(String, Document)> {
+pub(crate) fn examples() -> Vec<(String, Document)> {
     let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples");
     let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
         .unwrap()

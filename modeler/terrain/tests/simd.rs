@@ -3,14 +3,13 @@
 //! narrower copies stay tested on a machine that runs the widest. A copy the CPU lacks is not
 //! compared (the tests say so on stderr).
 
-use std::path::PathBuf;
 use std::sync::{Mutex, PoisonError};
 
 use crate::common::*;
 use crate::editing::{Op, detail, edit_for, erosion, metric, op};
 use penmodel_terrain::editor::Editor;
 use penmodel_terrain::simd::{self, Level};
-use penmodel_terrain::{Document, Heightmap, Metric, generate};
+use penmodel_terrain::{Heightmap, Metric, generate};
 use proptest::prelude::*;
 
 /// The tests that switch the copies, one at a time (the switch is the whole process's).
@@ -55,16 +54,9 @@ fn bits(map: &Heightmap) -> Vec<u32> {
 
 #[test]
 fn the_copies_give_the_examples_the_same_terrain() {
-    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples");
-    let mut paths: Vec<PathBuf> = std::fs::read_dir(&dir)
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .filter(|p| p.extension().is_some_and(|e| e == "json"))
-        .collect();
-    paths.sort();
-    assert_eq!(paths.len(), 5);
-    for path in paths {
-        let doc = Document::load(&path).unwrap();
+    let examples = crate::examples::examples();
+    assert_eq!(examples.len(), 5);
+    for (name, doc) in examples {
         for metric in [Metric::Taxicab, Metric::Euclidean] {
             // The example's own grid, and 256² over the same square.
             for n in [None, Some(256)] {
@@ -78,8 +70,7 @@ fn the_copies_give_the_examples_the_same_terrain() {
                 for (level, map) in &maps[1..] {
                     assert!(
                         *map == maps[0].1,
-                        "{} {metric:?} {n:?}: the {level:?} copy differs from the baseline",
-                        path.display()
+                        "{name} {metric:?} {n:?}: the {level:?} copy differs from the baseline"
                     );
                 }
             }
