@@ -126,13 +126,12 @@ impl Trees {
                 };
                 tree.draw(q, scene.time, drawn);
             });
-        let wanted: Vec<_> = scene
+        let wanted = scene
             .trees
             .iter()
             .zip(&self.drawn)
-            .flat_map(|(tree, drawn)| drawn.impostors.iter().map(move |imp| (&tree.nodes, imp.node)))
-            .collect();
-        self.cache.bake_missing(&wanted, &scene.style);
+            .flat_map(|(tree, drawn)| drawn.impostors.iter().map(move |imp| (&tree.nodes, imp.node)));
+        self.cache.bake_missing(wanted, &scene.style);
         for (tree, drawn) in scene.trees.iter().zip(&self.drawn) {
             for imp in &drawn.impostors {
                 let group = self.cache.group(&tree.nodes, imp.node, &scene.style);

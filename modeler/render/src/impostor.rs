@@ -18,7 +18,7 @@
 //!   product of its maps' scales decides where its branches stop), so textures are kept per
 //!   species and scale and baked the first time a group of that scale is drawn.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
 use glam::{DAffine3, DVec3, Vec3};
@@ -275,11 +275,13 @@ impl Cache {
     /// Bakes the groups of `wanted` (node trees and nodes) not baked yet, on the pool's threads:
     /// a grove planted, or a head leaning in, asks for tens of new groups in one frame, and
     /// baking them one by one inside the view took up to 120 ms of a tracked frame (issue 16).
-    pub fn bake_missing(&mut self, wanted: &[(&Arc<NodeTree>, u32)], style: &Style) {
+    pub fn bake_missing<'t>(&mut self, wanted: impl IntoIterator<Item = (&'t Arc<NodeTree>, u32)>, style: &Style) {
+        // In the order first asked for, so the groups are numbered as `group` would number them.
         let mut missing: Vec<((usize, u64), &Arc<NodeTree>, u32)> = Vec::new();
-        for &(tree, node) in wanted {
+        let mut seen = HashSet::new();
+        for (tree, node) in wanted {
             let k = key(tree, node);
-            if !self.groups.contains_key(&k) && !missing.iter().any(|m| m.0 == k) {
+            if !self.groups.contains_key(&k) && seen.insert(k) {
                 missing.push((k, tree, node));
             }
         }

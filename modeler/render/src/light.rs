@@ -89,6 +89,15 @@ pub fn vertex_light(
         .sum()
 }
 
+/// The light of a surface with unit normal `n` lit from both sides: `ambient + (1 − ambient)·|n·L|`
+/// for the world light `light` ([`world_light`]); meshes (rocks, water, trees) and their simplified
+/// shapes.
+#[inline]
+pub(crate) fn two_sided(n: [f32; 3], light: [f32; 3], ambient: f32) -> f32 {
+    let lambert = (n[0] * light[0] + n[1] * light[1] + n[2] * light[2]).abs();
+    ambient + (1.0 - ambient) * lambert
+}
+
 /// The style's light in the world frame (X = x, Y = up, Z = y), unit length; straight down when
 /// the style's light has no direction.
 pub(crate) fn world_light(style: &Style) -> [f32; 3] {

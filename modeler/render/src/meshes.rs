@@ -64,7 +64,16 @@ pub fn srgb(linear: [f32; 3]) -> [u8; 3] {
 
 /// One eye's projected meshes.
 #[derive(Debug, Default)]
-pub struct Projected(Binned<Surface>, PartsCache);
+pub struct Projected(Binned<Surface>, PartsCache, RockScratch);
+
+/// [`Projected::add_rocks`]'s per-frame lists, kept so that a frame allocates nothing.
+#[derive(Debug, Default)]
+struct RockScratch {
+    choices: Vec<rock_lod::Choice>,
+    /// The whole rocks' vertices, packed: `source[i]` is the mesh's vertex of the i-th.
+    source: Vec<u32>,
+    triangles: Vec<([u32; 3], Surface)>,
+}
 
 /// The last frames' rock meshes' [`rock_lod::parts`], by their indices: a field's triangles stay
 /// the same while it follows the terrain (only its positions change), and finding its parts
@@ -119,7 +128,10 @@ impl Projected {
         near: f32,
         style: &Style,
     ) {
-        let Projected(binned, cache) = self;
+        let Projected(binned, cache, scratch) = self;
+        let light = super::light::world_light(style);
+        let ambient = style.ambient.clamp(0.0, 1.0);
+        let s = cell_size as f32;
         for (k, mesh) in meshes.into_iter().enumerate() {
             let n = mesh.positions.len().min(mesh.normals.len());
             let parts = if pixels > 0.0 {
@@ -139,26 +151,25 @@ impl Projected {
                 );
                 continue;
             };
-            let light = super::light::world_light(style);
-            let ambient = style.ambient.clamp(0.0, 1.0);
-            let s = cell_size as f32;
-            let choices = rock_lod::choose(mesh, parts, affine, s, near, pixels, (light, ambient));
-            // The whole rocks' vertices, packed: `source[i]` is the mesh's vertex of the i-th.
-            let mut source = Vec::new();
-            let mut quads = 0;
-            for (part, choice) in parts.iter().zip(&choices) {
-                match choice {
-                    rock_lod::Choice::Whole => source.extend(part.vertices.clone().map(|v| v as u32)),
-                    rock_lod::Choice::Quad(_) => quads += 1,
+            let RockScratch {
+                choices,
+                source,
+                triangles,
+            } = scratch;
+            rock_lod::choose(mesh, parts, affine, s, near, pixels, (light, ambient), choices);
+            source.clear();
+            for (part, choice) in parts.iter().zip(choices.iter()) {
+                if *choice == rock_lod::Choice::Whole {
+                    source.extend(part.vertices.clone().map(|v| v as u32));
                 }
             }
             let first = binned.triangles();
             let base = binned.vertices_from(source.len(), near, |i| {
                 lit(mesh, source[i] as usize, (light, ambient), affine, s)
             });
-            let mut triangles = Vec::with_capacity(mesh.indices.len() / 3 - quads + 2 * quads);
+            triangles.clear();
             let mut packed = base;
-            for (part, choice) in parts.iter().zip(&choices) {
+            for (part, choice) in parts.iter().zip(choices.iter()) {
                 match choice {
                     rock_lod::Choice::Whole => {
                         // The part's vertex v is packed at `packed + (v − start)`.
@@ -178,7 +189,7 @@ impl Projected {
                     }
                 }
             }
-            binned.extend(triangles);
+            binned.extend(triangles.drain(..));
             binned.bin(first);
         }
     }
@@ -242,8 +253,7 @@ fn add<'m>(
 /// `ambient + (1 − ambient)·|n·L|`.
 #[inline]
 fn lit(mesh: &Mesh, i: usize, (light, ambient): ([f32; 3], f32), affine: &Affine, s: f32) -> ClipVertex {
-    let (p, n) = (mesh.positions[i], mesh.normals[i]);
-    let lambert = (n[0] * light[0] + n[1] * light[1] + n[2] * light[2]).abs();
-    let l = ambient + (1.0 - ambient) * lambert;
+    let p = mesh.positions[i];
+    let l = super::light::two_sided(mesh.normals[i], light, ambient);
     affine.clip_point(p[0] / s - 0.5, p[2] / s - 0.5, p[1], l)
 }

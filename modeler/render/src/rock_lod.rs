@@ -102,7 +102,8 @@ fn norm(v: [f32; 3]) -> f32 {
 /// What each of `parts` of `mesh` is drawn as, for an eye whose clip coordinates are `affine`'s
 /// (grid cells of `cell_size` metres), whose near plane is at depth `near`, lit from `light`
 /// with `ambient`: a quad when its bounding sphere projects within `pixels` of its centre and
-/// lies wholly in front of the near plane.
+/// lies wholly in front of the near plane. The choices replace what `out` held, one per part.
+#[allow(clippy::too_many_arguments)] // an eye's projection, its light and the list kept between frames.
 pub fn choose(
     mesh: &Mesh,
     parts: &[Part],
@@ -111,7 +112,8 @@ pub fn choose(
     near: f32,
     pixels: f32,
     (light, ambient): ([f32; 3], f32),
-) -> Vec<Choice> {
+    out: &mut Vec<Choice>,
+) {
     let [gx, gy, gw] = gradients(affine, cell_size);
     let gw_norm = norm(gw);
     let s = cell_size;
@@ -147,8 +149,7 @@ pub fn choose(
         }
         let len = norm(n);
         let n = if len > 0.0 { n.map(|v| v / len) } else { [0.0, 1.0, 0.0] };
-        let lambert = (n[0] * light[0] + n[1] * light[1] + n[2] * light[2]).abs();
-        let l = ambient + (1.0 - ambient) * lambert;
+        let l = super::light::two_sided(n, light, ambient);
         // The ellipse inscribed in the box has π/4 of its area: each side by √(π/4).
         let k = 0.5 * (std::f32::consts::PI / 4.0).sqrt();
         let (hx, hz) = (k * (hi[0] - lo[0]), k * (hi[2] - lo[2]));
@@ -156,7 +157,8 @@ pub fn choose(
             |dx: f32, dz: f32| affine.clip_point((centre[0] + dx) / s - 0.5, (centre[2] + dz) / s - 0.5, mean_y, l);
         Choice::Quad([corner(-hx, -hz), corner(hx, -hz), corner(hx, hz), corner(-hx, hz)])
     };
-    parts.par_iter().with_min_len(512).map(choose).collect()
+    out.clear();
+    out.par_extend(parts.par_iter().with_min_len(512).map(choose));
 }
 
 #[cfg(test)]

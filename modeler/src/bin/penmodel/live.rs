@@ -596,6 +596,13 @@ impl TreeBudget {
         }
     }
 
+    /// [`scene`] with the trees at this budget's detail.
+    fn scene<'a>(&self, p: &'a Picture, map: &'a Heightmap, revisions: Option<&'a Revisions>) -> Scene<'a> {
+        let mut scene = scene(p, map, revisions);
+        scene.tree_lod = scene.tree_lod.map(|r| self.apply(r));
+        scene
+    }
+
     /// Takes a view that took `ms`.
     fn after(&mut self, ms: f64) {
         let max = Self::MAX_Q0 / penmodel_terrain::trees::Roughness::default().q0;
@@ -720,8 +727,7 @@ impl Painter {
         self.insets(&picture, session.editor.heightmap(), revisions)?;
         // The terrain's changes taken in before the pose, not in the view after it: a frame
         // after a burst of edits spent up to 26 ms on them inside the latency window.
-        let mut before = scene(&picture, session.editor.heightmap(), revisions);
-        before.tree_lod = before.tree_lod.map(|r| self.trees.apply(r));
+        let before = self.trees.scene(&picture, session.editor.heightmap(), revisions);
         self.renderer.prepare_terrain(&before);
         // The trees' new simplified shapes baked for the last pose, at the budget's detail, not
         // in the view.
@@ -733,8 +739,9 @@ impl Painter {
         }
         session.frame_started();
         let picture = Picture::of(session, look);
-        let mut latched = scene(&picture, session.editor.heightmap(), Some(session.editor.revisions()));
-        latched.tree_lod = latched.tree_lod.map(|r| self.trees.apply(r));
+        let latched = self
+            .trees
+            .scene(&picture, session.editor.heightmap(), Some(session.editor.revisions()));
         let started = Instant::now();
         self.view_with(latched)?;
         self.trees.after(started.elapsed().as_secs_f64() * 1e3);
