@@ -172,6 +172,12 @@ impl Atmosphere {
         ]
     }
 
+    /// The world height of the table's plane: what a pixel below the horizon that shows no
+    /// surface sees (the table, the model's side, the land beyond).
+    pub fn table_y(&self) -> f32 {
+        self.table_y
+    }
+
     /// The step of [`Atmosphere::ray`] per pixel along a row.
     #[inline]
     pub fn step(&self) -> [f32; 3] {

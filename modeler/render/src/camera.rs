@@ -244,6 +244,16 @@ pub struct Viewpoint {
     pub near: f64,
 }
 
+impl Viewpoint {
+    /// The eye's distance from the screen's plane: every point of that plane is at this depth
+    /// `w` ([`Projection`]'s `w` is the distance along the screen's normal).
+    pub fn screen_distance(&self) -> f64 {
+        let vr = (self.lower_right - self.lower_left).normalize();
+        let vu = (self.upper_left - self.lower_left).normalize();
+        vr.cross(vu).dot(self.eye - self.lower_left)
+    }
+}
+
 fn world(ground: [f64; 2], height: f64) -> DVec3 {
     DVec3::new(ground[0], height, ground[1])
 }

@@ -111,4 +111,20 @@ impl Frame {
         let n = 3.0 * self.pixels.len() as f64;
         Some((sum / n, 10.0 * (255.0 * 255.0 / (sq / n)).log10()))
     }
+
+    /// The share of pixels whose colour differs from `other`'s by more than `levels` in R, G or
+    /// B: where the frames differ visibly, beside a shading that differs by a level or two;
+    /// `None` when the sizes differ.
+    pub fn visibly_different(&self, other: &Frame, levels: u8) -> Option<f64> {
+        if (self.width, self.height) != (other.width, other.height) {
+            return None;
+        }
+        let n = self
+            .pixels
+            .iter()
+            .zip(&other.pixels)
+            .filter(|(p, q)| (0..3).any(|c| p[c].abs_diff(q[c]) > levels))
+            .count();
+        Some(n as f64 / self.pixels.len().max(1) as f64)
+    }
 }

@@ -41,6 +41,7 @@ pub mod nodes;
 pub mod overlay;
 pub mod ramp;
 pub mod rasterise;
+pub mod reproject;
 pub mod rock_lod;
 pub mod scene;
 pub mod shade;
@@ -86,6 +87,42 @@ fn whole(frame: &Frame) -> Bounds {
     }
 }
 
+/// `held`, an eye of a frame drawn earlier, moved to `scene`'s `eye` in `out`: its viewport.
+fn warp_held(held: Option<&reproject::Held>, scene: &Scene, eye: Eye, out: &mut Frame) -> Result<Bounds, RenderError> {
+    let held = held
+        .filter(|h| h.width == out.width() as usize && h.invw.len() == out.pixels().len())
+        .ok_or(RenderError::Camera("no eye held at this frame's size to reproject"))?;
+    let to = projection(scene, eye, held.bounds, out.width(), out.height());
+    let motion = reproject::Motion::between(&held.projection, &to)
+        .ok_or(RenderError::Camera("the held eye's projection is degenerate"))?;
+    reproject::warp(held, &motion, out.pixels_mut());
+    Ok(held.bounds)
+}
+
+/// The index of `eye`'s buffers: centre, left, right.
+fn slot(eye: Eye) -> usize {
+    match eye {
+        Eye::Centre => 0,
+        Eye::Left => 1,
+        Eye::Right => 2,
+    }
+}
+
+/// The projection of `scene`'s `eye` drawn into `viewport` of a `width × height` frame.
+fn projection(scene: &Scene, eye: Eye, viewport: Bounds, width: u32, height: u32) -> Projection {
+    let vp = scene.camera.viewpoint(eye, f64::from(width) / f64::from(height));
+    Projection::new(
+        &vp,
+        scene.camera.tilt,
+        Viewport {
+            x: f64::from(viewport.x0),
+            y: f64::from(viewport.y0),
+            width: f64::from(viewport.x1 - viewport.x0),
+            height: f64::from(viewport.y1 - viewport.y0),
+        },
+    )
+}
+
 /// Rows per tile unless set otherwise ([`Renderer::with_tile_rows`]). Taller tiles set up fewer
 /// triangles twice (a 512² frame: 8 rows 343M instructions, 16 rows 303M, 32 rows 294M, 48 rows
 /// 291M); 32 still gives 23 tiles to balance over two cores.
@@ -127,6 +164,13 @@ pub struct Renderer {
     /// What [`Renderer::prepare_terrain`] prepared for — the terrain's revision, the vertical
     /// scale and the style — and what it found, for the frame that follows.
     prepared: Option<(penmodel_terrain::revision::Mark, f32, Style, RenderStats)>,
+    /// Whether [`Renderer::render_held`] is drawing: each eye then keeps its picture.
+    hold: bool,
+    /// Each eye's picture and depth as last drawn by [`Renderer::render_held`] (centre, left,
+    /// right), for [`Renderer::reproject`].
+    held: [Option<reproject::Held>; 3],
+    /// Held eyes' buffers from earlier frames, reused.
+    spare: Vec<reproject::Held>,
 }
 
 impl Default for Renderer {
@@ -156,6 +200,9 @@ impl Renderer {
             pyramid: lod::Pyramid::default(),
             pyramid_made: None,
             prepared: None,
+            hold: false,
+            held: Default::default(),
+            spare: Vec::new(),
         }
     }
 
@@ -209,6 +256,57 @@ impl Renderer {
         self.eye(scene, eye, full, frame);
         self.ui(scene, full, frame);
         Ok(stats)
+    }
+
+    /// Renders `scene` into `frame` as [`render`](Self::render) does, and holds each eye's
+    /// picture, depth and projection, so that [`reproject`](Self::reproject) can move them to a
+    /// newer head pose (issue 16: the view drawn before the pose comes, only moved after it).
+    pub fn render_held(&mut self, scene: &Scene, frame: &mut Frame) -> Result<RenderStats, RenderError> {
+        // Last frame's eyes are stale: their buffers are reused.
+        self.spare.extend(self.held.iter_mut().filter_map(Option::take));
+        self.hold = true;
+        let stats = self.render(scene, frame);
+        self.hold = false;
+        stats
+    }
+
+    /// The eyes [`render_held`](Self::render_held) drew, moved to `scene`'s camera by their depth
+    /// ([`reproject`]), combined as `scene.stereo` asks, and `scene`'s UI over them: the frame.
+    /// Only the eyes move: what the picture shows is what the held frame's scene showed. An eye
+    /// not held at `frame`'s size (or a degenerate projection) is refused.
+    pub fn reproject(&mut self, scene: &Scene, frame: &mut Frame) -> Result<(), RenderError> {
+        scene.camera.check()?;
+        let full = whole(frame);
+        let warp_eye = |held: &[Option<reproject::Held>; 3], eye: Eye, out: &mut Frame| {
+            warp_held(held[slot(eye)].as_ref(), scene, eye, out)
+        };
+        match scene.stereo {
+            Stereo::None => {
+                warp_eye(&self.held, Eye::Centre, frame)?;
+                self.ui(scene, full, frame);
+            }
+            Stereo::SideBySide => {
+                for eye in [Eye::Left, Eye::Right] {
+                    let half = warp_eye(&self.held, eye, frame)?;
+                    self.ui(scene, half, frame);
+                }
+            }
+            Stereo::Anaglyph => {
+                let mut left = match self.left.take() {
+                    Some(f) if f.width() == frame.width() && f.height() == frame.height() => f,
+                    _ => Frame::new(frame.width(), frame.height())?,
+                };
+                let warped =
+                    warp_eye(&self.held, Eye::Left, &mut left).and_then(|_| warp_eye(&self.held, Eye::Right, frame));
+                if warped.is_ok() {
+                    stereo::anaglyph(&left, frame);
+                }
+                self.left = Some(left);
+                warped?;
+                self.ui(scene, full, frame);
+            }
+        }
+        Ok(())
     }
 
     /// How many of the terrain's triangles cover each pixel of a `width × height` frame seen by
@@ -377,17 +475,7 @@ impl Renderer {
         width: u32,
         height: u32,
     ) -> (Affine, f32, Projection) {
-        let vp = scene.camera.viewpoint(eye, f64::from(width) / f64::from(height));
-        let projection = Projection::new(
-            &vp,
-            scene.camera.tilt,
-            Viewport {
-                x: f64::from(viewport.x0),
-                y: f64::from(viewport.y0),
-                width: f64::from(viewport.x1 - viewport.x0),
-                height: f64::from(viewport.y1 - viewport.y0),
-            },
-        );
+        let projection = projection(scene, eye, viewport, width, height);
         let affine = Affine::new(&projection, scene.terrain.cell_size(), f64::from(scene.vertical_scale));
         let near = projection.near as f32;
         self.eye.lod = scene.terrain_lod > 0.0;
@@ -450,11 +538,7 @@ impl Renderer {
         let air = (scene.style.look == scene::Look::Land)
             .then(|| atmosphere::Atmosphere::new(&projection, scene.terrain, scene.vertical_scale, &scene.style));
         let columns = (viewport.x0 as usize, viewport.x1 as usize);
-        let slot = match eye {
-            Eye::Centre => 0,
-            Eye::Left => 1,
-            Eye::Right => 2,
-        };
+        let slot = slot(eye);
         let back = air
             .as_ref()
             .map(|a| self.backdrops[slot].of(a, width as usize, height as usize, columns));
@@ -484,6 +568,34 @@ impl Renderer {
             width as usize,
             self.tile_rows,
         );
+        if self.hold {
+            // In an earlier frame's buffers (render_held emptied the slots, so one this frame did
+            // not draw is refused by reproject).
+            let mut held = self.spare.pop().unwrap_or_else(|| reproject::Held {
+                pixels: Vec::new(),
+                invw: Vec::new(),
+                width: 0,
+                bounds: viewport,
+                projection,
+            });
+            held.pixels.clear();
+            held.pixels.extend_from_slice(frame.pixels());
+            let background = match &air {
+                Some(air) => reproject::Background::Level(air.table_y()),
+                None => reproject::Background::Screen(
+                    (1.0 / scene
+                        .camera
+                        .viewpoint(eye, f64::from(width) / f64::from(height))
+                        .screen_distance()) as f32,
+                ),
+            };
+            let depths = self.samples.iter().map(|s| s.invw);
+            reproject::depths(depths, &projection, background, width as usize, &mut held.invw);
+            held.width = width as usize;
+            held.bounds = viewport;
+            held.projection = projection;
+            self.held[slot] = Some(held);
+        }
     }
 
     /// What the last frame's trees cost: polygons copied, simplified shapes drawn.

@@ -4,6 +4,7 @@ mod land;
 mod lod;
 mod outputs;
 mod render;
+mod reproject;
 mod rocks;
 mod simd;
 mod trees;
