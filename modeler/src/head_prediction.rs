@@ -120,11 +120,14 @@ impl HeadPredictor {
         Some(v)
     }
 
-    /// The newest pose carried on to device time `to_us` (at most [`MAX_LEAD_US`] past the
-    /// pose's own instant, never back before it), and how far it was carried, µs.
-    pub fn predict(&self, to_us: u64) -> Option<([f64; 3], u64)> {
+    /// The newest pose carried on to device time `to_us` (at most [`MAX_LEAD_US`] either way
+    /// of the pose's own instant), and how far it was carried, µs. Back, when the frame is done
+    /// before that instant: the base station predicts a fixed time past the burst, and a frame
+    /// moved to the newest pose after the latch (`Renderer::reproject`) is done sooner.
+    pub fn predict(&self, to_us: u64) -> Option<([f64; 3], i64)> {
         let &(at, p) = self.poses.back()?;
-        let lead = to_us.saturating_sub(at).min(MAX_LEAD_US);
+        let max = MAX_LEAD_US as i64;
+        let lead = (to_us as i64).saturating_sub(at as i64).clamp(-max, max);
         let v = self.velocity().unwrap_or([0.0; 3]);
         let s = lead as f64;
         Some(([p[0] + v[0] * s, p[1] + v[1] * s, p[2] + v[2] * s], lead))
@@ -151,9 +154,17 @@ mod tests {
         for a in 0..3 {
             assert!((got[a] - want[a]).abs() < 1e-9, "{got:?} {want:?}");
         }
-        // Never back in time, never past the limit.
-        assert_eq!(p.predict(newest - 5_000).map(|(_, l)| l), Some(0));
-        assert_eq!(p.predict(newest + 1_000_000).map(|(_, l)| l), Some(MAX_LEAD_US));
+        // Back, for a frame done before the pose's instant, along the same line.
+        let (got, lead) = p.predict(newest - 5_000).expect("poses");
+        assert_eq!(lead, -5_000);
+        let want = at(newest - 5_000);
+        for a in 0..3 {
+            assert!((got[a] - want[a]).abs() < 1e-9, "{got:?} {want:?}");
+        }
+        // Never past the limit either way.
+        let max = MAX_LEAD_US as i64;
+        assert_eq!(p.predict(newest + 1_000_000).map(|(_, l)| l), Some(max));
+        assert_eq!(p.predict(0).map(|(_, l)| l), Some(-max));
     }
 
     #[test]

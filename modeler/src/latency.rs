@@ -24,8 +24,9 @@ pub struct HeadLatency {
     started_us: Vec<u64>,
     /// The prediction of the poses drawn, ms (the latest).
     prediction_ms: u8,
-    /// How far the host carried each frame's pose on past the base station's prediction, µs.
-    leads_us: Vec<u64>,
+    /// How far the host carried each frame's pose on past the base station's prediction, µs
+    /// (negative: back, for a frame done before the pose's own instant).
+    leads_us: Vec<i64>,
     /// Per frame, emission to frame less both predictions, µs.
     uncovered_us: Vec<i64>,
     /// Per frame, with the head's true path: the pose reported and the pose drawn less the
@@ -52,7 +53,8 @@ pub struct LatencySummary {
     pub start_p50_ms: f64,
     /// See [`start_p50_ms`](Self::start_p50_ms).
     pub start_p95_ms: f64,
-    /// How far the host carried the poses on past the base station's prediction, ms: median.
+    /// How far the host carried the poses on past the base station's prediction, ms: median
+    /// (negative: back, frames done before their poses' own instants).
     pub host_lead_p50_ms: f64,
     /// Emission to frame less the base station's and the host's prediction, ms: 95th
     /// percentile ([`uncovered_p95_ms`](Self::uncovered_p95_ms)).
@@ -118,15 +120,14 @@ impl HeadLatency {
     /// ahead by the base station and `lead_us` further by the host, was started at device time
     /// `started_us` and produced at `done_us`. A burst after the start (a clock restarted by a
     /// reattached device) is not a latency: skipped.
-    pub fn frame(&mut self, started_us: u64, done_us: u64, burst_us: u64, prediction_ms: u8, lead_us: u64) {
+    pub fn frame(&mut self, started_us: u64, done_us: u64, burst_us: u64, prediction_ms: u8, lead_us: i64) {
         if let Some(start) = started_us.checked_sub(burst_us) {
             self.started_us.push(start);
             self.samples_us.push(done_us.saturating_sub(burst_us).max(start));
             self.prediction_ms = prediction_ms;
             self.leads_us.push(lead_us);
             let age = done_us.saturating_sub(burst_us).max(start) as i64;
-            self.uncovered_us
-                .push(age - i64::from(prediction_ms) * 1000 - lead_us as i64);
+            self.uncovered_us.push(age - i64::from(prediction_ms) * 1000 - lead_us);
         }
     }
 
@@ -163,13 +164,8 @@ impl HeadLatency {
             prediction_ms: self.prediction_ms,
             start_p50_ms: percentile_ms(&started, 0.5),
             start_p95_ms: percentile_ms(&started, 0.95),
-            host_lead_p50_ms: percentile_ms(&sorted(&self.leads_us), 0.5),
-            uncovered_p95: {
-                let mut u = self.uncovered_us.clone();
-                u.sort_unstable();
-                let rank = ((0.95 * u.len() as f64).ceil() as usize).clamp(1, u.len());
-                u[rank - 1] as f64 * 1e-3
-            },
+            host_lead_p50_ms: signed_percentile_ms(&self.leads_us, 0.5),
+            uncovered_p95: signed_percentile_ms(&self.uncovered_us, 0.95),
             reported_error: self.errors(0),
             drawn_error: self.errors(1),
             tracking_error: self.errors(2),
@@ -191,6 +187,14 @@ fn percentile_ms(sorted: &[u64], q: f64) -> f64 {
     sorted[rank - 1] as f64 * 1e-3
 }
 
+/// [`percentile_ms`] of µs that may be negative; `v` is not empty.
+fn signed_percentile_ms(v: &[i64], q: f64) -> f64 {
+    let mut v = v.to_vec();
+    v.sort_unstable();
+    let rank = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len());
+    v[rank - 1] as f64 * 1e-3
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -202,7 +206,13 @@ mod tests {
         // Ages 1..=20 ms, given out of order, each drawn in 1 ms; one frame started before its
         // burst is skipped.
         for k in (1..=20u64).rev() {
-            l.frame(100_000 + (k - 1) * 1000, 100_000 + k * 1000, 100_000, 20, k * 100);
+            l.frame(
+                100_000 + (k - 1) * 1000,
+                100_000 + k * 1000,
+                100_000,
+                20,
+                k as i64 * 100,
+            );
         }
         l.frame(5_000, 6_000, 9_000, 20, 0);
         let s = l.summary().expect("frames");

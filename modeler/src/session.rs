@@ -50,7 +50,7 @@ pub struct Session {
     /// The host's prediction of the head.
     predictor: HeadPredictor,
     /// How far the frame being drawn carried the pose on, µs.
-    head_lead_us: u64,
+    head_lead_us: i64,
     /// The head's true path, device µs to display mm, when the feed is a simulation that knows
     /// it: how far the poses drawn are from it is measured.
     head_truth: Option<HeadTruth>,
@@ -206,20 +206,30 @@ impl Session {
     pub fn frame_started(&mut self) {
         self.frame_started_us = self.paced_now_us();
         self.frame_started_at = Some(std::time::Instant::now());
-        self.head_drawn_mm = None;
-        self.head_lead_us = 0;
-        // An unpaced simulation's device time is not now: nothing to predict to.
+        let carried = self.head_carried(self.predictor.expected_draw_us());
+        self.head_drawn_mm = carried.map(|(mm, _)| mm);
+        self.head_lead_us = carried.map_or(0, |(_, lead_us)| lead_us);
+    }
+
+    /// Before a frame latched to the head: the pose its view is drawn from before the head's
+    /// newest pose comes, the last one carried on `ahead_us` past now — to about when the frame
+    /// will be done, so that moving the view to the newest pose after the latch
+    /// (`Renderer::reproject`) has little to move. [`frame_started`](Self::frame_started) then
+    /// takes the newest pose.
+    pub fn head_ahead(&mut self, ahead_us: u64) {
+        self.head_drawn_mm = self.head_carried(ahead_us).map(|(mm, _)| mm);
+    }
+
+    /// The tracked head's last pose carried on to `ahead_us` past now, and how far from its own
+    /// instant that is, µs (negative: back); `None` without a pose, or for an unpaced simulation (whose device
+    /// time is not now: nothing to predict to).
+    fn head_carried(&self, ahead_us: u64) -> Option<([f64; 3], i64)> {
         let now_us = match &self.clock {
-            Some(_) => self.frame_started_us,
+            Some(_) => self.paced_now_us(),
             None => self.predictor.device_at(unix_now_us()),
         };
-        if let Some(now_us) = now_us.filter(|_| self.head_burst.is_some()) {
-            let end_us = now_us.saturating_add(self.predictor.expected_draw_us());
-            if let Some((mm, lead_us)) = self.predictor.predict(end_us) {
-                self.head_drawn_mm = Some(mm);
-                self.head_lead_us = lead_us;
-            }
-        }
+        let now_us = now_us.filter(|_| self.head_burst.is_some())?;
+        self.predictor.predict(now_us.saturating_add(ahead_us))
     }
 
     /// A frame showing the session was just produced: with a tracked pose and the clock of a
