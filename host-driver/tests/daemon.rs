@@ -22,8 +22,12 @@ use pen_host::source::Source;
 use pen_host::transport::sim::SimOptions;
 use pen_protocol::Quality;
 
-fn socket_path(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("pend-test-{}-{name}/pend.sock", std::process::id()))
+/// A socket path in a directory pend creates (as it does its default's), inside a temporary
+/// directory removed with the returned guard: a test leaves nothing in /tmp behind.
+fn socket_path(name: &str) -> (tempfile::TempDir, PathBuf) {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let path = dir.path().join(name).join("pend.sock");
+    (dir, path)
 }
 
 /// What a client saw.
@@ -123,7 +127,7 @@ fn read_client(stream: UnixStream, enough: u64, until_missed: bool, until: Insta
 
 #[test]
 fn sixteen_clients_at_1_khz_while_one_stops_reading() {
-    let path = socket_path("fanout");
+    let (_dir, path) = socket_path("fanout");
     let listener = daemon::bind(&path).expect("bind");
     let mode = std::fs::metadata(&path).expect("socket").permissions().mode() & 0o777;
     assert_eq!(mode, 0o600, "the socket is the user's alone");
@@ -197,7 +201,7 @@ fn sixteen_clients_at_1_khz_while_one_stops_reading() {
 
 #[test]
 fn sigterm_stops_pend_cleanly() {
-    let path = socket_path("sigterm");
+    let (_dir, path) = socket_path("sigterm");
     let mut pend = Command::new(env!("CARGO_BIN_EXE_pend"))
         .args(["--sim", "hold", "--socket"])
         .arg(&path)
@@ -517,7 +521,7 @@ fn threads(pid: u32) -> usize {
 /// line saying why and is closed, costing no thread; a place is freed when a client leaves.
 #[test]
 fn clients_beyond_the_limit_are_refused_and_cost_no_thread() {
-    let path = socket_path("limit");
+    let (_dir, path) = socket_path("limit");
     let mut pend = Command::new(env!("CARGO_BIN_EXE_pend"))
         .args(["--sim", "hold", "--max-clients", "4", "--socket"])
         .arg(&path)
