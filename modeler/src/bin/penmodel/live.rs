@@ -1315,41 +1315,18 @@ mod tests {
 
     #[test]
     fn a_latched_frame_takes_the_newest_pose_and_the_next_one() {
-        use pen_host::events::{DisplayPoint, EventKind, HeadPose, HeadStatus, PenEvent};
-        // A head report at `device_us`: a pose `u_mm` along the display, or none (no fix).
-        let head = |u_mm: Option<f64>, device_us: u64| {
-            Feed::Event(PenEvent {
-                kind: EventKind::Head(HeadPose {
-                    at: u_mm.map(|u_mm| DisplayPoint {
-                        u_mm,
-                        v_mm: 170.0,
-                        h_mm: 650.0,
-                        u_px: 0.0,
-                        v_px: 0.0,
-                    }),
-                    status: if u_mm.is_some() {
-                        HeadStatus::Tracked
-                    } else {
-                        HeadStatus::Held
-                    },
-                    prediction_ms: 20,
-                    refused: 0,
-                    reason: None,
-                }),
-                t_us: device_us,
-                point: None,
-                sw: None,
-                seq: Some((0, device_us)),
-            })
-        };
         // Metres right of the 600 mm display's centre, as the camera takes the head.
         let x = |session: &Session| session.head_m().map(|h| h[0]);
         let editor = Editor::new(blank_document()).expect("a valid document");
         let mut session = Session::new(editor, [600.0, 340.0], Tuning::default());
-        session.feed(head(Some(100.0), 0));
+        session.feed(head_at(Some(100.0), 0));
         let (tx, rx) = std::sync::mpsc::channel();
         // Queued while the last frame was drawn: two newer poses, then a report without a fix.
-        for f in [head(Some(110.0), 16_000), head(Some(120.0), 32_000), head(None, 40_000)] {
+        for f in [
+            head_at(Some(110.0), 16_000),
+            head_at(Some(120.0), 32_000),
+            head_at(None, 40_000),
+        ] {
             tx.send(f).expect("queued");
         }
         // The next pose comes once the queue is taken: the frame waits for it (up to `WAIT` of
@@ -1357,7 +1334,7 @@ mod tests {
         const WAIT: Duration = Duration::from_secs(1);
         let later = std::thread::spawn(move || {
             std::thread::sleep(Duration::from_millis(5));
-            tx.send(head(Some(130.0), 48_000)).expect("sent");
+            tx.send(head_at(Some(130.0), 48_000)).expect("sent");
             tx
         });
         let mut said = Vec::new();
@@ -1366,7 +1343,7 @@ mod tests {
         assert_eq!(session.events(), 5, "everything queued was taken");
         // Glasses that stop reporting hold a frame up no longer than a head period.
         let tx = later.join().expect("sender");
-        tx.send(head(None, 60_000)).expect("queued");
+        tx.send(head_at(None, 60_000)).expect("queued");
         assert!(!latch_head(&rx, &mut session, &mut |m| said.extend(m), WAIT));
         assert_eq!((x(&session), session.events()), (Some((130.0 - 300.0) * 1e-3), 6));
         // A feed that ended: said so at once.
@@ -1374,19 +1351,23 @@ mod tests {
         assert!(latch_head(&rx, &mut session, &mut |m| said.extend(m), WAIT));
     }
 
-    /// A head report at `device_us` with a pose `u_mm` along the display (for the tests).
-    fn head_at(u_mm: f64, device_us: u64) -> Feed {
+    /// A head report at `device_us`: a pose `u_mm` along the display, or none (no fix).
+    fn head_at(u_mm: Option<f64>, device_us: u64) -> Feed {
         use pen_host::events::{DisplayPoint, EventKind, HeadPose, HeadStatus, PenEvent};
         Feed::Event(PenEvent {
             kind: EventKind::Head(HeadPose {
-                at: Some(DisplayPoint {
+                at: u_mm.map(|u_mm| DisplayPoint {
                     u_mm,
                     v_mm: 170.0,
                     h_mm: 650.0,
                     u_px: 0.0,
                     v_px: 0.0,
                 }),
-                status: HeadStatus::Tracked,
+                status: if u_mm.is_some() {
+                    HeadStatus::Tracked
+                } else {
+                    HeadStatus::Held
+                },
                 prediction_ms: 20,
                 refused: 0,
                 reason: None,
@@ -1429,7 +1410,7 @@ mod tests {
                 Tuning::default(),
             );
             for &(u, t) in poses {
-                session.feed(head_at(u, t));
+                session.feed(head_at(Some(u), t));
             }
             session
         };
@@ -1442,7 +1423,7 @@ mod tests {
         let mut session = session_at(&[(250.0, 0)]);
         let before = whole(&session);
         let (tx, rx) = std::sync::mpsc::channel();
-        tx.send(head_at(330.0, 16_000)).expect("queued");
+        tx.send(head_at(Some(330.0), 16_000)).expect("queued");
         let mut painter = Painter::new(320, 180, Overview::Off).expect("painter");
         let (shown, ended) = painter
             .session_latched(&rx, &mut session, &look, false, &mut |_| {})
