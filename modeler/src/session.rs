@@ -212,11 +212,12 @@ impl Session {
     }
 
     /// Before a frame latched to the head: the pose its view is drawn from before the head's
-    /// newest pose comes, the last one carried on `ahead_us` past now — to about when the frame
-    /// will be done, so that moving the view to the newest pose after the latch
-    /// (`Renderer::reproject`) has little to move. [`frame_started`](Self::frame_started) then
-    /// takes the newest pose.
-    pub fn head_ahead(&mut self, ahead_us: u64) {
+    /// newest pose comes, the last one carried on past now by `view_us` (the view's drawing) and
+    /// the last frames' median draw after the latch — to about when the frame will be done, so
+    /// that moving the view to the newest pose after the latch (`Renderer::reproject`) has little
+    /// to move. [`frame_started`](Self::frame_started) then takes the newest pose.
+    pub fn head_ahead(&mut self, view_us: u64) {
+        let ahead_us = view_us.saturating_add(self.predictor.expected_draw_us());
         self.head_drawn_mm = self.head_carried(ahead_us).map(|(mm, _)| mm);
     }
 
