@@ -211,6 +211,19 @@ fn resolve_land_body(
                 sin += d_sin;
             }
             st.invw[n..].fill(0.0);
+            // A stretch that shows no surface (the sky, the table, the land beyond: a quarter of
+            // the 30-tree scene's pixels) is its background, which needs none of the passes below
+            // (they would give the same bytes: an empty pixel is its background).
+            if !st.invw[..n].iter().any(|&invw| invw > 0.0) {
+                for (k, p) in ps.iter_mut().enumerate().take(n) {
+                    let c = match brow {
+                        Some(b) => b[first * LANES + k],
+                        None => air.background_bytes([st.ray[0][k], st.ray[1][k], st.ray[2][k]]),
+                    };
+                    *p = pack(c).to_le_bytes();
+                }
+                continue;
+            }
             // The samples' arithmetic, whether covered or not (an empty sample's is not used).
             for k in 0..LANES {
                 let invw = st.invw[k];
