@@ -30,6 +30,9 @@ pub enum RenderError {
     /// The camera's parameters are not usable.
     #[error("camera: {0}")]
     Camera(&'static str),
+    /// [`Renderer::reproject`](crate::Renderer::reproject) has no held eye to move.
+    #[error("nothing to reproject: {0}")]
+    NotHeld(&'static str),
 }
 
 /// An RGBA8 image, row-major, top row first.

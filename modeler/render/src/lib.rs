@@ -91,10 +91,10 @@ fn whole(frame: &Frame) -> Bounds {
 fn warp_held(held: Option<&reproject::Held>, scene: &Scene, eye: Eye, out: &mut Frame) -> Result<Bounds, RenderError> {
     let held = held
         .filter(|h| h.width == out.width() as usize && h.invw.len() == out.pixels().len())
-        .ok_or(RenderError::Camera("no eye held at this frame's size to reproject"))?;
+        .ok_or(RenderError::NotHeld("no eye held at this frame's size"))?;
     let to = projection(scene, eye, held.bounds, out.width(), out.height());
     let motion = reproject::Motion::between(&held.projection, &to)
-        .ok_or(RenderError::Camera("the held eye's projection is degenerate"))?;
+        .ok_or(RenderError::NotHeld("the held eye's projection is degenerate"))?;
     reproject::warp(held, &motion, out.pixels_mut());
     Ok(held.bounds)
 }
@@ -270,10 +270,11 @@ impl Renderer {
         stats
     }
 
-    /// The eyes [`render_held`](Self::render_held) drew, moved to `scene`'s camera by their depth
-    /// ([`reproject`]), combined as `scene.stereo` asks, and `scene`'s UI over them: the frame.
-    /// Only the eyes move: what the picture shows is what the held frame's scene showed. An eye
-    /// not held at `frame`'s size (or a degenerate projection) is refused.
+    /// The eyes the last [`render_held`](Self::render_held) drew, moved to `scene`'s camera by
+    /// their depth ([`reproject`]), combined as `scene.stereo` asks, and `scene`'s UI over them:
+    /// the frame. Only the eyes move: what the picture shows is what the held frame's scene
+    /// showed. An eye not held at `frame`'s size, or a degenerate projection, is refused
+    /// ([`RenderError::NotHeld`]).
     pub fn reproject(&mut self, scene: &Scene, frame: &mut Frame) -> Result<(), RenderError> {
         scene.camera.check()?;
         let full = whole(frame);
