@@ -807,8 +807,9 @@ impl Painter {
     /// when the frame will be done, and after the latch only moved to the newest pose by its
     /// depth (`Renderer::reproject`): what stands between the head's report and the frame is
     /// then a pass over the pixels, not the view's drawing (17–25 ms at 640 × 360 on two
-    /// cores). The view shows the pen's edits up to the latch's start, as the insets do; the
-    /// slope bar and the mode line are drawn after it.
+    /// cores). The view shows the pen's edits up to the view's start, as the insets do (at the
+    /// frame, older than before by the latch's wait and the move); the slope bar and the mode
+    /// line are drawn after the latch.
     fn session_latched(
         &mut self,
         rx: &std::sync::mpsc::Receiver<Feed>,
