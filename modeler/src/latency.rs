@@ -93,10 +93,9 @@ impl ErrorSummary {
             return None;
         }
         v.sort_unstable_by(f64::total_cmp);
-        let rank = |q: f64| ((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1;
         Some(ErrorSummary {
-            p50_mm: v[rank(0.5)],
-            p95_mm: v[rank(0.95)],
+            p50_mm: nearest_rank(&v, 0.5),
+            p95_mm: nearest_rank(&v, 0.95),
             rms_mm: (v.iter().map(|e| e * e).sum::<f64>() / v.len() as f64).sqrt(),
         })
     }
@@ -180,19 +179,22 @@ fn sorted(v: &[u64]) -> Vec<u64> {
     v
 }
 
-/// Nearest rank: the smallest sample with at least `q` of them at or below it, ms. `sorted` is
-/// not empty.
-fn percentile_ms(sorted: &[u64], q: f64) -> f64 {
-    let rank = ((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len());
-    sorted[rank - 1] as f64 * 1e-3
+/// Nearest rank: the smallest of the `sorted` samples with at least `q` of them at or below it.
+/// `sorted` is not empty.
+pub fn nearest_rank<T: Copy>(sorted: &[T], q: f64) -> T {
+    sorted[((q * sorted.len() as f64).ceil() as usize).clamp(1, sorted.len()) - 1]
 }
 
-/// [`percentile_ms`] of µs that may be negative; `v` is not empty.
+/// [`nearest_rank`] of sorted µs, in ms.
+fn percentile_ms(sorted: &[u64], q: f64) -> f64 {
+    nearest_rank(sorted, q) as f64 * 1e-3
+}
+
+/// [`percentile_ms`] of µs that may be negative, not sorted; `v` is not empty.
 fn signed_percentile_ms(v: &[i64], q: f64) -> f64 {
     let mut v = v.to_vec();
     v.sort_unstable();
-    let rank = ((q * v.len() as f64).ceil() as usize).clamp(1, v.len());
-    v[rank - 1] as f64 * 1e-3
+    nearest_rank(&v, q) as f64 * 1e-3
 }
 
 #[cfg(test)]

@@ -102,12 +102,7 @@ impl Atmosphere {
         let sign = if det < 0.0 { -1.0 } else { 1.0 };
         let (a, b, c) = (a.map(|v| v * sign), b.map(|v| v * sign), c.map(|v| v * sign));
         // The eye: where X, Y and w all vanish.
-        let m = glam::DMat3::from_cols(
-            glam::DVec3::new(r[0][0], r[1][0], r[2][0]),
-            glam::DVec3::new(r[0][1], r[1][1], r[2][1]),
-            glam::DVec3::new(r[0][2], r[1][2], r[2][2]),
-        );
-        let t = glam::DVec3::new(projection.rows[0][3], projection.rows[1][3], projection.rows[2][3]);
+        let (m, t) = projection.parts();
         let eye = if m.determinant().abs() > 0.0 {
             -(m.inverse() * t)
         } else {

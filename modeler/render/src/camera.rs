@@ -382,6 +382,20 @@ impl Projection {
         }
     }
 
+    /// The matrix as `M` (the rows' first three columns) and `t` (their last): `(X, Y, w) =
+    /// M·p + t`.
+    pub fn parts(&self) -> (DMat3, DVec3) {
+        let r = &self.rows;
+        (
+            DMat3::from_cols(
+                DVec3::new(r[0][0], r[1][0], r[2][0]),
+                DVec3::new(r[0][1], r[1][1], r[2][1]),
+                DVec3::new(r[0][2], r[1][2], r[2][2]),
+            ),
+            DVec3::new(r[0][3], r[1][3], r[2][3]),
+        )
+    }
+
     /// `(X, Y, w)` of a world point.
     pub fn apply(&self, p: DVec3) -> [f64; 3] {
         self.rows.map(|r| r[0] * p.x + r[1] * p.y + r[2] * p.z + r[3])

@@ -77,7 +77,7 @@ pub fn depths(
         Background::Level(height) => {
             // The ray through pixel (x, y) is w·u + e with u = M⁻¹·(x, y, 1) and e = −M⁻¹·t
             // (the eye): it meets the level at w = (height − e_y) / u_y, ahead when positive.
-            let (m, t) = parts(projection);
+            let (m, t) = projection.parts();
             let Some(inverse) = (m.determinant() != 0.0).then(|| m.inverse()) else {
                 out.extend(samples.map(|s| s.max(0.0)));
                 return;
@@ -104,14 +104,6 @@ pub fn depths(
     }
 }
 
-/// `M` and `t` of a projection `[M | t]`.
-fn parts(p: &Projection) -> (glam::DMat3, glam::DVec3) {
-    (
-        glam::DMat3::from_cols_array_2d(&p.rows.map(|r| [r[0], r[1], r[2]])).transpose(),
-        glam::DVec3::new(p.rows[0][3], p.rows[1][3], p.rows[2][3]),
-    )
-}
-
 /// The map from a held eye's pixels to another projection's: `(x', y')` from `(x, y, 1/w)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Motion {
@@ -125,7 +117,7 @@ impl Motion {
     /// The motion from `from`'s pixels to `to`'s; `None` when `from` is degenerate (its 3 × 3
     /// part not invertible).
     pub fn between(from: &Projection, to: &Projection) -> Option<Motion> {
-        let ((from_m, from_t), (to_m, to_t)) = (parts(from), parts(to));
+        let ((from_m, from_t), (to_m, to_t)) = (from.parts(), to.parts());
         if from_m.determinant() == 0.0 {
             return None;
         }

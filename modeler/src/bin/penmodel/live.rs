@@ -516,17 +516,19 @@ struct Reprojection {
 
 impl Reprojection {
     fn of(checks: &[Check]) -> Option<Reprojection> {
-        let rank = |mut v: Vec<f64>, q: f64| {
+        use penmodel::latency::nearest_rank;
+        let sorted = |f: fn(&Check) -> f64| {
+            let mut v: Vec<f64> = checks.iter().map(f).collect();
             v.sort_by(f64::total_cmp);
-            v[((q * v.len() as f64).ceil() as usize).clamp(1, v.len()) - 1]
+            v
         };
-        let (mean_abs, visible): (Vec<f64>, Vec<f64>) = checks.iter().map(|c| (c.mean_abs, c.visible)).unzip();
+        let (mean_abs, visible) = (sorted(|c| c.mean_abs), sorted(|c| c.visible));
         (!checks.is_empty()).then(|| Reprojection {
             frames: checks.len(),
-            mean_abs_p50: rank(mean_abs.clone(), 0.5),
-            mean_abs_max: rank(mean_abs, 1.0),
-            visible_p50: rank(visible.clone(), 0.5),
-            visible_p95: rank(visible, 0.95),
+            mean_abs_p50: nearest_rank(&mean_abs, 0.5),
+            mean_abs_max: nearest_rank(&mean_abs, 1.0),
+            visible_p50: nearest_rank(&visible, 0.5),
+            visible_p95: nearest_rank(&visible, 0.95),
         })
     }
 }
