@@ -3,7 +3,8 @@
 //! in the bands of rows its screen extent reaches (every band when it crosses the near plane),
 //! and drawn per tile — straight when it lies wholly in front of the near plane, clipped
 //! otherwise — from both windings (the rasteriser fills one; rocks are open underneath and
-//! leaves and quads are single-sided surfaces).
+//! leaves and quads are single-sided surfaces), or from the front only for the sides of closed
+//! shapes ([`Faces::Front`]).
 
 use super::clip::{self, ClipVertex};
 use super::rasterise::{self, Bounds, Sink, Vtx};
@@ -12,6 +13,19 @@ use super::transform;
 /// Vertices from which a mesh is projected on the pool's threads ([`Binned::vertices_from`]):
 /// fewer, and a tree's few hundred cost more to hand out than to project.
 const PARALLEL_VERTICES: usize = 4096;
+
+/// Which sides of a triangle are drawn.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Faces {
+    /// Both: a surface seen from either side (a leaf, a textured quad, a rock open underneath).
+    Both,
+    /// The front only: a side of a closed shape, whose back faces lie behind its front faces
+    /// (a branch's frustum). Its vertices run counter-clockwise seen from the front (the
+    /// exports' winding, glTF's); seen through the camera on rows growing downward a front
+    /// face is counter-clockwise on screen, and [`rasterise::triangle`] fills clockwise ones, so
+    /// it is drawn as `(a, c, b)`.
+    Front,
+}
 
 /// One eye's projected triangles, each tagged with a `T` (what it shows).
 #[derive(Debug)]
@@ -150,28 +164,39 @@ impl<T: Copy> Binned<T> {
     }
 
     /// Draws the triangles that reach the tile `bounds` (its first row starts a band) into
-    /// `sink`, after `prepare(sink, tag)` set it up for each; a triangle whose `prepare` returns
-    /// false is skipped.
-    pub fn draw<S: Sink>(&self, bounds: &Bounds, near: f32, sink: &mut S, mut prepare: impl FnMut(&mut S, T) -> bool) {
+    /// `sink`, after `prepare(sink, tag)` set it up for each and said which faces to draw; a
+    /// triangle whose `prepare` returns `None` is skipped.
+    pub fn draw<S: Sink>(
+        &self,
+        bounds: &Bounds,
+        near: f32,
+        sink: &mut S,
+        mut prepare: impl FnMut(&mut S, T) -> Option<Faces>,
+    ) {
         let Some(bin) = self.bins.get(bounds.y0.max(0) as usize / self.band_rows.max(1)) else {
             return;
         };
         for &i in bin {
             let (t, tag) = self.triangles[i as usize];
-            if !prepare(sink, tag) {
+            let Some(faces) = prepare(sink, tag) else {
                 continue;
-            }
+            };
+            let draw = |a: &Vtx, b: &Vtx, c: &Vtx, sink: &mut S| match faces {
+                Faces::Both => rasterise::two_sided(a, b, c, bounds, sink),
+                Faces::Front => rasterise::triangle(a, c, b, bounds, sink),
+            };
             if t.iter().all(|&k| self.direct[k as usize]) {
                 let [a, b, c] = t.map(|k| &self.screen[k as usize]);
-                rasterise::two_sided(a, b, c, bounds, sink);
+                draw(a, b, c, sink);
             } else {
+                // Clipping keeps the winding: the fan's triangles turn as the triangle did.
                 let poly = clip::triangle(t.map(|k| self.clip[k as usize]), near);
                 if poly.len < 3 {
                     continue;
                 }
                 let v: Vec<Vtx> = poly.vertices[..poly.len].iter().map(transform::project).collect();
                 for k in 1..poly.len - 1 {
-                    rasterise::two_sided(&v[0], &v[k], &v[k + 1], bounds, sink);
+                    draw(&v[0], &v[k], &v[k + 1], sink);
                 }
             }
         }

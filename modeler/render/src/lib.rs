@@ -518,7 +518,7 @@ impl Renderer {
                 meshes.add_rocks(rocks, scene.terrain_lod, &affine, cell, near, &scene.style);
                 let water = scene.water.iter().map(|(_, m)| m);
                 meshes.add(water, Paint::Whole(Surface::Water), &affine, cell, near, &scene.style);
-                meshes.add(trees.meshes(), Paint::Own, &affine, cell, near, &scene.style);
+                meshes.add(trees.meshes(), Paint::Tree, &affine, cell, near, &scene.style);
             },
             || {
                 textured.clear(bands);

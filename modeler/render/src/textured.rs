@@ -25,7 +25,7 @@
 //! - Quads are drawn from both windings, like the meshes; triangles are binned by bands of rows
 //!   as the meshes are.
 
-use super::binned::Binned;
+use super::binned::{Binned, Faces};
 use super::clip::ClipVertex;
 use super::frame::Rgba;
 use super::rasterise::{Bounds, Sample, Sink, Surface};
@@ -277,9 +277,9 @@ impl Projected {
             match textures.get(k as usize) {
                 Some(&texture) => {
                     sink.level = texture.level(level);
-                    true
+                    Some(Faces::Both)
                 }
-                None => false,
+                None => None,
             }
         });
     }

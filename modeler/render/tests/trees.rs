@@ -339,3 +339,81 @@ fn near_the_gaze_a_tree_is_full_and_far_in_the_periphery_it_is_simplified() {
     let to = (glam::DVec3::from_array(middle) - eye).normalize();
     assert!(gaze.dot(to) > 0.999_999, "gaze {gaze} towards {to}");
 }
+
+/// Draws `mesh` with `paint` into a 160 × 120 depth buffer seen by `camera`.
+fn samples_of(
+    mesh: &penmodel_terrain::export::Mesh,
+    paint: penmodel_render::meshes::Paint,
+    camera: &Camera,
+) -> Vec<penmodel_render::rasterise::Sample> {
+    use penmodel_render::rasterise::{Bounds, Sample};
+    use penmodel_render::transform::Affine;
+    let (w, h) = (160u32, 120u32);
+    let p = projection(camera, w, h);
+    let affine = Affine::new(&p, 1.0, 1.0);
+    let style = penmodel_render::Style::default();
+    let mut projected = penmodel_render::meshes::Projected::default();
+    projected.clear((h as usize, h as usize));
+    projected.add([mesh], paint, &affine, 1.0, p.near as f32, &style);
+    let mut samples = vec![Sample::default(); (w * h) as usize];
+    let bounds = Bounds {
+        x0: 0,
+        x1: w as i32,
+        y0: 0,
+        y1: h as i32,
+    };
+    projected.draw(&bounds, &mut samples, w as usize, p.near as f32);
+    samples
+}
+
+#[test]
+fn a_branchs_frustum_is_drawn_from_its_front_only_with_the_same_pixels() {
+    use penmodel_render::meshes::Paint;
+    use penmodel_terrain::trees::shapes::{self, Parts};
+    // A bark frustum, leaning towards the eye so that its open top shows, and a leaf.
+    let mut parts = Parts::default();
+    let lean = DAffine3::from_translation(DVec3::new(3.0, 0.5, 3.0)) * DAffine3::from_rotation_x(0.5);
+    parts.branch(&lean, 3.0, 0.6, 0.4);
+    parts.leaf(&DAffine3::from_translation(DVec3::new(4.5, 1.0, 3.0)), 1.0);
+    let mesh = penmodel_terrain::export::Mesh {
+        positions: parts.positions.clone(),
+        normals: parts.normals.clone(),
+        colors: parts.colors.clone(),
+        indices: parts.indices.clone(),
+    };
+    let camera = orbit([3.0, 2.0, 3.0], 30.0, 8.0, 7.0, 45.0);
+    let both = samples_of(&mesh, Paint::Own, &camera);
+    let front = samples_of(&mesh, Paint::Tree, &camera);
+    let drawn = both.iter().filter(|s| s.invw > 0.0).count();
+    assert!(drawn > 500, "the frustum and the leaf cover {drawn} pixels");
+    // Where the two differ, the two-sided draw shows a nearer surface: the inside of the tube
+    // seen through its open top, whose back faces the front-only draw skips. Everywhere else
+    // the same pixel, and from the side that is nearly everywhere.
+    let differ: Vec<usize> = (0..both.len()).filter(|&i| both[i] != front[i]).collect();
+    for &i in &differ {
+        assert!(
+            both[i].invw > front[i].invw,
+            "pixel {i}: {:?} against {:?}",
+            both[i],
+            front[i]
+        );
+    }
+    assert!(
+        differ.len() * 10 < drawn,
+        "{} of {drawn} pixels differ: more than the open top",
+        differ.len()
+    );
+    // The frustum wound the other way round (inside out): the front-only draw then shows its far
+    // wall from inside, farther than the two-sided draw's near wall in most of its pixels; so
+    // the winding `Paint::Tree` takes for the front is the one the shapes use.
+    let mut inside_out = mesh.clone();
+    let bark = shapes::BRANCH_POLYGONS * 2 * 3;
+    for t in inside_out.indices[..bark].chunks_exact_mut(3) {
+        t.swap(1, 2);
+    }
+    let culled = samples_of(&inside_out, Paint::Tree, &camera);
+    let farther = (0..both.len())
+        .filter(|&i| both[i].invw > 0.0 && culled[i].invw < both[i].invw)
+        .count();
+    assert!(farther * 2 > drawn, "inside out: {farther} of {drawn} pixels farther");
+}
