@@ -134,8 +134,7 @@ pub fn project(
     let cols = map.cols() as usize;
     let heights = map.heights();
     let levels = &out.levels;
-    let mut chunks: Vec<NodeChunk> = out
-        .picks
+    out.picks
         .par_iter()
         .zip(out.vertices.par_chunks_mut(SLOT))
         .zip(out.clip.par_chunks_mut(SLOT))
@@ -212,10 +211,10 @@ pub fn project(
                 stitch,
             }
         })
-        .collect();
-    chunks.retain(|c| c.state != ChunkState::Culled);
-    chunks.sort_unstable_by(|a, b| a.near.total_cmp(&b.near));
-    out.chunks = chunks;
+        // Into last frame's list: a frame allocates nothing.
+        .collect_into_vec(&mut out.chunks);
+    out.chunks.retain(|c| c.state != ChunkState::Culled);
+    out.chunks.sort_unstable_by(|a, b| a.near.total_cmp(&b.near));
 }
 
 /// Per edge (north, east, south, west), the sampled vertex each one is drawn with: where a
