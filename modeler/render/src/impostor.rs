@@ -272,6 +272,12 @@ impl Cache {
         self.insert(key, tree, baked(tree, node, style))
     }
 
+    /// The group index of `impostor`'s node of `tree` if it is baked: [`Cache::group`] without
+    /// the bake, for the trees' walks on the pool's threads.
+    pub fn find(&self, tree: &Arc<NodeTree>, node: u32) -> Option<u32> {
+        self.groups.get(&key(tree, node)).copied()
+    }
+
     /// Bakes the groups of `wanted` (node trees and nodes) not baked yet, on the pool's threads:
     /// a grove planted, or a head leaning in, asks for tens of new groups in one frame, and
     /// baking them one by one inside the view took up to 120 ms of a tracked frame (issue 16).

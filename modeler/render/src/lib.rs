@@ -72,7 +72,7 @@ pub struct RenderStats {
 }
 
 /// The textures the textured polygons name: the scene's, then the trees' simplified shapes' (the
-/// order [`Renderer::project`] offsets their indices by, and the tiles look them up in).
+/// order `EyeBuffers::project` offsets their indices by, and the tiles look them up in).
 fn all_textures<'a>(scene: &'a Scene, trees: &'a forest::Trees) -> Vec<&'a textured::Texture> {
     scene.textures.iter().chain(trees.cache().textures()).collect()
 }
@@ -128,18 +128,58 @@ fn projection(scene: &Scene, eye: Eye, viewport: Bounds, width: u32, height: u32
 /// 291M); 32 still gives 23 tiles to balance over two cores.
 pub const TILE_ROWS: usize = 32;
 
+/// Parts the meshes and the textured polygons are each projected in, on the pool's threads
+/// (`EyeBuffers::project`). Each part is a run of the scene's order and the tiles draw the parts
+/// in turn, so a tile draws the same triangles in the same order whatever the parts: the image
+/// does not depend on them.
+const PARTS: usize = 2;
+
+/// `N` consecutive ranges of the items of `weights`, about equal in weight with `first` added to
+/// the first range's (what that part projects besides the items).
+fn split<const N: usize>(first: usize, weights: impl Iterator<Item = usize> + Clone) -> [std::ops::Range<usize>; N] {
+    let total = first + weights.clone().sum::<usize>();
+    let mut ends = [0usize; N];
+    let (mut sum, mut n) = (first, 0);
+    let mut k = 0;
+    for w in weights {
+        // Item n goes to the part whose share its middle falls in.
+        while k + 1 < N && 2 * N * sum + N * w >= 2 * (k + 1) * total {
+            ends[k] = n;
+            k += 1;
+        }
+        sum += w;
+        n += 1;
+    }
+    for end in &mut ends[k..] {
+        *end = n;
+    }
+    std::array::from_fn(|i| if i == 0 { 0 } else { ends[i - 1] }..ends[i])
+}
+
 #[derive(Default)]
 struct EyeBuffers {
     projected: Projected,
     capsules: Vec<Capsule>,
-    /// Rocks, water and trees, in that order.
-    meshes: meshes::Projected,
-    /// The trees' simplified shapes.
-    textured: textured::Projected,
+    /// Rocks, water and trees, in that order, in [`PARTS`] parts drawn one after the other.
+    meshes: [meshes::Projected; PARTS],
+    /// The scene's textured polygons and the trees' simplified shapes, in [`PARTS`] parts.
+    textured: [textured::Projected; PARTS],
     /// The terrain's level-of-detail nodes, when [`Scene::terrain_lod`] is above 0.
     nodes: nodes::Projected,
     /// Whether the last projection drew the nodes rather than the full grid.
     lod: bool,
+    /// The depth buffer.
+    samples: Vec<Sample>,
+}
+
+/// What the eyes of a frame share: the terrain's light and level-of-detail pyramid, the land
+/// look's maps, the trees, the tile height.
+struct Shared<'a> {
+    light: &'a [f32],
+    pyramid: &'a lod::Pyramid,
+    land: &'a land::Land,
+    trees: &'a forest::Trees,
+    tile_rows: usize,
 }
 
 /// Renders scenes into frames, keeping its buffers from one frame to the next.
@@ -153,8 +193,11 @@ pub struct Renderer {
     classic: Option<(penmodel_terrain::revision::Mark, f32, Style, usize)>,
     /// The land look's background per eye (centre, left, right), kept while the camera stays.
     backdrops: [atmosphere::Backdrop; 3],
-    samples: Vec<Sample>,
-    eye: EyeBuffers,
+    /// The eyes' projections and depth buffers: the first for a mono frame's eye and the
+    /// left one of an anaglyph, the second for its right eye (drawn side by side with the left).
+    eyes: [EyeBuffers; 2],
+    /// Which of `eyes` the last eye drew.
+    last: usize,
     left: Option<Frame>,
     /// The trees drawn this frame and the simplified shapes' textures.
     trees: forest::Trees,
@@ -193,8 +236,8 @@ impl Renderer {
             land: land::Land::default(),
             classic: None,
             backdrops: Default::default(),
-            samples: Vec::new(),
-            eye: EyeBuffers::default(),
+            eyes: Default::default(),
+            last: 0,
             left: None,
             trees: forest::Trees::default(),
             pyramid: lod::Pyramid::default(),
@@ -236,8 +279,7 @@ impl Renderer {
                     Some(f) if f.width() == frame.width() && f.height() == frame.height() => f,
                     _ => Frame::new(frame.width(), frame.height())?,
                 };
-                self.eye(scene, Eye::Left, full, &mut left);
-                self.eye(scene, Eye::Right, full, frame);
+                self.anaglyph_eyes(scene, full, &mut left, frame);
                 stereo::anaglyph(&left, frame);
                 self.left = Some(left);
                 self.ui(scene, full, frame);
@@ -322,18 +364,20 @@ impl Renderer {
             y0: 0,
             y1: height as i32,
         };
-        let (affine, near, _) = self.project(scene, Eye::Centre, full, width, height);
+        self.last = 0;
+        let (shared, [bufs, _], _) = self.parts();
+        let (affine, near, _) = bufs.project(&shared, scene, Eye::Centre, full, width, height);
         let pass = tiles::EyePass {
             map: scene.terrain,
-            light: &self.light,
+            light: shared.light,
             affine: &affine,
-            projected: &self.eye.projected,
-            nodes: self.eye.lod.then_some(&self.eye.nodes),
+            projected: &bufs.projected,
+            nodes: bufs.lod.then_some(&bufs.nodes),
             near,
             viewport: full,
         };
         let mut counts = vec![0u16; width as usize * height as usize];
-        tiles::coverage(&pass, &mut counts, width as usize, self.tile_rows);
+        tiles::coverage(&pass, &mut counts, width as usize, shared.tile_rows);
         Ok(counts)
     }
 
@@ -350,16 +394,14 @@ impl Renderer {
 
     /// The nodes the last eye drew, each at its level ([`lod::Pick`]); empty at full detail.
     pub fn lod_picks(&self) -> &[lod::Pick] {
-        if self.eye.lod { &self.eye.nodes.picks } else { &[] }
+        let eye = &self.eyes[self.last];
+        if eye.lod { &eye.nodes.picks } else { &[] }
     }
 
     /// How many nodes of each level the last eye drew (level 0 first); empty at full detail.
     pub fn lod_levels(&self) -> Vec<usize> {
-        if self.eye.lod {
-            self.eye.nodes.per_level()
-        } else {
-            Vec::new()
-        }
+        let eye = &self.eyes[self.last];
+        if eye.lod { eye.nodes.per_level() } else { Vec::new() }
     }
 
     /// Brings the pyramid up to date: only the nodes over the cells changed since it was made
@@ -466,10 +508,13 @@ impl Renderer {
             skipped_vertices: skipped,
         }
     }
+}
 
+impl EyeBuffers {
     /// Projects the grid for `eye` drawn into `viewport` of a `width × height` frame.
     fn project(
         &mut self,
+        shared: &Shared,
         scene: &Scene,
         eye: Eye,
         viewport: Bounds,
@@ -479,124 +524,212 @@ impl Renderer {
         let projection = projection(scene, eye, viewport, width, height);
         let affine = Affine::new(&projection, scene.terrain.cell_size(), f64::from(scene.vertical_scale));
         let near = projection.near as f32;
-        self.eye.lod = scene.terrain_lod > 0.0;
-        if self.eye.lod {
-            self.eye.projected.chunks.clear();
-            let map = scene.terrain;
-            let pixels = scene.terrain_lod;
-            nodes::project(
-                &self.pyramid,
-                map,
-                &self.light,
-                &affine,
-                near,
-                viewport,
-                pixels,
-                &mut self.eye.nodes,
-            );
-        } else {
-            transform::project_grid(
-                scene.terrain,
-                &self.light,
-                &affine,
-                near,
-                viewport,
-                &mut self.eye.projected,
-            );
-        }
-        overlay::capsules(scene, &projection, &mut self.eye.capsules);
         let cell = scene.terrain.cell_size();
-        let bands = (height as usize, self.tile_rows);
-        let (meshes, textured, trees) = (&mut self.eye.meshes, &mut self.eye.textured, &self.trees);
-        // The meshes and the textured polygons side by side: each is projected and binned on one
-        // thread, and the trees' copied polygons and simplified shapes were a serial part of
-        // their frames.
-        rayon::join(
-            || {
-                meshes.clear(bands);
-                let rocks = scene.rocks.iter().map(|(_, m)| m);
-                meshes.add_rocks(rocks, scene.terrain_lod, &affine, cell, near, &scene.style);
-                let water = scene.water.iter().map(|(_, m)| m);
-                meshes.add(water, Paint::Whole(Surface::Water), &affine, cell, near, &scene.style);
-                meshes.add(trees.meshes(), Paint::Tree, &affine, cell, near, &scene.style);
-            },
-            || {
-                textured.clear(bands);
-                let textures = all_textures(scene, trees);
-                textured.add(scene.polygons, 0, &textures, &affine, cell, near);
-                let first = scene.textures.len() as u32;
-                textured.add(trees.quads(), first, &textures, &affine, cell, near);
-            },
+        let bands = (height as usize, shared.tile_rows);
+        let (meshes, textured, trees) = (&mut self.meshes, &mut self.textured, shared.trees);
+        let textures = all_textures(scene, trees);
+        let textures = &textures;
+        let all = 0..trees.len();
+        let before =
+            |m: &[(String, penmodel_terrain::export::Mesh)]| m.iter().map(|(_, m)| m.indices.len()).sum::<usize>();
+        let solid = split::<PARTS>(
+            before(scene.rocks) + before(scene.water),
+            trees.meshes(all.clone()).map(|m| m.indices.len()),
         );
+        let flat = split::<PARTS>(scene.polygons.len(), trees.quads(all).map(<[_]>::len));
+        let affine_ref = &affine;
+        // The meshes and the textured polygons in parts on the pool's threads, beside the
+        // terrain's nodes and the overlays on this one: one of each on a thread was a serial part
+        // of the trees' frames (the trees' 16,000 triangles and 6,000 polygons).
+        rayon::scope(|s| {
+            for (k, (part, range)) in meshes.iter_mut().zip(solid).enumerate() {
+                s.spawn(move |_| {
+                    part.clear(bands);
+                    if k == 0 {
+                        let rocks = scene.rocks.iter().map(|(_, m)| m);
+                        part.add_rocks(rocks, scene.terrain_lod, affine_ref, cell, near, &scene.style);
+                        let water = scene.water.iter().map(|(_, m)| m);
+                        part.add(
+                            water,
+                            Paint::Whole(Surface::Water),
+                            affine_ref,
+                            cell,
+                            near,
+                            &scene.style,
+                        );
+                    }
+                    let trees = trees.meshes(range);
+                    part.add(trees, Paint::Tree, affine_ref, cell, near, &scene.style);
+                });
+            }
+            for (k, (part, range)) in textured.iter_mut().zip(flat).enumerate() {
+                s.spawn(move |_| {
+                    part.clear(bands);
+                    if k == 0 {
+                        part.add(scene.polygons, 0, textures, affine_ref, cell, near);
+                    }
+                    let first = scene.textures.len() as u32;
+                    for quads in trees.quads(range) {
+                        part.add(quads, first, textures, affine_ref, cell, near);
+                    }
+                });
+            }
+            self.lod = scene.terrain_lod > 0.0;
+            if self.lod {
+                self.projected.chunks.clear();
+                nodes::project(
+                    shared.pyramid,
+                    scene.terrain,
+                    shared.light,
+                    affine_ref,
+                    near,
+                    viewport,
+                    scene.terrain_lod,
+                    &mut self.nodes,
+                );
+            } else {
+                transform::project_grid(
+                    scene.terrain,
+                    shared.light,
+                    affine_ref,
+                    near,
+                    viewport,
+                    &mut self.projected,
+                );
+            }
+            overlay::capsules(scene, &projection, &mut self.capsules);
+        });
         (affine, near, projection)
     }
 
-    fn eye(&mut self, scene: &Scene, eye: Eye, viewport: Bounds, frame: &mut Frame) {
+    /// Projects and draws `eye` of `scene` into `viewport` of `frame`, the buffers' depth
+    /// samples its depth buffer; returns its projection and what shows where no surface does
+    /// (for [`Renderer::keep`]).
+    fn draw(
+        &mut self,
+        shared: &Shared,
+        backdrop: &mut atmosphere::Backdrop,
+        scene: &Scene,
+        eye: Eye,
+        viewport: Bounds,
+        frame: &mut Frame,
+    ) -> (Projection, reproject::Background) {
         let (width, height) = (frame.width(), frame.height());
-        let (affine, near, projection) = self.project(scene, eye, viewport, width, height);
+        let (affine, near, projection) = self.project(shared, scene, eye, viewport, width, height);
         self.samples.resize(width as usize * height as usize, Sample::default());
         let ramp = ramp::Ramp::new(&scene.style);
         let air = (scene.style.look == scene::Look::Land)
             .then(|| atmosphere::Atmosphere::new(&projection, scene.terrain, scene.vertical_scale, &scene.style));
         let columns = (viewport.x0 as usize, viewport.x1 as usize);
-        let slot = slot(eye);
         let back = air
             .as_ref()
-            .map(|a| self.backdrops[slot].of(a, width as usize, height as usize, columns));
+            .map(|a| backdrop.of(a, width as usize, height as usize, columns));
         let shading = shade::Shading {
             ramp: &ramp,
-            land: air.as_ref().zip(back).map(|(a, b)| (&self.land, a, b)),
+            land: air.as_ref().zip(back).map(|(a, b)| (shared.land, a, b)),
         };
         let pass = tiles::EyePass {
             map: scene.terrain,
-            light: &self.light,
+            light: shared.light,
             affine: &affine,
-            projected: &self.eye.projected,
-            nodes: self.eye.lod.then_some(&self.eye.nodes),
+            projected: &self.projected,
+            nodes: self.lod.then_some(&self.nodes),
             near,
             viewport,
         };
-        let textures = all_textures(scene, &self.trees);
+        let textures = all_textures(scene, shared.trees);
         tiles::render(
             &pass,
-            &self.eye.meshes,
-            (&self.eye.textured, &textures),
-            &self.eye.capsules,
+            &self.meshes,
+            (&self.textured, &textures),
+            &self.capsules,
             &shading,
             &scene.style,
             frame.pixels_mut(),
             &mut self.samples,
             width as usize,
-            self.tile_rows,
+            shared.tile_rows,
         );
-        if self.hold {
-            // In an earlier frame's buffers (render_held emptied the slots, so one this frame did
-            // not draw is refused by reproject).
-            let mut held = self.spare.pop().unwrap_or_else(|| reproject::Held {
-                pixels: Vec::new(),
-                invw: Vec::new(),
-                width: 0,
-                bounds: viewport,
-                projection,
-            });
-            held.pixels.clear();
-            held.pixels.extend_from_slice(frame.pixels());
-            let background = match &air {
-                Some(air) => reproject::Background::Level(air.table_y()),
-                None => reproject::Background::Screen(
-                    (1.0 / scene
-                        .camera
-                        .viewpoint(eye, f64::from(width) / f64::from(height))
-                        .screen_distance()) as f32,
-                ),
-            };
-            let depths = self.samples.iter().map(|s| s.invw);
-            reproject::depths(depths, &projection, background, width as usize, &mut held.invw);
-            held.width = width as usize;
-            held.bounds = viewport;
-            held.projection = projection;
-            self.held[slot] = Some(held);
+        let background = match &air {
+            Some(air) => reproject::Background::Level(air.table_y()),
+            None => reproject::Background::Screen(
+                (1.0 / scene
+                    .camera
+                    .viewpoint(eye, f64::from(width) / f64::from(height))
+                    .screen_distance()) as f32,
+            ),
+        };
+        (projection, background)
+    }
+}
+
+impl Renderer {
+    /// What the eyes share, and the eyes' buffers and backgrounds to draw into.
+    fn parts(&mut self) -> (Shared<'_>, &mut [EyeBuffers; 2], &mut [atmosphere::Backdrop; 3]) {
+        let shared = Shared {
+            light: &self.light,
+            pyramid: &self.pyramid,
+            land: &self.land,
+            trees: &self.trees,
+            tile_rows: self.tile_rows,
+        };
+        (shared, &mut self.eyes, &mut self.backdrops)
+    }
+
+    fn eye(&mut self, scene: &Scene, eye: Eye, viewport: Bounds, frame: &mut Frame) {
+        self.last = 0;
+        let (shared, [bufs, _], backdrops) = self.parts();
+        let (projection, background) = bufs.draw(&shared, &mut backdrops[slot(eye)], scene, eye, viewport, frame);
+        self.keep(0, eye, viewport, projection, background, frame);
+    }
+
+    /// Both eyes of an anaglyph over `viewport`, the left into `left` and the right into
+    /// `right`, side by side on the pool's threads: drawn one after the other, each eye's
+    /// projection and the last of its tiles left a thread idle.
+    fn anaglyph_eyes(&mut self, scene: &Scene, viewport: Bounds, left: &mut Frame, right: &mut Frame) {
+        self.last = 1;
+        let (shared, [a, b], [_, back_left, back_right]) = self.parts();
+        let ((pl, bl), (pr, br)) = rayon::join(
+            || a.draw(&shared, back_left, scene, Eye::Left, viewport, left),
+            || b.draw(&shared, back_right, scene, Eye::Right, viewport, right),
+        );
+        self.keep(0, Eye::Left, viewport, pl, bl, left);
+        self.keep(1, Eye::Right, viewport, pr, br, right);
+    }
+
+    /// When [`Renderer::render_held`] is drawing, holds `eye`'s picture in `frame` and its depth
+    /// (in the buffers `eyes[k]` that drew it) for [`Renderer::reproject`].
+    fn keep(
+        &mut self,
+        k: usize,
+        eye: Eye,
+        viewport: Bounds,
+        projection: Projection,
+        background: reproject::Background,
+        frame: &Frame,
+    ) {
+        if !self.hold {
+            return;
         }
+        // In an earlier frame's buffers (render_held emptied the slots, so one this frame did
+        // not draw is refused by reproject).
+        let mut held = self.spare.pop().unwrap_or_else(|| reproject::Held {
+            pixels: Vec::new(),
+            invw: Vec::new(),
+            width: 0,
+            bounds: viewport,
+            projection,
+        });
+        held.pixels.clear();
+        held.pixels.extend_from_slice(frame.pixels());
+        let bufs = &self.eyes[k];
+        let width = frame.width() as usize;
+        let depths = bufs.samples.iter().map(|s| s.invw);
+        reproject::depths(depths, &projection, background, width, &mut held.invw);
+        held.width = width;
+        held.bounds = viewport;
+        held.projection = projection;
+        self.held[slot(eye)] = Some(held);
     }
 
     /// What the last frame's trees cost: polygons copied, simplified shapes drawn.

@@ -106,12 +106,13 @@ impl EyePass<'_> {
 }
 
 /// Renders one eye into the `viewport` columns of `pixels` (a frame `width` wide and
-/// `frame_height` tall), with `samples` as the depth buffer, `tile_rows` rows per tile.
+/// `frame_height` tall), with `samples` as the depth buffer, `tile_rows` rows per tile; the
+/// meshes and the textured polygons are each in parts, drawn in turn.
 #[allow(clippy::too_many_arguments)]
 pub fn render(
     pass: &EyePass,
-    meshes: &super::meshes::Projected,
-    (textured, textures): (&super::textured::Projected, &[&super::textured::Texture]),
+    meshes: &[super::meshes::Projected],
+    (textured, textures): (&[super::textured::Projected], &[&super::textured::Texture]),
     capsules: &[Capsule],
     shading: &Shading,
     style: &Style,
@@ -150,8 +151,13 @@ pub fn render(
                 surface: rasterise::Surface::Terrain,
             };
             pass.terrain(&bounds, &mut sink);
-            meshes.draw(&bounds, smp, width, pass.near);
-            textured.draw(&bounds, smp, width, pass.near, textures);
+            // Part after part: the scene's order ([`crate::Renderer`] projects them in parts).
+            for part in meshes {
+                part.draw(&bounds, smp, width, pass.near);
+            }
+            for part in textured {
+                part.draw(&bounds, smp, width, pass.near, textures);
+            }
             shade::resolve(smp, pix, width, (x0, x1), y0, frame_height, shading, style);
             let (top, bottom) = (bounds.y0 as f32, bounds.y1 as f32);
             for cap in capsules {
