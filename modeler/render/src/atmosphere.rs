@@ -28,6 +28,7 @@ use rayon::prelude::*;
 
 use super::camera::Projection;
 use super::frame::Rgba;
+use super::land::floor_small;
 use super::scene::Style;
 use penmodel_terrain::Heightmap;
 
@@ -203,9 +204,28 @@ impl Atmosphere {
         let x = d * self.inv_haze * ((HAZE_ENTRIES - 1) as f32 / HAZE_SPAN);
         // A 16-bit cast saturates as the 32- and 64-bit ones did (the table is shorter than 2¹⁶:
         // the same entry), in three instructions where 32 bits took six. The entry is read
-        // whatever `x` is (a NaN casts to 0) and then chosen: without a branch the resolve's
-        // last pass is vectorised (`shade::resolve_land`).
+        // whatever `x` is (a NaN casts to 0) and then chosen.
         let t = self.table[usize::from(x as u16).min(HAZE_ENTRIES - 1)];
+        if x.is_finite() { t } else { 1.0 }
+    }
+
+    /// [`Atmosphere::fog`] without the table: the same entry's `1 − exp(−i·HAZE_SPAN/(E − 1))`
+    /// for the same `i`, with the exponential computed ([`exp_small`], within 2 ulp of the
+    /// table's), so that the resolve computes it in vector lanes (a lookup per pixel was a tenth
+    /// of the resolve's instructions and stays scalar).
+    #[inline(always)]
+    fn fog_computed(&self, d: f32) -> f32 {
+        let x = d * self.inv_haze * ((HAZE_ENTRIES - 1) as f32 / HAZE_SPAN);
+        // The table's index: `x` truncated and clamped (a NaN and anything below 0: entry 0).
+        let i = if x > 0.0 { x } else { 0.0 };
+        let i = if i < (HAZE_ENTRIES - 1) as f32 {
+            i
+        } else {
+            (HAZE_ENTRIES - 1) as f32
+        };
+        // Truncated without a cast (which the compiler keeps scalar).
+        let (_, i) = floor_small(i);
+        let t = 1.0 - exp_small(-i * HAZE_SPAN / (HAZE_ENTRIES - 1) as f32);
         if x.is_finite() { t } else { 1.0 }
     }
 
@@ -220,6 +240,13 @@ impl Atmosphere {
     #[inline(always)]
     pub fn haze_at(&self, d: f32) -> f32 {
         self.haze * self.fog(d)
+    }
+
+    /// [`Atmosphere::haze_at`] without a lookup, for vector lanes ([`Atmosphere::fog_computed`]:
+    /// it may differ from the table's by an ulp or two).
+    #[inline(always)]
+    pub fn haze_computed(&self, d: f32) -> f32 {
+        self.haze * self.fog_computed(d)
     }
 
     /// `colour` tended to the horizon's by `t` ([`Atmosphere::haze_at`]).
@@ -262,23 +289,55 @@ impl Atmosphere {
         lerp(self.horizon, self.zenith, t)
     }
 
-    /// [`Atmosphere::background`] of row `y`'s pixels `x0..x1` as bytes, the ray stepped from the
-    /// row's first pixel (as the shading steps it, so both give the same bytes).
-    pub fn background_row(&self, y: usize, (x0, x1): (usize, usize), out: &mut [[u8; 3]]) {
-        let step = self.step();
-        let mut ray = self.ray(x0 as f32 + 0.5, y as f32 + 0.5);
-        for p in out.iter_mut().take(x1.saturating_sub(x0)) {
-            *p = self.background_bytes(ray);
-            ray = [ray[0] + step[0], ray[1] + step[1], ray[2] + step[2]];
+    /// [`Atmosphere::background`] of row `y`'s pixels `x0..x1` as opaque pixels
+    /// ([`Atmosphere::background_pixel`]), the ray of the `k`-th the row's first plus `k` steps
+    /// ([`Atmosphere::row_ray`], as the shading computes it, so both give the same bytes).
+    pub fn background_row(&self, y: usize, (x0, x1): (usize, usize), out: &mut [u32]) {
+        let first = self.ray(x0 as f32 + 0.5, y as f32 + 0.5);
+        for (k, p) in out.iter_mut().take(x1.saturating_sub(x0)).enumerate() {
+            *p = self.background_pixel(self.row_ray(first, k as f32));
         }
     }
 
-    /// [`Atmosphere::background`] as bytes.
+    /// The ray `k` pixels along a row from `first` (the row's first pixel's ray): `first + k·step`.
     #[inline(always)]
-    pub fn background_bytes(&self, ray: [f32; 3]) -> [u8; 3] {
-        let c = self.background(ray);
-        [c[0] as u8, c[1] as u8, c[2] as u8]
+    pub fn row_ray(&self, first: [f32; 3], k: f32) -> [f32; 3] {
+        let b = self.b;
+        [first[0] + k * b[0], first[1] + k * b[1], first[2] + k * b[2]]
     }
+
+    /// [`Atmosphere::background`] as an opaque pixel, the bytes `r, g, b, 255` of a
+    /// little-endian `u32` (the channels truncated, as `as u8` does).
+    #[inline(always)]
+    pub fn background_pixel(&self, ray: [f32; 3]) -> u32 {
+        let c = self.background(ray);
+        u32::from(c[0] as u8) | u32::from(c[1] as u8) << 8 | u32::from(c[2] as u8) << 16 | 0xff00_0000
+    }
+}
+
+/// `e^y` for `y` in `[−HAZE_SPAN, 0]` (beyond it too, less precisely, down to where `e^y` is
+/// subnormal), by arithmetic that vectorises: `y·log₂e` split into an integer `n` (by the 1.5·2²³
+/// rounding trick: no `round` instruction in baseline x86-64) and `f` in `[−½, ½]`, `e^(f·ln 2)`
+/// by Cephes' `expf` polynomial (`f·ln 2` reduced in two parts), scaled by `2^n` through the
+/// exponent's bits. Within 2 ulp of `f32::exp` over the haze's range (the test checks every entry).
+#[inline(always)]
+fn exp_small(y: f32) -> f32 {
+    const ROUND: f32 = 12_582_912.0;
+    let y = if y > -87.0 { y } else { -87.0 };
+    let t = y * std::f32::consts::LOG2_E + ROUND;
+    let n = t - ROUND;
+    // The integer `n`, from the bits of `t` (1.5·2²³ + n, exactly).
+    let ni = t.to_bits().wrapping_sub(ROUND.to_bits()) as i32;
+    // `y − n·ln 2`, in two parts (the first exact in `f32` for such `n`).
+    let r = y - n * 0.693_359_4 + n * 2.121_944_4e-4;
+    let p = 1.987_569_1e-4;
+    let p = p * r + 1.398_199_9e-3;
+    let p = p * r + 8.333_452e-3;
+    let p = p * r + 4.166_579_6e-2;
+    let p = p * r + 1.666_666_5e-1;
+    let p = p * r + 0.5;
+    let e = p * r * r + r + 1.0;
+    e * f32::from_bits(((ni + 127) as u32) << 23)
 }
 
 /// `a + t·(b − a)`, spelled out (an array `map` here costs a tenth of the frame).
@@ -316,7 +375,7 @@ fn edge_low(map: &Heightmap) -> f32 {
 /// terrain's extent and edge only, and costs about a square root and a division per pixel.
 ///
 /// While the view moves it is not made at all: the shading computes the background of the
-/// pixels that show no surface only (the same ray, stepped the same way, so the same bytes): the
+/// pixels that show no surface only (the same ray, [`Atmosphere::row_ray`], so the same bytes): the
 /// whole frame's background was 85 M of a turning view's 290 M instructions a frame (1024², LOD
 /// at 1 px). Once the view has stayed for a frame it is made whole and kept.
 #[derive(Debug, Default)]
@@ -324,20 +383,15 @@ pub struct Backdrop {
     key: Option<(Atmosphere, [usize; 4])>,
     /// Whether `pixels` holds the background of `key`.
     made: bool,
-    pixels: Vec<[u8; 3]>,
+    /// Opaque pixels ([`Atmosphere::background_pixel`]): the shading copies them as they are.
+    pixels: Vec<u32>,
 }
 
 impl Backdrop {
     /// The background of `air` over the columns `x0..x1` of a `width × height` frame, row-major
     /// over the whole frame (other columns unset), when the view is the last frame's; `None`
     /// when it changed (the caller computes [`Atmosphere::background`] where it needs it).
-    pub fn of(
-        &mut self,
-        air: &Atmosphere,
-        width: usize,
-        height: usize,
-        (x0, x1): (usize, usize),
-    ) -> Option<&[[u8; 3]]> {
+    pub fn of(&mut self, air: &Atmosphere, width: usize, height: usize, (x0, x1): (usize, usize)) -> Option<&[u32]> {
         let key = [width, height, x0, x1];
         if !self.key.as_ref().is_some_and(|(a, k)| a == air && *k == key) {
             self.key = Some((air.clone(), key));
@@ -347,12 +401,78 @@ impl Backdrop {
         if self.made {
             return Some(&self.pixels);
         }
-        self.pixels.resize(width * height, [0; 3]);
+        self.pixels.resize(width * height, 0);
         self.pixels
             .par_chunks_mut(width.max(1))
             .enumerate()
             .for_each(|(y, row)| air.background_row(y, (x0, x1), &mut row[x0..x1]));
         self.made = true;
         Some(&self.pixels)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::camera::{Camera, Eye, Tracked, View, Viewport};
+
+    fn atmosphere(haze_distance: f32) -> Atmosphere {
+        let camera = Camera {
+            view: View::Tracked(Tracked::fit([0.6, 0.34], [100.0, 60.0], 0.45)),
+            tilt: 0.2,
+        };
+        let vp = camera.viewpoint(Eye::Left, 16.0 / 9.0);
+        let viewport = Viewport {
+            x: 0.0,
+            y: 0.0,
+            width: 64.0,
+            height: 36.0,
+        };
+        let projection = Projection::new(&vp, camera.tilt, viewport);
+        let map = Heightmap::from_heights(4, 4, 25.0, vec![0.0; 16]).expect("a 4 × 4 map");
+        let style = Style {
+            haze_distance,
+            ..Style::land()
+        };
+        Atmosphere::new(&projection, &map, 1.0, &style)
+    }
+
+    #[test]
+    fn the_computed_exponential_is_within_two_ulp_of_the_tables() {
+        for i in 0..HAZE_ENTRIES {
+            let y = -(i as f32) * HAZE_SPAN / (HAZE_ENTRIES - 1) as f32;
+            let (got, want) = (exp_small(y), y.exp());
+            let ulps = (i64::from(got.to_bits()) - i64::from(want.to_bits())).abs();
+            assert!(ulps <= 2, "e^{y}: {got:e} against {want:e} ({ulps} ulp)");
+        }
+    }
+
+    #[test]
+    fn the_computed_haze_is_the_tables() {
+        let air = atmosphere(1000.0);
+        // Distances over the table and past it, on and between its entries, and the edges.
+        let mut ds: Vec<f32> = (0..=20_000).map(|i| i as f32 * 0.5).collect();
+        ds.extend([-5.0, -0.0, f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1e30, f32::MAX]);
+        for d in ds {
+            let (got, want) = (air.fog_computed(d), air.fog(d));
+            assert!(
+                (got - want).abs() <= 2.0 * f32::EPSILON,
+                "fog at {d}: {got:e} against the table's {want:e}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_rows_rays_are_its_first_plus_steps() {
+        let air = atmosphere(0.0);
+        let first = air.ray(3.5, 7.5);
+        for k in 0..64 {
+            let want = air.ray(3.5 + k as f32, 7.5);
+            let got = air.row_ray(first, k as f32);
+            let norm = want.iter().map(|w| w * w).sum::<f32>().sqrt();
+            for (g, w) in got.iter().zip(want) {
+                assert!((g - w).abs() <= 1e-5 * norm, "pixel {k}: {got:?} against {want:?}");
+            }
+        }
     }
 }

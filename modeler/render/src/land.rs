@@ -431,10 +431,17 @@ impl Ground<'_> {
     /// cells; `L`: the mean of `2^L × 2^L` of them) holding world `(x, z)` metres, with `fade` of
     /// the fine noise: for pixels where a cell is smaller than a pixel, where interpolating
     /// between cells would show nothing more and costs three times as much. A level past the
-    /// last one kept reads the last.
-    #[inline(always)]
+    /// last one kept reads the last. (The resolve applies the fade itself, in vector lanes:
+    /// [`Ground::nearest_parts`] and [`faded`].)
+    #[cfg(test)]
     pub(crate) fn nearest_at(&self, level: usize, x: f32, z: f32, fade: f32) -> [f32; 3] {
-        let a = match level.min(self.mips.len()) {
+        faded(self.nearest_parts(level, x, z), fade)
+    }
+
+    /// [`Ground::nearest_at`] before the fade: the colour and the fine noise's factor.
+    #[inline(always)]
+    pub(crate) fn nearest_parts(&self, level: usize, x: f32, z: f32) -> [f32; 4] {
+        match level.min(self.mips.len()) {
             0 => {
                 let (u, v) = self.place(x, z, 0.0);
                 self.albedo[v as u32 as usize * self.cols + u as u32 as usize]
@@ -446,28 +453,102 @@ impl Ground<'_> {
                 let v = within(z * inv, (m.rows - 1) as f32);
                 m.cells[v as u32 as usize * m.cols + u as u32 as usize].unpack()
             }
-        };
-        let k = 1.0 + fade * a[3];
-        [a[0] * k, a[1] * k, a[2] * k]
+        }
     }
 
     /// The ground's colour (sRGB 0–255, before light) at world `(x, z)` metres, bilinear between
-    /// the cell centres, with `fade` of the fine noise.
-    #[inline(always)]
+    /// the cell centres, with `fade` of the fine noise: [`Ground::corner`], [`Ground::bilinear`]
+    /// and [`faded`], which the resolve calls in its passes.
+    #[cfg(test)]
     pub(crate) fn albedo_at(&self, x: f32, z: f32, fade: f32) -> [f32; 3] {
+        faded(self.bilinear(self.corner(x, z)), fade)
+    }
+
+    /// Whether [`Ground::corner`] is exact for every point: the grid is under 2²³ cells a side
+    /// (so is any grid that fits in memory, short of a line of cells).
+    #[inline]
+    pub(crate) fn corners_computed(&self) -> bool {
+        self.last[0] < SMALL && self.last[1] < SMALL
+    }
+
+    /// Where [`Ground::albedo_at`] reads `(x, z)`: arithmetic only, without a branch, a lookup
+    /// or a float-to-integer cast (which the compiler keeps scalar), so that the resolve
+    /// computes it for a stretch of pixels in vector lanes ([`crate::shade`]); exact where
+    /// [`Ground::corners_computed`], [`Ground::corner_cast`] else. [`Ground::bilinear`] reads
+    /// the cells.
+    #[inline(always)]
+    pub(crate) fn corner(&self, x: f32, z: f32) -> Corner {
         let (u, v) = self.place(x, z, 0.5);
-        let (c, r) = (u as u32 as usize, v as u32 as usize);
-        let (fu, fv) = (u - c as f32, v - r as f32);
-        // The next column and row, or these on the last.
-        let dc = usize::from(u < self.last[0]);
-        let dr = if v < self.last[1] { self.cols } else { 0 };
-        let i = r * self.cols + c;
+        // `u` and `v` are in `[0, last]` (a NaN became 0).
+        let ((c, cf), (r, rf)) = (floor_small(u), floor_small(v));
+        Corner {
+            index: r.wrapping_mul(self.cols as u32).wrapping_add(c),
+            fu: u - cf,
+            fv: v - rf,
+            // The next column and row, or these on the last.
+            dc: u32::from(u < self.last[0]),
+            dr: if v < self.last[1] { self.cols as u32 } else { 0 },
+        }
+    }
+
+    /// [`Ground::corner`] by casts, for any grid.
+    #[inline(always)]
+    pub(crate) fn corner_cast(&self, x: f32, z: f32) -> Corner {
+        let (u, v) = self.place(x, z, 0.5);
+        let (c, r) = (u as u32, v as u32);
+        Corner {
+            index: r.wrapping_mul(self.cols as u32).wrapping_add(c),
+            fu: u - c as f32,
+            fv: v - r as f32,
+            dc: u32::from(u < self.last[0]),
+            dr: if v < self.last[1] { self.cols as u32 } else { 0 },
+        }
+    }
+
+    /// The colour and the fine noise's factor bilinear between the four cells at `corner`.
+    #[inline(always)]
+    pub(crate) fn bilinear(&self, corner: Corner) -> [f32; 4] {
+        let Corner { index, fu, fv, dc, dr } = corner;
+        let (i, dc, dr) = (index as usize, dc as usize, dr as usize);
         let a = self.albedo;
         let top = lerp4(a[i].into(), a[i + dc].into(), fu);
-        let p = lerp4(top, lerp4(a[i + dr].into(), a[i + dr + dc].into(), fu), fv).to_array();
-        let k = 1.0 + fade * p[3];
-        [p[0] * k, p[1] * k, p[2] * k]
+        lerp4(top, lerp4(a[i + dr].into(), a[i + dr + dc].into(), fu), fv).to_array()
     }
+}
+
+/// The cell at or before a point in both directions (row-major `index`), the point's fractions
+/// `fu`, `fv` past it, and the offsets of the next column (`dc`: 1, or 0 on the last) and row
+/// (`dr`: a row of cells, or 0 on the last): [`Ground::corner`]. (32 bits: a colour map of 2³²
+/// cells would be 64 GB.)
+#[derive(Debug, Clone, Copy, Default)]
+pub(crate) struct Corner {
+    pub(crate) index: u32,
+    pub(crate) fu: f32,
+    pub(crate) fv: f32,
+    pub(crate) dc: u32,
+    pub(crate) dr: u32,
+}
+
+/// 2²³: [`floor_small`]'s limit.
+const SMALL: f32 = 8_388_608.0;
+
+/// `⌊v⌋` as an integer and as a float for `v` in `[0, 2²³)`, without a cast: `v + 2²³` is `v`
+/// rounded to an integer, which the float's low bits hold; one less where that rounded up.
+#[inline(always)]
+pub(crate) fn floor_small(v: f32) -> (u32, f32) {
+    let t = v + SMALL;
+    let rounded = t - SMALL;
+    let i = t.to_bits().wrapping_sub(SMALL.to_bits());
+    let up = rounded > v;
+    (i.wrapping_sub(u32::from(up)), if up { rounded - 1.0 } else { rounded })
+}
+
+/// A colour with its fine noise's factor ([`Ground::bilinear`]) as a pixel shows it with `fade`
+/// of the noise: `colour × (1 + fade·factor)`.
+#[inline(always)]
+pub(crate) fn faded(p: [f32; 4], fade: f32) -> [f32; 3] {
+    let k = 1.0 + fade * p[3];
+    [p[0] * k, p[1] * k, p[2] * k]
 }
 
 /// `v` clamped to `[0, last]`, a NaN to 0: `v.max(0.0).min(last)` as two compares (a NaN fails
@@ -1075,6 +1156,37 @@ mod tests {
         // 1/1024.
         let faded = g.nearest_at(1, 4.0, 4.0, 1.0);
         assert!((faded[0] - 90.0 * 1.005).abs() <= 90.0 * 0.5 / 1024.0 + 1e-3);
+    }
+
+    #[test]
+    fn the_computed_floor_and_corner_are_the_casts() {
+        let mut values: Vec<f32> = (0..=40_000).map(|i| i as f32 * 0.125).collect();
+        values.extend([f32::EPSILON, 0.499_999_97, 0.5, 1.5, 2.5, 3.5, 8_388_607.0, 8_388_607.5]);
+        values.extend((1..=1000).map(|i| 8_388_608.0 * i as f32 / 1001.0));
+        for v in values {
+            let (i, f) = floor_small(v);
+            assert_eq!((i, f), (v as u32, v.floor()), "⌊{v}⌋");
+        }
+        let cells = [[1.0, 2.0, 3.0, 0.0]; 12];
+        let g = Ground {
+            cols: 4,
+            last: [3.0, 2.0],
+            ..ground(&cells)
+        };
+        assert!(g.corners_computed());
+        for x in -20..60 {
+            for z in -20..40 {
+                let (x, z) = (x as f32 * 0.7, z as f32 * 0.9);
+                let (a, b) = (g.corner(x, z), g.corner_cast(x, z));
+                assert_eq!(
+                    (a.index, a.fu, a.fv, a.dc, a.dr),
+                    (b.index, b.fu, b.fv, b.dc, b.dr),
+                    "at ({x}, {z})"
+                );
+            }
+        }
+        let wide = Ground { last: [9e6, 0.0], ..g };
+        assert!(!wide.corners_computed());
     }
 
     #[test]

@@ -13,7 +13,7 @@
 
 use super::atmosphere::Atmosphere;
 use super::frame::Rgba;
-use super::land::Land;
+use super::land::{Corner, Land, faded};
 use super::mips;
 use super::ramp::Ramp;
 use super::rasterise::{Sample, Surface};
@@ -36,7 +36,7 @@ pub struct Shading<'a> {
 
 /// The land look's part of [`Shading`]: the terrain's maps, the eye's atmosphere, its kept
 /// background if any.
-pub type LandShading<'a> = (&'a Land, &'a Atmosphere, Option<&'a [[u8; 3]]>);
+pub type LandShading<'a> = (&'a Land, &'a Atmosphere, Option<&'a [u32]>);
 
 /// A sample's colour before light, for surfaces other than the terrain.
 #[inline(always)]
@@ -89,6 +89,18 @@ pub fn resolve(
 /// buffers stay in the first-level cache.
 const LANES: usize = 64;
 
+/// `0, 1, …, LANES − 1`: a lane's pixel along its stretch, for the rays and sines computed as
+/// the stretch's first plus so many steps.
+const LANE: [f32; LANES] = {
+    let mut lane = [0.0; LANES];
+    let mut k = 0;
+    while k < LANES {
+        lane[k] = k as f32;
+        k += 1;
+    }
+    lane
+};
+
 /// One stretch of a row's pixels in the land look's resolve, field by field (structure of
 /// arrays), so that the passes without branches or lookups compile to vector instructions: they
 /// run over all [`LANES`] entries (a fixed count, no bounds checks), a short stretch's tail set
@@ -97,35 +109,37 @@ struct Stretch {
     /// The samples' `1/w` (0: empty) and `l/w`.
     invw: [f32; LANES],
     lw: [f32; LANES],
-    /// The view ray through each pixel (stepped one addition at a time, as before: the same
-    /// bits) and the sine of its elevation.
-    ray: [[f32; LANES]; 3],
+    /// The sine of the view ray's elevation, the sample's ground position, the fine noise's
+    /// fade, the light and the haze by the distance.
     sin: [f32; LANES],
-    /// The sample's ground position, distance, fine noise's fade, light, and the cells a pixel
-    /// spans (for the ground's level); the haze by the distance.
     at: [[f32; LANES]; 2],
-    d: [f32; LANES],
-    haze: [f32; LANES],
     fade: [f32; LANES],
     light: [f32; LANES],
-    cells: [f32; LANES],
-    /// The colour before light and haze (covered pixels), and the finished pixel (others).
-    colour: [[f32; LANES]; 3],
+    haze: [f32; LANES],
+    /// Where the bilinear ground colour reads ([`crate::land::Ground::corner`]), field by
+    /// field.
+    index: [u32; LANES],
+    fu: [f32; LANES],
+    fv: [f32; LANES],
+    dc: [u32; LANES],
+    dr: [u32; LANES],
+    /// The colour before light and haze and the fine noise's factor (covered pixels; the
+    /// factor 0 for surfaces other than the ground), and the background (the others).
+    colour: [[f32; LANES]; 4],
     background: [u32; LANES],
     /// The finished pixels.
     out: [u32; LANES],
 }
 
 /// [`resolve`] in the land look: a terrain sample's ground colour where its world point lies
-/// ([`crate::land::Ground::albedo_at`]) with as much of the fine noise as its footprint resolves
+/// ([`crate::land::Ground::bilinear`]) with as much of the fine noise as its footprint resolves
 /// ([`crate::land::FINE_FADE`]), every surface hazed by its distance, the atmosphere behind.
 ///
-/// Each stretch of [`LANES`] pixels of a row goes through passes: the rays (a sequence of
-/// additions) and the samples' fields, the samples' arithmetic (the world point, the fade, the
-/// light: no branch, so it is vectorised), the colour lookups (per pixel, by surface and level),
-/// and the light, the haze and the bytes (vectorised). Per pixel the operations are the ones the
-/// single loop did, in the same order, so the bytes are the same; the single loop's branches and
-/// lookups kept its arithmetic scalar (a ground pixel was about 150 instructions).
+/// Each stretch of [`LANES`] pixels of a row goes through passes: the samples' fields; the
+/// arithmetic (the rays and sines as the row's first plus `k` steps, the world point, the fade,
+/// the light, the haze in closed form, where the bilinear colour reads: no branch or lookup, so
+/// it is vectorised); the colour lookups (per pixel, by surface and level); the fine noise, the
+/// light, the haze and the bytes (vectorised). A stretch that shows no surface is its background.
 #[allow(clippy::too_many_arguments)]
 fn resolve_land(
     samples: &[Sample],
@@ -154,9 +168,11 @@ fn resolve_land_body(
     (land, air, back): LandShading,
     style: &Style,
 ) {
-    let step = air.step();
     let ground = land.ground();
     let levels = ground.levels();
+    // Whether the bilinear colours' cells are found in vector lanes (every grid short of a
+    // line of 2²³ cells), else per pixel.
+    let computed = ground.corners_computed();
     // Pixels a metre spans across the view at `w = 1`.
     let per_metre = air.pixels(1.0, 1.0);
     // Where a cell spans less than a pixel (1/w below this), the nearest cell's colour.
@@ -170,25 +186,27 @@ fn resolve_land_body(
     let mut st = Stretch {
         invw: zero,
         lw: zero,
-        ray: [zero; 3],
         sin: zero,
         at: [zero; 2],
-        d: zero,
-        haze: zero,
         fade: zero,
         light: zero,
-        cells: zero,
-        colour: [zero; 3],
+        haze: zero,
+        index: [0; LANES],
+        fu: zero,
+        fv: zero,
+        dc: [0; LANES],
+        dr: [0; LANES],
+        colour: [zero; 4],
         background: [0; LANES],
         out: [0; LANES],
     };
     for (row, (srow, prow)) in rows.enumerate() {
         let brow = back.and_then(|b| b.get(row * width + x0..row * width + x1));
         let y = (y0 + row) as f32 + 0.5;
-        let mut ray = air.ray(x0 as f32 + 0.5, y);
+        let ray = air.ray(x0 as f32 + 0.5, y);
         // The ray's elevation, for the ground's foreshortening: linear along the tile's row
         // between its ends (it is smooth, and a fade needs no more).
-        let mut sin = sine(ray);
+        let sin = sine(ray);
         let last = sine(air.ray(x1.max(x0 + 1) as f32 - 0.5, y));
         let d_sin = (last - sin) / (x1.saturating_sub(x0 + 1)).max(1) as f32;
         let srow = &srow[x0..x1];
@@ -197,82 +215,103 @@ fn resolve_land_body(
             // At most `LANES` (a chunk is), said so that the indexing below needs no checks.
             let n = ss.len().min(LANES);
             let ss = &ss[..n];
-            // The rays, each the one before plus a step as the pixels before did, and the
-            // samples' fields; past a short stretch's end, empty samples.
+            let ps = &mut ps[..n];
+            // The stretch's first pixel along the row, and a pixel's ray.
+            let base = (first * LANES) as f32;
+            let ray_of = |k: usize| air.row_ray(ray, base + LANE[k]);
+            // The samples' fields; past a short stretch's end, empty samples.
             for k in 0..n {
-                let s = &ss[k];
-                st.invw[k] = s.invw;
-                st.lw[k] = s.lw;
-                st.ray[0][k] = ray[0];
-                st.ray[1][k] = ray[1];
-                st.ray[2][k] = ray[2];
-                st.sin[k] = sin;
-                ray = [ray[0] + step[0], ray[1] + step[1], ray[2] + step[2]];
-                sin += d_sin;
+                st.invw[k] = ss[k].invw;
+                st.lw[k] = ss[k].lw;
             }
             st.invw[n..].fill(0.0);
+            // The background where it is kept (the others computed per pixel below).
+            if let Some(b) = brow {
+                st.background[..n].copy_from_slice(&b[first * LANES..first * LANES + n]);
+            }
             // A stretch that shows no surface (the sky, the table, the land beyond: a quarter of
             // the 30-tree scene's pixels) is its background, which needs none of the passes below
             // (they would give the same bytes: an empty pixel is its background).
             if !st.invw[..n].iter().any(|&invw| invw > 0.0) {
-                for (k, p) in ps.iter_mut().enumerate().take(n) {
-                    let c = match brow {
-                        Some(b) => b[first * LANES + k],
-                        None => air.background_bytes([st.ray[0][k], st.ray[1][k], st.ray[2][k]]),
-                    };
-                    *p = pack(c).to_le_bytes();
+                if brow.is_none() {
+                    for k in 0..n {
+                        st.background[k] = air.background_pixel(ray_of(k));
+                    }
+                }
+                for (p, c) in ps.iter_mut().zip(&st.background) {
+                    *p = c.to_le_bytes();
                 }
                 continue;
             }
-            // The samples' arithmetic, whether covered or not (an empty sample's is not used).
+            // The samples' arithmetic, whether covered or not (an empty sample's is not used):
+            // the ray `k` steps along (computed, not stepped: no chain of additions from pixel
+            // to pixel), the world point and its distance, the fade, the light, the haze and
+            // where the bilinear colour reads.
             for k in 0..LANES {
                 let invw = st.invw[k];
                 let w = 1.0 / invw;
-                let (at, d) = air.point([st.ray[0][k], st.ray[1][k], st.ray[2][k]], w);
+                let along = base + LANE[k];
+                let sin_k = sin + along * d_sin;
+                let (at, d) = air.point(air.row_ray(ray, along), w);
+                st.sin[k] = sin_k;
                 st.at[0][k] = at[0];
                 st.at[1][k] = at[1];
-                st.d[k] = d;
-                st.fade[k] = ground.fine_fade(per_metre * invw, st.sin[k]);
-                st.cells[k] = fine / (invw * st.sin[k].max(1e-3));
+                st.fade[k] = ground.fine_fade(per_metre * invw, sin_k);
                 st.light[k] = (st.lw[k] * w).clamp(0.0, 1.0);
+                st.haze[k] = air.haze_computed(d);
+            }
+            if computed {
+                for k in 0..LANES {
+                    let c = ground.corner(st.at[0][k], st.at[1][k]);
+                    st.index[k] = c.index;
+                    st.fu[k] = c.fu;
+                    st.fv[k] = c.fv;
+                    st.dc[k] = c.dc;
+                    st.dr[k] = c.dr;
+                }
             }
             // The colours, per pixel: by surface, and for the ground by level.
             for k in 0..n {
-                let s = &ss[k];
-                if s.invw > 0.0 {
+                let invw = st.invw[k];
+                if invw > 0.0 {
+                    let surface = ss[k].surface;
                     // The terrain tested first, by itself: most covered samples are ground, and
                     // the match in `surface_colour` was a jump through a table for every one.
-                    let c = if s.surface != Surface::Terrain {
-                        surface_colour(s.surface, style).unwrap_or_default()
-                    } else if s.invw < fine {
+                    let c = if surface != Surface::Terrain {
+                        let [r, g, b] = surface_colour(surface, style).unwrap_or_default();
+                        [r, g, b, 0.0]
+                    } else if invw < fine {
                         // The level whose cells are about the pixel's length: `fine / invw`
                         // cells span a pixel across the view, that over `sin` along the ray
                         // (the longer side, as a GPU's mipmaps choose without anisotropic
                         // filtering: sharper would alias, and read far more cells).
-                        let level = mips::level_for(st.cells[k], levels);
-                        ground.nearest_at(level, st.at[0][k], st.at[1][k], st.fade[k])
+                        let cells = fine / (invw * st.sin[k].max(1e-3));
+                        let level = mips::level_for(cells, levels);
+                        ground.nearest_parts(level, st.at[0][k], st.at[1][k])
+                    } else if computed {
+                        ground.bilinear(Corner {
+                            index: st.index[k],
+                            fu: st.fu[k],
+                            fv: st.fv[k],
+                            dc: st.dc[k],
+                            dr: st.dr[k],
+                        })
                     } else {
-                        ground.albedo_at(st.at[0][k], st.at[1][k], st.fade[k])
+                        ground.bilinear(ground.corner_cast(st.at[0][k], st.at[1][k]))
                     };
-                    st.colour[0][k] = c[0];
-                    st.colour[1][k] = c[1];
-                    st.colour[2][k] = c[2];
-                } else {
-                    let c = match brow {
-                        Some(b) => b[first * LANES + k],
-                        None => air.background_bytes([st.ray[0][k], st.ray[1][k], st.ray[2][k]]),
-                    };
-                    st.background[k] = pack(c);
+                    for (channel, v) in st.colour.iter_mut().zip(c) {
+                        channel[k] = v;
+                    }
+                } else if brow.is_none() {
+                    st.background[k] = air.background_pixel(ray_of(k));
                 }
             }
-            // Light, haze and bytes: the haze's table read first, so that the rest has no
-            // lookup and is vectorised.
-            for k in 0..LANES {
-                st.haze[k] = air.haze_at(st.d[k]);
-            }
+            // The fine noise, the light, the haze and the bytes.
             for k in 0..LANES {
                 let l = st.light[k];
-                let c = [st.colour[0][k] * l, st.colour[1][k] * l, st.colour[2][k] * l];
+                let c = &st.colour;
+                let c = faded([c[0][k], c[1][k], c[2][k], c[3][k]], st.fade[k]);
+                let c = [c[0] * l, c[1] * l, c[2] * l];
                 let c = air.hazed_by(c, st.haze[k]);
                 let lit = byte(c[0]) | byte(c[1]) << 8 | byte(c[2]) << 16 | 0xff00_0000;
                 st.out[k] = if st.invw[k] > 0.0 { lit } else { st.background[k] };
@@ -297,12 +336,6 @@ fn byte(v: f32) -> u32 {
     let bits = v.to_bits();
     let mantissa = (bits & 0x007f_ffff) | 0x0080_0000;
     mantissa >> (150 - (bits >> 23)).min(31)
-}
-
-/// An opaque pixel as one 32-bit store (the array literal was written a byte at a time).
-#[inline(always)]
-fn pack(c: [u8; 3]) -> u32 {
-    u32::from(c[0]) | u32::from(c[1]) << 8 | u32::from(c[2]) << 16 | 0xff00_0000
 }
 
 #[cfg(test)]
