@@ -466,8 +466,8 @@ fn rows_by_mask<S: Sink>(
     let down = es.map(|e| e.step_y as i32);
     for (row, y) in (py0..py1 + 1).enumerate() {
         let mut mask = 0u32;
-        for k in 0..LANES {
-            let v = (rows[0] + offsets[0][k]) | (rows[1] + offsets[1][k]) | (rows[2] + offsets[2][k]);
+        for (k, ((a, b), c)) in offsets[0].iter().zip(&offsets[1]).zip(&offsets[2]).enumerate() {
+            let v = (rows[0] + a) | (rows[1] + b) | (rows[2] + c);
             mask |= u32::from(v >= 0) << k;
         }
         mask &= in_box;
