@@ -222,11 +222,12 @@ fn run(w: i64, step: i64, inv: f64, lo: i64, hi: i64) -> (i64, i64) {
     }
 }
 
-/// The first `k` with `w + k·step ≥ 0`, for `w < 0 < step`: `⌈−w / step⌉`. The product's
-/// rounding leaves the estimate at most one off (|w| < 2⁵⁰), which the exact test corrects.
+/// The first `k` with `w + k·step ≥ 0`, for `w < 0 < step`: `⌈−w / step⌉`. The quotient by
+/// the product, truncated, is at most one short (|w| < 2⁵⁰: its rounding is far under one), and
+/// the exact test corrects it. (Truncated, not `ceil`: without SSE4.1 that is a library call.)
 #[inline(always)]
 fn first_at_or_above(w: i64, step: i64, inv: f64) -> i64 {
-    let k = (-(w as f64) * inv).ceil() as i64;
+    let k = (-(w as f64) * inv) as i64;
     if w + k * step < 0 {
         k + 1
     } else if w + (k - 1) * step >= 0 {
@@ -236,11 +237,11 @@ fn first_at_or_above(w: i64, step: i64, inv: f64) -> i64 {
     }
 }
 
-/// The last `k` with `w + k·step ≥ 0`, for `step < 0 ≤ w`: `⌊w / −step⌋`, corrected as
-/// [`first_at_or_above`] is.
+/// The last `k` with `w + k·step ≥ 0`, for `step < 0 ≤ w`: `⌊w / −step⌋` (the quotient is not
+/// negative, so truncating floors it), corrected as [`first_at_or_above`] is.
 #[inline(always)]
 fn last_at_or_above(w: i64, step: i64, inv: f64) -> i64 {
-    let k = (-(w as f64) * inv).floor() as i64;
+    let k = (-(w as f64) * inv) as i64;
     if w + k * step < 0 {
         k - 1
     } else if w + (k + 1) * step >= 0 {
