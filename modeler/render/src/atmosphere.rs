@@ -27,8 +27,8 @@
 use rayon::prelude::*;
 
 use super::camera::Projection;
+use super::floor::floor_small;
 use super::frame::Rgba;
-use super::land::floor_small;
 use super::scene::Style;
 use penmodel_terrain::Heightmap;
 

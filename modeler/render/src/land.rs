@@ -529,20 +529,6 @@ pub(crate) struct Corner {
     pub(crate) dr: u32,
 }
 
-/// 2²³: [`floor_small`]'s limit.
-const SMALL: f32 = 8_388_608.0;
-
-/// `⌊v⌋` as an integer and as a float for `v` in `[0, 2²³)`, without a cast: `v + 2²³` is `v`
-/// rounded to an integer, which the float's low bits hold; one less where that rounded up.
-#[inline(always)]
-pub(crate) fn floor_small(v: f32) -> (u32, f32) {
-    let t = v + SMALL;
-    let rounded = t - SMALL;
-    let i = t.to_bits().wrapping_sub(SMALL.to_bits());
-    let up = rounded > v;
-    (i.wrapping_sub(u32::from(up)), if up { rounded - 1.0 } else { rounded })
-}
-
 /// A colour with its fine noise's factor ([`Ground::bilinear`]) as a pixel shows it with `fade`
 /// of the noise: `colour × (1 + fade·factor)`.
 #[inline(always)]
@@ -618,6 +604,7 @@ fn smoothstep(a: f32, b: f32, t: f32) -> f32 {
 }
 
 use super::atmosphere::lerp as mix;
+use super::floor::{SMALL, floor_small};
 
 fn rgb(c: [u8; 3]) -> [f32; 3] {
     c.map(f32::from)
@@ -1159,14 +1146,8 @@ mod tests {
     }
 
     #[test]
-    fn the_computed_floor_and_corner_are_the_casts() {
-        let mut values: Vec<f32> = (0..=40_000).map(|i| i as f32 * 0.125).collect();
-        values.extend([f32::EPSILON, 0.499_999_97, 0.5, 1.5, 2.5, 3.5, 8_388_607.0, 8_388_607.5]);
-        values.extend((1..=1000).map(|i| 8_388_608.0 * i as f32 / 1001.0));
-        for v in values {
-            let (i, f) = floor_small(v);
-            assert_eq!((i, f), (v as u32, v.floor()), "⌊{v}⌋");
-        }
+    fn the_computed_corner_is_the_casts() {
+        // (The floor it uses is checked against the cast in `floor`.)
         let cells = [[1.0, 2.0, 3.0, 0.0]; 12];
         let g = Ground {
             cols: 4,

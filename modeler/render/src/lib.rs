@@ -29,6 +29,7 @@ pub mod atmosphere;
 pub mod binned;
 pub mod camera;
 pub mod clip;
+mod floor;
 pub mod forest;
 pub mod frame;
 pub mod impostor;
