@@ -174,12 +174,6 @@ impl Atmosphere {
         self.table_y
     }
 
-    /// The step of [`Atmosphere::ray`] per pixel along a row.
-    #[inline]
-    pub fn step(&self) -> [f32; 3] {
-        self.b
-    }
-
     /// The ground position `(x, z)` of the point of depth `w` along `ray`, and its distance from
     /// the eye along the view's axis (the haze's distance: within the 45° of a view it is at most
     /// 8 % short of the distance along the ray, and it costs no square root per pixel).

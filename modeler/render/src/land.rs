@@ -480,15 +480,7 @@ impl Ground<'_> {
     pub(crate) fn corner(&self, x: f32, z: f32) -> Corner {
         let (u, v) = self.place(x, z, 0.5);
         // `u` and `v` are in `[0, last]` (a NaN became 0).
-        let ((c, cf), (r, rf)) = (floor_small(u), floor_small(v));
-        Corner {
-            index: r.wrapping_mul(self.cols as u32).wrapping_add(c),
-            fu: u - cf,
-            fv: v - rf,
-            // The next column and row, or these on the last.
-            dc: u32::from(u < self.last[0]),
-            dr: if v < self.last[1] { self.cols as u32 } else { 0 },
-        }
+        self.corner_at(u, v, floor_small(u), floor_small(v))
     }
 
     /// [`Ground::corner`] by casts, for any grid.
@@ -496,10 +488,19 @@ impl Ground<'_> {
     pub(crate) fn corner_cast(&self, x: f32, z: f32) -> Corner {
         let (u, v) = self.place(x, z, 0.5);
         let (c, r) = (u as u32, v as u32);
+        self.corner_at(u, v, (c, c as f32), (r, r as f32))
+    }
+
+    /// The [`Corner`] of the cell position `(u, v)` whose floors are `(c, cf)` and `(r, rf)`
+    /// (as an integer and as a float), however [`Ground::corner`] or [`Ground::corner_cast`]
+    /// found them.
+    #[inline(always)]
+    fn corner_at(&self, u: f32, v: f32, (c, cf): (u32, f32), (r, rf): (u32, f32)) -> Corner {
         Corner {
             index: r.wrapping_mul(self.cols as u32).wrapping_add(c),
-            fu: u - c as f32,
-            fv: v - r as f32,
+            fu: u - cf,
+            fv: v - rf,
+            // The next column and row, or these on the last.
             dc: u32::from(u < self.last[0]),
             dr: if v < self.last[1] { self.cols as u32 } else { 0 },
         }
