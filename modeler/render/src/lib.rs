@@ -62,7 +62,7 @@ pub use frame::{Frame, RenderError, Rgba};
 pub use scene::{Look, Overlay, Scene, SlopeBar, Stereo, Style};
 
 use meshes::Paint;
-use rasterise::{Bounds, Capsule, Sample, Surface};
+use rasterise::{Bounds, Capsule, Surface};
 use transform::{Affine, Projected};
 
 /// What a render found in its input.
@@ -169,8 +169,9 @@ struct EyeBuffers {
     nodes: nodes::Projected,
     /// Whether the last projection drew the nodes rather than the full grid.
     lod: bool,
-    /// The depth buffer.
-    samples: Vec<Sample>,
+    /// Each pixel's `1/w` (0: no surface), kept while [`Renderer::render_held`] draws: the
+    /// tiles' samples are their threads' ([`tiles::render`]).
+    depths: Vec<f32>,
 }
 
 /// What the eyes of a frame share: the terrain's light and level-of-detail pyramid, the land
@@ -181,6 +182,8 @@ struct Shared<'a> {
     land: &'a land::Land,
     trees: &'a forest::Trees,
     tile_rows: usize,
+    /// Whether the eyes keep their depths ([`Renderer::render_held`]).
+    hold: bool,
 }
 
 /// Renders scenes into frames, keeping its buffers from one frame to the next.
@@ -617,7 +620,6 @@ impl EyeBuffers {
     ) -> (Projection, reproject::Background) {
         let (width, height) = (frame.width(), frame.height());
         let (affine, near, projection) = self.project(shared, scene, eye, viewport, width, height);
-        self.samples.resize(width as usize * height as usize, Sample::default());
         let ramp = ramp::Ramp::new(&scene.style);
         let air = (scene.style.look == scene::Look::Land)
             .then(|| atmosphere::Atmosphere::new(&projection, scene.terrain, scene.vertical_scale, &scene.style));
@@ -639,6 +641,10 @@ impl EyeBuffers {
             viewport,
         };
         let textures = all_textures(scene, shared.trees);
+        let depths = shared.hold.then(|| {
+            self.depths.resize(width as usize * height as usize, 0.0);
+            &mut self.depths[..]
+        });
         tiles::render(
             &pass,
             &self.meshes,
@@ -647,7 +653,7 @@ impl EyeBuffers {
             &shading,
             &scene.style,
             frame.pixels_mut(),
-            &mut self.samples,
+            depths,
             width as usize,
             shared.tile_rows,
         );
@@ -673,6 +679,7 @@ impl Renderer {
             land: &self.land,
             trees: &self.trees,
             tile_rows: self.tile_rows,
+            hold: self.hold,
         };
         (shared, &mut self.eyes, &mut self.backdrops)
     }
@@ -725,7 +732,7 @@ impl Renderer {
         held.pixels.extend_from_slice(frame.pixels());
         let bufs = &self.eyes[k];
         let width = frame.width() as usize;
-        let depths = bufs.samples.iter().map(|s| s.invw);
+        let depths = bufs.depths.iter().copied();
         reproject::depths(depths, &projection, background, width, &mut held.invw);
         held.width = width;
         held.bounds = viewport;
