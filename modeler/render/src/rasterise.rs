@@ -31,7 +31,11 @@
 //!   tenths empty.
 //! - A pixel's attributes come from its row's start on the planes plus its offset times the
 //!   step, so a run can start anywhere; stepped one addition at a time from the tile's first
-//!   row before, they differ in the last bits only.
+//!   row before, they differ in the last bits only. (Within a wide run the sink steps them one
+//!   addition at a time from its first pixel, unless it takes the run several pixels at once:
+//!   [`Sink::run`], [`Sink::masked`].)
+
+use std::ops::Range;
 
 use super::frame::Rgba;
 
@@ -109,9 +113,69 @@ pub enum Surface {
 }
 
 /// Where covered pixels go.
+///
+/// A row's pixels come with its start on the attribute planes (`row`: `1/w`, `h/w`, `l/w` at
+/// the box's first column `px0`) and the step along the row (`step`), so that a sink may take
+/// them several at once ([`Sink::run`], [`Sink::masked`]).
 pub trait Sink {
     /// Pixel `(x, y)` is covered with these interpolated values.
     fn pixel(&mut self, x: i32, y: i32, invw: f32, hw: f32, lw: f32);
+
+    /// Pixels `px0 + k` of row `y` for `k` in `ks` are covered: a wide triangle's run. By
+    /// default its first pixel's values are the row's start plus its offset times the step,
+    /// and the next pixels' are stepped one addition at a time from it (the same values to the
+    /// last bits, and cheaper than a product per pixel); a sink that takes pixels several at
+    /// once gives each the product ([`each_in_run`]).
+    #[inline(always)]
+    fn run(&mut self, y: i32, px0: i32, ks: Range<i32>, row: [f32; 3], step: [f32; 3]) {
+        let f = ks.start as f32;
+        let (mut iw, mut h, mut l) = (row[0] + f * step[0], row[1] + f * step[1], row[2] + f * step[2]);
+        for k in ks {
+            self.pixel(px0 + k, y, iw, h, l);
+            iw += step[0];
+            h += step[1];
+            l += step[2];
+        }
+    }
+
+    /// Pixels `px0 + k` of row `y` for the set bits `k` of `mask` are covered: a narrow box's
+    /// row ([`rows_by_mask`]).
+    #[inline(always)]
+    fn masked(&mut self, y: i32, px0: i32, mask: u32, row: [f32; 3], step: [f32; 3]) {
+        each_in_mask(self, y, px0, mask, row, step);
+    }
+}
+
+/// [`Sink::run`] one pixel at a time.
+#[inline(always)]
+pub fn each_in_run<S: Sink + ?Sized>(sink: &mut S, y: i32, px0: i32, ks: Range<i32>, row: [f32; 3], step: [f32; 3]) {
+    for k in ks {
+        let f = k as f32;
+        sink.pixel(
+            px0 + k,
+            y,
+            row[0] + f * step[0],
+            row[1] + f * step[1],
+            row[2] + f * step[2],
+        );
+    }
+}
+
+/// [`Sink::masked`] one pixel at a time.
+#[inline(always)]
+pub fn each_in_mask<S: Sink + ?Sized>(sink: &mut S, y: i32, px0: i32, mut mask: u32, row: [f32; 3], step: [f32; 3]) {
+    while mask != 0 {
+        let k = mask.trailing_zeros() as i32;
+        mask &= mask - 1;
+        let f = k as f32;
+        sink.pixel(
+            px0 + k,
+            y,
+            row[0] + f * step[0],
+            row[1] + f * step[1],
+            row[2] + f * step[2],
+        );
+    }
 }
 
 /// The depth test into a tile of samples whose first row is `y0`; a winning pixel is marked as
@@ -404,14 +468,8 @@ fn fill<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, (px0, px1, py0, py1): (i32, i32, i32
             ]
             .into_iter()
             .fold((0, last), |(lo, hi), (w, step, inv)| run(w, step, inv, lo, hi));
-            let fx = first as f32;
-            let (mut iw, mut h, mut l) = (riw + fx * iwx, rh + fx * hx, rl + fx * lx);
-            for x in first..end + 1 {
-                sink.pixel(px0 + x as i32, y, iw, h, l);
-                iw += iwx;
-                h += hx;
-                l += lx;
-            }
+            // Offsets within the box's width, an `i32` (the box is clipped to the tile).
+            sink.run(y, px0, first as i32..end as i32 + 1, [riw, rh, rl], [iwx, hx, lx]);
         } else {
             let (mut w0, mut w1, mut w2) = (r0, r1, r2);
             let (mut iw, mut h, mut l) = (riw, rh, rl);
@@ -474,13 +532,13 @@ fn rows_by_mask<S: Sink>(
         mask &= in_box;
         if mask != 0 {
             let fy = row as f32;
-            let (riw, rh, rl) = (iw0 + fy * iwy, h0 + fy * hy, l0 + fy * ly);
-            while mask != 0 {
-                let k = mask.trailing_zeros();
-                mask &= mask - 1;
-                let fx = k as f32;
-                sink.pixel(px0 + k as i32, y, riw + fx * iwx, rh + fx * hx, rl + fx * lx);
-            }
+            sink.masked(
+                y,
+                px0,
+                mask,
+                [iw0 + fy * iwy, h0 + fy * hy, l0 + fy * ly],
+                [iwx, hx, lx],
+            );
         }
         for (r, d) in rows.iter_mut().zip(down) {
             *r += d;

@@ -9,7 +9,8 @@
 //! run time, from the terrain engine's choice of copy (`penmodel_terrain::simd`: one detection of
 //! the CPU and one test switch for both crates). (The triangles' pixel loops step their
 //! attributes one addition after another, which no vector width changes, so they are compiled
-//! once.)
+//! once; the textured triangles' pixels have an AVX2 path of their own, eight pixels to a group
+//! in intrinsics, `textured/lanes.rs`, chosen by the same [`avx2`].)
 //!
 //! The two copies give the same bytes: AVX2 adds no operation the baseline copy lacks, and an
 //! IEEE addition, multiplication, division, square root or conversion gives the same result in
