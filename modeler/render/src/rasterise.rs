@@ -146,18 +146,13 @@ pub trait Sink {
     }
 }
 
-/// [`Sink::run`] one pixel at a time.
+/// A run's pixels one at a time, each pixel's values its row's start plus its offset times the
+/// step (as a sink that takes pixels several at once gives them; [`Sink::run`]'s default steps
+/// them one addition at a time instead).
 #[inline(always)]
 pub fn each_in_run<S: Sink + ?Sized>(sink: &mut S, y: i32, px0: i32, ks: Range<i32>, row: [f32; 3], step: [f32; 3]) {
     for k in ks {
-        let f = k as f32;
-        sink.pixel(
-            px0 + k,
-            y,
-            row[0] + f * step[0],
-            row[1] + f * step[1],
-            row[2] + f * step[2],
-        );
+        at_offset(sink, y, px0, k, row, step);
     }
 }
 
@@ -167,15 +162,21 @@ pub fn each_in_mask<S: Sink + ?Sized>(sink: &mut S, y: i32, px0: i32, mut mask: 
     while mask != 0 {
         let k = mask.trailing_zeros() as i32;
         mask &= mask - 1;
-        let f = k as f32;
-        sink.pixel(
-            px0 + k,
-            y,
-            row[0] + f * step[0],
-            row[1] + f * step[1],
-            row[2] + f * step[2],
-        );
+        at_offset(sink, y, px0, k, row, step);
     }
+}
+
+/// Pixel `px0 + k` of row `y`, its values the row's start plus `k` times the step.
+#[inline(always)]
+fn at_offset<S: Sink + ?Sized>(sink: &mut S, y: i32, px0: i32, k: i32, row: [f32; 3], step: [f32; 3]) {
+    let f = k as f32;
+    sink.pixel(
+        px0 + k,
+        y,
+        row[0] + f * step[0],
+        row[1] + f * step[1],
+        row[2] + f * step[2],
+    );
 }
 
 /// The depth test into a tile of samples whose first row is `y0`; a winning pixel is marked as

@@ -323,6 +323,7 @@ struct TexelSink<'a> {
     y0: i32,
     level: Level<'a>,
     /// Whether rows go to the AVX2 lanes ([`lanes`]): the CPU has AVX2 ([`crate::simd::avx2`]).
+    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
     lanes: bool,
 }
 
@@ -385,7 +386,7 @@ mod tests {
 
     /// The AVX2 lanes ([`lanes`]) draw the same samples, bit for bit, as one pixel at a time:
     /// triangles narrow (row masks) and wide (runs), in front of and behind what the buffer
-    /// holds, over clear and opaque texels, reaching past the tile's edges, at two levels.
+    /// holds, over clear and opaque texels, reaching past the tile's edges, at three levels.
     #[test]
     fn the_lanes_draw_what_one_pixel_at_a_time_draws() {
         if !crate::simd::has_avx2() {
