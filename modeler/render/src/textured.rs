@@ -315,6 +315,19 @@ fn texels_per_pixel(corners: &[ClipVertex; 4], texture: &Texture, near: f32) -> 
     most
 }
 
+/// The sample a drawn texel of colour `rgb` at depth `invw` leaves: its colour at full light —
+/// twice it, so that rounding in `lw / invw` cannot dim it (the resolve clamps the light to 1).
+/// One pixel at a time and the lanes ([`lanes`]) both write it.
+#[inline(always)]
+fn texel_sample(invw: f32, rgb: [u8; 3]) -> Sample {
+    Sample {
+        invw,
+        hw: 0.0,
+        lw: 2.0 * invw,
+        surface: Surface::Colour(rgb),
+    }
+}
+
 /// The depth test for textured triangles: the interpolated "height" and "light" are `u/w` and
 /// `v/w`; a texel of alpha under one half is discarded.
 struct TexelSink<'a> {
@@ -340,14 +353,7 @@ impl Sink for TexelSink<'_> {
         if a < 128 {
             return;
         }
-        *s = Sample {
-            invw,
-            hw: 0.0,
-            // Full light: twice it, so that rounding in `lw / invw` cannot dim it (the resolve
-            // clamps the light to 1).
-            lw: 2.0 * invw,
-            surface: Surface::Colour([r, g, b]),
-        };
+        *s = texel_sample(invw, [r, g, b]);
     }
 
     #[inline(always)]
