@@ -144,6 +144,10 @@ pub fn run(args: &SceneArgs) -> Result<()> {
     let aspect = f64::from(args.width) / f64::from(args.height);
     let trees = layout(args.trees, map, [2.0 * centre[0], 2.0 * centre[1]], &camera, aspect);
     let mut scene = Scene::new(map, camera);
+    // As the live loop: the renderer learns from the editor what changed since its last frame
+    // (nothing, in this still scene), where without it every frame rebuilt the terrain's
+    // level-of-detail pyramid and compared the heights with a copy.
+    scene.revisions = Some(editor.revisions());
     scene.trees = &trees;
     match args.look {
         crate::render::LookArg::Land => {
