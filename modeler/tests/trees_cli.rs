@@ -291,3 +291,42 @@ fn scene_bench_reports_both_levels_of_detail() {
     assert_eq!(out.status.code(), Some(2), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(String::from_utf8_lossy(&out.stderr).contains("--trees"));
 }
+
+#[test]
+fn scene_bench_turning_times_a_moving_view_and_keeps_the_still_pictures() {
+    let dir = tempfile::tempdir().expect("dir");
+    let run = |turn: &str, png: &str| {
+        let out = penmodel(
+            dir.path(),
+            &[
+                "trees", "scene", "--trees", "4", "--bench", "--frames", "2", "--width", "160", "--height", "90",
+                "--turn", turn, "--png", png, "--json",
+            ],
+        );
+        ok(&out);
+        serde_json::from_slice::<Value>(&out.stdout).expect("one JSON document on stdout")
+    };
+    let still = run("0", "still");
+    let turning = run("-2.5", "turning");
+    assert_eq!(still["turn_deg_per_frame"].as_f64(), Some(0.0), "{still}");
+    assert_eq!(turning["turn_deg_per_frame"].as_f64(), Some(-2.5), "{turning}");
+    assert!(turning["frame_ms_lod"].as_f64().expect("frame_ms_lod") > 0.0);
+    // The timed frames turn, but the pictures and their difference are the still view's.
+    assert_eq!(still["image_difference"], turning["image_difference"]);
+    for name in ["full.png", "lod.png", "stereo.png"] {
+        let a = std::fs::read(dir.path().join("still").join(name)).expect("still picture");
+        let b = std::fs::read(dir.path().join("turning").join(name)).expect("turning picture");
+        assert!(a == b, "{name} differs after turning");
+    }
+    // A turn that is not a number of degrees from -10 to 10 is refused, naming the flag.
+    for bad in ["11", "nan", "inf", "x"] {
+        let out = penmodel(dir.path(), &["trees", "scene", "--bench", "--turn", bad]);
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{bad}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        assert!(String::from_utf8_lossy(&out.stderr).contains("--turn"), "{bad}");
+    }
+}

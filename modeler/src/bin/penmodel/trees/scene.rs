@@ -48,6 +48,11 @@ pub struct SceneArgs {
     /// Timed frames per case with --bench (the median is reported).
     #[arg(long, default_value_t = 5, value_parser = clap::value_parser!(u32).range(1..=1000))]
     frames: u32,
+    /// With --bench, turn the view by this many degrees about its target from one timed frame
+    /// to the next (0: a still view). A moving view redraws what a still one keeps: the
+    /// background behind the surfaces, and the trees' levels of detail change.
+    #[arg(long, value_name = "DEG", default_value_t = 0.0, allow_hyphen_values = true, value_parser = turn_degrees)]
+    turn: f64,
     /// Frame width, pixels.
     #[arg(long, default_value_t = 1280, value_parser = clap::value_parser!(u32).range(16..=8192))]
     width: u32,
@@ -105,15 +110,43 @@ fn median(mut v: Vec<f64>) -> f64 {
     }
 }
 
-/// Renders `scene` once untimed, then `frames` times; the median in ms (`None` when untimed).
-fn time(renderer: &mut Renderer, scene: &Scene, frame: &mut Frame, frames: Option<u32>) -> Result<Option<f64>> {
+/// `--turn`'s degrees: finite, at most 10 a frame.
+fn turn_degrees(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|e| format!("{e}"))?;
+    if v.is_finite() && v.abs() <= 10.0 {
+        Ok(v)
+    } else {
+        Err(format!("{v} is not a turn from -10 to 10 degrees a frame"))
+    }
+}
+
+/// Renders `scene` once untimed, then `frames` times, the view turned by `turn` degrees about
+/// its orbit's target each timed frame; the median in ms (`None` when untimed). `frame` ends
+/// with the still view (drawn once more, untimed, after turning), so that the pictures and the
+/// image difference are the same whatever the turn.
+fn time(
+    renderer: &mut Renderer,
+    scene: &Scene,
+    frame: &mut Frame,
+    frames: Option<u32>,
+    turn: f64,
+) -> Result<Option<f64>> {
     renderer.render(scene, frame)?;
     let Some(n) = frames else { return Ok(None) };
     let mut ms = Vec::with_capacity(n as usize);
-    for _ in 0..n {
+    let mut turned = scene.clone();
+    for i in 1..=n {
+        if let View::Orbit(o) = &mut turned.camera.view
+            && let View::Orbit(start) = &scene.camera.view
+        {
+            o.azimuth = start.azimuth + (f64::from(i) * turn).to_radians();
+        }
         let t = Instant::now();
-        renderer.render(scene, frame)?;
+        renderer.render(&turned, frame)?;
         ms.push(t.elapsed().as_secs_f64() * 1e3);
+    }
+    if turn != 0.0 {
+        renderer.render(scene, frame)?;
     }
     Ok(Some(median(ms)))
 }
@@ -169,15 +202,21 @@ pub fn run(args: &SceneArgs) -> Result<()> {
     let mut on = Frame::new(args.width, args.height)?;
 
     scene.tree_lod = None;
-    let ms_full = time(&mut renderer, &scene, &mut full, frames.filter(|_| !args.lod_only))?;
+    let ms_full = time(
+        &mut renderer,
+        &scene,
+        &mut full,
+        frames.filter(|_| !args.lod_only),
+        args.turn,
+    )?;
     let stats_full = renderer.tree_stats();
     scene.tree_lod = lod;
-    let ms_lod = time(&mut renderer, &scene, &mut on, frames)?;
+    let ms_lod = time(&mut renderer, &scene, &mut on, frames, args.turn)?;
     let stats_lod = renderer.tree_stats();
     let (ms_stereo, pair) = if args.bench {
         scene.stereo = Stereo::Anaglyph;
         let mut pair = Frame::new(args.width, args.height)?;
-        let ms = time(&mut renderer, &scene, &mut pair, frames)?;
+        let ms = time(&mut renderer, &scene, &mut pair, frames, args.turn)?;
         scene.stereo = Stereo::None;
         (ms, Some(pair))
     } else {
@@ -203,7 +242,7 @@ pub fn run(args: &SceneArgs) -> Result<()> {
     if let Some(path) = &args.json {
         let v = json!({
             "trees": stats_full.trees, "width": args.width, "height": args.height,
-            "frames": frames, "stereo": "anaglyph", "look": look,
+            "frames": frames, "stereo": "anaglyph", "look": look, "turn_deg_per_frame": args.turn,
             "frame_ms_full": ms_full.map(round3), "frame_ms_lod": ms_lod.map(round3),
             "frame_ms_lod_stereo": ms_stereo.map(round3),
             "polygons_full": stats_full.total_polygons(), "polygons_lod": stats_lod.total_polygons(),
@@ -241,8 +280,13 @@ pub fn run(args: &SceneArgs) -> Result<()> {
         super::say(
             json,
             &format!(
-                "medians of {} frames; targets with LOD: ≤ 16.7 ms mono, ≤ 33 ms stereo",
-                args.frames
+                "medians of {} frames{}; targets with LOD: ≤ 16.7 ms mono, ≤ 33 ms stereo",
+                args.frames,
+                if args.turn == 0.0 {
+                    " of a still view".to_owned()
+                } else {
+                    format!(" of a view turning {}° a frame", args.turn)
+                }
             ),
         )?;
     }
