@@ -84,7 +84,12 @@ pub struct Bounds {
 }
 
 /// A depth-buffer entry: `1/w` (0 = empty) and the perspective-divided attributes.
+///
+/// Laid out as written (`repr(C)`, 16 bytes: `invw`, `hw`, `lw`, then the surface's 4 bytes), so
+/// that the textured polygons' AVX2 lanes write eight samples with four masked vector stores
+/// (`textured/lanes.rs`).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[repr(C)]
 pub struct Sample {
     /// `1/w` of the nearest surface, 0 if none.
     pub invw: f32,
@@ -98,18 +103,28 @@ pub struct Sample {
 }
 
 /// What a sample shows, which decides its colour.
+///
+/// Four bytes with a fixed layout (`repr(u8)`: the tag, then a colour's bytes): the AVX2 lanes
+/// of the textured polygons build `Colour([r, g, b])` as the word
+/// `COLOUR_TAG | r << 8 | g << 16 | b << 24` ([`Surface::COLOUR_TAG`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+#[repr(u8)]
 pub enum Surface {
     /// The terrain: the height ramp.
     #[default]
-    Terrain,
+    Terrain = 0,
     /// A rock: [`crate::Style::rock_colour`].
-    Rock,
+    Rock = 1,
     /// River or lake water: [`crate::Style::water_colour`].
-    Water,
+    Water = 2,
     /// A colour of its own, sRGB, before light: a tree's bark or leaf, a texel of a simplified
     /// shape ([`crate::meshes`], [`crate::textured`]).
-    Colour([u8; 3]),
+    Colour([u8; 3]) = 3,
+}
+
+impl Surface {
+    /// The tag byte of [`Surface::Colour`].
+    pub const COLOUR_TAG: u8 = 3;
 }
 
 /// Where covered pixels go.
