@@ -1,10 +1,11 @@
-//! Projected triangles binned by bands of rows, shared by the meshes ([`crate::meshes`]) and the
-//! textured quads ([`crate::textured`]): vertices projected once per eye, each triangle listed
-//! in the bands of rows its screen extent reaches (every band when it crosses the near plane),
-//! and drawn per tile — straight when it lies wholly in front of the near plane, clipped
-//! otherwise — from both windings (the rasteriser fills one; rocks are open underneath and
-//! leaves and quads are single-sided surfaces), or from the front only for the sides of closed
-//! shapes ([`Faces::Front`]).
+//! Projected triangles (or quads) binned by bands of rows, shared by the meshes
+//! ([`crate::meshes`]: triangles) and the textured quads ([`crate::textured`]: quads): vertices
+//! projected once per eye, each polygon listed in the bands of rows its screen extent reaches
+//! (every band when it crosses the near plane), and drawn per tile — straight when it lies
+//! wholly in front of the near plane (a quad in one pass, [`rasterise::quad_two_sided`]),
+//! clipped otherwise (a quad as its two triangles) — from both windings (the rasteriser fills
+//! one; rocks are open underneath and leaves and quads are single-sided surfaces), or from the
+//! front only for the sides of closed shapes ([`Faces::Front`]).
 
 use super::clip::{self, ClipVertex};
 use super::rasterise::{self, Bounds, Sink, Vtx};
@@ -27,22 +28,23 @@ pub enum Faces {
     Front,
 }
 
-/// One eye's projected triangles, each tagged with a `T` (what it shows).
+/// One eye's projected polygons of `N` corners (3: triangles; 4: quads, corners in order round
+/// them), each tagged with a `T` (what it shows).
 #[derive(Debug)]
-pub struct Binned<T> {
+pub struct Binned<T, const N: usize = 3> {
     clip: Vec<ClipVertex>,
     screen: Vec<Vtx>,
     /// Whether each vertex is in front of the near plane.
     direct: Vec<bool>,
-    /// Triangles (indices into `clip`) and their tags.
-    triangles: Vec<([u32; 3], T)>,
-    /// Triangle indices per band of `band_rows` rows.
+    /// Polygons (indices into `clip`) and their tags.
+    triangles: Vec<([u32; N], T)>,
+    /// Polygon indices per band of `band_rows` rows.
     bins: Vec<Vec<u32>>,
     band_rows: usize,
     frame_height: usize,
 }
 
-impl<T> Default for Binned<T> {
+impl<T, const N: usize> Default for Binned<T, N> {
     fn default() -> Self {
         Binned {
             clip: Vec::new(),
@@ -56,7 +58,7 @@ impl<T> Default for Binned<T> {
     }
 }
 
-impl<T: Copy> Binned<T> {
+impl<T: Copy, const N: usize> Binned<T, N> {
     /// Forgets the last frame's triangles, for a frame `frame_height` rows tall drawn in bands
     /// of `band_rows` rows.
     pub fn clear(&mut self, (frame_height, band_rows): (usize, usize)) {
@@ -132,7 +134,7 @@ impl<T: Copy> Binned<T> {
 
     /// Adds triangles (indices of added vertices) with their tags; bin them with
     /// [`Binned::bin`].
-    pub fn extend(&mut self, triangles: impl IntoIterator<Item = ([u32; 3], T)>) {
+    pub fn extend(&mut self, triangles: impl IntoIterator<Item = ([u32; N], T)>) {
         self.triangles.extend(triangles);
     }
 
@@ -148,7 +150,9 @@ impl<T: Copy> Binned<T> {
         for (i, (t, _)) in self.triangles.iter().enumerate().skip(first) {
             let (lo, hi) = if t.iter().all(|&k| self.direct[k as usize]) {
                 let ys = t.map(|k| self.screen[k as usize].y as f32 / one);
-                (ys[0].min(ys[1]).min(ys[2]), ys[0].max(ys[1]).max(ys[2]))
+                ys[1..]
+                    .iter()
+                    .fold((ys[0], ys[0]), |(lo, hi), &y| (lo.min(y), hi.max(y)))
             } else if t.iter().any(|&k| self.direct[k as usize]) {
                 // Crosses the near plane: every band may see it.
                 (0.0, self.frame_height as f32)
@@ -186,11 +190,21 @@ impl<T: Copy> Binned<T> {
                 Faces::Front => rasterise::triangle(a, c, b, bounds, sink),
             };
             if t.iter().all(|&k| self.direct[k as usize]) {
-                let [a, b, c] = t.map(|k| &self.screen[k as usize]);
-                draw(a, b, c, sink);
-            } else {
+                let v = t.map(|k| &self.screen[k as usize]);
+                if N == 4 && faces == Faces::Both {
+                    rasterise::quad_two_sided([v[0], v[1], v[2], v[3]], bounds, sink);
+                } else {
+                    // A polygon's fan: a triangle is its one triangle.
+                    for k in 1..N - 1 {
+                        draw(v[0], v[k], v[k + 1], sink);
+                    }
+                }
+                continue;
+            }
+            // A polygon's fan, each triangle clipped.
+            for k in 1..N - 1 {
                 // Clipping keeps the winding: the fan's triangles turn as the triangle did.
-                let poly = clip::triangle(t.map(|k| self.clip[k as usize]), near);
+                let poly = clip::triangle([t[0], t[k], t[k + 1]].map(|i| self.clip[i as usize]), near);
                 if poly.len < 3 {
                     continue;
                 }

@@ -203,9 +203,9 @@ pub struct Quad {
     pub texture: u32,
 }
 
-/// One eye's projected quads: two triangles each, tagged with their texture's index and level.
+/// One eye's projected quads, each tagged with its texture's index and level.
 #[derive(Debug, Default)]
-pub struct Projected(Binned<(u32, u8)>);
+pub struct Projected(Binned<(u32, u8), 4>);
 
 impl Projected {
     /// Forgets the last frame's quads, for a frame `frame_height` rows tall drawn in bands of
@@ -253,17 +253,15 @@ impl Projected {
             let level = textures
                 .get(texture as usize)
                 .map_or(0, |t| t.level_for(texels_per_pixel(&corners, t, near)));
-            self.0.extend([
-                ([base, base + 1, base + 2], (texture, level)),
-                ([base, base + 2, base + 3], (texture, level)),
-            ]);
+            self.0
+                .extend([([base, base + 1, base + 2, base + 3], (texture, level))]);
         }
         self.0.bin(first);
     }
 
     /// How many quads were projected.
     pub fn quads(&self) -> usize {
-        self.0.triangles() / 2
+        self.0.triangles()
     }
 
     /// Draws the triangles that reach the tile `bounds` (its first row starts a band) into its
