@@ -106,9 +106,11 @@ const LANE: [f32; LANES] = {
 /// run over all [`LANES`] entries (a fixed count, no bounds checks), a short stretch's tail set
 /// empty.
 struct Stretch {
-    /// The samples' `1/w` (0: empty) and `l/w`.
+    /// The samples' `1/w` (0: empty) and `l/w`, and whether each shows another surface than the
+    /// ground (1) or the ground (0).
     invw: [f32; LANES],
     lw: [f32; LANES],
+    other: [u8; LANES],
     /// The sine of the view ray's elevation, the sample's ground position, the fine noise's
     /// fade, the light and the haze by the distance.
     sin: [f32; LANES],
@@ -186,6 +188,7 @@ fn resolve_land_body(
     let mut st = Stretch {
         invw: zero,
         lw: zero,
+        other: [0; LANES],
         sin: zero,
         at: [zero; 2],
         fade: zero,
@@ -223,6 +226,7 @@ fn resolve_land_body(
             for k in 0..n {
                 st.invw[k] = ss[k].invw;
                 st.lw[k] = ss[k].lw;
+                st.other[k] = u8::from(ss[k].surface != Surface::Terrain);
             }
             st.invw[n..].fill(0.0);
             // The background where it is kept (the others computed per pixel below).
@@ -270,39 +274,51 @@ fn resolve_land_body(
                     st.dr[k] = c.dr;
                 }
             }
-            // The colours, per pixel: by surface, and for the ground by level.
-            for k in 0..n {
-                let invw = st.invw[k];
-                if invw > 0.0 {
-                    let surface = ss[k].surface;
-                    // The terrain tested first, by itself: most covered samples are ground, and
-                    // the match in `surface_colour` was a jump through a table for every one.
-                    let c = if surface != Surface::Terrain {
-                        let [r, g, b] = surface_colour(surface, style).unwrap_or_default();
-                        [r, g, b, 0.0]
-                    } else if invw < fine {
-                        // The level whose cells are about the pixel's length: `fine / invw`
-                        // cells span a pixel across the view, that over `sin` along the ray
-                        // (the longer side, as a GPU's mipmaps choose without anisotropic
-                        // filtering: sharper would alias, and read far more cells).
-                        let cells = fine / (invw * st.sin[k].max(1e-3));
-                        let level = mips::level_for(cells, levels);
-                        ground.nearest_parts(level, st.at[0][k], st.at[1][k])
-                    } else if computed {
-                        ground.bilinear(Corner {
-                            index: st.index[k],
-                            fu: st.fu[k],
-                            fv: st.fv[k],
-                            dc: st.dc[k],
-                            dr: st.dr[k],
-                        })
-                    } else {
-                        ground.bilinear(ground.corner_cast(st.at[0][k], st.at[1][k]))
-                    };
-                    for (channel, v) in st.colour.iter_mut().zip(c) {
-                        channel[k] = v;
-                    }
-                } else if brow.is_none() {
+            // The colours, per pixel: by surface, and for the ground by level. Each kind of
+            // pixel in a loop of its own over its lanes' bits: tested pixel by pixel, the
+            // surface and the level were branches on data that a crown's leaves against the
+            // ground mispredicted, most of this loop's time.
+            let covered = lanes_where::<true>(&st.invw, 0.0);
+            let far = lanes_where::<false>(&st.invw, fine);
+            let other = lanes_set(&st.other);
+            // Other surfaces: their colours.
+            for k in bits(covered & other) {
+                let [r, g, b] = surface_colour(ss[k].surface, style).unwrap_or_default();
+                set_colour(&mut st.colour, k, [r, g, b, 0.0]);
+            }
+            // The ground where its cells are under a pixel: the level whose cells are about
+            // the pixel's length (`fine / invw` cells span a pixel across the view, that over
+            // `sin` along the ray: the longer side, as a GPU's mipmaps choose without
+            // anisotropic filtering: sharper would alias, and read far more cells).
+            for k in bits(covered & !other & far) {
+                let cells = fine / (st.invw[k] * st.sin[k].max(1e-3));
+                let level = mips::level_for(cells, levels);
+                let c = ground.nearest_parts(level, st.at[0][k], st.at[1][k]);
+                set_colour(&mut st.colour, k, c);
+            }
+            // The ground nearer: bilinear between its cells.
+            let near = covered & !other & !far;
+            if computed {
+                for k in bits(near) {
+                    let c = ground.bilinear(Corner {
+                        index: st.index[k],
+                        fu: st.fu[k],
+                        fv: st.fv[k],
+                        dc: st.dc[k],
+                        dr: st.dr[k],
+                    });
+                    set_colour(&mut st.colour, k, c);
+                }
+            } else {
+                for k in bits(near) {
+                    let c = ground.bilinear(ground.corner_cast(st.at[0][k], st.at[1][k]));
+                    set_colour(&mut st.colour, k, c);
+                }
+            }
+            // What the pixels that show no surface see, unless it is kept.
+            if brow.is_none() {
+                let stretch = if n == LANES { u64::MAX } else { (1u64 << n) - 1 };
+                for k in bits(stretch & !covered) {
                     st.background[k] = air.background_pixel(ray_of(k));
                 }
             }
@@ -320,6 +336,84 @@ fn resolve_land_body(
                 *p = c.to_le_bytes();
             }
         }
+    }
+}
+
+/// Lane `k`'s colour and fine-noise factor in the stretch's channels.
+#[inline(always)]
+fn set_colour(channels: &mut [[f32; LANES]; 4], k: usize, c: [f32; 4]) {
+    for (channel, v) in channels.iter_mut().zip(c) {
+        channel[k] = v;
+    }
+}
+
+/// The set bits of `mask`, lowest first.
+#[inline(always)]
+fn bits(mut mask: u64) -> impl Iterator<Item = usize> {
+    std::iter::from_fn(move || {
+        (mask != 0).then(|| {
+            let k = mask.trailing_zeros() as usize;
+            mask &= mask - 1;
+            k
+        })
+    })
+}
+
+/// Bit `k` set where `values[k] > t` (`ABOVE`) or `values[k] < t` (else), IEEE compares (a NaN
+/// fails both): on x86-64 four lanes to a compare and their bits by `movmskps` (SSE2, which every
+/// x86-64 CPU has).
+#[inline(always)]
+fn lanes_where<const ABOVE: bool>(values: &[f32; LANES], t: f32) -> u64 {
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    {
+        use std::arch::x86_64::{_mm_cmpgt_ps, _mm_cmplt_ps, _mm_loadu_ps, _mm_movemask_ps, _mm_set1_ps};
+        let mut mask = 0u64;
+        for (j, four) in values.chunks_exact(4).enumerate() {
+            // SAFETY: SSE2 is part of x86-64; `four` holds four `f32`, all the load reads.
+            let bits = unsafe {
+                let (v, t) = (_mm_loadu_ps(four.as_ptr()), _mm_set1_ps(t));
+                _mm_movemask_ps(if ABOVE { _mm_cmpgt_ps(v, t) } else { _mm_cmplt_ps(v, t) })
+            };
+            mask |= u64::from(bits as u32) << (4 * j);
+        }
+        mask
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        let test = |v: f32| if ABOVE { v > t } else { v < t };
+        values
+            .iter()
+            .enumerate()
+            .fold(0u64, |m, (k, &v)| m | u64::from(test(v)) << k)
+    }
+}
+
+/// Bit `k` set where `flags[k]` is not 0: on x86-64 sixteen bytes to a compare and their bits by
+/// `pmovmskb` (SSE2).
+#[inline(always)]
+fn lanes_set(flags: &[u8; LANES]) -> u64 {
+    #[cfg(target_arch = "x86_64")]
+    #[allow(unsafe_code)]
+    {
+        use std::arch::x86_64::{__m128i, _mm_cmpeq_epi8, _mm_loadu_si128, _mm_movemask_epi8, _mm_setzero_si128};
+        let mut zero = 0u64;
+        for (j, sixteen) in flags.chunks_exact(16).enumerate() {
+            // SAFETY: SSE2 is part of x86-64; `sixteen` holds sixteen bytes, all the load reads.
+            let bits = unsafe {
+                let v = _mm_loadu_si128(sixteen.as_ptr().cast::<__m128i>());
+                _mm_movemask_epi8(_mm_cmpeq_epi8(v, _mm_setzero_si128()))
+            };
+            zero |= u64::from(bits as u32 & 0xffff) << (16 * j);
+        }
+        !zero
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        flags
+            .iter()
+            .enumerate()
+            .fold(0u64, |m, (k, &f)| m | u64::from(f != 0) << k)
     }
 }
 
