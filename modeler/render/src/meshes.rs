@@ -223,6 +223,9 @@ impl Projected {
     }
 }
 
+/// What a triangle shows and which of its faces are drawn.
+type Look = (Surface, Faces);
+
 /// [`Projected::add`] into `binned`.
 fn add<'m>(
     binned: &mut Binned<(Surface, Faces)>,
@@ -242,15 +245,27 @@ fn add<'m>(
         let base = binned.vertices_from(n, near, |i| lit(mesh, i, (light, ambient), affine, s));
         let own = matches!(paint, Paint::Own | Paint::Tree);
         let coloured = own && mesh.colors.len() == mesh.positions.len();
+        // The last triangle's vertex colours and what they made: a tree's triangles come in
+        // long runs of one colour (bark, leaf), and the mean and its sRGB bytes for each were
+        // most of the copied polygons' projection (0.7 of 1.4 ms a frame).
+        let mut last: Option<([[f32; 3]; 3], Look)> = None;
         binned.extend(mesh.indices.chunks_exact(3).map(|t| {
             let (surface, faces) = match paint {
                 Paint::Whole(s) => (s, Faces::Both),
                 _ if coloured => {
-                    let [a, b, c] = [0, 1, 2].map(|k| mesh.colors[t[k] as usize]);
-                    let third = 1.0 / 3.0;
-                    let colour = Surface::Colour(srgb([0, 1, 2].map(|i| (a[i] + b[i] + c[i]) * third)));
-                    let bark = paint == Paint::Tree && [a, b, c].iter().all(|&c| c == BARK);
-                    (colour, if bark { Faces::Front } else { Faces::Both })
+                    let corners = [0, 1, 2].map(|k| mesh.colors[t[k] as usize]);
+                    match last {
+                        Some((seen, look)) if seen == corners => look,
+                        _ => {
+                            let [a, b, c] = corners;
+                            let third = 1.0 / 3.0;
+                            let colour = Surface::Colour(srgb([0, 1, 2].map(|i| (a[i] + b[i] + c[i]) * third)));
+                            let bark = paint == Paint::Tree && corners.iter().all(|&c| c == BARK);
+                            let look = (colour, if bark { Faces::Front } else { Faces::Both });
+                            last = Some((corners, look));
+                            look
+                        }
+                    }
                 }
                 _ => (Surface::Rock, Faces::Both),
             };
