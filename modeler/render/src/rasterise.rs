@@ -762,7 +762,7 @@ impl Capsule {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     /// [`run`] by division, as it was: the reference the estimate must equal.
@@ -802,6 +802,17 @@ mod tests {
         assert_eq!(run(5, 0, 0.0, 0, 9), (0, 9));
     }
 
+    /// A deterministic sequence in `[0, 1]` from `seed` (xorshift), for the tests' cases here and
+    /// in `textured.rs`.
+    pub(crate) fn uniform(mut seed: u32) -> impl FnMut() -> f32 {
+        move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 17;
+            seed ^= seed << 5;
+            seed as f32 / u32::MAX as f32
+        }
+    }
+
     /// The pixels a sink was given, with their values.
     #[derive(Default)]
     struct Record(Vec<(i32, i32, [f32; 3])>);
@@ -837,13 +848,7 @@ mod tests {
     /// values past the 32-bit lanes).
     #[test]
     fn a_quad_in_one_pass_covers_what_its_two_triangles_cover() {
-        let mut seed = 0x9e37_79b9_u32;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 17;
-            seed ^= seed << 5;
-            seed as f32 / u32::MAX as f32
-        };
+        let mut next = uniform(0x9e37_79b9);
         let tile = Bounds {
             x0: 0,
             x1: 200,

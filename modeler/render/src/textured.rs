@@ -410,13 +410,7 @@ mod tests {
             y0: 8,
             y1: 8 + rows as i32,
         };
-        let mut seed = 0x2545_f491_u32;
-        let mut next = move || {
-            seed ^= seed << 13;
-            seed ^= seed >> 17;
-            seed ^= seed << 5;
-            seed as f32 / u32::MAX as f32
-        };
+        let mut next = crate::rasterise::tests::uniform(0x2545_f491);
         let held: Vec<Sample> = (0..width * rows)
             .map(|_| Sample {
                 invw: if next() < 0.3 { 0.0 } else { 0.3 * next() },
