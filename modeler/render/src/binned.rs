@@ -59,7 +59,7 @@ impl<T, const N: usize> Default for Binned<T, N> {
 }
 
 impl<T: Copy, const N: usize> Binned<T, N> {
-    /// Forgets the last frame's triangles, for a frame `frame_height` rows tall drawn in bands
+    /// Forgets the last frame's polygons, for a frame `frame_height` rows tall drawn in bands
     /// of `band_rows` rows.
     pub fn clear(&mut self, (frame_height, band_rows): (usize, usize)) {
         self.clip.clear();
@@ -132,18 +132,18 @@ impl<T: Copy, const N: usize> Binned<T, N> {
         self.clip.len() as u32
     }
 
-    /// Adds triangles (indices of added vertices) with their tags; bin them with
+    /// Adds polygons (indices of added vertices) with their tags; bin them with
     /// [`Binned::bin`].
     pub fn extend(&mut self, triangles: impl IntoIterator<Item = ([u32; N], T)>) {
         self.triangles.extend(triangles);
     }
 
-    /// How many triangles were added this frame.
+    /// How many polygons (triangles, or quads) were added this frame.
     pub fn triangles(&self) -> usize {
         self.triangles.len()
     }
 
-    /// Bins the triangles from index `first` on.
+    /// Bins the polygons from index `first` on.
     pub fn bin(&mut self, first: usize) {
         let bands = self.bins.len();
         let one = (1 << rasterise::SUBPIXEL) as f32;
@@ -167,9 +167,9 @@ impl<T: Copy, const N: usize> Binned<T, N> {
         }
     }
 
-    /// Draws the triangles that reach the tile `bounds` (its first row starts a band) into
+    /// Draws the polygons that reach the tile `bounds` (its first row starts a band) into
     /// `sink`, after `prepare(sink, tag)` set it up for each and said which faces to draw; a
-    /// triangle whose `prepare` returns `None` is skipped.
+    /// polygon whose `prepare` returns `None` is skipped.
     pub fn draw<S: Sink>(
         &self,
         bounds: &Bounds,
