@@ -406,12 +406,16 @@ pub fn quad_two_sided<S: Sink>(v: [&Vtx; 4], bounds: &Bounds, sink: &mut S) {
     let Some(tile) = box_of(&v, bounds) else {
         return;
     };
+    // The turn at each corner is twice the area of the triangle it makes with its neighbours:
+    // the turns at corners 0 and 2 are the areas of the two triangles, `(v0, v1, v2)` and
+    // `(v0, v2, v3)`.
     let turns = [0, 1, 2, 3].map(|i| area(v[i], v[(i + 1) % 4], v[(i + 2) % 4]));
-    let [a, b, c, d] = if turns.iter().all(|&t| t > 0) {
-        v
+    let ([a, b, c, d], (abc, acd)) = if turns.iter().all(|&t| t > 0) {
+        (v, (turns[0], turns[2]))
     } else if turns.iter().all(|&t| t < 0) {
-        // Anticlockwise: the same quad the other way round, as `two_sided` turns each triangle.
-        [v[0], v[3], v[2], v[1]]
+        // Anticlockwise: the same quad the other way round, as `two_sided` turns each triangle;
+        // its triangles `(v0, v3, v2)` and `(v0, v2, v1)` are the two above, turned.
+        ([v[0], v[3], v[2], v[1]], (-turns[2], -turns[0]))
     } else {
         two_sided(v[0], v[1], v[2], bounds, sink);
         two_sided(v[0], v[2], v[3], bounds, sink);
@@ -428,7 +432,7 @@ pub fn quad_two_sided<S: Sink>(v: [&Vtx; 4], bounds: &Bounds, sink: &mut S) {
     if px1 - px0 < SMALL_BOX && py1 - py0 < SMALL_BOX && !covers_a_centre(&es, px1 - px0, py1 - py0) {
         return;
     }
-    let planes = if area(a, b, c) >= area(a, c, d) {
+    let planes = if abc >= acd {
         planes(a, b, c, px0, py0)
     } else {
         planes(a, c, d, px0, py0)
