@@ -125,7 +125,11 @@ fn demo(seed: u64) {
     let view = *session.interaction.view();
     let mut want = expected(&view, &tuning);
     let got = session.editor.document();
-    assert_eq!((stats.ridgelines, stats.grown), (1, 1), "{log:#?}");
+    assert_eq!(
+        (stats.made("ridgelines"), stats.made("valley_rounds")),
+        (1, 1),
+        "{log:#?}"
+    );
     check_ridges(got, &view);
     // The terrain of the document built anew, ridges included, is the one the edits made.
     want.ridges = got.ridges.clone();
@@ -224,7 +228,7 @@ fn demo(seed: u64) {
         "river within {course_mm:.2} mm, {} wet cells, {moved} cells moved in two years",
         wet.len()
     );
-    assert_eq!((stats.trees, stats.groves), (2, 1), "{log:#?}");
+    assert_eq!((stats.made("trees"), stats.made("groves")), (2, 1), "{log:#?}");
     check_trees(&session, &view);
 }
 

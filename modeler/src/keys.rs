@@ -40,18 +40,6 @@ pub const KEYS: &[(&str, &str)] = &[
     ("q Esc", "save and quit"),
 ];
 
-/// The pen's gestures, as the help panel lists them (docs/modeler.md gives them in full).
-pub const GESTURES: &[(&str, &str)] = &[
-    ("SW1 on surface", "draw a figure; SW3 ends it"),
-    ("closed, outside", "a new generation region"),
-    ("SW2 + touch", "grab the highlighted figure"),
-    ("grabbed, lift", "pull it up"),
-    ("grabbed, SW3 sideways", "set its slope"),
-    ("grabbed, slide", "move it (out of its region: delete)"),
-    ("SW3 click", "undo; with SW2 held: redo"),
-    ("SW3 held, move", "pan; up and down zooms"),
-];
-
 /// What key `name` does on a display of `display_mm`; `name` is the window's key text (`"u"`,
 /// `"+"`) or key name (`"ArrowLeft"`, `"F1"`).
 pub fn action(name: &str, display_mm: [f64; 2]) -> Option<KeyAction> {
@@ -79,14 +67,15 @@ pub fn action(name: &str, display_mm: [f64; 2]) -> Option<KeyAction> {
     }
 }
 
-/// The help panel's lines: the keys, then the pen's gestures, in two aligned columns.
-pub fn help_lines() -> Vec<String> {
-    let width = KEYS.iter().chain(GESTURES).map(|(k, _)| k.len()).max().unwrap_or(0);
+/// The help panel's lines: the keys, then the pen's `gestures` (the tool on's and the shared
+/// ones, [`crate::interaction::Interaction::help`]), in two aligned columns.
+pub fn help_lines(gestures: &[(&str, &str)]) -> Vec<String> {
+    let width = KEYS.iter().chain(gestures).map(|(k, _)| k.len()).max().unwrap_or(0);
     let mut lines = vec!["keys".to_string()];
     lines.extend(KEYS.iter().map(|(k, d)| format!("  {k:width$}  {d}")));
     lines.push(String::new());
     lines.push("pen".to_string());
-    lines.extend(GESTURES.iter().map(|(k, d)| format!("  {k:width$}  {d}")));
+    lines.extend(gestures.iter().map(|(k, d)| format!("  {k:width$}  {d}")));
     lines
 }
 
@@ -128,7 +117,9 @@ mod tests {
 
     #[test]
     fn the_help_names_every_key_that_acts() {
-        let help = help_lines().join("\n");
+        let view = View::fit([600.0, 340.0], &blank_document().grid);
+        let gestures = Interaction::new(view, Tuning::default()).help();
+        let help = help_lines(&gestures).join("\n");
         for (keys, _) in KEYS {
             for key in keys.split(' ') {
                 let name = match key {
@@ -144,7 +135,7 @@ mod tests {
             }
             assert!(help.contains(keys));
         }
-        for (gesture, _) in GESTURES {
+        for (gesture, _) in &gestures {
             assert!(help.contains(gesture));
         }
         assert_eq!(action("h", [1.0, 1.0]), Some(KeyAction::Help));

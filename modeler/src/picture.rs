@@ -7,39 +7,18 @@ use penmodel_render::{Camera, Overlay, Rgba, Scene, SlopeBar, Stereo, Style, Tra
 use std::sync::Arc;
 
 use penmodel_terrain::Heightmap;
-use penmodel_terrain::address::{CurvePath, FigurePath};
-use penmodel_terrain::document::{Document, Figure, FigureKind, Point};
+use penmodel_terrain::document::{Document, Point};
 use penmodel_terrain::export::Mesh;
 use penmodel_terrain::trees::Standing;
 
 use crate::feed::Calibrating;
-use crate::interaction::rocks::{self, Tool};
-use crate::interaction::{Interaction, View};
-use crate::interaction::{ridge, river};
+use crate::interaction::{Interaction, Layers, View};
 use crate::session::Session;
 
-/// Colour of a rock field's outline.
-pub const ROCK_FIELD_COLOUR: Rgba = [200, 170, 130, 255];
-/// Colour of a river's control polygon and points.
-pub const RIVER_COLOUR: Rgba = [90, 160, 255, 255];
-/// Colour of the cells the next iteration erodes (the seed's red).
-pub const EROSION_COLOUR: Rgba = [230, 40, 30, 255];
-/// Colour of the cells the next iteration deposits (the seed's light blue).
-pub const DEPOSITION_COLOUR: Rgba = [160, 215, 255, 255];
-/// Colour of ridgelines and ridgeline trees.
-pub const RIDGE_COLOUR: Rgba = [150, 110, 60, 255];
-/// Colour of a grove's outline and a single tree's trunk, with the tree tool.
-pub const GROVE_COLOUR: Rgba = [60, 150, 70, 255];
-/// Colour of the palette button while the rock tool is on.
-pub const PALETTE_ON_COLOUR: Rgba = [255, 200, 90, 255];
-/// Colour of the palette button while figures are drawn.
-pub const PALETTE_OFF_COLOUR: Rgba = [170, 170, 170, 255];
-/// Colour of the figure being drawn.
-pub const DRAWING_COLOUR: Rgba = [64, 224, 255, 255];
-/// Colour of a figure or vertex being moved.
-pub const MOVING_COLOUR: Rgba = [255, 160, 32, 255];
-/// Colour of a figure that would be deleted where it is dropped.
-pub const DELETING_COLOUR: Rgba = [120, 120, 120, 255];
+pub use crate::interaction::figures::{FIGURE_COLOUR, REGION_COLOUR};
+pub use crate::interaction::tool::{
+    DELETING_COLOUR, DRAWING_COLOUR, MOVING_COLOUR, PALETTE_OFF_COLOUR, PALETTE_ON_COLOUR,
+};
 /// Colour of the pen's tip and its foot on the ground.
 pub const PEN_COLOUR: Rgba = [255, 255, 255, 255];
 /// Colour of the calibration target to touch next.
@@ -117,17 +96,6 @@ pub struct Picture {
     /// The pen's tip while it is over the display: its ground point and, in the air, its height
     /// (metres); on the surface, the terrain's. The trees' gaze turns to it (seed 004).
     pen_tip: Option<(Point, Option<f64>)>,
-}
-
-/// A tool button's outline: bright and thick while its tool is on.
-fn button(points: Vec<Point>, on: bool) -> Overlay {
-    Overlay {
-        points,
-        closed: true,
-        colour: if on { PALETTE_ON_COLOUR } else { PALETTE_OFF_COLOUR },
-        width: if on { 5.0 } else { 2.0 },
-        height: None,
-    }
 }
 
 fn dot(at: Point, height: Option<f64>, colour: Rgba, width: f32) -> Overlay {
@@ -273,151 +241,12 @@ impl Picture {
 
     fn from_parts(ui: &Interaction, doc: &Document, mode: String, look: &Look) -> Picture {
         let view = ui.view();
-        let at = document_overlays_at(doc);
-        let highlighted: Option<&CurvePath> = ui.grabbed().or(ui.hover().map(|h| &h.curve));
-        let moving = ui.moving(doc);
-        let mut selection = highlighted.and_then(|c| at.iter().position(|(p, _)| p == c));
-        let mut overlays: Vec<Overlay> = at.into_iter().map(|(_, o)| o).collect();
-        if let Some(m) = moving {
-            // The figure where the pen is taking it, in place of where it was.
-            if let Some(i) = selection.take() {
-                overlays[i].points = m.points;
-                overlays[i].colour = if m.deleting { DELETING_COLOUR } else { MOVING_COLOUR };
-            }
-        }
-        // Rock fields' outlines (the held one where the pen takes it), the palette button.
-        let moving_field = ui.field_moving(doc);
-        for (i, f) in doc.rocks.iter().enumerate() {
-            let (points, colour) = match &moving_field {
-                Some((m, pts)) if *m == i && rocks::outside_every_region(doc, pts) => (pts.clone(), DELETING_COLOUR),
-                Some((m, pts)) if *m == i => (pts.clone(), MOVING_COLOUR),
-                _ => (f.outline_at(), ROCK_FIELD_COLOUR),
-            };
-            if ui.tool() == Tool::Rocks && ui.field_hover() == Some(i) {
-                selection = Some(overlays.len());
-            }
-            overlays.push(Overlay {
-                points,
-                closed: true,
-                colour,
-                width: 2.0,
-                height: None,
-            });
-        }
-        overlays.push(button(rocks::palette_outline(view), ui.tool() == Tool::Rocks));
-        // Rivers: each control polygon and its points (the held river as the pen makes it), the
-        // next iteration's erosion and deposition while one is edited, the river button.
-        let moving_river = ui.river_moving(doc);
-        for (i, r) in doc.rivers.iter().enumerate() {
-            let points = match &moving_river {
-                Some((m, moved)) if *m == i => moved.points.clone(),
-                _ => r.points.clone(),
-            };
-            let held = moving_river.as_ref().is_some_and(|(m, _)| *m == i);
-            if ui.tool() == Tool::Rivers && ui.river_hover() == Some(i) && !held {
-                selection = Some(overlays.len());
-            }
-            let colour = if held { MOVING_COLOUR } else { RIVER_COLOUR };
-            overlays.push(Overlay {
-                points: points.clone(),
-                closed: false,
-                colour,
-                width: 1.0,
-                height: None,
-            });
-            if ui.tool() == Tool::Rivers {
-                overlays.extend(points.iter().map(|p| dot(*p, None, colour, 4.0)));
-            }
-        }
-        if let Some((erosion, deposition)) = ui.river_preview() {
-            overlays.extend(erosion.iter().map(|p| dot(*p, None, EROSION_COLOUR, 2.0)));
-            overlays.extend(deposition.iter().map(|p| dot(*p, None, DEPOSITION_COLOUR, 2.0)));
-        }
-        overlays.push(button(river::palette_outline(view), ui.tool() == Tool::Rivers));
-        // Ridgelines and trees (their nodes as dots with the ridge tool), the ridge stroke being
-        // drawn (its air part at the pen's height), the ridge button.
-        let ridges_on = ui.tool() == Tool::Ridges;
-        let ridge_lines = doc.ridges.iter().flat_map(|r| {
-            let lines = r.lines.iter().enumerate().map(|(i, l)| {
-                let pts: Vec<Point> = l.points.iter().map(|p| [p[0], p[1]]).collect();
-                (ridge::Part::Line(i), pts)
-            });
-            let trees = r.trees.iter().enumerate().flat_map(|(j, t)| {
-                t.edges.iter().filter_map(move |&[a, b]| {
-                    Some((
-                        ridge::Part::Tree(j),
-                        vec![*t.nodes.get(a as usize)?, *t.nodes.get(b as usize)?],
-                    ))
-                })
-            });
-            lines.chain(trees)
-        });
-        for (part, pts) in ridge_lines {
-            if ridges_on && ui.ridge_hover() == Some(part) && selection.is_none() {
-                selection = Some(overlays.len());
-            }
-            if ridges_on {
-                overlays.extend(pts.iter().map(|p| dot(*p, None, RIDGE_COLOUR, 4.0)));
-            }
-            overlays.push(Overlay {
-                points: pts,
-                closed: false,
-                colour: RIDGE_COLOUR,
-                width: if ridges_on { 2.0 } else { 1.0 },
-                height: None,
-            });
-        }
-        if let Some(samples) = ui.ridge_drawing() {
-            overlays.extend(samples.iter().map(|s| {
-                let h = (s.h_mm > 0.0).then(|| view.height_at(s.h_mm));
-                dot(s.at, h, DRAWING_COLOUR, 3.0)
-            }));
-        }
-        overlays.push(button(ridge::palette_outline(view), ridges_on));
-        // With the tree tool: the groves' outlines and the single trees' trunks (the held one where
-        // the pen takes it, the one under the pen selected); the tree button.
-        let trees_on = ui.tool() == Tool::Trees;
-        if trees_on {
-            use crate::interaction::trees::Held;
-            let moving = ui.tree_moving();
-            let shift = |held: Held, p: Point| match moving {
-                Some((h, by)) if h == held => [p[0] + by[0], p[1] + by[1]],
-                _ => p,
-            };
-            let colour = |held: Held| match moving {
-                Some((h, _)) if h == held => MOVING_COLOUR,
-                _ => GROVE_COLOUR,
-            };
-            for (i, g) in doc.groves.iter().enumerate() {
-                let held = Held::Grove(i);
-                if ui.tree_hover() == Some(held) && selection.is_none() {
-                    selection = Some(overlays.len());
-                }
-                overlays.push(Overlay {
-                    points: g.region.iter().map(|&p| shift(held, p)).collect(),
-                    closed: true,
-                    colour: colour(held),
-                    width: 2.0,
-                    height: None,
-                });
-            }
-            for (i, t) in doc.trees.iter().enumerate() {
-                let held = Held::Tree(i);
-                if ui.tree_hover() == Some(held) && selection.is_none() {
-                    selection = Some(overlays.len());
-                }
-                overlays.push(dot(shift(held, t.at), None, colour(held), 4.0));
-            }
-        }
-        overlays.push(button(crate::interaction::trees::palette_outline(view), trees_on));
+        let Layers {
+            mut overlays,
+            selection,
+        } = ui.layers(doc);
         if let Some(drawn) = ui.drawing() {
-            overlays.push(Overlay {
-                points: drawn.to_vec(),
-                closed: false,
-                colour: DRAWING_COLOUR,
-                width: 3.0,
-                height: None,
-            });
+            overlays.push(Layers::line(drawn.to_vec(), false, DRAWING_COLOUR, 3.0));
         }
         let pen_tip = ui.pen().map(|p| {
             (
@@ -432,16 +261,10 @@ impl Picture {
                 overlays.push(dot(ground, Some(view.height_at(p.h_mm)), PEN_COLOUR, 7.0));
             }
         }
-        let slope_bar = ui.slope_bar(doc).map(|(value, min, max)| SlopeBar {
-            value,
-            min,
-            max,
-            label: "slope".into(),
-        });
         Picture {
             overlays,
             selection,
-            slope_bar,
+            slope_bar: ui.gauge(doc),
             mode,
             camera: camera(view, look.head_m, look.eye_separation_m),
             vertical_scale: view.exaggeration as f32,
@@ -523,51 +346,14 @@ impl Picture {
     }
 }
 
-/// Colour of region boundaries in [`document_overlays`].
-pub const REGION_COLOUR: Rgba = [245, 245, 245, 255];
-/// Colour of control figures in [`document_overlays`].
-pub const FIGURE_COLOUR: Rgba = [220, 40, 40, 255];
-
 /// The document's region boundaries and figures as draped overlays, in document order: for
 /// each region its boundary, then its figures depth first (a closed figure before the figures
 /// nested in it).
 pub fn document_overlays(doc: &Document) -> Vec<Overlay> {
-    document_overlays_at(doc).into_iter().map(|(_, o)| o).collect()
-}
-
-/// [`document_overlays`], each with the curve it draws (to find a selection's index).
-pub fn document_overlays_at(doc: &Document) -> Vec<(CurvePath, Overlay)> {
-    fn figures(list: &[Figure], at: &dyn Fn(usize) -> FigurePath, out: &mut Vec<(CurvePath, Overlay)>) {
-        for (i, f) in list.iter().enumerate() {
-            let path = at(i);
-            out.push((
-                CurvePath::Figure(path.clone()),
-                Overlay {
-                    points: f.points.clone(),
-                    closed: f.kind == FigureKind::Closed,
-                    colour: FIGURE_COLOUR,
-                    width: 3.0,
-                    height: None,
-                },
-            ));
-            figures(&f.figures, &|j| path.child(j), out);
-        }
-    }
-    let mut out = Vec::new();
-    for (r, region) in doc.regions.iter().enumerate() {
-        out.push((
-            CurvePath::Boundary(r),
-            Overlay {
-                points: region.boundary.clone(),
-                closed: true,
-                colour: REGION_COLOUR,
-                width: 2.0,
-                height: None,
-            },
-        ));
-        figures(&region.figures, &|i| FigurePath::new(r, i), &mut out);
-    }
-    out
+    crate::interaction::figures::document_overlays(doc)
+        .into_iter()
+        .map(|(_, o)| o)
+        .collect()
 }
 
 #[cfg(test)]

@@ -10,6 +10,9 @@ use pen_host::calibration::{Calibration, DisplaySize};
 use pen_host::events::{EventDetector, PenEvent};
 use pen_host::sample::Sample;
 use pen_protocol::Quality;
+use penmodel::interaction::figures::Figures;
+use penmodel::interaction::ridge::Ridges;
+use penmodel::interaction::river::Rivers;
 use penmodel::interaction::{Interaction, KeyCommand, Tuning, View};
 use penmodel_terrain::{Document, Editor, FigureKind, FigurePath, Grid, Point, generate};
 
@@ -157,6 +160,10 @@ impl Pen {
         self.set(1, false)
     }
 
+    fn figures(&self) -> &Figures {
+        self.ui.tool::<Figures>().expect("the figures tool")
+    }
+
     fn doc(&self) -> &Document {
         self.editor.document()
     }
@@ -252,7 +259,7 @@ fn grab_pull_and_slope_are_one_undoable_edit() {
 
     // Hovering over the point highlights it.
     pen.hover(151.0, 201.0);
-    let hover = pen.ui.hover().expect("highlighted");
+    let hover = pen.figures().highlighted(pen.ui.phase()).cloned().expect("highlighted");
     assert_eq!(hover.curve.to_string(), "regions[0].figures[0]");
 
     pen.set(1, true).touch().pull_to(90.0);
@@ -316,7 +323,7 @@ fn sliding_a_grab_moves_a_vertex_or_the_figure_and_outside_deletes_it() {
 
     // Dragged out of its region and dropped: deleted.
     pen.grab(150.0, 200.0).drag_to(30.0, 200.0);
-    let moving = pen.ui.moving(pen.editor.document()).expect("moving");
+    let moving = pen.figures().moving(pen.editor.document()).expect("moving");
     assert!(moving.deleting);
     pen.lift(HOVER).let_go();
     assert_eq!(pen.doc().regions[0].figures.len(), 1);
@@ -388,12 +395,11 @@ fn losing_the_pen_mid_pull_cancels_the_pull_and_keeps_the_document() {
 /// The rock tool (issue 11): tapping the palette button picks it; an outline becomes a rock field.
 #[test]
 fn the_rock_tool_draws_moves_and_tunes_a_field() {
-    use penmodel::interaction::rocks::Tool;
     let mut pen = Pen::new(blank());
     pen.closed(&REGION);
     // A tap on the palette button (8 to 28 mm in the corner) picks the rock tool.
     pen.hover(18.0, 18.0).touch().lift(HOVER);
-    assert_eq!(pen.ui.tool(), Tool::Rocks);
+    assert_eq!(pen.ui.tool_name(), "rocks");
     let outline = [(150.0, 100.0), (260.0, 100.0), (260.0, 180.0), (150.0, 180.0)];
     pen.closed(&outline);
     assert_eq!(pen.doc().rocks.len(), 1, "{:?}", pen.ui.take_messages());
@@ -404,7 +410,7 @@ fn the_rock_tool_draws_moves_and_tunes_a_field() {
     }
     let rocks = pen.editor.rocks().fields()[0].scatter.rocks.len();
     assert!(rocks > 100, "{rocks} rocks");
-    assert_eq!(pen.ui.stats().rock_fields, 1);
+    assert_eq!(pen.ui.stats().made("rock_fields"), 1);
 
     // SW2 + touch inside it and a slide moves it by the slide: the same rocks.
     pen.grab(200.0, 140.0).drag_to(230.0, 150.0).lift(HOVER).let_go();
@@ -450,7 +456,7 @@ fn the_rock_tool_draws_moves_and_tunes_a_field() {
 
     // Back to figures: a tap on the palette again; an open stroke with the rock tool is refused.
     pen.hover(18.0, 18.0).touch().lift(HOVER);
-    assert_eq!(pen.ui.tool(), Tool::Figures);
+    assert_eq!(pen.ui.tool_name(), "figures");
     pen.hover(18.0, 18.0).touch().lift(HOVER);
     pen.stroke(&[(300.0, 200.0), (400.0, 220.0)]);
     assert_eq!(pen.doc().rocks.len(), 1);
@@ -482,13 +488,12 @@ fn a_rock_field_dropped_outside_every_region_goes() {
 /// pull sets a tree's height, SW3 sideways its height or a grove's density; each one undoable edit.
 #[test]
 fn the_tree_tool_plants_moves_and_sizes_trees_and_groves() {
-    use penmodel::interaction::rocks::Tool;
     // The reference display shows the 6000 m grid on 600 mm: 10 m per mm, across and up.
     const M_PER_MM: f64 = 10.0;
     let mut pen = Pen::new(blank());
     // The tree button is the square 8 to 28 mm across and 56 to 76 mm down.
     pen.hover(18.0, 66.0).touch().lift(HOVER);
-    assert_eq!(pen.ui.tool(), Tool::Trees);
+    assert_eq!(pen.ui.tool_name(), "trees");
 
     // A tap plants one table-3.1 tree where it touched, 8 mm tall on the display, swaying.
     pen.hover(200.0, 150.0).touch().lift(HOVER);
@@ -500,11 +505,11 @@ fn the_tree_tool_plants_moves_and_sizes_trees_and_groves() {
     assert!(tree.wind.is_some(), "a planted tree sways");
     // The button again: the next preset.
     pen.hover(18.0, 66.0).touch().lift(HOVER);
-    assert_eq!(pen.ui.tool(), Tool::Trees);
+    assert_eq!(pen.ui.tool_name(), "trees");
     pen.hover(250.0, 150.0).touch().lift(HOVER);
     assert_eq!(pen.doc().trees.len(), 2);
     assert_eq!(pen.doc().trees[1].preset.as_deref(), Some("sample-3.2"));
-    assert_eq!(pen.ui.stats().trees, 2);
+    assert_eq!(pen.ui.stats().made("trees"), 2);
 
     // An outline back to its start plants a grove; lifting the tip ends it (no SW3).
     let outline = GROVE_OUTLINE;
@@ -526,7 +531,7 @@ fn the_tree_tool_plants_moves_and_sizes_trees_and_groves() {
     let expected = per_m2 * (120.0 * M_PER_MM) * (100.0 * M_PER_MM);
     let n = penmodel_terrain::trees::grove::trees(&grove).len() as f64;
     assert!((n / expected - 1.0).abs() < 0.2, "{n} trees, expected about {expected}");
-    assert_eq!(pen.ui.stats().groves, 1);
+    assert_eq!(pen.ui.stats().made("groves"), 1);
 
     // SW2 + touch on the first tree and a slide moves it by the slide.
     let second_at = pen.doc().trees[1].at;
@@ -603,7 +608,7 @@ fn the_tree_tool_plants_moves_and_sizes_trees_and_groves() {
     for _ in 1..penmodel_terrain::trees::Preset::ALL.len() {
         pen.hover(18.0, 66.0).touch().lift(HOVER);
     }
-    assert_eq!(pen.ui.tool(), Tool::Figures);
+    assert_eq!(pen.ui.tool_name(), "figures");
 }
 
 /// The tree tool's pull and SW3 gesture show as they go (issue 14): before the release, the held
@@ -716,12 +721,11 @@ fn a_tree_pull_shows_as_it_goes_and_records_one_edit() {
 /// the next year's erosion and deposition previewed; SW2 + SW3 sideways widens it.
 #[test]
 fn the_river_tool_draws_ages_reshapes_and_widens_a_river() {
-    use penmodel::interaction::rocks::Tool;
     let mut pen = Pen::new(blank());
     pen.closed(&REGION);
     // The river button: 8 to 28 mm across, 32 to 52 mm down.
     pen.hover(18.0, 42.0).touch().lift(HOVER);
-    assert_eq!(pen.ui.tool(), Tool::Rivers);
+    assert_eq!(pen.ui.tool_name(), "rivers");
     let course = [
         (100.0, 250.0),
         (180.0, 170.0),
@@ -735,7 +739,7 @@ fn the_river_tool_draws_ages_reshapes_and_widens_a_river() {
     assert_eq!(pen.doc().regions[0].figures.len(), 0, "the course is no figure");
     let river = pen.doc().rivers[0].clone();
     assert_eq!(river.points.len() % 3, 1, "whole cubic segments");
-    assert_eq!(pen.ui.stats().rivers, 1);
+    assert_eq!(pen.ui.stats().made("rivers"), 1);
     assert!(near(river.points[0], pen.ground(100.0, 250.0), 15.0));
     assert!(near(
         *river.points.last().expect("points"),
@@ -749,7 +753,8 @@ fn the_river_tool_draws_ages_reshapes_and_widens_a_river() {
     // SW2 on control point 3 and a slide: the point moves by the slide, the preview shows.
     let p3 = pen.view().to_display(pen.doc().rivers[0].points[3]);
     pen.grab(p3[0], p3[1]).drag_to(p3[0] + 20.0, p3[1] + 10.0);
-    let (erosion, deposition) = pen.ui.river_preview().cloned().expect("a preview while reshaping");
+    let rivers = pen.ui.tool::<Rivers>().expect("the river tool");
+    let (erosion, deposition) = rivers.preview().cloned().expect("a preview while reshaping");
     assert!(!erosion.is_empty() && !deposition.is_empty());
     pen.lift(HOVER).let_go();
     let moved = pen.doc().rivers[0].clone();
@@ -789,7 +794,7 @@ fn the_river_tool_draws_ages_reshapes_and_widens_a_river() {
     assert!(pen.doc().rivers.is_empty());
     // Back to figures with the button again.
     pen.hover(18.0, 42.0).touch().lift(HOVER);
-    assert_eq!(pen.ui.tool(), Tool::Figures);
+    assert_eq!(pen.ui.tool_name(), "figures");
 }
 
 /// Several years in one gesture (issue 13): SW3 held still over a river counts on past the click,
@@ -843,12 +848,11 @@ fn sw3_held_over_a_river_commits_the_years_counted() {
 #[test]
 fn the_ridge_tool_draws_lines_in_the_air_trees_on_the_surface_pulls_grows_and_deletes() {
     use penmodel::interaction::ridge::Part;
-    use penmodel::interaction::rocks::Tool;
     use penmodel_terrain::ridge::layer::tree_of;
     let mut pen = Pen::new(blank());
     // The ridge button: the top right corner, 572 to 592 mm across, 8 to 28 mm down.
     pen.hover(582.0, 18.0).touch().lift(HOVER);
-    assert_eq!(pen.ui.tool(), Tool::Ridges);
+    assert_eq!(pen.ui.tool_name(), "ridges");
     let view = pen.view();
     // A 3D ridgeline: touch at its start, lift and draw in the air at 30 then 50 mm, touch
     // again at its end (snapped to the surface), SW3.
@@ -890,7 +894,7 @@ fn the_ridge_tool_draws_lines_in_the_air_trees_on_the_surface_pulls_grows_and_de
     // The terrain follows: the heightmap under the top node is at its elevation (filtered).
     let peak = pen.editor.heightmap().range().1 as f64;
     assert!(peak > 0.8 * top && peak <= top + 1e-6, "peak {peak} vs {top}");
-    assert_eq!(pen.ui.stats().ridgelines, 1);
+    assert_eq!(pen.ui.stats().made("ridgelines"), 1);
 
     // A tree on the surface: a stroke, then a branch from its middle node.
     pen.stroke(&[(150.0, 250.0), (250.0, 250.0), (350.0, 250.0)]);
@@ -977,11 +981,11 @@ fn the_ridge_tool_draws_lines_in_the_air_trees_on_the_surface_pulls_grows_and_de
     // ridge and run downhill (elevations never rising along them).
     let on = pen.view().to_display([line[8][0], line[8][1]]);
     pen.hover(on[0], on[1]);
-    assert_eq!(pen.ui.ridge_hover(), Some(Part::Line(0)));
+    assert_eq!(pen.ui.tool::<Ridges>().and_then(Ridges::part), Some(Part::Line(0)));
     pen.click(2);
     let grown = pen.doc().ridges.clone().expect("ridges");
     assert!(grown.lines.len() > 1, "{:?}", pen.ui.take_messages());
-    assert_eq!(pen.ui.stats().grown, 1);
+    assert_eq!(pen.ui.stats().made("valley_rounds"), 1);
     assert!(grown.slope > pulled.slope, "each round steepens the flanks");
     let clicked: Vec<Point> = pulled.lines[0].points.iter().map(|p| [p[0], p[1]]).collect();
     for l in &grown.lines[1..] {
@@ -1003,7 +1007,7 @@ fn the_ridge_tool_draws_lines_in_the_air_trees_on_the_surface_pulls_grows_and_de
     assert_eq!(pen.doc().ridges.as_ref(), Some(&grown));
     // Back to figures.
     pen.hover(582.0, 18.0).touch().lift(HOVER);
-    assert_eq!(pen.ui.tool(), Tool::Figures);
+    assert_eq!(pen.ui.tool_name(), "figures");
 }
 
 /// The pen lost while a ridgeline's node is pulled: the ridges and terrain are as before the grab.

@@ -24,38 +24,23 @@
 //! - **Delete**: the Delete key removes the highlighted ridgeline or tree.
 
 use glam::DVec2;
-use penmodel_terrain::document::{Document, Point, RidgeTree, Ridgeline, Ridges};
+use pen_host::events::DisplayPoint;
+use penmodel_render::Rgba;
+use penmodel_terrain::document::{Document, Point, RidgeTree, Ridgeline, Ridges as RidgeSet};
+use penmodel_terrain::edit::Edit;
 use penmodel_terrain::ridge::grow::{self, Growth};
 use penmodel_terrain::ridge::layer;
 
-use super::palette::Button;
 use super::pick::line_distance;
+use super::tool::{Context, Counter, DRAWING_COLOUR, Layers, Phase, Release, Seen, Tool};
 use super::view::View;
 
-/// The ridge button's side on the display, mm; it sits in the top right corner, 8 mm in.
-pub const BUTTON_MM: f64 = 20.0;
 /// Horizontal stroke travel between two nodes of a drawn ridgeline, mm.
 pub const NODE_MM: f64 = 8.0;
 /// A tree node pulled up sets θ within these limits, degrees (Alg. 2.4 needs (0°, 90°)).
 const THETA_LIMITS: (f64, f64) = (0.5, 85.0);
-
-/// The ridge button: in the display's top right corner, 8 mm in.
-fn button(view: &View) -> Button {
-    Button {
-        corner_mm: [view.display_mm[0] - 8.0 - BUTTON_MM, 8.0],
-        side_mm: BUTTON_MM,
-    }
-}
-
-/// Whether display point `(u, v)` mm is on the ridge button.
-pub fn on_palette(view: &View, u_mm: f64, v_mm: f64) -> bool {
-    button(view).contains(u_mm, v_mm)
-}
-
-/// The ridge button's outline on the ground (closed), for drawing.
-pub fn palette_outline(view: &View) -> Vec<Point> {
-    button(view).outline(view)
-}
+/// Colour of ridgelines and ridgeline trees.
+pub const RIDGE_COLOUR: Rgba = [150, 110, 60, 255];
 
 /// One pen position of a ridge stroke: ground metres and the pen's height, mm (0 on the surface).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -214,7 +199,7 @@ pub fn node_at(doc: &Document, g: Point, tol: f64) -> Option<(Part, usize)> {
 }
 
 /// The ridges with a 3D ridgeline added.
-pub fn with_line(doc: &Document, points: Vec<[f64; 3]>) -> Ridges {
+pub fn with_line(doc: &Document, points: Vec<[f64; 3]>) -> RidgeSet {
     let mut r = doc.ridges.clone().unwrap_or_default();
     r.lines.push(Ridgeline { points });
     r
@@ -223,7 +208,7 @@ pub fn with_line(doc: &Document, points: Vec<[f64; 3]>) -> Ridges {
 /// The ridges with a tree stroke added: a branch of the tree whose node or segment lies within
 /// `tol` metres of the stroke's start (a segment is split there), else a new tree (θ 20°,
 /// `h_end` 0). Returns the tree's index too.
-pub fn with_tree_stroke(doc: &Document, stroke: &[Point], tol: f64) -> (Ridges, usize) {
+pub fn with_tree_stroke(doc: &Document, stroke: &[Point], tol: f64) -> (RidgeSet, usize) {
     let mut r = doc.ridges.clone().unwrap_or_default();
     let start = stroke[0];
     let node = node_at(doc, start, tol).and_then(|(part, k)| match part {
@@ -270,7 +255,7 @@ pub fn with_tree_stroke(doc: &Document, stroke: &[Point], tol: f64) -> (Ridges, 
 
 /// The ridges with a node carried by `by` (ground metres) and, if `height` is given, pulled to
 /// that elevation: a ridgeline node's z; a tree's end node sets `h_end`, an inner node θ.
-pub fn with_node(ridges: &Ridges, (part, k): (Part, usize), by: Point, height: Option<f64>) -> Ridges {
+pub fn with_node(ridges: &RidgeSet, (part, k): (Part, usize), by: Point, height: Option<f64>) -> RidgeSet {
     let mut r = ridges.clone();
     match part {
         Part::Line(i) => {
@@ -300,7 +285,7 @@ pub fn with_node(ridges: &Ridges, (part, k): (Part, usize), by: Point, height: O
 /// The ridges with one round of Alg. 2.5 grown from `from` (`seed`) on the DTM of all their
 /// lines and trees, the grown lines added and the slope the next round's; `Err` names why it
 /// cannot grow.
-pub fn grown(doc: &Document, from: Part, seed: u64) -> Result<(Ridges, usize), String> {
+pub fn grown(doc: &Document, from: Part, seed: u64) -> Result<(RidgeSet, usize), String> {
     let r = doc.ridges.as_ref().ok_or("no ridgelines to grow from")?;
     let grid = doc.grid;
     let base: Vec<_> = layer::skeletons(r)
@@ -351,7 +336,7 @@ pub struct NodeGrab {
 
 impl NodeGrab {
     /// The ridges as the pen is making them from `base`: the node carried or pulled, α set.
-    pub fn ridges(&self, base: &Ridges) -> Ridges {
+    pub fn ridges(&self, base: &RidgeSet) -> RidgeSet {
         let mut r = with_node(base, self.node, self.by, self.height);
         if let Some(a) = self.slope {
             r.slope = a;
@@ -365,3 +350,387 @@ impl NodeGrab {
 pub const SLOPE_DEG_PER_MM: f64 = 0.25;
 /// The range the SW3 gesture keeps α in, degrees.
 pub const SLOPE_LIMITS: (f64, f64) = (5.0, 80.0);
+
+/// What the ridge tool holds: its own stroke (drawn in the air or on the surface), or a node.
+#[derive(Debug, Clone)]
+enum Held {
+    /// The pen's positions since the first touch.
+    Stroke(Vec<Sample>),
+    /// A node held with SW2, with the ridges from before the grab.
+    Node(NodeGrab, Box<RidgeSet>),
+}
+
+/// The ridgeline tool: the ridgeline or tree under the pen, and what it holds.
+#[derive(Debug, Clone, Default)]
+pub struct Ridges {
+    hover: Option<Part>,
+    held: Option<Held>,
+}
+
+impl Ridges {
+    /// The ridgeline or tree under the pen, or whose node is held.
+    pub fn part(&self) -> Option<Part> {
+        match &self.held {
+            Some(Held::Node(g, _)) => Some(g.node.0),
+            _ => self.hover,
+        }
+    }
+
+    /// The ridge stroke being drawn: ground points and the pen's height, mm.
+    pub fn drawing(&self) -> Option<&[Sample]> {
+        match &self.held {
+            Some(Held::Stroke(samples)) => Some(samples),
+            _ => None,
+        }
+    }
+
+    /// Ends the ridge stroke: a 3D ridgeline if it went into the air, else a tree or a branch.
+    fn finish(&mut self, cx: &mut Context, samples: &[Sample]) {
+        let map = cx.editor.heightmap();
+        let surface = |g: Point| {
+            let cell = map.cell_size();
+            let c = ((g[0] / cell).floor().max(0.0) as u32).min(map.cols() - 1);
+            let r = ((g[1] / cell).floor().max(0.0) as u32).min(map.rows() - 1);
+            f64::from(map.get(c, r))
+        };
+        let tol = (cx.tuning.lift_mm, cx.tuning.close_mm);
+        let doc = cx.editor.document();
+        let (ridges, what) = match drawn(samples, cx.view, tol, surface) {
+            None => {
+                cx.say("a ridgeline needs a longer stroke".into());
+                return;
+            }
+            Some(Drawn::Line(points)) => {
+                let n = points.len();
+                let top = points.iter().map(|p| p[2]).fold(f64::MIN, f64::max);
+                let r = with_line(doc, points);
+                let i = r.lines.len() - 1;
+                (r, format!("ridgeline {i}: {n} nodes, up to {top:.0} m"))
+            }
+            Some(Drawn::Tree(points)) => {
+                let before = doc.ridges.as_ref().map_or(0, |r| r.trees.len());
+                let (r, j) = with_tree_stroke(doc, &points, cx.pick_m());
+                let how = if j < before { "a branch of" } else { "new" };
+                (r, format!("{how} ridgeline tree {j}: elevations computed"))
+            }
+        };
+        if cx.commit(Edit::SetRidges { ridges: Some(ridges) }, "the ridgeline") {
+            cx.stats.count("ridgelines");
+            cx.say(what);
+        }
+    }
+
+    /// The held node follows the pen: carried along the surface, or pulled to the pen's height.
+    fn follow(&mut self, cx: &mut Context, g: Point, p: DisplayPoint) {
+        let s = *cx.tuning;
+        let touching = cx.sw[0];
+        let Some(Held::Node(grab, base)) = &mut self.held else {
+            return;
+        };
+        let slid = (p.u_mm - grab.at_mm[0]).hypot(p.v_mm - grab.at_mm[1]);
+        if let Some((u0, a0)) = grab.slope_from {
+            let (lo, hi) = SLOPE_LIMITS;
+            grab.slope = Some((a0 - (p.u_mm - u0) * SLOPE_DEG_PER_MM).clamp(lo, hi));
+        } else if touching && grab.height.is_none() && grab.slope.is_none() && (grab.moving || slid > s.move_mm) {
+            grab.moving = true;
+            let from = cx.view.to_ground(grab.at_mm[0], grab.at_mm[1]);
+            grab.by = [g[0] - from[0], g[1] - from[1]];
+        } else if !touching && !grab.moving && p.h_mm > s.lift_mm {
+            grab.height = Some(cx.view.height_at(p.h_mm));
+        } else {
+            return;
+        }
+        if let Err(e) = cx.editor.preview_ridges(Some(grab.ridges(base))) {
+            cx.refuse(format!("cannot show the change: {e}"));
+        }
+    }
+
+    /// Records the held node's move, pull or slope.
+    fn commit_node(&mut self, cx: &mut Context) {
+        let Some(Held::Node(grab, _)) = &self.held else { return };
+        let (moved, pulled, sloped) = (grab.moving, grab.height.is_some(), grab.slope.is_some());
+        match cx.editor.commit_ridges_preview() {
+            Ok(Some(_)) => {
+                cx.stats.moves += u32::from(moved);
+                cx.stats.pulls += u32::from(pulled);
+                cx.stats.slopes += u32::from(sloped);
+            }
+            Ok(None) => {}
+            Err(e) => cx.refuse(format!("the ridgeline change was not recorded: {e}")),
+        }
+        self.held = None;
+    }
+
+    /// One round of valleys (Alg. 2.5) grown from the clicked ridgeline or tree.
+    fn grow(cx: &mut Context, part: Part) {
+        let doc = cx.editor.document();
+        let seed = doc
+            .ridges
+            .as_ref()
+            .map_or(0, |r| (r.lines.len() + r.trees.len()) as u64);
+        match grown(doc, part, seed) {
+            Ok((ridges, n)) => {
+                let slope = ridges.slope;
+                if cx.commit(Edit::SetRidges { ridges: Some(ridges) }, "the grown valleys") {
+                    cx.stats.count("valley_rounds");
+                    cx.say(format!(
+                        "grew {n} valley lines from {}; slope now {slope:.0}°",
+                        part.name()
+                    ));
+                }
+            }
+            Err(e) => cx.refuse(format!("cannot grow valleys: {e}")),
+        }
+    }
+}
+
+impl Tool for Ridges {
+    fn name(&self) -> &'static str {
+        "ridges"
+    }
+
+    fn title(&self) -> String {
+        "ridge tool".into()
+    }
+
+    fn picked(&self) -> String {
+        "ridge tool: touch, lift and draw a ridgeline in the air, or draw a tree on the surface; SW3 ends it".into()
+    }
+
+    fn counters(&self) -> &'static [Counter] {
+        &[
+            Counter {
+                key: "ridgelines",
+                noun: Some("ridgeline"),
+            },
+            Counter {
+                key: "valley_rounds",
+                noun: None,
+            },
+        ]
+    }
+
+    fn clear_hover(&mut self) {
+        self.hover = None;
+    }
+
+    fn hover(&mut self, cx: &mut Context, g: Point) {
+        self.hover = part_at(cx.editor.document(), g, cx.pick_m());
+    }
+
+    /// A touch starts the tool's own stroke: it goes on in the air, which the hub's does not.
+    fn touch(&mut self, _cx: &mut Context, g: Point, _p: DisplayPoint) -> bool {
+        self.held = Some(Held::Stroke(vec![Sample { at: g, h_mm: 0.0 }]));
+        true
+    }
+
+    fn grab(&mut self, cx: &mut Context, g: Point, p: DisplayPoint) -> bool {
+        let doc = cx.editor.document();
+        let Some(node) = node_at(doc, g, cx.pick_m()) else {
+            cx.say("no ridgeline node here to grab".into());
+            return false;
+        };
+        let base = Box::new(doc.ridges.clone().unwrap_or_default());
+        let grab = NodeGrab {
+            node,
+            at_mm: [p.u_mm, p.v_mm],
+            by: [0.0, 0.0],
+            moving: false,
+            height: None,
+            slope_from: None,
+            slope: None,
+        };
+        self.held = Some(Held::Node(grab, base));
+        true
+    }
+
+    fn motion(&mut self, cx: &mut Context, g: Point, p: DisplayPoint) {
+        match &mut self.held {
+            Some(Held::Stroke(samples)) => {
+                let h_mm = if cx.sw[0] { 0.0 } else { p.h_mm.max(0.0) };
+                samples.push(Sample { at: g, h_mm });
+            }
+            Some(Held::Node(..)) => self.follow(cx, g, p),
+            None => {}
+        }
+    }
+
+    fn tip_down(&mut self, _cx: &mut Context, g: Point, _p: DisplayPoint) {
+        if let Some(Held::Stroke(samples)) = &mut self.held {
+            samples.push(Sample { at: g, h_mm: 0.0 });
+        }
+    }
+
+    fn tip_up(&mut self, cx: &mut Context) -> Release {
+        match &self.held {
+            Some(Held::Node(grab, _)) if grab.moving => {
+                self.commit_node(cx);
+                Release::Armed
+            }
+            _ => Release::Keep,
+        }
+    }
+
+    fn sw2_up(&mut self, cx: &mut Context) -> Release {
+        match &self.held {
+            Some(Held::Node(..)) => {
+                self.commit_node(cx);
+                Release::Idle
+            }
+            // SW2 plays no part in a stroke.
+            _ => Release::Keep,
+        }
+    }
+
+    fn sw3_down(&mut self, cx: &mut Context) -> Release {
+        match &mut self.held {
+            Some(Held::Stroke(samples)) => {
+                let samples = std::mem::take(samples);
+                self.held = None;
+                self.finish(cx, &samples);
+                Release::Idle
+            }
+            Some(Held::Node(grab, base)) => {
+                if let Some(p) = cx.pen {
+                    grab.slope_from = Some((p.u_mm, grab.slope.unwrap_or(base.slope)));
+                }
+                Release::Keep
+            }
+            None => Release::Idle,
+        }
+    }
+
+    fn sw3_up(&mut self, _cx: &mut Context) {
+        if let Some(Held::Node(grab, _)) = &mut self.held {
+            grab.slope_from = None;
+        }
+    }
+
+    fn lost(&mut self, cx: &mut Context, reason: &str) -> Release {
+        if let Some(Held::Stroke(_)) = self.held {
+            cx.say(format!("pen lost ({reason}): the ridge stroke is kept; SW3 ends it"));
+            return Release::Keep;
+        }
+        if let Err(e) = cx.editor.cancel_preview() {
+            cx.say(format!("cannot restore the ridgeline: {e}"));
+        }
+        cx.say(format!("pen lost ({reason}): the node stays where it was"));
+        self.held = None;
+        Release::Idle
+    }
+
+    /// An SW3 click over a ridgeline or tree grows one round of valleys from it.
+    fn press(&mut self, cx: &mut Context, _held_us: u64, click: bool) -> bool {
+        match self.hover {
+            Some(part) if click => {
+                Ridges::grow(cx, part);
+                true
+            }
+            _ => false,
+        }
+    }
+
+    fn delete(&mut self, cx: &mut Context) {
+        let Some(part) = self.part() else {
+            cx.say("no ridgeline highlighted to delete".into());
+            return;
+        };
+        let Some(mut r) = cx.editor.document().ridges.clone() else {
+            return;
+        };
+        match part {
+            Part::Line(i) if i < r.lines.len() => {
+                r.lines.remove(i);
+            }
+            Part::Tree(j) if j < r.trees.len() => {
+                r.trees.remove(j);
+            }
+            _ => return,
+        }
+        if cx.commit(Edit::SetRidges { ridges: Some(r) }, "delete") {
+            cx.stats.deletes += 1;
+            self.hover = None;
+            cx.say(format!("{} deleted", part.name()));
+        }
+    }
+
+    fn status(&self, seen: &Seen) -> Option<String> {
+        Some(match (seen.phase, &self.held) {
+            (Phase::Held, Some(Held::Stroke(samples))) => match samples.last() {
+                Some(s) if s.h_mm > 0.0 => format!(
+                    "ridgeline: {:.0} m high | touch: on the surface | SW3 ends it",
+                    seen.view.height_at(s.h_mm)
+                ),
+                _ => "ridge stroke on the surface | lift to draw in the air | SW3 ends it".to_string(),
+            },
+            (Phase::Held, Some(Held::Node(g, _))) if g.slope_from.is_some() => format!(
+                "flank slope {:.1}° | left steeper, right gentler | release SW2 to set",
+                g.slope.unwrap_or(0.0)
+            ),
+            (Phase::Held, Some(Held::Node(g, _))) => {
+                let (part, k) = (g.node.0.name(), g.node.1);
+                match (g.height, g.moving) {
+                    (Some(h), _) => format!("{part} node {k}: {h:.0} m | release SW2 to set"),
+                    (None, true) => format!("moving {part} node {k} | lift to set"),
+                    (None, false) => format!("{part} node {k}: slide to move, lift to pull"),
+                }
+            }
+            (Phase::Idle, _) => match self.hover {
+                Some(part) => format!(
+                    "ridges: {}: SW3 click grows valleys | SW2 + touch a node grabs it",
+                    part.name()
+                ),
+                None => {
+                    "ridges: touch, lift and draw in the air (a ridgeline), or on the surface (a tree) | SW3 ends it"
+                        .to_string()
+                }
+            },
+            (Phase::Armed, _) => "ridges: SW2: touch a node to grab it | SW3: redo".to_string(),
+            _ => return None,
+        })
+    }
+
+    /// Ridgelines and trees (their nodes as dots while the tool is on), and the stroke being
+    /// drawn, its air part at the pen's height.
+    fn overlays(&self, seen: &Seen, active: bool, layers: &mut Layers) {
+        let lines = seen.doc.ridges.iter().flat_map(|r| {
+            let lines = r.lines.iter().enumerate().map(|(i, l)| {
+                let pts: Vec<Point> = l.points.iter().map(|p| [p[0], p[1]]).collect();
+                (Part::Line(i), pts)
+            });
+            let trees = r
+                .trees
+                .iter()
+                .enumerate()
+                .flat_map(|(j, t)| segments(t).map(move |(_, s)| (Part::Tree(j), s.to_vec())));
+            lines.chain(trees)
+        });
+        for (part, pts) in lines {
+            // The highlight marks the part's first segment, from its first node.
+            if active && self.part() == Some(part) && layers.selection.is_none() {
+                layers.selection = Some(layers.overlays.len());
+            }
+            if active {
+                for p in &pts {
+                    layers.push(Layers::dot(*p, None, RIDGE_COLOUR, 4.0));
+                }
+            }
+            layers.push(Layers::line(pts, false, RIDGE_COLOUR, if active { 2.0 } else { 1.0 }));
+        }
+        for s in self.drawing().unwrap_or_default() {
+            let h = (s.h_mm > 0.0).then(|| seen.view.height_at(s.h_mm));
+            layers.push(Layers::dot(s.at, h, DRAWING_COLOUR, 3.0));
+        }
+    }
+
+    fn help(&self) -> &'static [(&'static str, &'static str)] {
+        &[
+            ("touch, lift, draw, SW3", "a ridgeline in the air"),
+            ("SW1 on surface, SW3", "a ridgeline tree (or a branch)"),
+            ("SW2 + touch a node", "slide to move it, lift to pull it"),
+            ("node held, SW3 sideways", "flank slope: left steeper"),
+            ("SW3 click over one", "grow a round of valleys"),
+            ("Del", "delete the highlighted ridgeline"),
+        ]
+    }
+}

@@ -20,18 +20,22 @@
 //!   commits them as one undoable edit, moving (a pan) commits none.
 
 use glam::DVec2;
+use pen_host::events::DisplayPoint;
+use penmodel_render::Rgba;
 use penmodel_terrain::document::{Document, Grid, Point, River};
+use penmodel_terrain::edit::Edit;
 use penmodel_terrain::river::drag::{Cells, Drag};
 use penmodel_terrain::river::{Constants, MAX_ITERATIONS, Shape, course};
 
-use super::palette::Button;
+use super::tool::{Context, Counter, Layers, MOVING_COLOUR, Phase, Release, Seen, Tool};
 use super::view::View;
 
-/// The river button on the display (below the rock tool's).
-pub const BUTTON: Button = Button {
-    corner_mm: [8.0, 32.0],
-    side_mm: 20.0,
-};
+/// Colour of a river's control polygon and points.
+pub const RIVER_COLOUR: Rgba = [90, 160, 255, 255];
+/// Colour of the cells the next iteration erodes (the seed's red).
+pub const EROSION_COLOUR: Rgba = [230, 40, 30, 255];
+/// Colour of the cells the next iteration deposits (the seed's light blue).
+pub const DEPOSITION_COLOUR: Rgba = [160, 215, 255, 255];
 /// Gain of the width and depth gestures, per mm.
 pub const GAIN_PER_MM: f64 = 0.02;
 /// A new river's width (the disc radius) on the display, mm.
@@ -47,16 +51,6 @@ pub const YEAR_HOLD_US: u64 = 450_000;
 pub fn years_held(held_us: u64, click_us: u64) -> u32 {
     let more = (held_us.saturating_sub(click_us) / YEAR_HOLD_US).min(u64::from(MAX_ITERATIONS));
     1 + more as u32
-}
-
-/// Whether display point `(u, v)` mm is on the river button.
-pub fn on_palette(u_mm: f64, v_mm: f64) -> bool {
-    BUTTON.contains(u_mm, v_mm)
-}
-
-/// The river button's outline on the ground (closed), for drawing.
-pub fn palette_outline(view: &View) -> Vec<Point> {
-    BUTTON.outline(view)
 }
 
 /// A river along a stroke (ground metres): its Bézier fit, [`WIDTH_MM`] wide on the display, half
@@ -212,5 +206,282 @@ impl RiverGrab {
             Some((_, w, d)) => tuned(&r, w, d),
             None => r,
         })
+    }
+}
+
+/// The river tool: the river under the pen, the one held and its next iteration's preview.
+#[derive(Debug, Clone, Default)]
+pub struct Rivers {
+    hover: Option<usize>,
+    grab: Option<RiverGrab>,
+    /// The held river's next erosion and deposition cells (ground metres).
+    preview: Option<(Vec<Point>, Vec<Point>)>,
+}
+
+impl Rivers {
+    /// The river under the pen, or held.
+    pub fn river(&self) -> Option<usize> {
+        self.grab.as_ref().map(|g| g.index).or(self.hover)
+    }
+
+    /// The held river as the pen is making it: `(index, river)`.
+    pub fn moving(&self, doc: &Document) -> Option<(usize, River)> {
+        let g = self.grab.as_ref()?;
+        Some((g.index, g.river(doc)?))
+    }
+
+    /// The held river's next erosion and deposition cells (ground metres), while it is edited.
+    pub fn preview(&self) -> Option<&(Vec<Point>, Vec<Point>)> {
+        self.grab.as_ref().and(self.preview.as_ref())
+    }
+
+    /// Sets the held river's point where the pen has taken it.
+    fn drop_point(&mut self, cx: &mut Context) {
+        let Some(grab) = &self.grab else { return };
+        if !grab.moving || grab.by == [0.0, 0.0] {
+            return;
+        }
+        let (index, k) = (grab.index, grab.control);
+        let Some(river) = grab.river(cx.editor.document()) else {
+            return;
+        };
+        if cx.commit(Edit::ReplaceRiver { index, river }, "moving the river's point") {
+            cx.stats.moves += 1;
+            cx.say(format!("river {index}: point {} moved", k.unwrap_or(0)));
+        }
+    }
+
+    fn let_go(&mut self) {
+        self.grab = None;
+        self.preview = None;
+    }
+}
+
+impl Tool for Rivers {
+    fn name(&self) -> &'static str {
+        "rivers"
+    }
+
+    fn title(&self) -> String {
+        "river tool".into()
+    }
+
+    fn picked(&self) -> String {
+        "river tool: draw a course from source to mouth, SW3 ends it".into()
+    }
+
+    fn counters(&self) -> &'static [Counter] {
+        &[Counter {
+            key: "rivers",
+            noun: Some("river"),
+        }]
+    }
+
+    fn clear_hover(&mut self) {
+        self.hover = None;
+    }
+
+    fn hover(&mut self, cx: &mut Context, g: Point) {
+        self.hover = river_at(cx.editor.document(), g, cx.pick_m());
+    }
+
+    /// The course drawn becomes a river: its Bézier fit.
+    fn stroke(&mut self, cx: &mut Context, positions: &[Point]) {
+        let Some(river) = new_river(positions, cx.view) else {
+            cx.say("a river's course needs a longer stroke".into());
+            return;
+        };
+        let index = cx.editor.document().rivers.len();
+        let points = river.points.len();
+        if cx.commit(Edit::AddRiver { index, river }, &format!("river {index}")) {
+            cx.stats.count("rivers");
+            cx.say(format!(
+                "river {index}: {points} control points | SW3 click over it: one year"
+            ));
+        }
+    }
+
+    fn grab(&mut self, cx: &mut Context, g: Point, p: DisplayPoint) -> bool {
+        let doc = cx.editor.document();
+        let tol = cx.pick_m();
+        let held = match control_at(doc, g, tol) {
+            Some((index, k)) => Some((index, Some(k))),
+            None => river_at(doc, g, tol).map(|i| (i, None)),
+        };
+        let Some((index, control)) = held else {
+            cx.say("no river here to grab".into());
+            return false;
+        };
+        let grab = RiverGrab::new(doc, index, control, [p.u_mm, p.v_mm]);
+        self.preview = grab.preview(doc);
+        self.grab = Some(grab);
+        true
+    }
+
+    fn motion(&mut self, cx: &mut Context, g: Point, p: DisplayPoint) {
+        let Some(grab) = &mut self.grab else { return };
+        let slid = (p.u_mm - grab.at_mm[0]).hypot(p.v_mm - grab.at_mm[1]);
+        if let Some((start, _, _)) = grab.tuning {
+            let width = ((p.u_mm - start[0]) * GAIN_PER_MM).exp();
+            let depth = ((p.h_mm - start[1]) * GAIN_PER_MM).exp();
+            grab.tuning = Some((start, width, depth));
+        } else if cx.sw[0] && grab.control.is_some() && (grab.moving || slid > cx.tuning.move_mm) {
+            grab.moving = true;
+            let from = cx.view.to_ground(grab.at_mm[0], grab.at_mm[1]);
+            grab.by = [g[0] - from[0], g[1] - from[1]];
+        }
+        self.preview = grab.preview(cx.editor.document());
+    }
+
+    fn tip_up(&mut self, cx: &mut Context) -> Release {
+        if !self.grab.as_ref().is_some_and(|g| g.moving) {
+            return Release::Keep;
+        }
+        self.drop_point(cx);
+        self.let_go();
+        Release::Armed
+    }
+
+    fn sw2_up(&mut self, cx: &mut Context) -> Release {
+        self.drop_point(cx);
+        self.let_go();
+        Release::Idle
+    }
+
+    fn sw3_down(&mut self, cx: &mut Context) -> Release {
+        if let Some(grab) = &mut self.grab
+            && let Some(p) = cx.pen
+            && !grab.moving
+        {
+            grab.tuning = Some(([p.u_mm, p.h_mm], 1.0, 1.0));
+        }
+        Release::Keep
+    }
+
+    /// Sets the width and depth the gesture chose, as one edit.
+    fn sw3_up(&mut self, cx: &mut Context) {
+        let Some(grab) = &mut self.grab else { return };
+        let Some((_, width, depth)) = grab.tuning else {
+            return;
+        };
+        let index = grab.index;
+        let Some(river) = grab.river(cx.editor.document()) else {
+            return;
+        };
+        grab.tuning = None;
+        if cx.commit(Edit::ReplaceRiver { index, river }, "the river's width and depth") {
+            cx.say(format!("river {index}: width ×{width:.2}, depth ×{depth:.2}"));
+        }
+    }
+
+    fn lost(&mut self, cx: &mut Context, reason: &str) -> Release {
+        cx.say(format!("pen lost ({reason}): the river stays as it was"));
+        self.let_go();
+        Release::Idle
+    }
+
+    /// SW3 released over a river: one more year, or as many as the press was held for.
+    fn press(&mut self, cx: &mut Context, held_us: u64, _click: bool) -> bool {
+        let Some(index) = self.hover else { return false };
+        let more = years_held(held_us, cx.tuning.click_us);
+        let Some(river) = cx.editor.document().rivers.get(index).and_then(|r| aged(r, more)) else {
+            cx.say(format!("river {index} has had the most years a river may have"));
+            return true;
+        };
+        let years = river.iterations;
+        if cx.commit(Edit::ReplaceRiver { index, river }, "the river's years") {
+            cx.say(format!("river {index}: {years} years of erosion and deposition"));
+        }
+        true
+    }
+
+    fn delete(&mut self, cx: &mut Context) {
+        let Some(index) = self.river() else {
+            cx.say("no river highlighted to delete".into());
+            return;
+        };
+        if cx.commit(Edit::DeleteRiver { index }, "delete") {
+            cx.stats.deletes += 1;
+            self.hover = None;
+        }
+    }
+
+    fn status(&self, seen: &Seen) -> Option<String> {
+        Some(match (seen.phase, &self.grab) {
+            (Phase::Held, Some(g)) => match (g.tuning, g.control) {
+                (Some((_, w, d)), _) => format!(
+                    "river {}: width ×{w:.2}, depth ×{d:.2} | sideways: width, up/down: depth",
+                    g.index
+                ),
+                (None, Some(k)) if g.moving => format!("river {}: moving point {k} | lift to set", g.index),
+                (None, _) => format!("river {}: slide a point to reshape | SW3 + move: width, depth", g.index),
+            },
+            (Phase::Idle, _) => match self.hover {
+                Some(i) => format!("rivers: river {i}: SW3 click: one more year | SW2 + touch grabs it"),
+                None => "rivers: draw a course from source to mouth | SW3 ends it | tap the river button for figures"
+                    .to_string(),
+            },
+            (Phase::Armed, _) => {
+                "rivers: SW2: touch a control point to move it, the course to hold it | SW3: redo".to_string()
+            }
+            // SW3 held still over a river counts the years a release commits.
+            (Phase::Pressing { held_us, moved: false }, _) => {
+                let index = self.hover?;
+                let years = years_held(held_us, seen.tuning.click_us);
+                let had = seen.doc.rivers.get(index).map_or(0, |r| r.iterations);
+                let to = seen
+                    .doc
+                    .rivers
+                    .get(index)
+                    .and_then(|r| aged(r, years))
+                    .map_or(had, |r| r.iterations);
+                format!(
+                    "river {index}: +{} years ({to} in all) | hold to count on, release to commit, move to pan",
+                    to - had
+                )
+            }
+            _ => return None,
+        })
+    }
+
+    /// Each river's control polygon (the held one as the pen makes it; its points as dots while
+    /// the tool is on), and the next iteration's erosion and deposition while one is held.
+    fn overlays(&self, seen: &Seen, active: bool, layers: &mut Layers) {
+        let doc = seen.doc;
+        let moving = self.moving(doc);
+        for (i, r) in doc.rivers.iter().enumerate() {
+            let held = moving.as_ref().filter(|(m, _)| *m == i);
+            let points = held.map_or_else(|| r.points.clone(), |(_, moved)| moved.points.clone());
+            let colour = if held.is_some() { MOVING_COLOUR } else { RIVER_COLOUR };
+            let line = Layers::line(points.clone(), false, colour, 1.0);
+            if active && self.river() == Some(i) && held.is_none() {
+                layers.push_selected(line);
+            } else {
+                layers.push(line);
+            }
+            if active {
+                for p in &points {
+                    layers.push(Layers::dot(*p, None, colour, 4.0));
+                }
+            }
+        }
+        if let Some((erosion, deposition)) = self.preview() {
+            for p in erosion {
+                layers.push(Layers::dot(*p, None, EROSION_COLOUR, 2.0));
+            }
+            for p in deposition {
+                layers.push(Layers::dot(*p, None, DEPOSITION_COLOUR, 2.0));
+            }
+        }
+    }
+
+    fn help(&self) -> &'static [(&'static str, &'static str)] {
+        &[
+            ("SW1 course, SW3", "a river from source to mouth"),
+            ("SW2 + touch a point", "slide it to reshape the course"),
+            ("held, SW3 + move", "sideways: width; up, down: depth"),
+            ("SW3 click over it", "one more year (hold: more)"),
+            ("Del", "delete the highlighted river"),
+        ]
     }
 }

@@ -25,18 +25,20 @@
 //! frames and a grove is scattered again; the release records it as one edit, losing the pen
 //! restores it. Every change is one editor edit (undo, journal); new trees sway in [`breeze`].
 
-use penmodel_terrain::document::{Document, Grove, GroveSpecies, Point, Sway, Tree, Wind};
+use pen_host::events::DisplayPoint;
+use penmodel_render::Rgba;
+use penmodel_terrain::document::{Document, FigureKind, Grove, GroveSpecies, Point, Sway, Tree, Wind};
+use penmodel_terrain::edit::Edit;
 use penmodel_terrain::geometry::{Side, locate};
 use penmodel_terrain::trees::{MAX_HEIGHT, Preset, grove};
 
-use super::palette::Button;
+use super::figures::tolerances;
+use super::stroke::{self, Shape};
+use super::tool::{Context, Counter, Layers, MOVING_COLOUR, Phase, Release, Seen, Tool};
 use super::view::View;
 
-/// The tree tool's button on the display: below the river button.
-pub const BUTTON: Button = Button {
-    corner_mm: [8.0, 56.0],
-    side_mm: 20.0,
-};
+/// Colour of a grove's outline and a single tree's trunk, with the tree tool.
+pub const GROVE_COLOUR: Rgba = [60, 150, 70, 255];
 /// A new tree's (or grove's mean) height as drawn on the display, mm.
 pub const TREE_MM: f64 = 8.0;
 /// A new grove's least distance between trees on the display, mm.
@@ -45,16 +47,6 @@ pub const SPACING_MM: f64 = 4.0;
 pub const GAIN_PER_MM: f64 = 0.02;
 /// The shortest tree the pen sets, metres.
 pub const MIN_HEIGHT: f64 = 1.0;
-
-/// Whether display point `(u, v)` mm is on the tree button.
-pub fn on_palette(u_mm: f64, v_mm: f64) -> bool {
-    BUTTON.contains(u_mm, v_mm)
-}
-
-/// The tree button's outline on the ground (closed), for drawing.
-pub fn palette_outline(view: &View) -> Vec<Point> {
-    BUTTON.outline(view)
-}
 
 /// The preset after `p` in [`Preset::ALL`]; `None` after the last (back to figures).
 pub fn next_preset(p: Preset) -> Option<Preset> {
@@ -213,8 +205,7 @@ pub fn grove_with_height(grove: &Grove, height: f64) -> Grove {
 /// gesture's height (a grove's density) × its factor; `None` while it neither pulls nor tunes,
 /// or when `held` is not in `doc`. The editor previews it at each pen move
 /// ([`penmodel_terrain::Editor::preview_tree`]) and records it on release.
-pub fn sized(doc: &Document, grab: &TreeGrab) -> Option<penmodel_terrain::Edit> {
-    use penmodel_terrain::Edit;
+pub fn sized(doc: &Document, grab: &TreeGrab) -> Option<Edit> {
     match (grab.held, grab.tuning, grab.pull) {
         (Held::Tree(index), Some((_, k)), _) => doc.trees.get(index).map(|t| Edit::ReplaceTree {
             index,
@@ -244,5 +235,358 @@ pub fn size_of(doc: &Document, held: Held) -> Option<f64> {
     match held {
         Held::Tree(i) => doc.trees.get(i).map(|t| t.height),
         Held::Grove(i) => doc.groves.get(i).map(|g| g.density),
+    }
+}
+
+/// The tree tool: the preset a tap plants, the tree or grove under the pen and the one held.
+#[derive(Debug, Clone)]
+pub struct Trees {
+    preset: Preset,
+    hover: Option<Held>,
+    grab: Option<TreeGrab>,
+}
+
+impl Default for Trees {
+    fn default() -> Trees {
+        Trees {
+            preset: Preset::Table31,
+            hover: None,
+            grab: None,
+        }
+    }
+}
+
+impl Trees {
+    /// The preset an SW1 tap plants.
+    pub fn preset(&self) -> Preset {
+        self.preset
+    }
+
+    /// The tree or grove under the pen, or held.
+    pub fn held(&self) -> Option<Held> {
+        self.grab.as_ref().map(|g| g.held).or(self.hover)
+    }
+
+    /// The held tree or grove and how far the pen has slid it, ground metres.
+    pub fn moving(&self) -> Option<(Held, Point)> {
+        self.grab.as_ref().filter(|g| g.moving).map(|g| (g.held, g.by))
+    }
+
+    /// Sets the held tree or grove: where the pen slid it, or the height it pulled to (or the
+    /// SW3 gesture's size, when SW2 is released first), shown since the pull began.
+    fn drop(&mut self, cx: &mut Context) {
+        let Some(grab) = &self.grab else { return };
+        let (held, by) = (grab.held, grab.by);
+        if !grab.moving {
+            let pulled = grab.tuning.is_none() && grab.pull.is_some();
+            if Trees::commit_preview(cx, &format!("the height of {}", held.name())) && pulled {
+                cx.stats.pulls += 1;
+            }
+            return;
+        }
+        let edit = match held {
+            _ if by == [0.0, 0.0] => return,
+            Held::Tree(index) => Edit::MoveTree { index, by },
+            Held::Grove(index) => Edit::MoveGrove { index, by },
+        };
+        if cx.commit(edit, &format!("moving {}", held.name())) {
+            cx.stats.moves += 1;
+        }
+    }
+
+    /// Shows the held tree or grove as the pen sizes it (the pull, the SW3 gesture) at once,
+    /// unrecorded: the forest and the frames follow it before the release records it.
+    fn show(&self, cx: &mut Context) {
+        let Some(grab) = &self.grab else { return };
+        let Some(edit) = sized(cx.editor.document(), grab) else {
+            return;
+        };
+        if let Err(e) = cx.editor.preview_tree(&edit) {
+            cx.refuse(format!("cannot show {}: {e}", grab.held.name()));
+        }
+    }
+
+    /// Records the tree preview shown as one edit; whether there was one and it was recorded.
+    fn commit_preview(cx: &mut Context, what: &str) -> bool {
+        match cx.editor.commit_tree_preview() {
+            Ok(edit) => edit.is_some(),
+            Err(e) => {
+                cx.refuse(format!("{what} refused: {e}"));
+                false
+            }
+        }
+    }
+}
+
+impl Tool for Trees {
+    fn name(&self) -> &'static str {
+        "trees"
+    }
+
+    fn title(&self) -> String {
+        format!("tree tool: {}", self.preset.name())
+    }
+
+    fn picked(&self) -> String {
+        format!(
+            "tree tool ({}): tap to plant a tree, draw an outline for a grove",
+            self.preset.name()
+        )
+    }
+
+    /// Each tap picks the next preset; after the last, back to figures.
+    fn tapped(&mut self, again: bool) -> bool {
+        let next = if again {
+            next_preset(self.preset)
+        } else {
+            Some(Preset::Table31)
+        };
+        match next {
+            Some(preset) => {
+                self.preset = preset;
+                true
+            }
+            None => false,
+        }
+    }
+
+    fn counters(&self) -> &'static [Counter] {
+        &[
+            Counter {
+                key: "trees",
+                noun: Some("tree"),
+            },
+            Counter {
+                key: "groves",
+                noun: Some("grove"),
+            },
+        ]
+    }
+
+    fn clear_hover(&mut self) {
+        self.hover = None;
+    }
+
+    fn hover(&mut self, cx: &mut Context, g: Point) {
+        self.hover = held_at(cx.editor.document(), g, cx.pick_m());
+    }
+
+    /// A tree-tool stroke is one touch: lifting the tip ends it.
+    fn ends_stroke_on_lift(&self) -> bool {
+        true
+    }
+
+    /// A tap (a point figure's stroke) plants a tree, a closed outline a grove.
+    fn stroke(&mut self, cx: &mut Context, positions: &[Point]) {
+        let doc = cx.editor.document();
+        match stroke::classify(positions, &tolerances(cx)) {
+            Some(Shape {
+                kind: FigureKind::Point,
+                points,
+            }) => {
+                let index = doc.trees.len();
+                let tree = new_tree(points[0], cx.view, self.preset, index as u64 + 1);
+                let name = format!("{} tree {index}", self.preset.name());
+                if cx.commit(Edit::AddTree { index, tree }, &name) {
+                    cx.stats.count("trees");
+                    cx.say(format!("planted {name}"));
+                }
+            }
+            Some(Shape {
+                kind: FigureKind::Closed,
+                points,
+            }) => {
+                let index = doc.groves.len();
+                let grove = new_grove(&points, cx.view, index as u64 + 1);
+                if cx.commit(Edit::AddGrove { index, grove }, &format!("grove {index}")) {
+                    cx.stats.count("groves");
+                    let n = cx
+                        .editor
+                        .document()
+                        .groves
+                        .get(index)
+                        .map_or(0, |g| grove::trees(g).len());
+                    cx.say(format!("planted grove {index}: {n} trees"));
+                }
+            }
+            _ => cx.refuse("a grove needs an outline back to its start (a tap plants one tree)".into()),
+        }
+    }
+
+    fn grab(&mut self, cx: &mut Context, g: Point, p: DisplayPoint) -> bool {
+        let Some(held) = held_at(cx.editor.document(), g, cx.pick_m()) else {
+            cx.say("no tree or grove here to grab".into());
+            return false;
+        };
+        self.grab = Some(TreeGrab::new(held, [p.u_mm, p.v_mm]));
+        true
+    }
+
+    fn motion(&mut self, cx: &mut Context, g: Point, p: DisplayPoint) {
+        let Some(grab) = &mut self.grab else { return };
+        let slid = (p.u_mm - grab.at_mm[0]).hypot(p.v_mm - grab.at_mm[1]);
+        if let Some((u0, _)) = grab.tuning {
+            grab.tuning = Some((u0, ((p.u_mm - u0) * GAIN_PER_MM).exp()));
+        } else if grab.pull.is_some() {
+            grab.pull = Some(clamp_height(cx.view.height_at(p.h_mm.max(0.0))));
+        } else if cx.sw[0] && !grab.tuned && (grab.moving || slid > cx.tuning.move_mm) {
+            grab.moving = true;
+            let from = cx.view.to_ground(grab.at_mm[0], grab.at_mm[1]);
+            grab.by = [g[0] - from[0], g[1] - from[1]];
+        }
+        self.show(cx);
+    }
+
+    /// Lifting drops a slid tree or grove, or starts its pull.
+    fn tip_up(&mut self, cx: &mut Context) -> Release {
+        let Some(grab) = &mut self.grab else {
+            return Release::Keep;
+        };
+        if grab.moving {
+            self.drop(cx);
+            self.grab = None;
+            return Release::Armed;
+        }
+        if !grab.tuned && grab.tuning.is_none() {
+            let h = cx.pen.map_or(0.0, |p| p.h_mm.max(0.0));
+            grab.pull = Some(clamp_height(cx.view.height_at(h)));
+            self.show(cx);
+        }
+        Release::Keep
+    }
+
+    fn sw2_up(&mut self, cx: &mut Context) -> Release {
+        self.drop(cx);
+        self.grab = None;
+        Release::Idle
+    }
+
+    fn sw3_down(&mut self, cx: &mut Context) -> Release {
+        if let Some(grab) = &mut self.grab
+            && let Some(p) = cx.pen
+            && !grab.moving
+            && grab.pull.is_none()
+            && let Some(size) = size_of(cx.editor.document(), grab.held)
+        {
+            grab.tuning = Some((p.u_mm, 1.0));
+            grab.tuned_from = size;
+            grab.tuned = true;
+        }
+        Release::Keep
+    }
+
+    /// Sets the height (a grove's density) the sideways gesture chose, as one edit.
+    fn sw3_up(&mut self, cx: &mut Context) {
+        let Some(grab) = &mut self.grab else { return };
+        let Some((_, k)) = grab.tuning else { return };
+        let held = grab.held;
+        let what = if matches!(held, Held::Tree(_)) {
+            "height"
+        } else {
+            "density"
+        };
+        if Trees::commit_preview(cx, &format!("the {what} of {}", held.name())) {
+            cx.say(format!("{}: {what} ×{k:.2}", held.name()));
+        }
+        if let Some(grab) = &mut self.grab {
+            grab.tuning = None;
+        }
+    }
+
+    fn lost(&mut self, cx: &mut Context, reason: &str) -> Release {
+        let name = self.grab.as_ref().map(|g| g.held.name()).unwrap_or_default();
+        if let Err(e) = cx.editor.cancel_preview() {
+            cx.say(format!("cannot restore {name}: {e}"));
+        }
+        cx.say(format!("pen lost ({reason}): {name} stays as it was"));
+        self.grab = None;
+        Release::Idle
+    }
+
+    fn delete(&mut self, cx: &mut Context) {
+        let Some(held) = self.held() else {
+            cx.say("no tree or grove highlighted to delete".into());
+            return;
+        };
+        let edit = match held {
+            Held::Tree(index) => Edit::DeleteTree { index },
+            Held::Grove(index) => Edit::DeleteGrove { index },
+        };
+        if cx.commit(edit, "delete") {
+            cx.stats.deletes += 1;
+            self.hover = None;
+        }
+    }
+
+    fn status(&self, seen: &Seen) -> Option<String> {
+        Some(match (seen.phase, &self.grab) {
+            (Phase::Held, Some(g)) => match (g.tuning, g.pull) {
+                (Some((_, k)), _) => {
+                    let what = if matches!(g.held, Held::Tree(_)) {
+                        "height"
+                    } else {
+                        "density"
+                    };
+                    format!("{}: {what} ×{k:.2} | sideways: more or less", g.held.name())
+                }
+                (None, Some(h)) => format!("{}: {h:.0} m high | release SW2 to set", g.held.name()),
+                (None, None) if g.moving => format!("moving {} | lift to drop", g.held.name()),
+                (None, None) => format!("{}: slide to move, lift to pull | SW3 + sideways", g.held.name()),
+            },
+            (Phase::Idle, _) => match self.hover {
+                Some(h) => format!("trees: {}: SW2 + touch grabs it | tap: plant a tree", h.name()),
+                None => format!(
+                    "trees ({}): tap plants a tree, an outline back to its start a grove | tap the tree button: next preset",
+                    self.preset.name()
+                ),
+            },
+            (Phase::Armed, _) => "trees: SW2: touch a tree or grove to grab it | SW3: redo".to_string(),
+            _ => return None,
+        })
+    }
+
+    /// While the tool is on: the groves' outlines and the single trees' trunks (the held one
+    /// where the pen takes it, the one under the pen highlighted).
+    fn overlays(&self, seen: &Seen, active: bool, layers: &mut Layers) {
+        if !active {
+            return;
+        }
+        let moving = self.moving();
+        let shift = |held: Held, p: Point| match moving {
+            Some((h, by)) if h == held => [p[0] + by[0], p[1] + by[1]],
+            _ => p,
+        };
+        let colour = |held: Held| match moving {
+            Some((h, _)) if h == held => MOVING_COLOUR,
+            _ => GROVE_COLOUR,
+        };
+        let mut push = |held: Held, overlay| {
+            if self.held() == Some(held) && layers.selection.is_none() {
+                layers.push_selected(overlay);
+            } else {
+                layers.push(overlay);
+            }
+        };
+        for (i, g) in seen.doc.groves.iter().enumerate() {
+            let held = Held::Grove(i);
+            let points = g.region.iter().map(|&p| shift(held, p)).collect();
+            push(held, Layers::line(points, true, colour(held), 2.0));
+        }
+        for (i, t) in seen.doc.trees.iter().enumerate() {
+            let held = Held::Tree(i);
+            push(held, Layers::dot(shift(held, t.at), None, colour(held), 4.0));
+        }
+    }
+
+    fn help(&self) -> &'static [(&'static str, &'static str)] {
+        &[
+            ("tree button again", "the next preset; after the last, figures"),
+            ("SW1 tap", "plant a tree of the preset"),
+            ("SW1 outline to its start", "plant a grove inside it"),
+            ("SW2 + touch, slide", "move a tree or grove"),
+            ("held, lift", "pull: its height follows the pen"),
+            ("held, SW3 sideways", "a tree's height, a grove's density"),
+            ("Del", "delete the highlighted tree or grove"),
+        ]
     }
 }

@@ -115,13 +115,7 @@ pub struct LiveArgs {
 }
 
 /// `n` and the noun, plural unless one: "1 region", "2 regions".
-fn count(n: u64, noun: &str) -> String {
-    if n == 1 {
-        format!("1 {noun}")
-    } else {
-        format!("{n} {noun}s")
-    }
-}
+use penmodel::interaction::stats::count;
 
 /// The file beside the demo's document that says an earlier demo wrote it, so the next demo may
 /// replace it; a user's document has none.
@@ -408,31 +402,15 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
             "animation_frames": written.held,
             "results": results,
             "heights_m": [lo, hi],
-            "stats": {
-                "regions": stats.regions, "figures": stats.figures, "pulls": stats.pulls,
-                "slopes": stats.slopes, "moves": stats.moves, "deletes": stats.deletes,
-                "undos": stats.undos, "redos": stats.redos, "refused": stats.refused,
-                "missed": stats.missed, "rock_fields": stats.rock_fields, "rivers": stats.rivers,
-                "ridgelines": stats.ridgelines, "valley_rounds": stats.grown,
-                "trees": stats.trees, "groves": stats.groves,
-            },
+            "stats": stats.to_json(),
             "head_latency": head_latency_json(&session, &painter.checks),
         });
         pen_host::outln!("{summary}");
     } else {
         pen_host::outln!(
-            "{state}: {}; {}, {}, {}, {}, {}, {}, {}, {}, {}, {}; terrain {lo:.0} to {hi:.0} m",
+            "{state}: {}; {}; terrain {lo:.0} to {hi:.0} m",
             count(session.events(), "pen event"),
-            count(stats.regions as u64, "region"),
-            count(stats.figures as u64, "figure"),
-            count(stats.pulls as u64, "pull"),
-            count(stats.slopes as u64, "slope"),
-            count(stats.undos as u64, "undo"),
-            count(stats.rock_fields as u64, "rock field"),
-            count(stats.rivers as u64, "river"),
-            count(stats.ridgelines as u64, "ridgeline"),
-            count(stats.trees as u64, "tree"),
-            count(stats.groves as u64, "grove"),
+            stats.summary(),
         );
         let what = match (written.shown, &written.animation) {
             (true, _) => format!("showed {}; wrote", count(written.frames as u64, "frame")),
@@ -1194,7 +1172,13 @@ fn run_window(
                 style,
             );
             if help {
-                ui::panel(&mut frame, &viewport, &keys::help_lines(), Place::Centre, style);
+                ui::panel(
+                    &mut frame,
+                    &viewport,
+                    &keys::help_lines(&session.interaction.help()),
+                    Place::Centre,
+                    style,
+                );
             }
             if viewer.show(frame).is_err() {
                 break;
