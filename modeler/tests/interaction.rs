@@ -1061,3 +1061,38 @@ fn sw3_sideways_on_a_held_node_sets_the_flank_slope() {
     pen.editor.undo().expect("undo");
     assert_eq!(pen.doc(), &before);
 }
+
+/// Every tool button picks its tool from whichever tool is on, the ridge tool too (whose touch
+/// elsewhere starts a stroke of its own), and the pen's help lists the tool on's gestures.
+#[test]
+fn any_tool_button_switches_from_any_tool() {
+    let mut pen = Pen::new(blank());
+    let buttons = [
+        ("rocks", (18.0, 18.0)),
+        ("rivers", (18.0, 42.0)),
+        ("ridges", (582.0, 18.0)),
+        ("trees", (18.0, 66.0)),
+    ];
+    for (from, (fu, fv)) in buttons {
+        for (to, (tu, tv)) in buttons {
+            if from == to {
+                continue;
+            }
+            pen.hover(fu, fv).touch().lift(HOVER);
+            assert_eq!(pen.ui.tool_name(), from);
+            pen.hover(tu, tv).touch().lift(HOVER);
+            assert_eq!(pen.ui.tool_name(), to, "from {from}");
+            // The same button again: back to figures (the tree button steps through its presets
+            // first).
+            while pen.ui.tool_name() == to {
+                pen.hover(tu, tv).touch().lift(HOVER);
+            }
+            assert_eq!(pen.ui.tool_name(), "figures");
+        }
+    }
+    assert!(pen.doc().ridges.is_none(), "no tap drew a ridge stroke");
+    pen.hover(18.0, 18.0).touch().lift(HOVER);
+    let help: Vec<&str> = pen.ui.help().iter().map(|(g, _)| *g).collect();
+    assert!(help.contains(&"SW1 outline, SW3"), "{help:?}");
+    assert!(help.contains(&"SW3 click"), "{help:?}");
+}
