@@ -12,6 +12,10 @@
 //! true path, each frame also measures how far the pose reported and the pose drawn are from
 //! where the head was when the frame was done.
 
+use serde_json::json;
+
+use crate::interaction::stats::count;
+
 /// The target: end of flight to frame, ms.
 pub const TARGET_MS: f64 = 20.0;
 
@@ -195,6 +199,128 @@ fn signed_percentile_ms(v: &[i64], q: f64) -> f64 {
     let mut v = v.to_vec();
     v.sort_unstable();
     nearest_rank(&v, q) as f64 * 1e-3
+}
+
+/// How views moved to their poses compare with views drawn whole from the same poses.
+/// A view moved to its pose against the view drawn whole from it.
+#[derive(Debug, Clone, Copy)]
+pub struct Check {
+    /// Mean absolute difference per channel, 0–255.
+    pub mean_abs: f64,
+    /// The share of pixels that differ by more than [`VISIBLE_LEVELS`].
+    pub visible: f64,
+}
+
+/// A pixel differs visibly by more than this many levels in a channel.
+pub const VISIBLE_LEVELS: u8 = 8;
+
+/// The tracked head's emission-to-frame latency `latency` (a session's) and the `checks` of its
+/// reprojected views for the JSON summary (issue 16), or null
+/// without a tracked head on a paced simulated device's clock (`--source sim --speed 1`).
+pub fn head_json(latency: Option<LatencySummary>, checks: &[Check]) -> serde_json::Value {
+    match latency {
+        None => serde_json::Value::Null,
+        Some(l) => json!({
+            "reprojection": reprojection_json(checks),
+            "frames": l.frames, "p50_ms": l.p50_ms, "p95_ms": l.p95_ms, "max_ms": l.max_ms,
+            "prediction_ms": l.prediction_ms, "uncovered_p95_ms": l.uncovered_p95_ms(),
+            "draw_start_p50_ms": l.start_p50_ms, "draw_start_p95_ms": l.start_p95_ms,
+            "target_ms": TARGET_MS, "meets_target": l.meets_target(),
+            "host_lead_p50_ms": l.host_lead_p50_ms,
+            "reported_error_mm": error_json(l.reported_error), "drawn_error_mm": error_json(l.drawn_error),
+            "tracking_error_mm": error_json(l.tracking_error), "bias_mm": l.bias_mm,
+        }),
+    }
+}
+
+/// How the views moved to their poses compare with views drawn whole from them
+/// ([`crate::painter::Painter::check_reprojection`]), or null when none was moved.
+fn reprojection_json(checks: &[Check]) -> serde_json::Value {
+    match Reprojection::of(checks) {
+        None => serde_json::Value::Null,
+        Some(r) => json!({
+            "frames": r.frames, "mean_abs_p50": r.mean_abs_p50, "mean_abs_max": r.mean_abs_max,
+            "visibly_different_p50": r.visible_p50, "visibly_different_p95": r.visible_p95,
+            "visible_levels": VISIBLE_LEVELS,
+        }),
+    }
+}
+
+/// [`Check`]s summed up.
+struct Reprojection {
+    frames: usize,
+    mean_abs_p50: f64,
+    mean_abs_max: f64,
+    /// Shares of pixels, 0–1.
+    visible_p50: f64,
+    visible_p95: f64,
+}
+
+impl Reprojection {
+    fn of(checks: &[Check]) -> Option<Reprojection> {
+        let sorted = |f: fn(&Check) -> f64| {
+            let mut v: Vec<f64> = checks.iter().map(f).collect();
+            v.sort_by(f64::total_cmp);
+            v
+        };
+        let (mean_abs, visible) = (sorted(|c| c.mean_abs), sorted(|c| c.visible));
+        (!checks.is_empty()).then(|| Reprojection {
+            frames: checks.len(),
+            mean_abs_p50: nearest_rank(&mean_abs, 0.5),
+            mean_abs_max: nearest_rank(&mean_abs, 1.0),
+            visible_p50: nearest_rank(&visible, 0.5),
+            visible_p95: nearest_rank(&visible, 0.95),
+        })
+    }
+}
+
+/// Distances of the poses from the head's true path, or null without it.
+fn error_json(e: Option<ErrorSummary>) -> serde_json::Value {
+    e.map_or(
+        serde_json::Value::Null,
+        |e| json!({"p50": e.p50_mm, "p95": e.p95_mm, "rms": e.rms_mm}),
+    )
+}
+
+/// [`head_json`] for a person: emission to frame against the 20 ms target, and what prediction
+/// leaves uncovered.
+pub fn head_line(latency: Option<LatencySummary>, checks: &[Check]) -> Option<String> {
+    let l = latency?;
+    let moved = Reprojection::of(checks).map_or(String::new(), |r| {
+        format!(
+            "; {} moved to their poses after the latch, against the same drawn whole: p50 {:.2}/255 \
+             (most {:.2}), pixels differing visibly p50 {:.2} % / p95 {:.2} %",
+            count(r.frames as u64, "view"),
+            r.mean_abs_p50,
+            r.mean_abs_max,
+            r.visible_p50 * 100.0,
+            r.visible_p95 * 100.0
+        )
+    });
+    let truth = match (l.reported_error, l.drawn_error, l.tracking_error) {
+        (Some(r), Some(d), Some(t)) => format!(
+            "; from the true head when the frame was done: as reported p50 {:.1} / p95 {:.1} mm, as drawn p50 {:.1} / \
+             p95 {:.1} mm (at the pose's own instant p50 {:.1} / p95 {:.1} mm)",
+            r.p50_mm, r.p95_mm, d.p50_mm, d.p95_mm, t.p50_mm, t.p95_mm
+        ),
+        _ => String::new(),
+    };
+    Some(format!(
+        "head: emission to frame on the device's clock p50 {:.1} ms, p95 {:.1} ms, max {:.1} ms over {} \
+         (to the start of drawing p50 {:.1}, p95 {:.1}); target {} ms {}; predicted {} ms ahead, p95 uncovered {:.1} ms, \
+         carried on by the host p50 {:.1} ms{truth}{moved}",
+        l.p50_ms,
+        l.p95_ms,
+        l.max_ms,
+        count(l.frames as u64, "frame"),
+        l.start_p50_ms,
+        l.start_p95_ms,
+        TARGET_MS,
+        if l.meets_target() { "met" } else { "missed" },
+        l.prediction_ms,
+        l.uncovered_p95_ms(),
+        l.host_lead_p50_ms,
+    ))
 }
 
 #[cfg(test)]

@@ -1,0 +1,178 @@
+//! A session in a window: keys, the pen's edits, frames at the display's pace, the help and the
+//! notices.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::mpsc::{Receiver, RecvTimeoutError};
+use std::time::{Duration, Instant};
+
+use anyhow::Result;
+use penmodel::feed::Feed;
+use penmodel::keys::{self, KeyAction};
+use penmodel::painter::{Overview, Painter};
+use penmodel::picture::Look;
+use penmodel::session::Session;
+use penmodel_render::output::{Viewer, ViewerEvent};
+use penmodel_render::ui::{self, Place};
+
+use super::{Written, say};
+
+/// A message shown under the mode line for a while: what a key did (saved, undone, nothing to
+/// delete), what the pen's edits said — the window's user may not see the terminal.
+struct Notice {
+    text: String,
+    since: Instant,
+}
+
+impl Notice {
+    const SHOWN: Duration = Duration::from_secs(4);
+
+    fn lines(notice: &Option<Notice>) -> Vec<String> {
+        match notice {
+            Some(n) if n.since.elapsed() < Notice::SHOWN => vec![n.text.clone()],
+            _ => Vec::new(),
+        }
+    }
+}
+
+/// Says `messages` on stderr and keeps the last for the window.
+fn tell(messages: Vec<String>, notice: &mut Option<Notice>) {
+    if let Some(last) = messages.last() {
+        *notice = Some(Notice {
+            text: last.clone(),
+            since: Instant::now(),
+        });
+    }
+    say(messages, None);
+}
+
+/// Runs the session until the window closes (or a signal stops it).
+pub fn run(
+    mut viewer: Viewer,
+    rx: &Receiver<Feed>,
+    session: &mut Session,
+    look: &Look,
+    painter: &mut Painter,
+    stop: &AtomicBool,
+) -> Result<Written> {
+    const FRAME: Duration = Duration::from_millis(16);
+    let mut dirty = true;
+    let mut last = Instant::now() - FRAME;
+    let mut frames = 0;
+    let mut help = false;
+    let mut notice: Option<Notice> = None;
+    'session: while viewer.is_open() && !stop.load(Ordering::Relaxed) {
+        while let Some(e) = viewer.poll() {
+            let ViewerEvent::Key(k) = &e else {
+                if e == ViewerEvent::Closed {
+                    break 'session;
+                }
+                dirty = true;
+                continue;
+            };
+            match keys::action(k, session.interaction.view().display_mm) {
+                Some(KeyAction::Quit) => break 'session,
+                Some(KeyAction::Help) => help = !help,
+                Some(KeyAction::Overview) => {
+                    let next = if painter.overview() == Overview::Off {
+                        Overview::Corner
+                    } else {
+                        Overview::Off
+                    };
+                    painter.set_overview(next)?;
+                }
+                Some(KeyAction::Save) => {
+                    let said = match session.editor.save() {
+                        Ok(()) => match session.editor.path() {
+                            Some(p) => format!("saved {}", p.display()),
+                            None => "saved".to_string(),
+                        },
+                        Err(e) => format!("cannot save: {e}"),
+                    };
+                    tell(vec![said], &mut notice);
+                }
+                Some(KeyAction::Command(c)) => {
+                    session.interaction.command(&mut session.editor, c);
+                    tell(session.interaction.take_messages(), &mut notice);
+                }
+                None => tell(vec![format!("key {k} does nothing: h shows the keys")], &mut notice),
+            }
+            dirty = true;
+        }
+        // Take what the pen sent until it is time for the next frame.
+        let wait = FRAME.saturating_sub(last.elapsed());
+        match rx.recv_timeout(wait.max(Duration::from_millis(1))) {
+            Ok(feed) => {
+                tell(session.feed(feed), &mut notice);
+                dirty = true;
+                while let Ok(more) = rx.try_recv() {
+                    tell(session.feed(more), &mut notice);
+                    if last.elapsed() >= FRAME {
+                        break;
+                    }
+                }
+            }
+            Err(RecvTimeoutError::Timeout) => {}
+            Err(RecvTimeoutError::Disconnected) => {
+                // The pen has ended; the window stays until it is closed.
+                std::thread::sleep(FRAME);
+            }
+        }
+        // A notice going away is a change too.
+        let noticed = notice
+            .as_ref()
+            .is_some_and(|n| n.since.elapsed() < Notice::SHOWN + FRAME * 2);
+        if (dirty || noticed) && last.elapsed() >= FRAME {
+            let mut frame = if session.realtime() {
+                // Latched to the head's newest pose (issue 16); the feed's end shows next round.
+                let said = &mut |m| tell(m, &mut notice);
+                painter.session_latched(rx, session, look, true, said)?.0.clone()
+            } else {
+                if let Some(t) = session.last_event_us() {
+                    session.interaction.advance(t);
+                }
+                session.frame_started();
+                painter.session(session, look)?.clone()
+            };
+            let (w, h) = (
+                painter.view_frame().width() as i32,
+                painter.view_frame().height() as i32,
+            );
+            let viewport = penmodel_render::rasterise::Bounds {
+                x0: 0,
+                x1: w,
+                y0: 0,
+                y1: h,
+            };
+            let style = &look.style;
+            ui::panel(
+                &mut frame,
+                &viewport,
+                &Notice::lines(&notice),
+                Place::UnderModeLine,
+                style,
+            );
+            if help {
+                ui::panel(
+                    &mut frame,
+                    &viewport,
+                    &keys::help_lines(&session.interaction.help()),
+                    Place::Centre,
+                    style,
+                );
+            }
+            if viewer.show(frame).is_err() {
+                break;
+            }
+            session.frame_produced();
+            frames += 1;
+            last = Instant::now();
+            dirty = session.interaction.pulling() || session.interaction.view().tilt > 1e-3;
+        }
+    }
+    Ok(Written {
+        frames,
+        animation: None,
+        held: 0,
+        shown: true,
+    })
+}
