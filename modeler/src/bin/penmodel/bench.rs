@@ -23,6 +23,8 @@
 //!   N × N grid (default 100 figures on 1024², cell size 1 m), beside the bound validation
 //!   computes for it ([`validate::engine_bytes`], at most [`validate::MAX_ENGINE_BYTES`]).
 
+mod still;
+
 use std::io::IsTerminal;
 use std::time::Instant;
 
@@ -477,10 +479,10 @@ pub fn run(args: &Args) -> Result<()> {
 }
 
 /// Still frames ([`crate::frames`]) of every grid: LOD off and at `--lod-error`, mono and stereo.
-fn still_figures(grids: &[u32], args: &Args) -> Result<Vec<crate::frames::Still>> {
+fn still_figures(grids: &[u32], args: &Args) -> Result<Vec<still::Still>> {
     let mut out = Vec::new();
     for &n in grids {
-        let map = crate::frames::terrain(n)?;
+        let map = still::terrain(n)?;
         for stereo in [false, true] {
             for lod in [0.0, args.lod_error] {
                 if args.still_lod_only && lod != args.lod_error {
@@ -490,7 +492,7 @@ fn still_figures(grids: &[u32], args: &Args) -> Result<Vec<crate::frames::Still>
                     .still_png
                     .as_ref()
                     .map(|dir| dir.join(format!("still-{n}-lod{lod}-{}eye.png", if stereo { 2 } else { 1 })));
-                out.push(crate::frames::measure(
+                out.push(still::measure(
                     &map,
                     lod,
                     stereo,
@@ -504,7 +506,7 @@ fn still_figures(grids: &[u32], args: &Args) -> Result<Vec<crate::frames::Still>
     Ok(out)
 }
 
-fn still_json(still: &[crate::frames::Still]) -> Vec<serde_json::Value> {
+fn still_json(still: &[still::Still]) -> Vec<serde_json::Value> {
     still
         .iter()
         .map(|s| {
@@ -514,7 +516,7 @@ fn still_json(still: &[crate::frames::Still]) -> Vec<serde_json::Value> {
         .collect()
 }
 
-fn print_still(still: &[crate::frames::Still], frames: u32) -> Result<()> {
+fn print_still(still: &[still::Still], frames: u32) -> Result<()> {
     if still.is_empty() {
         return Ok(());
     }

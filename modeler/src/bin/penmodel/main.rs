@@ -8,7 +8,6 @@
 
 mod analyze;
 mod bench;
-mod frames;
 mod generate;
 mod live;
 mod out;

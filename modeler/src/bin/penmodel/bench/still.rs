@@ -34,9 +34,9 @@ pub struct Still {
 /// The terrain of `n` × `n` cells.
 pub fn terrain(n: u32) -> Result<Heightmap> {
     if n <= 1024 {
-        return Ok(Editor::new(super::bench::document(n)?)?.heightmap().clone());
+        return Ok(Editor::new(super::document(n)?)?.heightmap().clone());
     }
-    let base = Editor::new(super::bench::document(1024)?)?.heightmap().clone();
+    let base = Editor::new(super::document(1024)?)?.heightmap().clone();
     let k = f64::from(n) / 1024.0;
     let b = base.heights();
     let cell = base.cell_size() / k;
@@ -76,7 +76,7 @@ pub fn measure(
     ];
     let history = Revisions::new();
     let mut renderer = Renderer::new();
-    let mut frame = Frame::new(super::bench::FRAME.0, super::bench::FRAME.1)?;
+    let mut frame = Frame::new(super::FRAME.0, super::FRAME.1)?;
     let mut times = Vec::with_capacity(frames);
     for i in 0..WARM_UP + frames {
         let azimuth = 30.0 + 0.1 * i as f64;
@@ -85,7 +85,7 @@ pub fn measure(
         scene.revisions = Some(&history);
         scene.terrain_lod = lod_error;
         scene.stereo = if stereo { Stereo::Anaglyph } else { Stereo::None };
-        scene.style = super::bench::style(look);
+        scene.style = super::style(look);
         let t = Instant::now();
         renderer.render(&scene, &mut frame)?;
         if i >= WARM_UP {
@@ -99,7 +99,7 @@ pub fn measure(
         grid: map.cols(),
         lod_error,
         stereo,
-        frame_ms: super::bench::median(times),
+        frame_ms: super::median(times),
         levels: renderer.lod_levels(),
     })
 }
