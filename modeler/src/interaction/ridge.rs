@@ -706,16 +706,18 @@ impl Tool for Ridges {
             lines.chain(trees)
         });
         for (part, pts) in lines {
-            // The highlight marks the part's first segment, from its first node.
-            if active && self.part() == Some(part) && layers.selection.is_none() {
-                layers.selection = Some(layers.overlays.len());
-            }
             if active {
                 for p in &pts {
                     layers.push(Layers::dot(*p, None, RIDGE_COLOUR, 4.0));
                 }
             }
-            layers.push(Layers::line(pts, false, RIDGE_COLOUR, if active { 2.0 } else { 1.0 }));
+            let line = Layers::line(pts, false, RIDGE_COLOUR, if active { 2.0 } else { 1.0 });
+            // The highlight: a ridgeline's line, a tree's first segment (one overlay is lit).
+            if active && self.part() == Some(part) && layers.selection.is_none() {
+                layers.push_selected(line);
+            } else {
+                layers.push(line);
+            }
         }
         for s in self.drawing().unwrap_or_default() {
             let h = (s.h_mm > 0.0).then(|| seen.view.height_at(s.h_mm));
