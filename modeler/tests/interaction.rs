@@ -985,7 +985,10 @@ fn the_ridge_tool_draws_lines_in_the_air_trees_on_the_surface_pulls_grows_and_de
     // It is highlighted: the ridgeline's line, not one of its nodes' dots.
     let layers = pen.ui.layers(pen.doc());
     let lit = &layers.overlays[layers.selection.expect("a highlight")];
-    assert_eq!(lit.points.len(), pen.doc().ridges.as_ref().map_or(0, |r| r.lines[0].points.len()));
+    assert_eq!(
+        lit.points.len(),
+        pen.doc().ridges.as_ref().map_or(0, |r| r.lines[0].points.len())
+    );
     pen.click(2);
     let grown = pen.doc().ridges.clone().expect("ridges");
     assert!(grown.lines.len() > 1, "{:?}", pen.ui.take_messages());
