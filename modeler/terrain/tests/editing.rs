@@ -8,6 +8,7 @@ use std::fs;
 use common::*;
 use penmodel_terrain::change::Scope;
 use penmodel_terrain::editor::{Editor, EditorError, OpenReport};
+use penmodel_terrain::validate::CurveDefect;
 use penmodel_terrain::{
     CurvePath, Defect, Detail, Document, Edit, EditError, Erosion, Figure, FigurePath, Metric, TerrainEngine, generate,
     journal,
@@ -343,7 +344,10 @@ fn refused_edits_name_the_problem() {
         panic!("{outside:?}")
     };
     assert_eq!(e.path, "regions[0].figures[0].points[0]");
-    assert!(matches!(e.defect, Defect::OutsideGrid { .. }), "{e}");
+    assert!(
+        matches!(e.defect, Defect::Curve(CurveDefect::OutsideGrid { .. })),
+        "{e}"
+    );
     let nan = editor.apply(Edit::SetHeight {
         at: FigurePath::new(0, 1).child(0),
         height: f64::NAN,

@@ -5,7 +5,7 @@ use crate::common::*;
 use penmodel_terrain::editor::{Editor, EditorError};
 use penmodel_terrain::export::{self, ExportError};
 use penmodel_terrain::geometry::{self, Side};
-use penmodel_terrain::validate::{self, MAX_DEPTH, MAX_ENGINE_BYTES};
+use penmodel_terrain::validate::{self, CurveDefect, FigureDefect, MAX_DEPTH, MAX_ENGINE_BYTES};
 use penmodel_terrain::{Defect, Document, Edit, EditError, FigurePath, Heightmap, LoadError, Point, Region};
 
 /// A square `[lo, hi]²`, closed.
@@ -60,7 +60,7 @@ fn the_deepest_document_the_editor_allows_saves_and_loads_back() {
         .unwrap_err();
     match e {
         EditorError::Edit(EditError::Invalid(v)) => {
-            assert_eq!(v.defect, Defect::TooDeep(MAX_DEPTH + 1), "{v}");
+            assert_eq!(v.defect, Defect::Figure(FigureDefect::TooDeep(MAX_DEPTH + 1)), "{v}");
             assert_eq!(v.path, chain(MAX_DEPTH + 1).to_string());
         }
         other => panic!("{other}"),
@@ -89,7 +89,7 @@ fn the_deepest_document_the_editor_allows_saves_and_loads_back() {
     }
     f.figures.push(point([100.0, 100.0], 5.0, 0.0));
     match Document::from_json(&deeper.to_json()) {
-        Err(LoadError::Invalid(v)) => assert_eq!(v.defect, Defect::TooDeep(MAX_DEPTH + 1)),
+        Err(LoadError::Invalid(v)) => assert_eq!(v.defect, Defect::Figure(FigureDefect::TooDeep(MAX_DEPTH + 1))),
         other => panic!("{other:?}"),
     }
     // Far deeper than the JSON reader goes: a plain message, no "recursion limit".
@@ -115,16 +115,26 @@ fn heights_slopes_and_cell_sizes_out_of_range_are_refused_everywhere() {
             1.7e308,
             0.0,
             "regions[0].figures[0].height",
-            Defect::HeightRange(1.7e308),
+            Defect::Figure(FigureDefect::HeightRange(1.7e308)),
         ),
         (
             -1.7e308,
             0.0,
             "regions[0].figures[0].height",
-            Defect::HeightRange(-1.7e308),
+            Defect::Figure(FigureDefect::HeightRange(-1.7e308)),
         ),
-        (1e39, 0.0, "regions[0].figures[0].height", Defect::HeightRange(1e39)),
-        (10.0, 1e300, "regions[0].figures[0].slope", Defect::SlopeRange(1e300)),
+        (
+            1e39,
+            0.0,
+            "regions[0].figures[0].height",
+            Defect::Figure(FigureDefect::HeightRange(1e39)),
+        ),
+        (
+            10.0,
+            1e300,
+            "regions[0].figures[0].slope",
+            Defect::Figure(FigureDefect::SlopeRange(1e300)),
+        ),
     ] {
         let d = doc(h, s);
         let e = validate::document(&d).unwrap_err();
@@ -392,7 +402,7 @@ fn ring_result(doc: &Document) -> Option<(usize, usize)> {
     match validate::document(doc) {
         Ok(()) => None,
         Err(e) => match e.defect.clone() {
-            Defect::SelfIntersecting(i) => {
+            Defect::Curve(CurveDefect::SelfIntersecting(i)) => {
                 let j = e
                     .path
                     .rsplit('[')
@@ -492,7 +502,7 @@ fn large_curves_are_checked_correctly() {
         (e.path.as_str(), e.defect),
         (
             format!("regions[0].boundary[{}]", j + 1).as_str(),
-            Defect::SelfIntersecting(j - 1)
+            Defect::Curve(CurveDefect::SelfIntersecting(j - 1))
         )
     );
 
@@ -511,8 +521,8 @@ fn large_curves_are_checked_correctly() {
         let e = validate::document(&d).unwrap_err();
         assert_eq!(e.path, format!("regions[0].figures[1].points[{k}]"), "{e}");
         let want = match expect {
-            Side::On => Defect::OnRegionEdge("regions[0].boundary".into()),
-            _ => Defect::OutsideRegion("regions[0].boundary".into()),
+            Side::On => Defect::Figure(FigureDefect::OnRegionEdge("regions[0].boundary".into())),
+            _ => Defect::Figure(FigureDefect::OutsideRegion("regions[0].boundary".into())),
         };
         assert_eq!(e.defect, want);
     }

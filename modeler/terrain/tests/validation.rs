@@ -3,6 +3,7 @@
 use crate::common;
 
 use common::*;
+use penmodel_terrain::validate::{CurveDefect, FigureDefect, GridDefect};
 use penmodel_terrain::{Defect, Document, LoadError, Region, validate};
 
 fn base() -> Document {
@@ -47,7 +48,7 @@ fn rejects(doc: &Document, path: &str, problem: impl Fn(&Defect) -> bool) {
 }
 
 fn doc_is_finite(problem: &Defect) -> bool {
-    !matches!(problem, Defect::NotFinite | Defect::CellSize(_))
+    !matches!(problem, Defect::NotFinite | Defect::Grid(GridDefect::CellSize(_)))
 }
 
 #[test]
@@ -59,11 +60,13 @@ fn the_base_document_is_valid() {
 fn open_curves() {
     let mut d = base();
     d.regions[0].boundary.pop();
-    rejects(&d, "regions[0].boundary", |p| matches!(p, Defect::OpenCurve { .. }));
+    rejects(&d, "regions[0].boundary", |p| {
+        matches!(p, Defect::Curve(CurveDefect::OpenCurve { .. }))
+    });
     let mut d = base();
     d.regions[0].figures[2].points.pop();
     rejects(&d, "regions[0].figures[2].points", |p| {
-        matches!(p, Defect::OpenCurve { .. })
+        matches!(p, Defect::Curve(CurveDefect::OpenCurve { .. }))
     });
 }
 
@@ -74,12 +77,14 @@ fn self_intersecting_curves() {
     d.regions[0].figures[2].points = vec![[21.0, 11.0], [27.0, 17.0], [27.0, 11.0], [21.0, 17.0], [21.0, 11.0]];
     d.regions[0].figures[2].figures.clear();
     rejects(&d, "regions[0].figures[2].points[2]", |p| {
-        *p == Defect::SelfIntersecting(0)
+        *p == Defect::Curve(CurveDefect::SelfIntersecting(0))
     });
     // A boundary doubling back on itself along a line.
     let mut d = base();
     d.regions[0].boundary = vec![[5.0, 5.0], [35.0, 5.0], [20.0, 5.0], [20.0, 35.0], [5.0, 5.0]];
-    rejects(&d, "regions[0].boundary[1]", |p| *p == Defect::SelfIntersecting(0));
+    rejects(&d, "regions[0].boundary[1]", |p| {
+        *p == Defect::Curve(CurveDefect::SelfIntersecting(0))
+    });
 }
 
 #[test]
@@ -87,13 +92,13 @@ fn figures_outside_their_region() {
     let mut d = base();
     d.regions[0].figures[0].points[0] = [2.0, 2.0];
     rejects(&d, "regions[0].figures[0].points[0]", |p| {
-        *p == Defect::OutsideRegion("regions[0].boundary".into())
+        *p == Defect::Figure(FigureDefect::OutsideRegion("regions[0].boundary".into()))
     });
     // A nested figure outside its closed figure (but inside the region).
     let mut d = base();
     d.regions[0].figures[2].figures[0].points[0] = [20.0, 25.0];
     rejects(&d, "regions[0].figures[2].figures[0].points[0]", |p| {
-        *p == Defect::OutsideRegion("regions[0].figures[2].points".into())
+        *p == Defect::Figure(FigureDefect::OutsideRegion("regions[0].figures[2].points".into()))
     });
     // A polyline whose points are inside but whose segment leaves the region: a square region
     // with a notch, the segment jumping across the notch.
@@ -110,7 +115,7 @@ fn figures_outside_their_region() {
     ];
     d.regions[0].figures = vec![polyline(vec![[10.0, 30.0], [30.0, 30.0]], 5.0, 0.0)];
     rejects(&d, "regions[0].figures[0].points[1]", |p| {
-        *p == Defect::CrossesRegionEdge("regions[0].boundary".into())
+        *p == Defect::Figure(FigureDefect::CrossesRegionEdge("regions[0].boundary".into()))
     });
 }
 
@@ -125,7 +130,7 @@ fn overlapping_regions() {
     rejects(
         &d,
         "regions[1]",
-        |p| matches!(p, Defect::Overlap { other, .. } if other == "regions[0]"),
+        |p| matches!(p, Defect::Figure(FigureDefect::Overlap { other, .. }) if other == "regions[0]"),
     );
     // Closer than a cell without touching still overlaps on the grid: x = 35.1 and x = 35.4
     // both fall in column 35.
@@ -141,10 +146,10 @@ fn overlapping_regions() {
         figures: vec![],
     });
     rejects(&d, "regions[1]", |p| {
-        *p == Defect::Overlap {
+        *p == Defect::Figure(FigureDefect::Overlap {
             other: "regions[0]".into(),
             cell: (35, 1),
-        }
+        })
     });
     // Sibling closed figures bound nested regions: they must not overlap either.
     let mut d = base();
@@ -154,7 +159,7 @@ fn overlapping_regions() {
     rejects(
         &d,
         "regions[0].figures[3]",
-        |p| matches!(p, Defect::Overlap { other, .. } if other == "regions[0].figures[2]"),
+        |p| matches!(p, Defect::Figure(FigureDefect::Overlap { other, .. }) if other == "regions[0].figures[2]"),
     );
 }
 
@@ -173,7 +178,9 @@ fn non_finite_numbers() {
     rejects(&d, "regions[0].figures[1].points[2]", |p| *p == Defect::NotFinite);
     let mut d = base();
     d.grid.cell_size = f64::NAN;
-    rejects(&d, "grid.cell_size", |p| matches!(p, Defect::CellSize(_)));
+    rejects(&d, "grid.cell_size", |p| {
+        matches!(p, Defect::Grid(GridDefect::CellSize(_)))
+    });
 }
 
 #[test]
@@ -182,18 +189,18 @@ fn grids() {
     d.grid.cols = 100_000;
     d.grid.rows = 100_000;
     rejects(&d, "grid", |p| {
-        *p == Defect::GridTooLarge {
+        *p == Defect::Grid(GridDefect::GridTooLarge {
             cells: 10_000_000_000,
             max: validate::MAX_CELLS,
-        }
+        })
     });
     let mut d = base();
     d.grid.rows = 0;
-    rejects(&d, "grid", |p| *p == Defect::EmptyGrid);
+    rejects(&d, "grid", |p| *p == Defect::Grid(GridDefect::EmptyGrid));
     let mut d = base();
     d.grid.cols = 30; // the region reaches x = 35
     rejects(&d, "regions[0].boundary[0]", |p| {
-        matches!(p, Defect::OutsideGrid { .. })
+        matches!(p, Defect::Curve(CurveDefect::OutsideGrid { .. }))
     });
 }
 
@@ -201,23 +208,29 @@ fn grids() {
 fn figure_shapes() {
     let mut d = base();
     d.regions[0].figures[0].points.push([15.0, 18.0]);
-    rejects(&d, "regions[0].figures[0].points", |p| *p == Defect::PointCount(2));
+    rejects(&d, "regions[0].figures[0].points", |p| {
+        *p == Defect::Figure(FigureDefect::PointCount(2))
+    });
     let mut d = base();
     d.regions[0].figures[1].points.truncate(1);
     rejects(&d, "regions[0].figures[1].points", |p| {
-        *p == Defect::PolylineTooShort(1)
+        *p == Defect::Figure(FigureDefect::PolylineTooShort(1))
     });
     let mut d = base();
     d.regions[0].figures[1].points[1] = d.regions[0].figures[1].points[0];
-    rejects(&d, "regions[0].figures[1].points[1]", |p| *p == Defect::RepeatedPoint);
+    rejects(&d, "regions[0].figures[1].points[1]", |p| {
+        *p == Defect::Curve(CurveDefect::RepeatedPoint)
+    });
     let mut d = base();
     d.regions[0].figures[2].points = vec![[22.0, 12.0], [25.0, 12.0], [22.0, 12.0]];
     d.regions[0].figures[2].figures.clear();
-    rejects(&d, "regions[0].figures[2].points", |p| *p == Defect::CurveTooShort(2));
+    rejects(&d, "regions[0].figures[2].points", |p| {
+        *p == Defect::Curve(CurveDefect::CurveTooShort(2))
+    });
     let mut d = base();
     d.regions[0].figures[1].figures.push(point([20.0, 20.0], 1.0, 0.0));
     rejects(&d, "regions[0].figures[1].figures", |p| {
-        *p == Defect::NestedInOpenFigure("polyline")
+        *p == Defect::Figure(FigureDefect::NestedInOpenFigure("polyline"))
     });
 }
 
