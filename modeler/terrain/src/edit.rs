@@ -364,51 +364,13 @@ fn apply(doc: &mut Document, edit: &Edit) -> Result<Applied, EditError> {
             replace_region(doc, *index, region.clone(), Scope::RegionReplaced(*index))
         }
         Edit::Group { .. } => Err(EditError::Group),
-        Edit::AddRocks { index, field } => {
-            if *index > doc.rocks.len() {
-                return Err(EditError::NoRocks(*index));
-            }
-            doc.rocks.insert(*index, field.clone());
-            if let Err(e) = validate::rock_fields(doc) {
-                doc.rocks.remove(*index);
-                return Err(e.into());
-            }
-            Ok(Applied {
-                inverse: Edit::DeleteRocks { index: *index },
-                scope: Scope::Rocks(*index),
-            })
-        }
-        Edit::DeleteRocks { index } => {
-            if *index >= doc.rocks.len() {
-                return Err(EditError::NoRocks(*index));
-            }
-            let field = doc.rocks.remove(*index);
-            Ok(Applied {
-                inverse: Edit::AddRocks { index: *index, field },
-                scope: Scope::Rocks(*index),
-            })
-        }
-        Edit::MoveRocks { index, by } => {
-            let mut field = doc.rocks.get(*index).ok_or(EditError::NoRocks(*index))?.clone();
-            field.at = [field.at[0] + by[0], field.at[1] + by[1]];
-            replace_rocks(doc, *index, field)
-        }
-        Edit::ReplaceRocks { index, field } => {
-            doc.rocks.get(*index).ok_or(EditError::NoRocks(*index))?;
-            replace_rocks(doc, *index, field.clone())
-        }
-        Edit::AddRiver { index, river } => add_river(doc, *index, river.clone()),
-        Edit::DeleteRiver { index } => {
-            if *index >= doc.rivers.len() {
-                return Err(EditError::NoRiver(*index));
-            }
-            let river = doc.rivers.remove(*index);
-            Ok(Applied {
-                inverse: Edit::AddRiver { index: *index, river },
-                scope: Scope::Rivers(*index),
-            })
-        }
-        Edit::ReplaceRiver { index, river } => replace_river(doc, *index, river.clone()),
+        Edit::AddRocks { index, field } => insert(doc, *index, field),
+        Edit::DeleteRocks { index } => remove::<RockField>(doc, *index),
+        Edit::MoveRocks { index, by } => shift(doc, *index, |f: &mut RockField| f.at = plus(f.at, *by)),
+        Edit::ReplaceRocks { index, field } => replace(doc, *index, field.clone()),
+        Edit::AddRiver { index, river } => insert(doc, *index, river),
+        Edit::DeleteRiver { index } => remove::<River>(doc, *index),
+        Edit::ReplaceRiver { index, river } => replace(doc, *index, river.clone()),
         Edit::SetRidges { ridges } => {
             let old = std::mem::replace(&mut doc.ridges, ridges.clone());
             if let Err(e) = validate::ridges(doc) {
@@ -420,138 +382,184 @@ fn apply(doc: &mut Document, edit: &Edit) -> Result<Applied, EditError> {
                 scope: Scope::Ridges,
             })
         }
-        Edit::AddTree { index, tree } => {
-            if *index > doc.trees.len() {
-                return Err(EditError::NoTree(*index));
+        Edit::AddTree { index, tree } => insert(doc, *index, tree),
+        Edit::DeleteTree { index } => remove::<Tree>(doc, *index),
+        Edit::MoveTree { index, by } => shift(doc, *index, |t: &mut Tree| t.at = plus(t.at, *by)),
+        Edit::ReplaceTree { index, tree } => replace(doc, *index, tree.clone()),
+        Edit::AddGrove { index, grove } => insert(doc, *index, grove),
+        Edit::DeleteGrove { index } => remove::<Grove>(doc, *index),
+        Edit::MoveGrove { index, by } => shift(doc, *index, |g: &mut Grove| {
+            for p in &mut g.region {
+                *p = plus(*p, *by);
             }
-            doc.trees.insert(*index, tree.clone());
-            if let Err(e) = validate::trees(doc) {
-                doc.trees.remove(*index);
-                return Err(e.into());
-            }
-            Ok(Applied {
-                inverse: Edit::DeleteTree { index: *index },
-                scope: Scope::Trees,
-            })
-        }
-        Edit::DeleteTree { index } => {
-            if *index >= doc.trees.len() {
-                return Err(EditError::NoTree(*index));
-            }
-            let tree = doc.trees.remove(*index);
-            Ok(Applied {
-                inverse: Edit::AddTree { index: *index, tree },
-                scope: Scope::Trees,
-            })
-        }
-        Edit::MoveTree { index, by } => {
-            let mut tree = doc.trees.get(*index).ok_or(EditError::NoTree(*index))?.clone();
-            tree.at = [tree.at[0] + by[0], tree.at[1] + by[1]];
-            replace_tree(doc, *index, tree)
-        }
-        Edit::ReplaceTree { index, tree } => {
-            doc.trees.get(*index).ok_or(EditError::NoTree(*index))?;
-            replace_tree(doc, *index, tree.clone())
-        }
-        Edit::AddGrove { index, grove } => {
-            if *index > doc.groves.len() {
-                return Err(EditError::NoGrove(*index));
-            }
-            doc.groves.insert(*index, grove.clone());
-            if let Err(e) = validate::groves(doc) {
-                doc.groves.remove(*index);
-                return Err(e.into());
-            }
-            Ok(Applied {
-                inverse: Edit::DeleteGrove { index: *index },
-                scope: Scope::Trees,
-            })
-        }
-        Edit::DeleteGrove { index } => {
-            if *index >= doc.groves.len() {
-                return Err(EditError::NoGrove(*index));
-            }
-            let grove = doc.groves.remove(*index);
-            Ok(Applied {
-                inverse: Edit::AddGrove { index: *index, grove },
-                scope: Scope::Trees,
-            })
-        }
-        Edit::MoveGrove { index, by } => {
-            let mut grove = doc.groves.get(*index).ok_or(EditError::NoGrove(*index))?.clone();
-            for p in &mut grove.region {
-                *p = [p[0] + by[0], p[1] + by[1]];
-            }
-            replace_grove(doc, *index, grove)
-        }
-        Edit::ReplaceGrove { index, grove } => {
-            doc.groves.get(*index).ok_or(EditError::NoGrove(*index))?;
-            replace_grove(doc, *index, grove.clone())
-        }
+        }),
+        Edit::ReplaceGrove { index, grove } => replace(doc, *index, grove.clone()),
     }
 }
 
-fn add_river(doc: &mut Document, index: usize, river: River) -> Result<Applied, EditError> {
-    if index > doc.rivers.len() {
-        return Err(EditError::NoRiver(index));
+fn plus(p: Point, by: Point) -> Point {
+    [p[0] + by[0], p[1] + by[1]]
+}
+
+/// An element kind the document keeps in a list and edits by index (rock fields, rivers, trees,
+/// groves): its list, its check, its edits and its scope. Adding, deleting, replacing and moving
+/// are written once, below, for every such kind.
+trait Listed: Clone + Sized {
+    fn list(doc: &mut Document) -> &mut Vec<Self>;
+    /// Checks the kind's elements after a change (the whole list: a check may compare them).
+    fn check(doc: &Document) -> Result<(), ValidationError>;
+    /// The error for a missing index.
+    fn missing(index: usize) -> EditError;
+    fn scope(index: usize) -> Scope;
+    fn add(index: usize, element: Self) -> Edit;
+    fn delete(index: usize) -> Edit;
+    fn replace(index: usize, element: Self) -> Edit;
+}
+
+impl Listed for RockField {
+    fn list(doc: &mut Document) -> &mut Vec<Self> {
+        &mut doc.rocks
     }
-    doc.rivers.insert(index, river);
-    if let Err(e) = validate::rivers(doc) {
-        doc.rivers.remove(index);
+    fn check(doc: &Document) -> Result<(), ValidationError> {
+        validate::rock_fields(doc)
+    }
+    fn missing(index: usize) -> EditError {
+        EditError::NoRocks(index)
+    }
+    fn scope(index: usize) -> Scope {
+        Scope::Rocks(index)
+    }
+    fn add(index: usize, field: Self) -> Edit {
+        Edit::AddRocks { index, field }
+    }
+    fn delete(index: usize) -> Edit {
+        Edit::DeleteRocks { index }
+    }
+    fn replace(index: usize, field: Self) -> Edit {
+        Edit::ReplaceRocks { index, field }
+    }
+}
+
+impl Listed for River {
+    fn list(doc: &mut Document) -> &mut Vec<Self> {
+        &mut doc.rivers
+    }
+    fn check(doc: &Document) -> Result<(), ValidationError> {
+        validate::rivers(doc)
+    }
+    fn missing(index: usize) -> EditError {
+        EditError::NoRiver(index)
+    }
+    fn scope(index: usize) -> Scope {
+        Scope::Rivers(index)
+    }
+    fn add(index: usize, river: Self) -> Edit {
+        Edit::AddRiver { index, river }
+    }
+    fn delete(index: usize) -> Edit {
+        Edit::DeleteRiver { index }
+    }
+    fn replace(index: usize, river: Self) -> Edit {
+        Edit::ReplaceRiver { index, river }
+    }
+}
+
+impl Listed for Tree {
+    fn list(doc: &mut Document) -> &mut Vec<Self> {
+        &mut doc.trees
+    }
+    fn check(doc: &Document) -> Result<(), ValidationError> {
+        validate::trees(doc)
+    }
+    fn missing(index: usize) -> EditError {
+        EditError::NoTree(index)
+    }
+    fn scope(_: usize) -> Scope {
+        Scope::Trees
+    }
+    fn add(index: usize, tree: Self) -> Edit {
+        Edit::AddTree { index, tree }
+    }
+    fn delete(index: usize) -> Edit {
+        Edit::DeleteTree { index }
+    }
+    fn replace(index: usize, tree: Self) -> Edit {
+        Edit::ReplaceTree { index, tree }
+    }
+}
+
+impl Listed for Grove {
+    fn list(doc: &mut Document) -> &mut Vec<Self> {
+        &mut doc.groves
+    }
+    fn check(doc: &Document) -> Result<(), ValidationError> {
+        validate::groves(doc)
+    }
+    fn missing(index: usize) -> EditError {
+        EditError::NoGrove(index)
+    }
+    fn scope(_: usize) -> Scope {
+        Scope::Trees
+    }
+    fn add(index: usize, grove: Self) -> Edit {
+        Edit::AddGrove { index, grove }
+    }
+    fn delete(index: usize) -> Edit {
+        Edit::DeleteGrove { index }
+    }
+    fn replace(index: usize, grove: Self) -> Edit {
+        Edit::ReplaceGrove { index, grove }
+    }
+}
+
+/// Inserts `element` at `index` (the list's length appends), if the kind's check passes.
+fn insert<T: Listed>(doc: &mut Document, index: usize, element: &T) -> Result<Applied, EditError> {
+    if index > T::list(doc).len() {
+        return Err(T::missing(index));
+    }
+    T::list(doc).insert(index, element.clone());
+    if let Err(e) = T::check(doc) {
+        T::list(doc).remove(index);
         return Err(e.into());
     }
     Ok(Applied {
-        inverse: Edit::DeleteRiver { index },
-        scope: Scope::Rivers(index),
+        inverse: T::delete(index),
+        scope: T::scope(index),
     })
 }
 
-fn replace_river(doc: &mut Document, index: usize, new: River) -> Result<Applied, EditError> {
-    let old = std::mem::replace(doc.rivers.get_mut(index).ok_or(EditError::NoRiver(index))?, new);
-    if let Err(e) = validate::rivers(doc) {
-        doc.rivers[index] = old;
-        return Err(e.into());
+/// Removes element `index`; a removal leaves the other elements valid.
+fn remove<T: Listed>(doc: &mut Document, index: usize) -> Result<Applied, EditError> {
+    if index >= T::list(doc).len() {
+        return Err(T::missing(index));
     }
+    let old = T::list(doc).remove(index);
     Ok(Applied {
-        inverse: Edit::ReplaceRiver { index, river: old },
-        scope: Scope::Rivers(index),
+        inverse: T::add(index, old),
+        scope: T::scope(index),
     })
 }
 
-fn replace_rocks(doc: &mut Document, index: usize, new: RockField) -> Result<Applied, EditError> {
-    let old = std::mem::replace(&mut doc.rocks[index], new);
-    if let Err(e) = validate::rock_fields(doc) {
-        doc.rocks[index] = old;
+/// Replaces element `index` with `new`, if the kind's check passes.
+fn replace<T: Listed>(doc: &mut Document, index: usize, new: T) -> Result<Applied, EditError> {
+    let slot = T::list(doc).get_mut(index).ok_or_else(|| T::missing(index))?;
+    let old = std::mem::replace(slot, new);
+    if let Err(e) = T::check(doc) {
+        T::list(doc)[index] = old;
         return Err(e.into());
     }
     Ok(Applied {
-        inverse: Edit::ReplaceRocks { index, field: old },
-        scope: Scope::Rocks(index),
+        inverse: T::replace(index, old),
+        scope: T::scope(index),
     })
 }
 
-fn replace_tree(doc: &mut Document, index: usize, new: Tree) -> Result<Applied, EditError> {
-    let old = std::mem::replace(&mut doc.trees[index], new);
-    if let Err(e) = validate::trees(doc) {
-        doc.trees[index] = old;
-        return Err(e.into());
-    }
-    Ok(Applied {
-        inverse: Edit::ReplaceTree { index, tree: old },
-        scope: Scope::Trees,
-    })
-}
-
-fn replace_grove(doc: &mut Document, index: usize, new: Grove) -> Result<Applied, EditError> {
-    let old = std::mem::replace(&mut doc.groves[index], new);
-    if let Err(e) = validate::groves(doc) {
-        doc.groves[index] = old;
-        return Err(e.into());
-    }
-    Ok(Applied {
-        inverse: Edit::ReplaceGrove { index, grove: old },
-        scope: Scope::Trees,
-    })
+/// Replaces element `index` with a copy changed by `by` (a move: the inverse restores the old
+/// element exactly rather than moving back).
+fn shift<T: Listed>(doc: &mut Document, index: usize, by: impl FnOnce(&mut T)) -> Result<Applied, EditError> {
+    let mut new = T::list(doc).get(index).ok_or_else(|| T::missing(index))?.clone();
+    by(&mut new);
+    replace(doc, index, new)
 }
 
 fn no_point(curve: &CurvePath, index: usize) -> EditError {
