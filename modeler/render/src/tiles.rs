@@ -15,12 +15,12 @@ use std::cell::RefCell;
 
 use rayon::prelude::*;
 
-use super::frame::Rgba;
-use super::nodes;
-use super::rasterise::{self, Bounds, Capsule, Sample, Sink};
-use super::scene::Style;
-use super::shade::{self, Shading};
-use super::transform::{self, Affine, ChunkState, Projected};
+use crate::lod::nodes;
+use crate::output::frame::Rgba;
+use crate::raster::rasterise::{self, Bounds, Capsule, Sample, Sink};
+use crate::raster::transform::{self, Affine, ChunkState, Projected};
+use crate::scene::Style;
+use crate::shade::{self, Shading};
 use penmodel_terrain::Heightmap;
 
 /// What the tiles of one eye share.
@@ -124,8 +124,11 @@ thread_local! {
 #[allow(clippy::too_many_arguments)]
 pub fn render(
     pass: &EyePass,
-    meshes: &[super::meshes::Projected],
-    (textured, textures): (&[super::textured::Projected], &[&super::textured::Texture]),
+    meshes: &[crate::scene::meshes::Projected],
+    (textured, textures): (
+        &[crate::raster::textured::Projected],
+        &[&crate::raster::textured::Texture],
+    ),
     capsules: &[Capsule],
     shading: &Shading,
     style: &Style,

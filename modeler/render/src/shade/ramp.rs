@@ -3,7 +3,7 @@
 //! to `ramp_top`. Looked up per pixel from a [`RAMP_ENTRIES`]-entry table over
 //! `[−ramp_depth, ramp_top]` ([`Ramp`]), so the bands stay sharp on triangles large on screen.
 
-use super::scene::Style;
+use crate::scene::Style;
 
 /// Entries of the colour table.
 pub const RAMP_ENTRIES: usize = 1024;

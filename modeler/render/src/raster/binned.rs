@@ -1,5 +1,5 @@
 //! Projected triangles (or quads) binned by bands of rows, shared by the meshes
-//! ([`crate::meshes`]: triangles) and the textured quads ([`crate::textured`]: quads): vertices
+//! ([`crate::scene::meshes`]: triangles) and the textured quads ([`super::textured`]: quads): vertices
 //! projected once per eye, each polygon listed in the bands of rows its screen extent reaches
 //! (every band when it crosses the near plane), and drawn per tile — straight when it lies
 //! wholly in front of the near plane (a quad in one pass, [`rasterise::quad_two_sided`]),

@@ -39,7 +39,7 @@
 
 use glam::{DMat3, DVec3};
 
-use super::frame::RenderError;
+use crate::output::frame::RenderError;
 
 /// A virtual camera circling a target point.
 #[derive(Debug, Clone, Copy, PartialEq)]

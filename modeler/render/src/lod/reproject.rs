@@ -25,9 +25,9 @@
 
 use rayon::prelude::*;
 
-use crate::camera::Projection;
-use crate::frame::Rgba;
-use crate::rasterise::Bounds;
+use crate::output::frame::Rgba;
+use crate::raster::camera::Projection;
+use crate::raster::rasterise::Bounds;
 
 /// Steps an output pixel takes towards its source pixel. The source pixel's motion differs from
 /// its neighbours' only at depth edges: one step lands within a pixel elsewhere, a second
@@ -57,7 +57,7 @@ pub enum Background {
     /// they are. In a tracked view every point of the screen's plane does, and it is at depth
     /// `w` = the eye's distance from the screen: this is its `1/w`.
     Screen(f32),
-    /// The land look's world ([`crate::atmosphere`]): below the horizon a level plane at this
+    /// The land look's world ([`crate::shade::atmosphere`]): below the horizon a level plane at this
     /// world height (the table and the land beyond it), above it the sky, at infinity.
     Level(f32),
 }
@@ -249,7 +249,7 @@ fn settle(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::{Camera, Eye, Tracked, View, Viewport};
+    use crate::raster::camera::{Camera, Eye, Tracked, View, Viewport};
 
     fn projection(head: [f64; 3]) -> Projection {
         let camera = Camera {

@@ -28,10 +28,13 @@
 //! - The choice per node ([`Pick`]) is data: the landscape tools' meshes may use [`Pyramid::select`]
 //!   to pick their own levels later.
 
+pub mod nodes;
+pub mod reproject;
+
 use rayon::prelude::*;
 
-use super::rasterise::Bounds;
-use super::transform::{Affine, CHUNK};
+use crate::raster::rasterise::Bounds;
+use crate::raster::transform::{Affine, CHUNK};
 use penmodel_terrain::Heightmap;
 
 /// Quads per node side at every level.

@@ -48,10 +48,10 @@
 use rayon::prelude::*;
 use wide::f32x4;
 
-use super::light;
-use super::mips::{Level, Mips};
 use super::ramp::{self, WATER};
-use super::scene::{Scene, Style};
+use crate::raster::mips::{Level, Mips};
+use crate::scene::light;
+use crate::scene::{Scene, Style};
 use penmodel_terrain::revision::Mark;
 use penmodel_terrain::ridge::sun::{self, Field};
 
@@ -383,7 +383,7 @@ impl Land {
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Ground<'a> {
     albedo: &'a [[f32; 4]],
-    /// Levels 1, 2, … of `albedo`, box-filtered ([`crate::mips`]).
+    /// Levels 1, 2, … of `albedo`, box-filtered ([`crate::raster::mips`]).
     mips: &'a [Level],
     cols: usize,
     /// 1 / cell size.
@@ -421,7 +421,7 @@ impl Ground<'_> {
         )
     }
 
-    /// The box-filtered levels above the colours ([`crate::mips`]).
+    /// The box-filtered levels above the colours ([`crate::raster::mips`]).
     #[inline]
     pub(crate) fn levels(&self) -> usize {
         self.mips.len()
@@ -605,7 +605,7 @@ fn smoothstep(a: f32, b: f32, t: f32) -> f32 {
 }
 
 use super::atmosphere::lerp as mix;
-use super::floor::{SMALL, floor_small};
+use crate::simd::floor::{SMALL, floor_small};
 
 fn rgb(c: [u8; 3]) -> [f32; 3] {
     c.map(f32::from)

@@ -5,10 +5,12 @@
 //! squeezed like the rest of the half), at zero parallax. They sit on translucent dark panels so
 //! they read on snow as well as on water.
 
-use super::frame::{Frame, Rgba};
-use super::rasterise::Bounds;
-use super::scene::{SlopeBar, Style};
-use super::text;
+pub mod overlay;
+pub mod text;
+
+use crate::output::frame::{Frame, Rgba};
+use crate::raster::rasterise::Bounds;
+use crate::scene::{SlopeBar, Style};
 
 /// Colour of the slope bar's track.
 pub const TRACK_COLOUR: Rgba = [70, 70, 76, 255];

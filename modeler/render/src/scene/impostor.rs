@@ -26,10 +26,10 @@ use penmodel_terrain::export::Mesh;
 use penmodel_terrain::trees::{Impostor, NodeTree};
 use rayon::prelude::*;
 
+use super::Style;
 use super::meshes::srgb;
-use super::rasterise::{self, Bounds, DepthSink, Sample, Surface, Vtx};
-use super::scene::Style;
-use super::textured::{Quad, Texture};
+use crate::raster::rasterise::{self, Bounds, DepthSink, Sample, Surface, Vtx};
+use crate::raster::textured::{Quad, Texture};
 
 /// Texels across a side of a simplified shape's texture. A group drawn as one shape is at most
 /// `Q·S_tree` across, tens of pixels at the distances where it replaces geometry.

@@ -1,23 +1,27 @@
 //! Shading: samples become colours.
 //!
-//! - The rasteriser leaves the interpolated height and light ([`crate::light`]) in each sample;
-//!   the classic look's colour is `ramp(height) × light` ([`crate::ramp`]), per pixel.
+//! - The rasteriser leaves the interpolated height and light ([`crate::scene::light`]) in each sample;
+//!   the classic look's colour is `ramp(height) × light` ([`crate::shade::ramp`]), per pixel.
 //! - Empty samples show the sky, a vertical gradient.
 //! - The land look ([`crate::scene::Look::Land`]) colours a terrain sample by the ground colour at
-//!   its world point ([`crate::land`]) instead of the ramp, hazes every surface by its distance
+//!   its world point ([`crate::shade::land`]) instead of the ramp, hazes every surface by its distance
 //!   and shows the sky, the table and the land beyond where nothing was drawn
-//!   ([`crate::atmosphere`]).
+//!   ([`crate::shade::atmosphere`]).
 //!
 //! The ramp and the light live in their own modules, which the land look uses too: shading
 //! depends on the land look, not the other way round.
 
-use super::atmosphere::Atmosphere;
-use super::frame::Rgba;
-use super::land::{Corner, Land, faded};
-use super::mips;
-use super::ramp::Ramp;
-use super::rasterise::{Sample, Surface};
-use super::scene::Style;
+pub mod atmosphere;
+pub mod land;
+pub mod ramp;
+
+use crate::output::frame::Rgba;
+use crate::raster::mips;
+use crate::raster::rasterise::{Sample, Surface};
+use crate::scene::Style;
+use crate::shade::atmosphere::Atmosphere;
+use crate::shade::land::{Corner, Land, faded};
+use crate::shade::ramp::Ramp;
 
 fn mix(a: Rgba, b: Rgba, t: f32) -> Rgba {
     [0, 1, 2, 3].map(|i| (f32::from(a[i]) + t * (f32::from(b[i]) - f32::from(a[i]))).round() as u8)
@@ -29,7 +33,7 @@ pub struct Shading<'a> {
     /// The classic look's colour table (unused by the land look).
     pub ramp: &'a Ramp,
     /// The land look's maps of the terrain, this eye's atmosphere and its background when kept
-    /// (row-major over the frame: [`crate::atmosphere::Backdrop`]; else computed per pixel that
+    /// (row-major over the frame: [`crate::shade::atmosphere::Backdrop`]; else computed per pixel that
     /// shows no surface).
     pub land: Option<LandShading<'a>>,
 }
@@ -118,7 +122,7 @@ struct Stretch {
     fade: [f32; LANES],
     light: [f32; LANES],
     haze: [f32; LANES],
-    /// Where the bilinear ground colour reads ([`crate::land::Ground::corner`]), field by
+    /// Where the bilinear ground colour reads ([`crate::shade::land::Ground::corner`]), field by
     /// field.
     index: [u32; LANES],
     fu: [f32; LANES],
@@ -134,8 +138,8 @@ struct Stretch {
 }
 
 /// [`resolve`] in the land look: a terrain sample's ground colour where its world point lies
-/// ([`crate::land::Ground::bilinear`]) with as much of the fine noise as its footprint resolves
-/// ([`crate::land::FINE_FADE`]), every surface hazed by its distance, the atmosphere behind.
+/// ([`crate::shade::land::Ground::bilinear`]) with as much of the fine noise as its footprint resolves
+/// ([`crate::shade::land::FINE_FADE`]), every surface hazed by its distance, the atmosphere behind.
 ///
 /// Each stretch of [`LANES`] pixels of a row goes through passes: the samples' fields; the
 /// arithmetic (the rays and sines as the row's first plus `k` steps, the world point, the fade,

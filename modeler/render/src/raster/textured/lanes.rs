@@ -15,7 +15,7 @@
 //! frame in one process).
 //!
 //! The same values as [`TexelSink::pixel`](super::TexelSink): a lane's attributes are the row's
-//! start plus its offset times the step (the rasteriser's rule, [`crate::rasterise::Sink`]), the
+//! start plus its offset times the step (the rasteriser's rule, [`crate::raster::rasterise::Sink`]), the
 //! depth test is "not `1/w` ≤ the sample's" (a NaN passes, as there), the division and the
 //! products are the same IEEE operations, the texel index is clamped as the 16-bit cast and
 //! `min` clamp it, and alpha ≥ 128 is the texel's top bit. A test in `textured.rs` compares the
@@ -25,7 +25,7 @@ use std::arch::x86_64::*;
 use std::ops::Range;
 
 use super::{Level, texel_sample};
-use crate::rasterise::{Sample, Surface};
+use crate::raster::rasterise::{Sample, Surface};
 
 /// Lanes in a group.
 const LANES: i32 = 8;
@@ -36,7 +36,7 @@ fn fits(level: &Level<'_>) -> bool {
 }
 
 /// Draws pixels `k` in `ks` of the row whose first box column is sample `at` (the sink's
-/// [`run`](crate::rasterise::Sink::run)). `false` (nothing drawn) when the texels' indices do not
+/// [`run`](crate::raster::rasterise::Sink::run)). `false` (nothing drawn) when the texels' indices do not
 /// fit the lanes or a pixel lies past the samples: the caller draws them one at a time.
 ///
 /// Safe to call where the CPU has AVX2.
@@ -65,7 +65,7 @@ pub(super) fn run(
 }
 
 /// Draws pixels `k` for the set bits of `mask` of the row whose first box column is sample `at`
-/// (the sink's [`masked`](crate::rasterise::Sink::masked)); `false` as [`run`].
+/// (the sink's [`masked`](crate::raster::rasterise::Sink::masked)); `false` as [`run`].
 ///
 /// Safe to call where the CPU has AVX2.
 #[target_feature(enable = "avx2")]

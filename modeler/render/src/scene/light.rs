@@ -1,11 +1,11 @@
 //! Light per vertex (Gouraud): the normal from central differences of the heights (with the
 //! vertical scale), `light = ambient + (1 − ambient)·max(0, n·L)` with `L` fixed to the terrain,
 //! so tilting the ground or moving the eye does not change it; computed once per frame for both
-//! eyes. The land look gives its own light per cell instead ([`crate::land`]).
+//! eyes. The land look gives its own light per cell instead ([`crate::shade::land`]).
 
 use rayon::prelude::*;
 
-use super::scene::Style;
+use super::Style;
 use penmodel_terrain::Heightmap;
 
 /// The drawn surface's gradient `[∂y/∂x, ∂y/∂z]` at vertex `(c, r)` of the `cols × rows`
@@ -42,7 +42,7 @@ pub(crate) fn gradient(
 
 /// Per-vertex light, row-major like the heights; `NaN` where the height is not finite. Returns
 /// how many heights are not finite. With `given` (one value per cell, 0 to 1: see
-/// [`Scene::light_map`](super::scene::Scene::light_map)) the light is `ambient + (1 − ambient)·given`
+/// [`Scene::light_map`](super::Scene::light_map)) the light is `ambient + (1 − ambient)·given`
 /// instead of Lambert's.
 pub fn vertex_light(
     map: &Heightmap,

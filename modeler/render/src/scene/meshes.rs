@@ -17,12 +17,12 @@
 use penmodel_terrain::export::Mesh;
 use penmodel_terrain::trees::shapes::BARK;
 
-use super::binned::{Binned, Faces};
-use super::clip::ClipVertex;
-use super::rasterise::{Bounds, DepthSink, Sample, Surface};
+use super::Style;
 use super::rock_lod;
-use super::scene::Style;
-use super::transform::Affine;
+use crate::raster::binned::{Binned, Faces};
+use crate::raster::clip::ClipVertex;
+use crate::raster::rasterise::{Bounds, DepthSink, Sample, Surface};
+use crate::raster::transform::Affine;
 
 /// How a mesh is coloured.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -126,7 +126,7 @@ impl Projected {
 
     /// Projects and bins rock fields like [`Projected::add`] with [`Paint::Whole`]`(`[`Surface::Rock`]`)`,
     /// each rock whose bounding sphere projects within `pixels` of its centre as one quad
-    /// ([`crate::rock_lod`]); `pixels` 0 draws every rock whole.
+    /// ([`super::rock_lod`]); `pixels` 0 draws every rock whole.
     pub fn add_rocks<'m>(
         &mut self,
         meshes: impl IntoIterator<Item = &'m Mesh>,

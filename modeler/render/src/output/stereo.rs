@@ -1,7 +1,7 @@
 //! Stereo: combining the two eyes' images.
 //!
 //! Each eye is its own off-axis projection from the tracked head (or the orbit camera) ± half
-//! the eye separation ([`super::camera`]); this module only combines the pictures.
+//! the eye separation ([`crate::raster::camera`]); this module only combines the pictures.
 //!
 //! - **Anaglyph**, red–cyan, *half-colour*: the red channel is the left eye's luminance
 //!   (Rec. 601 weights), green and blue are the right eye's. A full-colour anaglyph would take the

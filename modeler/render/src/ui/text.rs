@@ -6,8 +6,8 @@
 //! pixels (one column of spacing; the eighth row is the descenders' or the line's spacing), drawn
 //! at an integer scale. Characters outside ASCII 32–126 are drawn as `?`.
 
-use super::frame::{Frame, Rgba};
-use super::rasterise::Bounds;
+use crate::output::frame::{Frame, Rgba};
+use crate::raster::rasterise::Bounds;
 
 /// Font pixels per glyph cell, horizontally.
 pub const CELL_WIDTH: u32 = 6;

@@ -5,7 +5,7 @@ use thiserror::Error;
 /// A colour: red, green, blue, alpha, 8 bits each (sRGB, alpha 255 = opaque).
 pub type Rgba = [u8; 4];
 
-/// The largest frame side the rasteriser's fixed-point coordinates allow (see [`super::rasterise`]).
+/// The largest frame side the rasteriser's fixed-point coordinates allow (see [`crate::raster::rasterise`]).
 pub const MAX_SIDE: u32 = 16384;
 
 /// Refuses a zero side or one above [`MAX_SIDE`].

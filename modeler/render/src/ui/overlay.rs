@@ -7,7 +7,7 @@
 //! - Lines at a **fixed height** (a figure being pulled) are straight in 3D and need no cutting.
 //! - Lines are screen-space capsules (round caps, so joins need no extra work), drawn after the
 //!   terrain of a tile and **depth-tested** against it with a relative bias
-//!   ([`Style::overlay_bias`](super::scene::Style::overlay_bias)): a line on the surface
+//!   ([`Style::overlay_bias`](crate::scene::Style::overlay_bias)): a line on the surface
 //!   passes where the terrain beside it is slightly nearer (a line is several pixels wide, the
 //!   surface under its edge is not the surface under its centre), a line behind a ridge does not.
 //! - The selected overlay is drawn last, in the selection colour and width.
@@ -15,10 +15,10 @@
 
 use glam::DVec3;
 
-use super::camera::Projection;
-use super::clip::{self, ClipVertex};
-use super::rasterise::Capsule;
-use super::scene::{Overlay, Scene};
+use crate::raster::camera::Projection;
+use crate::raster::clip::{self, ClipVertex};
+use crate::raster::rasterise::Capsule;
+use crate::scene::{Overlay, Scene};
 use penmodel_terrain::Heightmap;
 
 /// The terrain's height at ground point `(x, y)` on the drawn surface: the triangle of the quad

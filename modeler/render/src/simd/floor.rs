@@ -1,7 +1,7 @@
 //! A floor without casts, for the vector passes ([`crate::shade`]'s resolve): the compiler
 //! expands a vector `as i32` or `as u32` into one scalar conversion per lane, so the land look's
 //! cell index and the haze's table index are floored from the float's bits instead. Its own
-//! module because the ground's maps ([`crate::land`]) and the atmosphere both use it.
+//! module because the ground's maps ([`crate::shade::land`]) and the atmosphere both use it.
 
 /// 2²³: [`floor_small`]'s limit.
 pub(crate) const SMALL: f32 = 8_388_608.0;

@@ -37,7 +37,7 @@
 
 use std::ops::Range;
 
-use super::frame::Rgba;
+use crate::output::frame::Rgba;
 
 /// Fractional bits of fixed-point pixel coordinates.
 pub const SUBPIXEL: i32 = 8;
@@ -118,7 +118,7 @@ pub enum Surface {
     /// River or lake water: [`crate::Style::water_colour`].
     Water = 2,
     /// A colour of its own, sRGB, before light: a tree's bark or leaf, a texel of a simplified
-    /// shape ([`crate::meshes`], [`crate::textured`]).
+    /// shape ([`crate::scene::meshes`], [`super::textured`]).
     Colour([u8; 3]) = 3,
 }
 

@@ -6,14 +6,14 @@
 //! bits in both). A node's edge against a coarser neighbour is stitched ([`crate::lod`]): its
 //! vertex indices along that edge point at the vertex before them on the coarser node's lattice.
 //! Nodes carry their screen bounds and the pixel rows of each quad row, and are sorted near to
-//! far, as the full grid's chunks are ([`super::transform`]).
+//! far, as the full grid's chunks are ([`crate::raster::transform`]).
 
 use rayon::prelude::*;
 
-use super::clip::ClipVertex;
-use super::lod::{Levels, NODE, Pick, Pyramid};
-use super::rasterise::{self, Bounds, Sink, Vtx};
-use super::transform::{self, Affine, CLIP, ChunkState, OK, SKIP};
+use crate::lod::{Levels, NODE, Pick, Pyramid};
+use crate::raster::clip::ClipVertex;
+use crate::raster::rasterise::{self, Bounds, Sink, Vtx};
+use crate::raster::transform::{self, Affine, CLIP, ChunkState, OK, SKIP};
 use penmodel_terrain::Heightmap;
 
 /// Vertices per node row.
@@ -98,7 +98,7 @@ impl Projected {
     }
 
     /// The level drawn at each sampled grid point: for every chosen node, `(level, area)`.
-    pub fn choice<'a>(&'a self, pyramid: &'a Pyramid) -> impl Iterator<Item = (u32, super::lod::Area)> + 'a {
+    pub fn choice<'a>(&'a self, pyramid: &'a Pyramid) -> impl Iterator<Item = (u32, super::Area)> + 'a {
         self.picks.iter().map(|p| (p.level, pyramid.area(p.level, p.i, p.j)))
     }
 }
@@ -220,7 +220,7 @@ pub fn project(
 /// Per edge (north, east, south, west), the sampled vertex each one is drawn with: where a
 /// coarser neighbour of level `coarser[e]` lies across edge `e`, the vertex before it on that
 /// neighbour's lattice (the grid's last column or row is on every lattice).
-fn stitching(area: &super::lod::Area, coarser: [Option<u32>; 4]) -> [[u8; PITCH]; 4] {
+fn stitching(area: &super::Area, coarser: [Option<u32>; 4]) -> [[u8; PITCH]; 4] {
     let mut out = [[0u8; PITCH]; 4];
     let (nc, nr) = area.quads();
     for (e, (line, level)) in out.iter_mut().zip(coarser).enumerate() {

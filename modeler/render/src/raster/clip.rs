@@ -20,7 +20,7 @@
 /// Pixels left of (above) the frame that fixed-point coordinates still hold.
 pub const GUARD_MIN: f32 = -8192.0;
 /// Pixels right of (below) the frame's origin that fixed-point coordinates still hold.
-pub const GUARD_MAX: f32 = super::frame::MAX_SIDE as f32 + 8192.0;
+pub const GUARD_MAX: f32 = crate::output::frame::MAX_SIDE as f32 + 8192.0;
 
 /// A vertex before the perspective division, with its attributes: height (metres) and light.
 #[derive(Debug, Clone, Copy, PartialEq)]

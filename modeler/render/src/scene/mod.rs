@@ -3,15 +3,21 @@
 //! A [`Scene`] borrows the terrain and the overlays, so a live session builds one per frame at no
 //! cost and hands it to [`Renderer::render`](super::Renderer::render).
 
-use super::camera::Camera;
-use super::frame::Rgba;
+pub mod forest;
+pub mod impostor;
+pub mod light;
+pub mod meshes;
+pub mod rock_lod;
+
+use crate::output::frame::Rgba;
+use crate::raster::camera::Camera;
 use penmodel_terrain::Heightmap;
 use penmodel_terrain::Point;
 use penmodel_terrain::export::Mesh;
 use penmodel_terrain::revision::Revisions;
 use penmodel_terrain::trees::{Roughness, Standing};
 
-use super::textured::{Quad, Texture};
+use crate::raster::textured::{Quad, Texture};
 
 /// How the two eyes' images are combined.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -74,7 +80,7 @@ pub enum Look {
     #[default]
     Classic,
     /// Land (issue 20): colour by height in metres and by slope, cast shadows and sky light,
-    /// sky, table and haze beyond the terrain ([`crate::land`], [`crate::atmosphere`]).
+    /// sky, table and haze beyond the terrain ([`crate::shade::land`], [`crate::shade::atmosphere`]).
     Land,
 }
 
@@ -194,7 +200,7 @@ pub struct Scene<'a> {
     pub terrain: &'a Heightmap,
     /// The terrain's history of changes (its editor's: `Editor::revisions`), when known: the
     /// land look then learns what changed since its last frame from it and recomputes only
-    /// there; without it, it compares the heights with a copy ([`crate::land`]).
+    /// there; without it, it compares the heights with a copy ([`crate::shade::land`]).
     pub revisions: Option<&'a Revisions>,
     /// Vertical exaggeration: heights are drawn × this (1 = true scale).
     pub vertical_scale: f32,
@@ -225,7 +231,7 @@ pub struct Scene<'a> {
     pub style: Style,
     /// Trees standing on the terrain (a document's: `Editor::trees().trees()`), drawn with
     /// their own bark and leaf colours at the roughness [`Scene::tree_lod`] chooses
-    /// (`crate::forest`).
+    /// (`crate::scene::forest`).
     pub trees: &'a [Standing],
     /// How trees choose their roughness `Q` by distance and gaze; `None` draws every tree in
     /// full (level of detail off).
@@ -243,7 +249,7 @@ pub struct Scene<'a> {
     /// Seconds, for the trees' sway in the wind.
     pub time: f64,
     /// Textured, alpha-tested quads (the exports' frame), each naming a texture of
-    /// [`Scene::textures`] (`crate::textured`).
+    /// [`Scene::textures`] (`crate::raster::textured`).
     pub polygons: &'a [Quad],
     /// The textures [`Scene::polygons`] name.
     pub textures: &'a [Texture],

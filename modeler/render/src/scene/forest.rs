@@ -26,10 +26,10 @@ use penmodel_terrain::trees::nodes::STOP;
 use penmodel_terrain::trees::{Drawn, Roughness};
 use rayon::prelude::*;
 
-use super::camera::Eye;
+use super::Scene;
 use super::impostor::Cache;
-use super::scene::Scene;
-use super::textured::Quad;
+use crate::raster::camera::Eye;
+use crate::raster::textured::Quad;
 
 /// What the trees of the last frame cost.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

@@ -22,7 +22,7 @@ use penmodel_terrain::Heightmap;
 /// A chunk's pixel bounds from its vertices' fixed-point extent `[x0, x1, y0, y1]` (8 fraction
 /// bits), and its state: the whole viewport when a vertex is clipped at the near plane (clipped
 /// triangles may reach anywhere), culled when nothing is drawable or the bounds are empty. The
-/// grid's chunks ([`Projected`]) and the level-of-detail nodes (`nodes.rs`) share it.
+/// grid's chunks ([`Projected`]) and the level-of-detail nodes (`lod/nodes.rs`) share it.
 pub(crate) fn screen_bounds(
     state: ChunkState,
     nearest: f32,
@@ -101,7 +101,7 @@ impl Affine {
 
 impl Affine {
     /// The change of the clip coordinates `(X, Y, w)` per metre of height (the vertical scale
-    /// included): what a height error moves on screen ([`super::lod::Bound`]).
+    /// included): what a height error moves on screen ([`crate::lod::Bound`]).
     pub fn height_axis(&self) -> [f32; 3] {
         self.dh
     }
@@ -191,7 +191,7 @@ pub struct Projected {
 }
 
 /// Projects every vertex of `map` and sorts its chunks; `light` is per vertex
-/// ([`super::light::vertex_light`]), `viewport` the pixels this eye may draw.
+/// ([`crate::scene::light::vertex_light`]), `viewport` the pixels this eye may draw.
 pub fn project_grid(map: &Heightmap, light: &[f32], affine: &Affine, near: f32, viewport: Bounds, out: &mut Projected) {
     let (cols, rows) = (map.cols() as usize, map.rows() as usize);
     let n = cols * rows;

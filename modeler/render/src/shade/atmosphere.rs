@@ -7,7 +7,7 @@
 //!   normals' cross product, `r₀×r₁ + x·(r₁×r₂) + y·(r₂×r₀)`: affine in the pixel, a step per
 //!   pixel. Along it `w` grows by `r₂·(r₀×r₁)` (the determinant) per unit, so a sample of depth `w`
 //!   is at `eye + dir·w/det` — the world point a terrain pixel shows, whose ground colour
-//!   the ground's `albedo_at` ([`crate::land`]) gives, and its distance from the eye.
+//!   the ground's `albedo_at` ([`super::land`]) gives, and its distance from the eye.
 //! - **Sky**: a gradient by the ray's elevation, from [`Style::sky_bottom`] at the horizon to
 //!   [`Style::sky_top`] at the zenith (`√sin` of the elevation: the pale band stays near the
 //!   horizon), instead of a gradient down the screen.
@@ -26,10 +26,10 @@
 
 use rayon::prelude::*;
 
-use super::camera::Projection;
-use super::floor::floor_small;
-use super::frame::Rgba;
-use super::scene::Style;
+use crate::output::frame::Rgba;
+use crate::raster::camera::Projection;
+use crate::scene::Style;
+use crate::simd::floor::floor_small;
 use penmodel_terrain::Heightmap;
 
 /// Distant land beyond the table, before light and haze.
@@ -408,7 +408,7 @@ impl Backdrop {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::camera::{Camera, Eye, Tracked, View, Viewport};
+    use crate::raster::camera::{Camera, Eye, Tracked, View, Viewport};
 
     fn atmosphere(haze_distance: f32) -> Atmosphere {
         let camera = Camera {

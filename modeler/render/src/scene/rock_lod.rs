@@ -18,8 +18,8 @@ use rayon::prelude::*;
 
 use penmodel_terrain::export::Mesh;
 
-use super::clip::ClipVertex;
-use super::transform::Affine;
+use crate::raster::clip::ClipVertex;
+use crate::raster::transform::Affine;
 
 /// A run of a mesh's vertices and of its triangles that use only them.
 #[derive(Debug, Clone, PartialEq, Eq)]

@@ -1,5 +1,5 @@
 //! Textured, alpha-tested polygons: quads with an RGBA texture, drawn into the terrain's depth
-//! buffer (the simplified shapes of trees, [`crate::impostor`]).
+//! buffer (the simplified shapes of trees, [`crate::scene::impostor`]).
 //!
 //! - **Perspective-correct texture coordinates**: a vertex carries `u/w` and `v/w` in the
 //!   rasteriser's two interpolated slots (the height's and the light's), which are affine in
@@ -12,7 +12,7 @@
 //! - **Alpha test**: texels with alpha below 128 (0.5) are discarded before the depth buffer is
 //!   touched, so they neither hide what lies behind nor write depth; the order in which
 //!   polygons are drawn does not matter.
-//! - Texels are lit already (rendered with the light, [`crate::impostor::bake`]): a drawn texel
+//! - Texels are lit already (rendered with the light, [`crate::scene::impostor::bake`]): a drawn texel
 //!   is [`Surface::Colour`] at full light.
 //! - **Levels** (mipmaps): a texture keeps box-filtered halvings of itself, each texel the mean
 //!   of four (colour weighted by alpha, so transparent texels do not darken the edge), and a quad
@@ -29,9 +29,9 @@ use std::ops::Range;
 
 use super::binned::{Binned, Faces};
 use super::clip::ClipVertex;
-use super::frame::Rgba;
 use super::rasterise::{self, Bounds, Sample, Sink, Surface};
 use super::transform::Affine;
+use crate::output::frame::Rgba;
 
 #[cfg(target_arch = "x86_64")]
 mod lanes;
@@ -386,7 +386,7 @@ impl Sink for TexelSink<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::rasterise::{Vtx, snap};
+    use crate::raster::rasterise::{Vtx, snap};
 
     /// The AVX2 lanes ([`lanes`]) draw the same samples, bit for bit, as one pixel at a time:
     /// triangles narrow (row masks) and wide (runs), in front of and behind what the buffer
@@ -410,7 +410,7 @@ mod tests {
             y0: 8,
             y1: 8 + rows as i32,
         };
-        let mut next = crate::rasterise::tests::uniform(0x2545_f491);
+        let mut next = crate::raster::rasterise::tests::uniform(0x2545_f491);
         let held: Vec<Sample> = (0..width * rows)
             .map(|_| Sample {
                 invw: if next() < 0.3 { 0.0 } else { 0.3 * next() },
@@ -457,7 +457,7 @@ mod tests {
                     level: texture.level((k % 3) as u8),
                     lanes: lanes_on,
                 };
-                crate::rasterise::two_sided(&a, &b, &c, &bounds, &mut sink);
+                crate::raster::rasterise::two_sided(&a, &b, &c, &bounds, &mut sink);
             }
         }
         assert!(bits(&one) == bits(&lanes), "the lanes drew other samples");

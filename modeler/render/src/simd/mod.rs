@@ -3,7 +3,7 @@
 //! The workspace builds for baseline x86-64 (SSE2: four `f32` lanes, no 32-bit lane multiply,
 //! no variable shifts); the machines the modeler runs on, and CI's, have AVX2. The loops over
 //! every pixel of a frame that vectorise — the land look's resolve ([`crate::shade`], written in
-//! passes for it) and the anaglyph ([`crate::stereo`]) — are compiled twice: once for the
+//! passes for it) and the anaglyph ([`crate::output::stereo`]) — are compiled twice: once for the
 //! baseline, once inside a `#[target_feature(enable = "avx2")]` function that calls the same
 //! `#[inline(always)]` body, so that LLVM uses eight lanes in that copy. [`avx2`] picks one at
 //! run time, from the terrain engine's choice of copy (`penmodel_terrain::simd`: one detection of
@@ -18,6 +18,8 @@
 //! fused multiply-add written later would round once where the baseline rounds twice). The tests
 //! render the same scenes with both copies and compare the bytes
 //! (`tests/simd.rs`), so the baseline copy stays tested on an AVX2 machine.
+
+pub(crate) mod floor;
 
 use std::sync::OnceLock;
 
