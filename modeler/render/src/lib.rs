@@ -24,6 +24,10 @@
 //!
 //! `simd/` holds the lane code of every stage: the AVX2 copies' dispatch and the vector helpers.
 //!
+//! The stages are private to the crate: what callers use is re-exported here, flat, with
+//! [`land`] (the land look's maps, palette and materials) and [`impostor`] (the trees' simplified
+//! shapes) as namespaces, and [`output`] a module of its own.
+//!
 //! `tiles` runs stages 2, 4 and 5 per band of rows in parallel (rayon). A [`Renderer`] keeps its
 //! buffers between frames, so a live session calls [`Renderer::render`] once per pen report
 //! without allocating. `docs/renderer.md` gives the maths and the measured figures behind the
@@ -34,30 +38,45 @@
 //! height leaves a hole (the triangles touching it are skipped, and [`RenderStats`] counts such
 //! vertices); a grid smaller than 2 × 2 has no triangles and shows only sky, overlays and UI.
 
-pub mod lod;
+mod lod;
 pub mod output;
-pub mod raster;
-pub mod scene;
-pub mod shade;
+mod raster;
+mod scene;
+mod shade;
 #[doc(hidden)]
 pub mod simd;
-pub mod tiles;
-pub mod ui;
+mod tiles;
+mod ui;
 
-pub use lod::{nodes, reproject};
-pub use output::{frame, stereo};
-pub use raster::{binned, camera, clip, rasterise, textured, transform};
-pub use scene::{forest, impostor, light, meshes, rock_lod};
-pub use shade::{atmosphere, land, ramp};
-pub use ui::{overlay, text};
-
-pub use camera::{Camera, Eye, Orbit, Projection, Tracked, View, Viewport};
-pub use frame::{Frame, RenderError, Rgba};
+pub use lod::{Area, DEFAULT_PIXELS as DEFAULT_LOD_PIXELS, Pick, Pyramid};
+pub use output::frame::{Frame, MAX_SIDE, RenderError, Rgba};
+pub use output::stereo::luma;
+pub use raster::camera::{Camera, Eye, Orbit, Projection, Tracked, View, Viewpoint, Viewport};
+pub use raster::rasterise::{Bounds, Sample};
+pub use raster::textured::{Quad, Texture};
+pub use raster::transform::Affine;
+pub use scene::forest::{TreeStats, eye_and_gaze};
+pub use scene::meshes::{Paint, Projected as ProjectedMeshes};
 pub use scene::{Look, Overlay, Scene, SlopeBar, Stereo, Style};
+pub use ui::overlay::surface_height;
+pub use ui::text::glyph;
+pub use ui::{BarLayout, Place, panel};
 
-use meshes::Paint;
-use rasterise::{Bounds, Capsule, Surface};
-use transform::{Affine, Projected};
+/// The trees' simplified shapes (seed 004, §5.2.3): which side faces an eye, the quads and the
+/// opaque part of a texture.
+pub use scene::impostor;
+/// The land look's maps, its palette and its materials.
+pub use shade::land;
+
+use lod::{nodes, reproject};
+use output::{frame, stereo};
+use raster::{rasterise, textured, transform};
+use scene::{forest, light, meshes};
+use shade::{atmosphere, ramp};
+use ui::overlay;
+
+use rasterise::{Capsule, Surface};
+use transform::Projected;
 
 /// What a render found in its input.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

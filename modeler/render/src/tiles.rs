@@ -25,7 +25,7 @@ use penmodel_terrain::Heightmap;
 
 /// What the tiles of one eye share.
 #[allow(missing_docs)] // fields named for what they hold.
-pub struct EyePass<'a> {
+pub(crate) struct EyePass<'a> {
     pub map: &'a Heightmap,
     /// Per-vertex light.
     pub light: &'a [f32],
@@ -53,7 +53,7 @@ impl EyePass<'_> {
     }
 
     /// Draws the terrain's triangles over `bounds` into `sink`.
-    pub fn terrain<S: Sink>(&self, bounds: &Bounds, sink: &mut S) {
+    pub(crate) fn terrain<S: Sink>(&self, bounds: &Bounds, sink: &mut S) {
         if let Some(nodes) = self.nodes {
             nodes::draw(nodes, self.near, bounds, sink);
             return;
@@ -122,7 +122,7 @@ thread_local! {
 /// `depths` (a frame's worth), each pixel's `1/w` is kept there too (0: no surface), for the
 /// reprojection of a held frame.
 #[allow(clippy::too_many_arguments)]
-pub fn render(
+pub(crate) fn render(
     pass: &EyePass,
     meshes: &[crate::scene::meshes::Projected],
     (textured, textures): (
@@ -214,7 +214,7 @@ pub fn render(
 }
 
 /// Counts the terrain's coverage of each pixel of the viewport (no depth test).
-pub fn coverage(pass: &EyePass, counts: &mut [u16], width: usize, tile_rows: usize) {
+pub(crate) fn coverage(pass: &EyePass, counts: &mut [u16], width: usize, tile_rows: usize) {
     let tile = tile_rows.max(1) * width;
     counts.par_chunks_mut(tile).enumerate().for_each(|(i, cnt)| {
         let y0 = (i * tile_rows.max(1)) as i32;

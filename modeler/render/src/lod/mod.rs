@@ -28,8 +28,8 @@
 //! - The choice per node ([`Pick`]) is data: the landscape tools' meshes may use [`Pyramid::select`]
 //!   to pick their own levels later.
 
-pub mod nodes;
-pub mod reproject;
+pub(crate) mod nodes;
+pub(crate) mod reproject;
 
 use rayon::prelude::*;
 
@@ -38,11 +38,11 @@ use crate::raster::transform::{Affine, CHUNK};
 use penmodel_terrain::Heightmap;
 
 /// Quads per node side at every level.
-pub const NODE: usize = CHUNK;
+pub(crate) const NODE: usize = CHUNK;
 
 /// The largest level difference between neighbouring nodes: `2^MAX_STEP` = [`NODE`], so a node's
 /// corners lie on its coarser neighbours' vertices.
-pub const MAX_STEP: u32 = 4;
+pub(crate) const MAX_STEP: u32 = 4;
 
 /// The default largest error on screen, pixels ([`crate::Scene::terrain_lod`]).
 pub const DEFAULT_PIXELS: f32 = 1.0;
@@ -135,7 +135,7 @@ pub struct Pyramid {
 
 /// How to project a node's error: [`Bound::pixels`].
 #[derive(Debug, Clone, Copy)]
-pub struct Bound {
+pub(crate) struct Bound {
     /// `|(|dX| + |x|·|dw|, |dY| + |y|·|dw|)|`.
     k: f32,
     /// `|dw|`: clip depth per metre of height.
@@ -144,7 +144,7 @@ pub struct Bound {
 
 impl Bound {
     /// The bound for `affine` drawn into `viewport`.
-    pub fn new(affine: &Affine, viewport: Bounds) -> Bound {
+    pub(crate) fn new(affine: &Affine, viewport: Bounds) -> Bound {
         let d = affine.height_axis();
         let x = viewport.x0.unsigned_abs().max(viewport.x1.unsigned_abs()) as f32;
         let y = viewport.y0.unsigned_abs().max(viewport.y1.unsigned_abs()) as f32;
@@ -159,7 +159,7 @@ impl Bound {
     /// The most pixels a vertical offset of `e` metres of height moves a point at depth `w` or
     /// more: +∞ when the offset may reach the eye's plane.
     #[inline]
-    pub fn pixels(&self, e: f32, w: f32) -> f32 {
+    pub(crate) fn pixels(&self, e: f32, w: f32) -> f32 {
         if e <= 0.0 {
             return 0.0;
         }
@@ -493,7 +493,7 @@ impl Frustum<'_> {
 
 /// The level chosen over each level-0 node's square, for finding neighbours.
 #[derive(Debug, Default)]
-pub struct Levels {
+pub(crate) struct Levels {
     nx: usize,
     ny: usize,
     /// `u8::MAX` where nothing was chosen (culled).
@@ -502,7 +502,7 @@ pub struct Levels {
 
 impl Levels {
     /// Marks each pick's squares with its level.
-    pub fn fill(&mut self, p: &Pyramid, picks: &[Pick]) {
+    pub(crate) fn fill(&mut self, p: &Pyramid, picks: &[Pick]) {
         let Some(l0) = p.levels.first() else {
             return;
         };
@@ -530,7 +530,7 @@ impl Levels {
 
     /// The coarser neighbour's level across each edge of `pk` (north, east, south, west): the
     /// neighbour's level when one node coarser than `pk` lies across it.
-    pub fn coarser(&self, pk: &Pick) -> [Option<u32>; 4] {
+    pub(crate) fn coarser(&self, pk: &Pick) -> [Option<u32>; 4] {
         let n = 1isize << pk.level;
         let (i0, j0) = ((pk.i as isize) << pk.level, (pk.j as isize) << pk.level);
         // A coarser neighbour covers the whole edge, so one square beside the edge tells.

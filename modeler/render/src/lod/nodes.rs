@@ -23,7 +23,7 @@ const SLOT: usize = PITCH * PITCH;
 
 /// A node and where it lands on screen.
 #[derive(Debug, Clone, Copy)]
-pub struct NodeChunk {
+pub(crate) struct NodeChunk {
     /// Its first vertex in [`Projected::vertices`].
     pub base: usize,
     /// Quads across.
@@ -64,7 +64,7 @@ impl NodeChunk {
 
 /// One eye's chosen nodes, projected.
 #[derive(Debug, Default)]
-pub struct Projected {
+pub(crate) struct Projected {
     /// Projected vertices, [`NODE`]+1 squared per node.
     pub vertices: Vec<Vtx>,
     /// The same vertices before the division, for the clipping path.
@@ -80,7 +80,7 @@ pub struct Projected {
 
 impl Projected {
     /// How many nodes of each level were chosen (level 0 first): the picture of the choice.
-    pub fn per_level(&self) -> Vec<usize> {
+    pub(crate) fn per_level(&self) -> Vec<usize> {
         let mut n = Vec::new();
         for p in &self.picks {
             let l = p.level as usize;
@@ -91,22 +91,12 @@ impl Projected {
         }
         n
     }
-
-    /// Triangles the chosen nodes hold (before culling by the tiles).
-    pub fn triangles(&self) -> usize {
-        self.chunks.iter().map(|c| 2 * c.nc * c.nr).sum()
-    }
-
-    /// The level drawn at each sampled grid point: for every chosen node, `(level, area)`.
-    pub fn choice<'a>(&'a self, pyramid: &'a Pyramid) -> impl Iterator<Item = (u32, super::Area)> + 'a {
-        self.picks.iter().map(|p| (p.level, pyramid.area(p.level, p.i, p.j)))
-    }
 }
 
 /// Chooses the nodes of `pyramid` for the view of `affine` (at most `pixels` of error on
 /// screen), and projects them; `light` is per grid vertex.
 #[allow(clippy::too_many_arguments)]
-pub fn project(
+pub(crate) fn project(
     pyramid: &Pyramid,
     map: &Heightmap,
     light: &[f32],
@@ -246,7 +236,7 @@ fn stitching(area: &super::Area, coarser: [Option<u32>; 4]) -> [[u8; PITCH]; 4] 
 }
 
 /// Draws the nodes' triangles over `bounds` into `sink`.
-pub fn draw<S: Sink>(p: &Projected, near: f32, bounds: &Bounds, sink: &mut S) {
+pub(crate) fn draw<S: Sink>(p: &Projected, near: f32, bounds: &Bounds, sink: &mut S) {
     let (v, f, cv) = (&p.vertices, &p.flags, &p.clip);
     for ch in &p.chunks {
         let b = &ch.bounds;

@@ -32,12 +32,12 @@ use crate::raster::rasterise::Bounds;
 /// Steps an output pixel takes towards its source pixel. The source pixel's motion differs from
 /// its neighbours' only at depth edges: one step lands within a pixel elsewhere, a second
 /// settles the rounding, a third a pixel that crossed an edge.
-pub const ITERATIONS: usize = 3;
+pub(crate) const ITERATIONS: usize = 3;
 
 /// One eye's picture as drawn, for [`warp`]: pixels and depth over the frame (only `bounds`,
 /// the eye's viewport, is the eye's), and the projection it was drawn with.
 #[derive(Debug, Clone)]
-pub struct Held {
+pub(crate) struct Held {
     /// The frame's pixels, row-major, `width` per row.
     pub pixels: Vec<Rgba>,
     /// `1/w` per pixel (0: nothing drawn, the sky or the table's backdrop).
@@ -52,7 +52,7 @@ pub struct Held {
 
 /// What the pixels that show no surface show, which decides how they move.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Background {
+pub(crate) enum Background {
     /// A picture fixed to the screen (the classic look's sky gradient): its pixels stay where
     /// they are. In a tracked view every point of the screen's plane does, and it is at depth
     /// `w` = the eye's distance from the screen: this is its `1/w`.
@@ -64,7 +64,7 @@ pub enum Background {
 
 /// The depth `1/w` of each pixel of an eye drawn with `projection` into a frame `width` wide:
 /// the surface's where a sample has one (`samples`, row-major), else the background's.
-pub fn depths(
+pub(crate) fn depths(
     samples: impl Iterator<Item = f32>,
     projection: &Projection,
     background: Background,
@@ -106,7 +106,7 @@ pub fn depths(
 
 /// The map from a held eye's pixels to another projection's: `(x', y')` from `(x, y, 1/w)`.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Motion {
+pub(crate) struct Motion {
     /// `K = M'·M⁻¹`, rows.
     k: [[f32; 3]; 3],
     /// `c = t' − K·t`.
@@ -116,7 +116,7 @@ pub struct Motion {
 impl Motion {
     /// The motion from `from`'s pixels to `to`'s; `None` when `from` is degenerate (its 3 × 3
     /// part not invertible).
-    pub fn between(from: &Projection, to: &Projection) -> Option<Motion> {
+    pub(crate) fn between(from: &Projection, to: &Projection) -> Option<Motion> {
         let ((from_m, from_t), (to_m, to_t)) = (from.parts(), to.parts());
         if from_m.determinant() == 0.0 {
             return None;
@@ -136,14 +136,14 @@ impl Motion {
     }
 
     /// Where the pixel at `(x, y)` (its centre) with depth `invw` lands; `None` at or behind
-    /// the new eye.
-    #[inline(always)]
+    /// the new eye (the tests' reference).
+    #[cfg(test)]
     pub fn apply(&self, x: f32, y: f32, invw: f32) -> Option<(f32, f32)> {
         let (lx, ly, ahead) = self.lands(x, y, invw);
         ahead.then_some((lx, ly))
     }
 
-    /// [`apply`](Self::apply) without a branch: the position, and whether it is ahead of the
+    /// Where the pixel lands, without a branch: the position, and whether it is ahead of the
     /// new eye (the position is meaningless where not).
     #[inline(always)]
     fn lands(&self, x: f32, y: f32, invw: f32) -> (f32, f32, bool) {
@@ -156,7 +156,7 @@ impl Motion {
 
 /// Writes `held`'s eye, moved by `motion`, over its viewport of `out` (a frame `held.width`
 /// wide): each pixel the source pixel that lands on it (see the module's notes).
-pub fn warp(held: &Held, motion: &Motion, out: &mut [Rgba]) {
+pub(crate) fn warp(held: &Held, motion: &Motion, out: &mut [Rgba]) {
     let Bounds { x0, x1, y0, y1 } = held.bounds;
     let width = held.width;
     if x1 <= x0 || y1 <= y0 || width == 0 {

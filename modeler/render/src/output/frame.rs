@@ -9,7 +9,7 @@ pub type Rgba = [u8; 4];
 pub const MAX_SIDE: u32 = 16384;
 
 /// Refuses a zero side or one above [`MAX_SIDE`].
-pub fn check_size(width: u32, height: u32) -> Result<(), RenderError> {
+pub(crate) fn check_size(width: u32, height: u32) -> Result<(), RenderError> {
     if width == 0 || height == 0 || width > MAX_SIDE || height > MAX_SIDE {
         return Err(RenderError::FrameSize { width, height });
     }

@@ -21,7 +21,7 @@ pub fn luma(p: Rgba) -> u8 {
 }
 
 /// Replaces `right`'s red channel by the luminance of `left` (same size): the anaglyph.
-pub fn anaglyph(left: &Frame, right: &mut Frame) {
+pub(crate) fn anaglyph(left: &Frame, right: &mut Frame) {
     right
         .pixels_mut()
         .par_chunks_mut(4096)

@@ -17,7 +17,7 @@ const PARALLEL_VERTICES: usize = 4096;
 
 /// Which sides of a triangle are drawn.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Faces {
+pub(crate) enum Faces {
     /// Both: a surface seen from either side (a leaf, a textured quad, a rock open underneath).
     Both,
     /// The front only: a side of a closed shape, whose back faces lie behind its front faces
@@ -31,7 +31,7 @@ pub enum Faces {
 /// One eye's projected polygons of `N` corners (3: triangles; 4: quads, corners in order round
 /// them), each tagged with a `T` (what it shows).
 #[derive(Debug)]
-pub struct Binned<T, const N: usize = 3> {
+pub(crate) struct Binned<T, const N: usize = 3> {
     clip: Vec<ClipVertex>,
     screen: Vec<Vtx>,
     /// Whether each vertex is in front of the near plane.
@@ -61,7 +61,7 @@ impl<T, const N: usize> Default for Binned<T, N> {
 impl<T: Copy, const N: usize> Binned<T, N> {
     /// Forgets the last frame's polygons, for a frame `frame_height` rows tall drawn in bands
     /// of `band_rows` rows.
-    pub fn clear(&mut self, (frame_height, band_rows): (usize, usize)) {
+    pub(crate) fn clear(&mut self, (frame_height, band_rows): (usize, usize)) {
         self.clip.clear();
         self.screen.clear();
         self.direct.clear();
@@ -75,7 +75,7 @@ impl<T: Copy, const N: usize> Binned<T, N> {
 
     /// Adds a vertex; returns its index.
     #[inline]
-    pub fn vertex(&mut self, v: ClipVertex, near: f32) -> u32 {
+    pub(crate) fn vertex(&mut self, v: ClipVertex, near: f32) -> u32 {
         let i = self.clip.len() as u32;
         self.direct.push(v.inside(near));
         self.screen.push(transform::project(&v));
@@ -86,7 +86,7 @@ impl<T: Copy, const N: usize> Binned<T, N> {
     /// Adds the `n` vertices `vertex(0)`, …, `vertex(n − 1)`; returns the first one's index.
     /// A large mesh's (a rock field's 10⁵ triangles) are projected on the pool's threads: it was
     /// one side of the eye's join, alone, while the textured polygons took the other.
-    pub fn vertices_from(&mut self, n: usize, near: f32, vertex: impl Fn(usize) -> ClipVertex + Sync) -> u32 {
+    pub(crate) fn vertices_from(&mut self, n: usize, near: f32, vertex: impl Fn(usize) -> ClipVertex + Sync) -> u32 {
         use rayon::prelude::*;
         let first = self.clip.len();
         let unset = ClipVertex {
@@ -128,23 +128,23 @@ impl<T: Copy, const N: usize> Binned<T, N> {
     }
 
     /// How many vertices were added this frame.
-    pub fn vertices(&self) -> u32 {
+    pub(crate) fn vertices(&self) -> u32 {
         self.clip.len() as u32
     }
 
     /// Adds polygons (indices of added vertices) with their tags; bin them with
     /// [`Binned::bin`].
-    pub fn extend(&mut self, triangles: impl IntoIterator<Item = ([u32; N], T)>) {
+    pub(crate) fn extend(&mut self, triangles: impl IntoIterator<Item = ([u32; N], T)>) {
         self.triangles.extend(triangles);
     }
 
     /// How many polygons (triangles, or quads) were added this frame.
-    pub fn triangles(&self) -> usize {
+    pub(crate) fn triangles(&self) -> usize {
         self.triangles.len()
     }
 
     /// Bins the polygons from index `first` on.
-    pub fn bin(&mut self, first: usize) {
+    pub(crate) fn bin(&mut self, first: usize) {
         let bands = self.bins.len();
         let one = (1 << rasterise::SUBPIXEL) as f32;
         for (i, (t, _)) in self.triangles.iter().enumerate().skip(first) {
@@ -170,7 +170,7 @@ impl<T: Copy, const N: usize> Binned<T, N> {
     /// Draws the polygons that reach the tile `bounds` (its first row starts a band) into
     /// `sink`, after `prepare(sink, tag)` set it up for each and said which faces to draw; a
     /// polygon whose `prepare` returns `None` is skipped.
-    pub fn draw<S: Sink>(
+    pub(crate) fn draw<S: Sink>(
         &self,
         bounds: &Bounds,
         near: f32,

@@ -18,9 +18,9 @@
 //! [`super::transform::Affine::clip_vertex`]).
 
 /// Pixels left of (above) the frame that fixed-point coordinates still hold.
-pub const GUARD_MIN: f32 = -8192.0;
+pub(crate) const GUARD_MIN: f32 = -8192.0;
 /// Pixels right of (below) the frame's origin that fixed-point coordinates still hold.
-pub const GUARD_MAX: f32 = crate::output::frame::MAX_SIDE as f32 + 8192.0;
+pub(crate) const GUARD_MAX: f32 = crate::output::frame::MAX_SIDE as f32 + 8192.0;
 
 /// A vertex before the perspective division, with its attributes: height (metres) and light.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -76,12 +76,12 @@ fn planes(near: f32) -> [Plane; 5] {
 }
 
 /// The most vertices a triangle clipped by five planes can have.
-pub const MAX_POLYGON: usize = 8;
+pub(crate) const MAX_POLYGON: usize = 8;
 
 /// A convex polygon of up to [`MAX_POLYGON`] vertices.
 #[allow(missing_docs)] // `len` counts the vertices used.
 #[derive(Debug, Clone, Copy)]
-pub struct Polygon {
+pub(crate) struct Polygon {
     /// The vertices; the first `len` are used.
     pub vertices: [ClipVertex; MAX_POLYGON],
     pub len: usize,
@@ -97,7 +97,7 @@ fn cut(a: ClipVertex, da: f32, b: ClipVertex, db: f32) -> ClipVertex {
 }
 
 /// The part of triangle `tri` inside the near plane and the guard band, in the same winding.
-pub fn triangle(tri: [ClipVertex; 3], near: f32) -> Polygon {
+pub(crate) fn triangle(tri: [ClipVertex; 3], near: f32) -> Polygon {
     let mut poly = Polygon {
         vertices: [tri[0]; MAX_POLYGON],
         len: 3,
@@ -130,7 +130,7 @@ pub fn triangle(tri: [ClipVertex; 3], near: f32) -> Polygon {
 }
 
 /// The part of segment `(a, b)` inside the near plane and the guard band, if any.
-pub fn segment(mut a: ClipVertex, mut b: ClipVertex, near: f32) -> Option<(ClipVertex, ClipVertex)> {
+pub(crate) fn segment(mut a: ClipVertex, mut b: ClipVertex, near: f32) -> Option<(ClipVertex, ClipVertex)> {
     for plane in planes(near) {
         let (da, db) = (plane.distance(&a), plane.distance(&b));
         match (da >= 0.0, db >= 0.0) {

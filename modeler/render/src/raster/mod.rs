@@ -2,10 +2,10 @@
 //! and cut into chunks, clipping, rasterisation into a tile's depth buffer, the triangles and
 //! quads binned by bands of rows, textured polygons and their texture levels.
 
-pub mod binned;
-pub mod camera;
-pub mod clip;
+pub(crate) mod binned;
+pub(crate) mod camera;
+pub(crate) mod clip;
 pub(crate) mod mips;
-pub mod rasterise;
-pub mod textured;
-pub mod transform;
+pub(crate) mod rasterise;
+pub(crate) mod textured;
+pub(crate) mod transform;

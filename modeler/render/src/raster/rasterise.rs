@@ -40,13 +40,13 @@ use std::ops::Range;
 use crate::output::frame::Rgba;
 
 /// Fractional bits of fixed-point pixel coordinates.
-pub const SUBPIXEL: i32 = 8;
+pub(crate) const SUBPIXEL: i32 = 8;
 const ONE: i32 = 1 << SUBPIXEL;
 const HALF: i32 = ONE / 2;
 
 /// A projected vertex: fixed-point pixel position, `1/w`, `h/w`, `l/w`.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct Vtx {
+pub(crate) struct Vtx {
     /// Pixel x × 2⁸.
     pub x: i32,
     /// Pixel y × 2⁸.
@@ -65,7 +65,7 @@ pub struct Vtx {
 /// conversion; it is clipped, never drawn from these coordinates, so the subtraction wraps as a
 /// release build's does instead of panicking in a debug one.
 #[inline]
-pub fn snap(p: f32) -> i32 {
+pub(crate) fn snap(p: f32) -> i32 {
     const OFFSET: f32 = 16384.0;
     (((p + OFFSET) * ONE as f32 + 0.5) as i32).wrapping_sub((OFFSET as i32) * ONE)
 }
@@ -132,7 +132,7 @@ impl Surface {
 /// A row's pixels come with its start on the attribute planes (`row`: `1/w`, `h/w`, `l/w` at
 /// the box's first column `px0`) and the step along the row (`step`), so that a sink may take
 /// them several at once ([`Sink::run`], [`Sink::masked`]).
-pub trait Sink {
+pub(crate) trait Sink {
     /// Pixel `(x, y)` is covered with these interpolated values.
     fn pixel(&mut self, x: i32, y: i32, invw: f32, hw: f32, lw: f32);
 
@@ -165,7 +165,14 @@ pub trait Sink {
 /// step (as a sink that takes pixels several at once gives them; [`Sink::run`]'s default steps
 /// them one addition at a time instead).
 #[inline(always)]
-pub fn each_in_run<S: Sink + ?Sized>(sink: &mut S, y: i32, px0: i32, ks: Range<i32>, row: [f32; 3], step: [f32; 3]) {
+pub(crate) fn each_in_run<S: Sink + ?Sized>(
+    sink: &mut S,
+    y: i32,
+    px0: i32,
+    ks: Range<i32>,
+    row: [f32; 3],
+    step: [f32; 3],
+) {
     for k in ks {
         at_offset(sink, y, px0, k, row, step);
     }
@@ -173,7 +180,14 @@ pub fn each_in_run<S: Sink + ?Sized>(sink: &mut S, y: i32, px0: i32, ks: Range<i
 
 /// [`Sink::masked`] one pixel at a time.
 #[inline(always)]
-pub fn each_in_mask<S: Sink + ?Sized>(sink: &mut S, y: i32, px0: i32, mut mask: u32, row: [f32; 3], step: [f32; 3]) {
+pub(crate) fn each_in_mask<S: Sink + ?Sized>(
+    sink: &mut S,
+    y: i32,
+    px0: i32,
+    mut mask: u32,
+    row: [f32; 3],
+    step: [f32; 3],
+) {
     while mask != 0 {
         let k = mask.trailing_zeros() as i32;
         mask &= mask - 1;
@@ -196,7 +210,7 @@ fn at_offset<S: Sink + ?Sized>(sink: &mut S, y: i32, px0: i32, k: i32, row: [f32
 
 /// The depth test into a tile of samples whose first row is `y0`; a winning pixel is marked as
 /// the `surface` drawn.
-pub struct DepthSink<'a> {
+pub(crate) struct DepthSink<'a> {
     /// The tile's samples, row-major.
     pub samples: &'a mut [Sample],
     /// Frame width.
@@ -224,7 +238,7 @@ impl Sink for DepthSink<'_> {
 }
 
 /// Counts how often each pixel is covered (no depth test): the coverage diagnostics.
-pub struct CountSink<'a> {
+pub(crate) struct CountSink<'a> {
     /// Counts of the tile, row-major.
     pub counts: &'a mut [u16],
     /// Frame width.
@@ -358,7 +372,7 @@ fn covers_a_centre<const N: usize>(es: &[Edge; N], dx: i32, dy: i32) -> bool {
 /// vertices can cover a pixel. A 512² grid's quad is under a pixel across at 1280 × 720, so one
 /// test per quad rejects most of them before either triangle is looked at.
 #[inline]
-pub fn holds_no_pixel(vs: [&Vtx; 4], bounds: &Bounds) -> bool {
+pub(crate) fn holds_no_pixel(vs: [&Vtx; 4], bounds: &Bounds) -> bool {
     box_of(&vs, bounds).is_none()
 }
 
@@ -366,7 +380,7 @@ pub fn holds_no_pixel(vs: [&Vtx; 4], bounds: &Bounds) -> bool {
 /// whose vertices run clockwise on screen (the grid's triangles seen from above); others are
 /// culled, as are triangles of zero area.
 #[inline]
-pub fn triangle<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut S) {
+pub(crate) fn triangle<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut S) {
     let Some(tile) = box_in(a, b, c, bounds) else {
         return;
     };
@@ -379,7 +393,7 @@ pub fn triangle<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut 
 /// and then of `(a, c, b)` (one of them is culled; zero area draws nothing), with the box and
 /// the area found once.
 #[inline]
-pub fn two_sided<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut S) {
+pub(crate) fn two_sided<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut S) {
     let Some(tile) = box_in(a, b, c, bounds) else {
         return;
     };
@@ -402,7 +416,7 @@ pub fn two_sided<S: Sink>(a: &Vtx, b: &Vtx, c: &Vtx, bounds: &Bounds, sink: &mut
 /// its own plane's value in the last bits. A quad that is not strictly convex (a corner on a
 /// line, or bent by the snapping) is drawn as the two triangles.
 #[inline]
-pub fn quad_two_sided<S: Sink>(v: [&Vtx; 4], bounds: &Bounds, sink: &mut S) {
+pub(crate) fn quad_two_sided<S: Sink>(v: [&Vtx; 4], bounds: &Bounds, sink: &mut S) {
     let Some(tile) = box_of(&v, bounds) else {
         return;
     };
@@ -711,7 +725,7 @@ impl<const N: usize> RowLanes<N> {
 /// along it; drawn where it passes the depth test against `samples` with `bias`.
 #[allow(missing_docs)] // `colour` is the fill.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Capsule {
+pub(crate) struct Capsule {
     /// Start: pixel x, y and `1/w`.
     pub a: [f32; 3],
     /// End: pixel x, y and `1/w`.
@@ -723,7 +737,7 @@ pub struct Capsule {
 
 impl Capsule {
     /// The pixel rows it may touch.
-    pub fn rows(&self) -> (f32, f32) {
+    pub(crate) fn rows(&self) -> (f32, f32) {
         (
             self.a[1].min(self.b[1]) - self.radius,
             self.a[1].max(self.b[1]) + self.radius,
@@ -733,7 +747,7 @@ impl Capsule {
     /// Draws the capsule's pixels (centres within `radius` of the segment) inside `bounds`,
     /// where `1/w·(1 + bias)` ≥ the sample's `1/w`. `pixels` and `samples` are the tile's, whose
     /// first row is `bounds.y0`.
-    pub fn draw(&self, bounds: &Bounds, width: usize, samples: &[Sample], pixels: &mut [Rgba], bias: f32) {
+    pub(crate) fn draw(&self, bounds: &Bounds, width: usize, samples: &[Sample], pixels: &mut [Rgba], bias: f32) {
         let r = self.radius;
         let x0 = ((self.a[0].min(self.b[0]) - r).floor() as i32).max(bounds.x0);
         let x1 = ((self.a[0].max(self.b[0]) + r).ceil() as i32).min(bounds.x1 - 1);

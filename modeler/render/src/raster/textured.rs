@@ -37,7 +37,7 @@ use crate::output::frame::Rgba;
 mod lanes;
 
 /// Most texels a side of a [`Texture`] has (the texel lookup indexes a side in 16 bits).
-pub const MAX_SIDE: u32 = 1 << 16;
+pub(crate) const MAX_SIDE: u32 = 1 << 16;
 
 /// An RGBA image, row 0 at the top, and its box-filtered levels.
 #[derive(Debug, Clone, PartialEq, Eq, Default)]
@@ -205,12 +205,12 @@ pub struct Quad {
 
 /// One eye's projected quads, each tagged with its texture's index and level.
 #[derive(Debug, Default)]
-pub struct Projected(Binned<(u32, u8), 4>);
+pub(crate) struct Projected(Binned<(u32, u8), 4>);
 
 impl Projected {
     /// Forgets the last frame's quads, for a frame `frame_height` rows tall drawn in bands of
     /// `band_rows` rows; then [`Projected::add`] the quads.
-    pub fn clear(&mut self, bands: (usize, usize)) {
+    pub(crate) fn clear(&mut self, bands: (usize, usize)) {
         self.0.clear(bands);
     }
 
@@ -219,7 +219,7 @@ impl Projected {
     /// be given) are offset by `first_texture`, and each quad reads the level of its texture
     /// whose texels are about its pixels.
     #[allow(clippy::too_many_arguments)]
-    pub fn add(
+    pub(crate) fn add(
         &mut self,
         quads: &[Quad],
         first_texture: u32,
@@ -259,14 +259,9 @@ impl Projected {
         self.0.bin(first);
     }
 
-    /// How many quads were projected.
-    pub fn quads(&self) -> usize {
-        self.0.triangles()
-    }
-
     /// Draws the triangles that reach the tile `bounds` (its first row starts a band) into its
     /// samples, each with its texture from `textures` (a quad naming none is skipped).
-    pub fn draw(&self, bounds: &Bounds, samples: &mut [Sample], width: usize, near: f32, textures: &[&Texture]) {
+    pub(crate) fn draw(&self, bounds: &Bounds, samples: &mut [Sample], width: usize, near: f32, textures: &[&Texture]) {
         let Some(&first) = textures.first() else {
             return;
         };

@@ -52,14 +52,14 @@ pub(crate) fn screen_bounds(
 }
 
 /// Quads per chunk side.
-pub const CHUNK: usize = 16;
+pub(crate) const CHUNK: usize = 16;
 
 /// The vertex may be drawn directly.
-pub const OK: u8 = 0;
+pub(crate) const OK: u8 = 0;
 /// The vertex is behind the near plane or outside the guard band: clip its triangles.
-pub const CLIP: u8 = 1;
+pub(crate) const CLIP: u8 = 1;
 /// The vertex's height is not finite: skip its triangles.
-pub const SKIP: u8 = 2;
+pub(crate) const SKIP: u8 = 2;
 
 /// Clip coordinates as an affine function of column, row and height.
 #[derive(Debug, Clone, Copy)]
@@ -123,7 +123,7 @@ impl Affine {
 
 /// A clip-space vertex after the perspective division.
 #[inline]
-pub fn project(v: &ClipVertex) -> Vtx {
+pub(crate) fn project(v: &ClipVertex) -> Vtx {
     let invw = 1.0 / v.w;
     Vtx {
         x: snap(v.x * invw),
@@ -135,7 +135,7 @@ pub fn project(v: &ClipVertex) -> Vtx {
 }
 
 /// Draws the triangle `tri` cut by the near plane and the guard band, as a fan, over `bounds`.
-pub fn draw_clipped<S: Sink>(tri: [ClipVertex; 3], near: f32, bounds: &Bounds, sink: &mut S) {
+pub(crate) fn draw_clipped<S: Sink>(tri: [ClipVertex; 3], near: f32, bounds: &Bounds, sink: &mut S) {
     let poly = super::clip::triangle(tri, near);
     if poly.len < 3 {
         return;
@@ -148,7 +148,7 @@ pub fn draw_clipped<S: Sink>(tri: [ClipVertex; 3], near: f32, bounds: &Bounds, s
 
 /// What a chunk needs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ChunkState {
+pub(crate) enum ChunkState {
     /// Every vertex drawable directly.
     Direct,
     /// Some vertices need clipping or are skipped: check each triangle.
@@ -159,7 +159,7 @@ pub enum ChunkState {
 
 /// A block of quads and where it lands on screen.
 #[derive(Debug, Clone, Copy)]
-pub struct Chunk {
+pub(crate) struct Chunk {
     /// First quad column.
     pub c0: usize,
     /// First quad row.
@@ -181,7 +181,7 @@ pub struct Chunk {
 
 /// The projected grid of one eye.
 #[derive(Debug, Default)]
-pub struct Projected {
+pub(crate) struct Projected {
     /// Projected vertices, row-major.
     pub vertices: Vec<Vtx>,
     /// [`OK`], [`CLIP`] or [`SKIP`] per vertex.
@@ -192,7 +192,14 @@ pub struct Projected {
 
 /// Projects every vertex of `map` and sorts its chunks; `light` is per vertex
 /// ([`crate::scene::light::vertex_light`]), `viewport` the pixels this eye may draw.
-pub fn project_grid(map: &Heightmap, light: &[f32], affine: &Affine, near: f32, viewport: Bounds, out: &mut Projected) {
+pub(crate) fn project_grid(
+    map: &Heightmap,
+    light: &[f32],
+    affine: &Affine,
+    near: f32,
+    viewport: Bounds,
+    out: &mut Projected,
+) {
     let (cols, rows) = (map.cols() as usize, map.rows() as usize);
     let n = cols * rows;
     out.vertices.resize(n, Vtx::default());

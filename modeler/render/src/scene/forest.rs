@@ -53,7 +53,7 @@ impl TreeStats {
 
 /// The trees' per-frame buffers and the simplified shapes' textures.
 #[derive(Debug, Default)]
-pub struct Trees {
+pub(crate) struct Trees {
     /// Per tree of the scene, in its order, what it drew this frame.
     drawn: Vec<Walked>,
     cache: Cache,
@@ -91,7 +91,7 @@ pub fn eye_and_gaze(scene: &Scene, aspect: f64) -> (DVec3, DVec3) {
 
 /// The roughness for a tree whose middle is at `middle`, `height` tall, seen from `eye` with
 /// `gaze` (unit).
-pub fn roughness(lod: &Roughness, eye: DVec3, gaze: DVec3, middle: DVec3, height: f64) -> f64 {
+pub(crate) fn roughness(lod: &Roughness, eye: DVec3, gaze: DVec3, middle: DVec3, height: f64) -> f64 {
     let to = middle - eye;
     let d = to.length();
     let theta = if d > 0.0 {
@@ -104,7 +104,7 @@ pub fn roughness(lod: &Roughness, eye: DVec3, gaze: DVec3, middle: DVec3, height
 
 impl Trees {
     /// Draws `scene`'s trees for this frame (both eyes), seen from a frame of `aspect`.
-    pub fn prepare(&mut self, scene: &Scene, aspect: f64) {
+    pub(crate) fn prepare(&mut self, scene: &Scene, aspect: f64) {
         self.drawn.resize_with(scene.trees.len(), Walked::default);
         if scene.trees.is_empty() {
             self.stats = TreeStats {
@@ -170,18 +170,13 @@ impl Trees {
     }
 
     /// How many trees the last frame drew.
-    pub fn len(&self) -> usize {
+    pub(crate) fn len(&self) -> usize {
         self.drawn.len()
-    }
-
-    /// Whether the last frame drew no trees.
-    pub fn is_empty(&self) -> bool {
-        self.drawn.is_empty()
     }
 
     /// The copied branches and leaves of trees `range` (of the scene's, in its order), coloured:
     /// a mesh per tree.
-    pub fn meshes(
+    pub(crate) fn meshes(
         &self,
         range: std::ops::Range<usize>,
     ) -> impl Iterator<Item = &penmodel_terrain::export::Mesh> + Clone {
@@ -189,17 +184,17 @@ impl Trees {
     }
 
     /// The simplified shapes' polygons of trees `range`, per tree in the scene's order.
-    pub fn quads(&self, range: std::ops::Range<usize>) -> impl Iterator<Item = &[Quad]> + Clone {
+    pub(crate) fn quads(&self, range: std::ops::Range<usize>) -> impl Iterator<Item = &[Quad]> + Clone {
         self.drawn[range].iter().map(|w| &w.quads[..])
     }
 
     /// The simplified shapes' textures.
-    pub fn cache(&self) -> &Cache {
+    pub(crate) fn cache(&self) -> &Cache {
         &self.cache
     }
 
     /// What the last frame's trees cost.
-    pub fn stats(&self) -> TreeStats {
+    pub(crate) fn stats(&self) -> TreeStats {
         self.stats
     }
 }

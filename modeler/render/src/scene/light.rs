@@ -44,7 +44,7 @@ pub(crate) fn gradient(
 /// how many heights are not finite. With `given` (one value per cell, 0 to 1: see
 /// [`Scene::light_map`](super::Scene::light_map)) the light is `ambient + (1 − ambient)·given`
 /// instead of Lambert's.
-pub fn vertex_light(
+pub(crate) fn vertex_light(
     map: &Heightmap,
     vertical_scale: f32,
     style: &Style,

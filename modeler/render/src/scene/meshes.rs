@@ -61,7 +61,7 @@ fn srgb_table() -> &'static [u8; LINEAR_STEPS] {
 }
 
 /// Linear RGB (0 to 1) → sRGB bytes.
-pub fn srgb(linear: [f32; 3]) -> [u8; 3] {
+pub(crate) fn srgb(linear: [f32; 3]) -> [u8; 3] {
     let table = srgb_table();
     let last = (LINEAR_STEPS - 1) as f32;
     linear.map(|c| {

@@ -3,11 +3,11 @@
 //! A [`Scene`] borrows the terrain and the overlays, so a live session builds one per frame at no
 //! cost and hands it to [`Renderer::render`](super::Renderer::render).
 
-pub mod forest;
+pub(crate) mod forest;
 pub mod impostor;
-pub mod light;
-pub mod meshes;
-pub mod rock_lod;
+pub(crate) mod light;
+pub(crate) mod meshes;
+pub(crate) mod rock_lod;
 
 use crate::output::frame::Rgba;
 use crate::raster::camera::Camera;

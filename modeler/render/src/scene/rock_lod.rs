@@ -23,7 +23,7 @@ use crate::raster::transform::Affine;
 
 /// A run of a mesh's vertices and of its triangles that use only them.
 #[derive(Debug, Clone, PartialEq, Eq)]
-pub struct Part {
+pub(crate) struct Part {
     /// Vertex indices.
     pub vertices: Range<usize>,
     /// Triangle indices (three mesh indices each).
@@ -34,7 +34,7 @@ pub struct Part {
 /// triangles whose vertices it holds. `None` when those triangles are not consecutive in the mesh
 /// (a part's triangles come after a later part's), or an index is past the mesh's `vertices`:
 /// the mesh is then drawn whole.
-pub fn parts(indices: &[u32], vertices: usize) -> Option<Vec<Part>> {
+pub(crate) fn parts(indices: &[u32], vertices: usize) -> Option<Vec<Part>> {
     // `depth[v]`: how many triangles span from below v to v or above; 0 starts a run at v.
     let mut depth = vec![0i32; vertices + 1];
     for tri in indices.chunks_exact(3) {
@@ -76,7 +76,7 @@ pub fn parts(indices: &[u32], vertices: usize) -> Option<Vec<Part>> {
 
 /// How a part is drawn for one eye.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Choice {
+pub(crate) enum Choice {
     /// Every triangle.
     Whole,
     /// The footprint quad's four corners, in order around it.
@@ -104,7 +104,7 @@ fn norm(v: [f32; 3]) -> f32 {
 /// with `ambient`: a quad when its bounding sphere projects within `pixels` of its centre and
 /// lies wholly in front of the near plane. The choices replace what `out` held, one per part.
 #[allow(clippy::too_many_arguments)] // an eye's projection, its light and the list kept between frames.
-pub fn choose(
+pub(crate) fn choose(
     mesh: &Mesh,
     parts: &[Part],
     affine: &Affine,

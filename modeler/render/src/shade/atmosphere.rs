@@ -33,9 +33,9 @@ use crate::simd::floor::floor_small;
 use penmodel_terrain::Heightmap;
 
 /// Distant land beyond the table, before light and haze.
-pub const FAR_LAND: [u8; 3] = [118, 136, 96];
+pub(crate) const FAR_LAND: [u8; 3] = [118, 136, 96];
 /// The model's side (its cut-away earth), before light.
-pub const SIDE: [u8; 3] = [104, 86, 66];
+pub(crate) const SIDE: [u8; 3] = [104, 86, 66];
 
 /// Entries of the haze table over `d/L` in `[0, HAZE_SPAN]`.
 const HAZE_ENTRIES: usize = 512;
@@ -61,7 +61,7 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 
 /// One eye's view of the world around the terrain.
 #[derive(Debug, Clone, PartialEq)]
-pub struct Atmosphere {
+pub(crate) struct Atmosphere {
     /// The ray through pixel `(x, y)` (pixel coordinates, centres at `+½`) is `a + x·b + y·c`.
     a: [f32; 3],
     b: [f32; 3],
@@ -93,7 +93,7 @@ pub struct Atmosphere {
 
 impl Atmosphere {
     /// The atmosphere of `projection` (one eye) around `map` drawn × `vertical_scale`.
-    pub fn new(projection: &Projection, map: &Heightmap, vertical_scale: f32, style: &Style) -> Atmosphere {
+    pub(crate) fn new(projection: &Projection, map: &Heightmap, vertical_scale: f32, style: &Style) -> Atmosphere {
         let r = projection.rows.map(|row| [row[0], row[1], row[2]]);
         let a = cross(r[0], r[1]);
         let b = cross(r[1], r[2]);
@@ -159,7 +159,7 @@ impl Atmosphere {
 
     /// The ray through pixel `(x, y)` (a pixel's centre is at `+½`), not unit length.
     #[inline]
-    pub fn ray(&self, x: f32, y: f32) -> [f32; 3] {
+    pub(crate) fn ray(&self, x: f32, y: f32) -> [f32; 3] {
         let (a, b, c) = (self.a, self.b, self.c);
         [
             a[0] + x * b[0] + y * c[0],
@@ -170,7 +170,7 @@ impl Atmosphere {
 
     /// The world height of the table's plane: what a pixel below the horizon that shows no
     /// surface sees (the table, the model's side, the land beyond).
-    pub fn table_y(&self) -> f32 {
+    pub(crate) fn table_y(&self) -> f32 {
         self.table_y
     }
 
@@ -178,7 +178,7 @@ impl Atmosphere {
     /// the eye along the view's axis (the haze's distance: within the 45° of a view it is at most
     /// 8 % short of the distance along the ray, and it costs no square root per pixel).
     #[inline(always)]
-    pub fn point(&self, ray: [f32; 3], w: f32) -> ([f32; 2], f32) {
+    pub(crate) fn point(&self, ray: [f32; 3], w: f32) -> ([f32; 2], f32) {
         let k = w * self.inv_det;
         (
             [self.eye[0] + ray[0] * k, self.eye[2] + ray[2] * k],
@@ -188,7 +188,7 @@ impl Atmosphere {
 
     /// At most how many pixels `metres` span across the view at depth `1/invw`.
     #[inline]
-    pub fn pixels(&self, metres: f32, invw: f32) -> f32 {
+    pub(crate) fn pixels(&self, metres: f32, invw: f32) -> f32 {
         metres * self.pixels_per_metre * invw
     }
 
@@ -225,34 +225,34 @@ impl Atmosphere {
 
     /// `colour` (lit) seen from `d` metres away.
     #[inline(always)]
-    pub fn hazed(&self, colour: [f32; 3], d: f32) -> [f32; 3] {
+    pub(crate) fn hazed(&self, colour: [f32; 3], d: f32) -> [f32; 3] {
         self.hazed_by(colour, self.haze_at(d))
     }
 
     /// How far a surface `d` metres away tends to the horizon's colour: [`Atmosphere::hazed`]
     /// in two steps, this one a table lookup, the other arithmetic (the resolve vectorises it).
     #[inline(always)]
-    pub fn haze_at(&self, d: f32) -> f32 {
+    pub(crate) fn haze_at(&self, d: f32) -> f32 {
         self.haze * self.fog(d)
     }
 
     /// [`Atmosphere::haze_at`] without a lookup, for vector lanes ([`Atmosphere::fog_computed`]:
     /// it may differ from the table's by an ulp or two).
     #[inline(always)]
-    pub fn haze_computed(&self, d: f32) -> f32 {
+    pub(crate) fn haze_computed(&self, d: f32) -> f32 {
         self.haze * self.fog_computed(d)
     }
 
     /// `colour` tended to the horizon's by `t` ([`Atmosphere::haze_at`]).
     #[inline(always)]
-    pub fn hazed_by(&self, colour: [f32; 3], t: f32) -> [f32; 3] {
+    pub(crate) fn hazed_by(&self, colour: [f32; 3], t: f32) -> [f32; 3] {
         lerp(colour, self.horizon, t)
     }
 
     /// What a pixel that shows no surface sees along `ray`: the table, the model's side, the
     /// land beyond, or the sky.
     #[inline(always)]
-    pub fn background(&self, ray: [f32; 3]) -> [f32; 3] {
+    pub(crate) fn background(&self, ray: [f32; 3]) -> [f32; 3] {
         let len = (ray[0] * ray[0] + ray[1] * ray[1] + ray[2] * ray[2]).sqrt();
         if len.is_nan() || len <= 0.0 {
             return self.horizon;
@@ -286,7 +286,7 @@ impl Atmosphere {
     /// [`Atmosphere::background`] of row `y`'s pixels `x0..x1` as opaque pixels
     /// ([`Atmosphere::background_pixel`]), the ray of the `k`-th the row's first plus `k` steps
     /// ([`Atmosphere::row_ray`], as the shading computes it, so both give the same bytes).
-    pub fn background_row(&self, y: usize, (x0, x1): (usize, usize), out: &mut [u32]) {
+    pub(crate) fn background_row(&self, y: usize, (x0, x1): (usize, usize), out: &mut [u32]) {
         let first = self.ray(x0 as f32 + 0.5, y as f32 + 0.5);
         for (k, p) in out.iter_mut().take(x1.saturating_sub(x0)).enumerate() {
             *p = self.background_pixel(self.row_ray(first, k as f32));
@@ -295,7 +295,7 @@ impl Atmosphere {
 
     /// The ray `k` pixels along a row from `first` (the row's first pixel's ray): `first + k·step`.
     #[inline(always)]
-    pub fn row_ray(&self, first: [f32; 3], k: f32) -> [f32; 3] {
+    pub(crate) fn row_ray(&self, first: [f32; 3], k: f32) -> [f32; 3] {
         let b = self.b;
         [first[0] + k * b[0], first[1] + k * b[1], first[2] + k * b[2]]
     }
@@ -303,7 +303,7 @@ impl Atmosphere {
     /// [`Atmosphere::background`] as an opaque pixel, the bytes `r, g, b, 255` of a
     /// little-endian `u32` (the channels truncated, as `as u8` does).
     #[inline(always)]
-    pub fn background_pixel(&self, ray: [f32; 3]) -> u32 {
+    pub(crate) fn background_pixel(&self, ray: [f32; 3]) -> u32 {
         let c = self.background(ray);
         u32::from(c[0] as u8) | u32::from(c[1] as u8) << 8 | u32::from(c[2] as u8) << 16 | 0xff00_0000
     }
@@ -336,7 +336,7 @@ fn exp_small(y: f32) -> f32 {
 
 /// `a + t·(b − a)`, spelled out (an array `map` here costs a tenth of the frame).
 #[inline(always)]
-pub fn lerp(a: [f32; 3], b: [f32; 3], t: f32) -> [f32; 3] {
+pub(crate) fn lerp(a: [f32; 3], b: [f32; 3], t: f32) -> [f32; 3] {
     [
         a[0] + t * (b[0] - a[0]),
         a[1] + t * (b[1] - a[1]),
@@ -373,7 +373,7 @@ fn edge_low(map: &Heightmap) -> f32 {
 /// whole frame's background was 85 M of a turning view's 290 M instructions a frame (1024², LOD
 /// at 1 px). Once the view has stayed for a frame it is made whole and kept.
 #[derive(Debug, Default)]
-pub struct Backdrop {
+pub(crate) struct Backdrop {
     key: Option<(Atmosphere, [usize; 4])>,
     /// Whether `pixels` holds the background of `key`.
     made: bool,
@@ -385,7 +385,13 @@ impl Backdrop {
     /// The background of `air` over the columns `x0..x1` of a `width × height` frame, row-major
     /// over the whole frame (other columns unset), when the view is the last frame's; `None`
     /// when it changed (the caller computes [`Atmosphere::background`] where it needs it).
-    pub fn of(&mut self, air: &Atmosphere, width: usize, height: usize, (x0, x1): (usize, usize)) -> Option<&[u32]> {
+    pub(crate) fn of(
+        &mut self,
+        air: &Atmosphere,
+        width: usize,
+        height: usize,
+        (x0, x1): (usize, usize),
+    ) -> Option<&[u32]> {
         let key = [width, height, x0, x1];
         if !self.key.as_ref().is_some_and(|(a, k)| a == air && *k == key) {
             self.key = Some((air.clone(), key));

@@ -11,9 +11,9 @@
 //! The ramp and the light live in their own modules, which the land look uses too: shading
 //! depends on the land look, not the other way round.
 
-pub mod atmosphere;
+pub(crate) mod atmosphere;
 pub mod land;
-pub mod ramp;
+pub(crate) mod ramp;
 
 use crate::output::frame::Rgba;
 use crate::raster::mips;
@@ -29,7 +29,7 @@ fn mix(a: Rgba, b: Rgba, t: f32) -> Rgba {
 
 /// How one eye's samples become colours: the classic ramp, or the land look's ground colours and
 /// atmosphere.
-pub struct Shading<'a> {
+pub(crate) struct Shading<'a> {
     /// The classic look's colour table (unused by the land look).
     pub ramp: &'a Ramp,
     /// The land look's maps of the terrain, this eye's atmosphere and its background when kept
@@ -40,7 +40,7 @@ pub struct Shading<'a> {
 
 /// The land look's part of [`Shading`]: the terrain's maps, the eye's atmosphere, its kept
 /// background if any.
-pub type LandShading<'a> = (&'a Land, &'a Atmosphere, Option<&'a [u32]>);
+pub(crate) type LandShading<'a> = (&'a Land, &'a Atmosphere, Option<&'a [u32]>);
 
 /// A sample's colour before light, for surfaces other than the terrain.
 #[inline(always)]
@@ -57,7 +57,7 @@ fn surface_colour(surface: Surface, style: &Style) -> Option<[f32; 3]> {
 /// Resolves a tile of samples into colours: terrain where covered, sky elsewhere. `y0` is the
 /// tile's first row in a frame of `frame_height` rows; only columns `x0..x1` are written.
 #[allow(clippy::too_many_arguments)]
-pub fn resolve(
+pub(crate) fn resolve(
     samples: &[Sample],
     pixels: &mut [Rgba],
     width: usize,

@@ -6,10 +6,10 @@
 use crate::scene::Style;
 
 /// Entries of the colour table.
-pub const RAMP_ENTRIES: usize = 1024;
+pub(crate) const RAMP_ENTRIES: usize = 1024;
 
 /// Land colours at fractions of `ramp_top`.
-pub const LAND: [(f32, [u8; 3]); 7] = [
+pub(crate) const LAND: [(f32, [u8; 3]); 7] = [
     (0.0, [214, 200, 146]),  // sand at the shore
     (0.04, [120, 168, 82]),  // grass
     (0.35, [66, 120, 58]),   // forest
@@ -20,7 +20,7 @@ pub const LAND: [(f32, [u8; 3]); 7] = [
 ];
 
 /// Water colours at fractions of `ramp_depth` below sea level.
-pub const WATER: [(f32, [u8; 3]); 2] = [(0.0, [78, 150, 212]), (1.0, [16, 40, 104])];
+pub(crate) const WATER: [(f32, [u8; 3]); 2] = [(0.0, [78, 150, 212]), (1.0, [16, 40, 104])];
 
 pub(crate) fn interpolate(stops: &[(f32, [u8; 3])], t: f32) -> [u8; 3] {
     let t = t.clamp(0.0, 1.0);
@@ -34,19 +34,10 @@ pub(crate) fn interpolate(stops: &[(f32, [u8; 3])], t: f32) -> [u8; 3] {
     stops[stops.len() - 1].1
 }
 
-/// The colour of height `h` metres before lighting.
-pub fn ramp_colour(style: &Style, h: f32) -> [u8; 3] {
-    if h < 0.0 {
-        interpolate(&WATER, -h / style.ramp_depth.max(f32::MIN_POSITIVE))
-    } else {
-        interpolate(&LAND, h / style.ramp_top.max(f32::MIN_POSITIVE))
-    }
-}
-
 /// The colour tables: land over `[0, ramp_top]`, water over `[−ramp_depth, 0)`, so that sea level
 /// is an exact boundary (height 0 is land, any height below it water).
 #[derive(Debug, Clone)]
-pub struct Ramp {
+pub(crate) struct Ramp {
     land: Vec<[f32; 3]>,
     water: Vec<[f32; 3]>,
     land_scale: f32,
@@ -55,7 +46,7 @@ pub struct Ramp {
 
 impl Ramp {
     /// The tables for `style`.
-    pub fn new(style: &Style) -> Ramp {
+    pub(crate) fn new(style: &Style) -> Ramp {
         let top = style.ramp_top.max(f32::MIN_POSITIVE);
         let depth = style.ramp_depth.max(f32::MIN_POSITIVE);
         let last = (RAMP_ENTRIES - 1) as f32;
@@ -74,7 +65,7 @@ impl Ramp {
 
     /// The colour of height `h` before lighting.
     #[inline]
-    pub fn get(&self, h: f32) -> [f32; 3] {
+    pub(crate) fn get(&self, h: f32) -> [f32; 3] {
         let last = (RAMP_ENTRIES - 1) as f32;
         if h >= 0.0 {
             self.land[(h * self.land_scale + 0.5).min(last) as usize]

@@ -5,17 +5,17 @@
 //! squeezed like the rest of the half), at zero parallax. They sit on translucent dark panels so
 //! they read on snow as well as on water.
 
-pub mod overlay;
-pub mod text;
+pub(crate) mod overlay;
+pub(crate) mod text;
 
 use crate::output::frame::{Frame, Rgba};
 use crate::raster::rasterise::Bounds;
 use crate::scene::{SlopeBar, Style};
 
 /// Colour of the slope bar's track.
-pub const TRACK_COLOUR: Rgba = [70, 70, 76, 255];
+pub(crate) const TRACK_COLOUR: Rgba = [70, 70, 76, 255];
 /// Colour of the slope bar's tick at the neutral value 0.
-pub const TICK_COLOUR: Rgba = [180, 180, 180, 255];
+pub(crate) const TICK_COLOUR: Rgba = [180, 180, 180, 255];
 /// How much of the frame shows through a panel, 0 to 1.
 const PANEL_SHOW: f32 = 0.45;
 /// Margin around panels, pixels.
@@ -76,7 +76,7 @@ fn fill(frame: &mut Frame, clip: &Bounds, (x0, y0, x1, y1): (i64, i64, i64, i64)
 /// Draws the slope bar into `viewport`: a panel, the track, a tick at 0 when the range holds it,
 /// the marker at the value's position (selection colour), the label and value above, the range's
 /// ends below.
-pub fn slope_bar(frame: &mut Frame, viewport: &Bounds, bar: &SlopeBar, style: &Style) {
+pub(crate) fn slope_bar(frame: &mut Frame, viewport: &Bounds, bar: &SlopeBar, style: &Style) {
     let l = BarLayout::of(viewport, style);
     let s = style.text_scale.max(1);
     let th = i64::from(text::height(s));
@@ -140,7 +140,7 @@ pub fn slope_bar(frame: &mut Frame, viewport: &Bounds, bar: &SlopeBar, style: &S
 }
 
 /// Draws the mode line at the top left of `viewport`, on a panel.
-pub fn mode_line(frame: &mut Frame, viewport: &Bounds, mode: &str, style: &Style) {
+pub(crate) fn mode_line(frame: &mut Frame, viewport: &Bounds, mode: &str, style: &Style) {
     if mode.is_empty() {
         return;
     }

@@ -127,7 +127,7 @@ fn screen(v: &ClipVertex) -> [f32; 3] {
 
 /// The scene's overlays as screen-space capsules for `projection`, in drawing order (the
 /// selection last).
-pub fn capsules(scene: &Scene, projection: &Projection, out: &mut Vec<Capsule>) {
+pub(crate) fn capsules(scene: &Scene, projection: &Projection, out: &mut Vec<Capsule>) {
     out.clear();
     let near = projection.near as f32;
     let vs = f64::from(scene.vertical_scale);

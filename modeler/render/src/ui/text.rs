@@ -10,9 +10,9 @@ use crate::output::frame::{Frame, Rgba};
 use crate::raster::rasterise::Bounds;
 
 /// Font pixels per glyph cell, horizontally.
-pub const CELL_WIDTH: u32 = 6;
+pub(crate) const CELL_WIDTH: u32 = 6;
 /// Font pixels per glyph cell, vertically.
-pub const CELL_HEIGHT: u32 = 8;
+pub(crate) const CELL_HEIGHT: u32 = 8;
 
 #[rustfmt::skip]
 const GLYPHS: [[u8; 5]; 95] = [
@@ -125,18 +125,18 @@ pub fn glyph(ch: char) -> [u8; 5] {
 }
 
 /// Width in pixels of `text` drawn at `scale`.
-pub fn width(text: &str, scale: u32) -> u32 {
+pub(crate) fn width(text: &str, scale: u32) -> u32 {
     text.chars().count() as u32 * CELL_WIDTH * scale
 }
 
 /// Height in pixels of a line at `scale`.
-pub fn height(scale: u32) -> u32 {
+pub(crate) fn height(scale: u32) -> u32 {
     CELL_HEIGHT * scale
 }
 
 /// Draws `text` with its top-left corner at `(x, y)`; pixels outside `clip` or the frame are
 /// skipped.
-pub fn draw(frame: &mut Frame, clip: &Bounds, (x, y): (i64, i64), text: &str, colour: Rgba, scale: u32) {
+pub(crate) fn draw(frame: &mut Frame, clip: &Bounds, (x, y): (i64, i64), text: &str, colour: Rgba, scale: u32) {
     let scale = i64::from(scale.max(1));
     let xs = i64::from(clip.x0).max(0)..i64::from(clip.x1).min(i64::from(frame.width()));
     let ys = i64::from(clip.y0).max(0)..i64::from(clip.y1).min(i64::from(frame.height()));
