@@ -38,6 +38,7 @@
 use std::ops::Range;
 
 use crate::output::frame::Rgba;
+use crate::simd::lanes::{ROW_LANES, RowLanes};
 
 /// Fractional bits of fixed-point pixel coordinates.
 pub(crate) const SUBPIXEL: i32 = 8;
@@ -85,9 +86,7 @@ pub struct Bounds {
 
 /// A depth-buffer entry: `1/w` (0 = empty) and the perspective-divided attributes.
 ///
-/// Laid out as written (`repr(C)`, 16 bytes: `invw`, `hw`, `lw`, then the surface's 4 bytes), so
-/// that the textured polygons' AVX2 lanes write eight samples with four masked vector stores
-/// (`textured/lanes.rs`).
+/// Laid out as written (`repr(C)`, 16 bytes: `invw`, `hw`, `lw`, then the surface's 4 bytes).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 #[repr(C)]
 pub struct Sample {
@@ -104,9 +103,7 @@ pub struct Sample {
 
 /// What a sample shows, which decides its colour.
 ///
-/// Four bytes with a fixed layout (`repr(u8)`: the tag, then a colour's bytes): the AVX2 lanes
-/// of the textured polygons build `Colour([r, g, b])` as the word
-/// `COLOUR_TAG | r << 8 | g << 16 | b << 24` ([`Surface::COLOUR_TAG`]).
+/// Four bytes with a fixed layout (`repr(u8)`: the tag, then a colour's bytes).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 #[repr(u8)]
 pub enum Surface {
@@ -120,11 +117,6 @@ pub enum Surface {
     /// A colour of its own, sRGB, before light: a tree's bark or leaf, a texel of a simplified
     /// shape ([`crate::scene::meshes`], [`super::textured`]).
     Colour([u8; 3]) = 3,
-}
-
-impl Surface {
-    /// The tag byte of [`Surface::Colour`].
-    pub const COLOUR_TAG: u8 = 3;
 }
 
 /// Where covered pixels go.
@@ -596,6 +588,7 @@ fn fill_rows<const N: usize, S: Sink>(
 
 /// Pixels of a row a narrow box's mask holds: boxes narrower than [`SPAN_BOX`] fit.
 const LANES: usize = SPAN_BOX as usize;
+const _: () = assert!(LANES == ROW_LANES);
 
 /// Whether the edge functions stay within `i32` over a box `LANES` wide and `dy + 1` rows tall
 /// from their start (then [`rows_by_mask`] may test its rows in 32-bit lanes).
@@ -639,85 +632,6 @@ fn rows_by_mask<const N: usize, S: Sink>(
         for (r, d) in rows.iter_mut().zip(down) {
             *r += d;
         }
-    }
-}
-
-/// The edge functions' offsets along a row, lane by lane, for [`rows_by_mask`]'s test (three
-/// edges for a triangle, four for a quad). On x86-64 in SSE2 registers, four lanes to each: the
-/// covered lanes' bits come from the lanes' signs packed to bytes and gathered by one
-/// instruction (`pmovmskb`), where the compiler built the mask from the sixteen comparisons a
-/// few bits at a time, most of a sliver's row.
-#[cfg(target_arch = "x86_64")]
-struct RowLanes<const N: usize>([[std::arch::x86_64::__m128i; LANES / 4]; N]);
-
-#[cfg(target_arch = "x86_64")]
-impl<const N: usize> RowLanes<N> {
-    /// Lane `k`'s offset `k·step` from the row's first pixel, per edge. (No overflow:
-    /// [`fits_lanes`] bounds `|step|·LANES`.)
-    #[inline(always)]
-    #[allow(unsafe_code)]
-    fn new(steps: [i32; N]) -> RowLanes<N> {
-        use std::arch::x86_64::{_mm_add_epi32, _mm_set1_epi32, _mm_setr_epi32};
-        // SAFETY: SSE2 is part of x86-64 itself (every x86-64 CPU has it), the one requirement
-        // of these intrinsics; they take no pointers.
-        unsafe {
-            let mut lanes = [[_mm_set1_epi32(0); LANES / 4]; N];
-            for (edge, s) in lanes.iter_mut().zip(steps) {
-                let four = _mm_set1_epi32(4 * s);
-                let mut at = _mm_setr_epi32(0, s, 2 * s, 3 * s);
-                for quad in edge.iter_mut() {
-                    *quad = at;
-                    at = _mm_add_epi32(at, four);
-                }
-            }
-            RowLanes(lanes)
-        }
-    }
-
-    /// Bit `k` set where every edge function `rows[i] + k·step_i` is ≥ 0: its sign is clear.
-    /// The packs saturate, which keeps each lane's sign.
-    #[inline(always)]
-    #[allow(unsafe_code)]
-    fn covered(&self, rows: [i32; N]) -> u32 {
-        use std::arch::x86_64::{
-            _mm_add_epi32, _mm_movemask_epi8, _mm_or_si128, _mm_packs_epi16, _mm_packs_epi32, _mm_set1_epi32,
-        };
-        // SAFETY: as in `new`: SSE2 only, no pointers.
-        unsafe {
-            let mut v = [_mm_set1_epi32(0); LANES / 4];
-            for (offsets, &r) in self.0.iter().zip(&rows) {
-                let r = _mm_set1_epi32(r);
-                for (v, &o) in v.iter_mut().zip(offsets) {
-                    *v = _mm_or_si128(*v, _mm_add_epi32(r, o));
-                }
-            }
-            let low = _mm_packs_epi32(v[0], v[1]);
-            let high = _mm_packs_epi32(v[2], v[3]);
-            let negative = _mm_movemask_epi8(_mm_packs_epi16(low, high)) as u32;
-            !negative & 0xffff
-        }
-    }
-}
-
-/// [`RowLanes`] in plain arrays, elsewhere.
-#[cfg(not(target_arch = "x86_64"))]
-struct RowLanes<const N: usize>([[i32; LANES]; N]);
-
-#[cfg(not(target_arch = "x86_64"))]
-impl<const N: usize> RowLanes<N> {
-    #[inline(always)]
-    fn new(steps: [i32; N]) -> RowLanes<N> {
-        RowLanes(steps.map(|s| std::array::from_fn(|k| k as i32 * s)))
-    }
-
-    #[inline(always)]
-    fn covered(&self, rows: [i32; N]) -> u32 {
-        let mut mask = 0u32;
-        for k in 0..LANES {
-            let v = self.0.iter().zip(&rows).fold(0, |acc, (o, r)| acc | (r + o[k]));
-            mask |= u32::from(v >= 0) << k;
-        }
-        mask
     }
 }
 

@@ -33,9 +33,6 @@ use super::rasterise::{self, Bounds, Sample, Sink, Surface};
 use super::transform::Affine;
 use crate::output::frame::Rgba;
 
-#[cfg(target_arch = "x86_64")]
-mod lanes;
-
 /// Most texels a side of a [`Texture`] has (the texel lookup indexes a side in 16 bits).
 pub(crate) const MAX_SIDE: u32 = 1 << 16;
 
@@ -270,7 +267,6 @@ impl Projected {
             width,
             y0: bounds.y0,
             level: first.level(0),
-            lanes: crate::simd::avx2(),
         };
         self.0.draw(bounds, near, &mut sink, |sink, (k, level)| {
             match textures.get(k as usize) {
@@ -310,7 +306,6 @@ fn texels_per_pixel(corners: &[ClipVertex; 4], texture: &Texture, near: f32) -> 
 
 /// The sample a drawn texel of colour `rgb` at depth `invw` leaves: its colour at full light —
 /// twice it, so that rounding in `lw / invw` cannot dim it (the resolve clamps the light to 1).
-/// One pixel at a time and the lanes ([`lanes`]) both write it.
 #[inline(always)]
 fn texel_sample(invw: f32, rgb: [u8; 3]) -> Sample {
     Sample {
@@ -328,9 +323,6 @@ struct TexelSink<'a> {
     width: usize,
     y0: i32,
     level: Level<'a>,
-    /// Whether rows go to the AVX2 lanes ([`lanes`]): the CPU has AVX2 ([`crate::simd::avx2`]).
-    #[cfg_attr(not(target_arch = "x86_64"), allow(dead_code))]
-    lanes: bool,
 }
 
 impl Sink for TexelSink<'_> {
@@ -349,117 +341,18 @@ impl Sink for TexelSink<'_> {
         *s = texel_sample(invw, [r, g, b]);
     }
 
+    /// A run's pixels each with its offset times the step (not stepped one addition at a time:
+    /// the values the textured polygons were drawn with when an AVX2 path took eight pixels at
+    /// once, kept to the bit).
     #[inline(always)]
     fn run(&mut self, y: i32, px0: i32, ks: Range<i32>, row: [f32; 3], step: [f32; 3]) {
-        #[cfg(target_arch = "x86_64")]
-        if self.lanes {
-            let at = (y - self.y0) as usize * self.width + px0 as usize;
-            // SAFETY: `lanes` is set only where the CPU has AVX2, all `lanes::run` needs.
-            #[allow(unsafe_code)]
-            if unsafe { lanes::run(self.samples, at, &self.level, ks.clone(), row, step) } {
-                return;
-            }
-        }
         rasterise::each_in_run(self, y, px0, ks, row, step);
-    }
-
-    #[inline(always)]
-    fn masked(&mut self, y: i32, px0: i32, mask: u32, row: [f32; 3], step: [f32; 3]) {
-        #[cfg(target_arch = "x86_64")]
-        if self.lanes {
-            let at = (y - self.y0) as usize * self.width + px0 as usize;
-            // SAFETY: as in `run`.
-            #[allow(unsafe_code)]
-            if unsafe { lanes::masked(self.samples, at, &self.level, mask, row, step) } {
-                return;
-            }
-        }
-        rasterise::each_in_mask(self, y, px0, mask, row, step);
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::raster::rasterise::{Vtx, snap};
-
-    /// The AVX2 lanes ([`lanes`]) draw the same samples, bit for bit, as one pixel at a time:
-    /// triangles narrow (row masks) and wide (runs), in front of and behind what the buffer
-    /// holds, over clear and opaque texels, reaching past the tile's edges, at three levels.
-    #[test]
-    fn the_lanes_draw_what_one_pixel_at_a_time_draws() {
-        if !crate::simd::has_avx2() {
-            println!("no AVX2 on this CPU: one pixel at a time only");
-            return;
-        }
-        // Alpha from 0 to 255 in an irregular pattern, so that both sides of 128 occur.
-        let texels = (0..32 * 32u32)
-            .map(|i| [i as u8, (i * 7) as u8, (i * 13) as u8, ((i * 37) % 256) as u8])
-            .collect();
-        let texture = Texture::new(32, 32, texels).expect("texture");
-        let (width, rows) = (120usize, 48usize);
-        // A tile from row 8 of a taller frame.
-        let bounds = Bounds {
-            x0: 0,
-            x1: width as i32,
-            y0: 8,
-            y1: 8 + rows as i32,
-        };
-        let mut next = crate::raster::rasterise::tests::uniform(0x2545_f491);
-        let held: Vec<Sample> = (0..width * rows)
-            .map(|_| Sample {
-                invw: if next() < 0.3 { 0.0 } else { 0.3 * next() },
-                hw: 1.0,
-                lw: 1.0,
-                surface: Surface::Terrain,
-            })
-            .collect();
-        let (mut one, mut lanes) = (held.clone(), held);
-        let bits = |s: &[Sample]| -> Vec<(u32, u32, u32, Surface)> {
-            s.iter()
-                .map(|s| (s.invw.to_bits(), s.hw.to_bits(), s.lw.to_bits(), s.surface))
-                .collect()
-        };
-        let mut last = [Vtx::default(); 3];
-        for k in 0..400 {
-            // Narrow triangles first, then up to the tile's width and past its edges.
-            let span = if k < 200 { 14.0 } else { 150.0 };
-            let mut vertex = || {
-                let w = 0.05 + 0.4 * next();
-                Vtx {
-                    x: snap(-10.0 + span * next() + if k < 200 { 100.0 * next() } else { 0.0 }),
-                    y: snap(0.0 + 64.0 * next()),
-                    invw: w,
-                    hw: w * next(),
-                    lw: w * next(),
-                }
-            };
-            let (mut a, mut b, mut c) = (vertex(), vertex(), vertex());
-            // Every fourth, the triangle before at the same depths with other texels: ties,
-            // which the depth test refuses.
-            if k % 4 == 3 {
-                for (v, old) in [(&mut a, last[0]), (&mut b, last[1]), (&mut c, last[2])] {
-                    let (hw, lw) = (v.hw, v.lw);
-                    *v = Vtx { hw, lw, ..old };
-                }
-            }
-            last = [a, b, c];
-            for (lanes_on, samples) in [(false, &mut one), (true, &mut lanes)] {
-                let mut sink = TexelSink {
-                    samples,
-                    width,
-                    y0: bounds.y0,
-                    level: texture.level((k % 3) as u8),
-                    lanes: lanes_on,
-                };
-                crate::raster::rasterise::two_sided(&a, &b, &c, &bounds, &mut sink);
-            }
-        }
-        assert!(bits(&one) == bits(&lanes), "the lanes drew other samples");
-        // The triangles drew texels (the comparison is not of two untouched buffers).
-        let textured = one.iter().filter(|s| matches!(s.surface, Surface::Colour(_))).count();
-        assert!(textured > width * rows / 10, "{textured} textured samples");
-    }
 
     #[test]
     fn a_level_weights_colour_by_alpha_and_averages_alpha() {

@@ -46,7 +46,6 @@
 //!   maps alone, so the maps after any sequence of changes equal fresh ones to the bit.
 
 use rayon::prelude::*;
-use wide::f32x4;
 
 use super::ramp::{self, WATER};
 use crate::raster::mips::{Level, Mips};
@@ -547,14 +546,6 @@ fn within(v: f32, last: f32) -> f32 {
     if v < last { v } else { last }
 }
 
-/// `a + t·(b − a)` on four lanes, as one vector each (the compiler did it a lane at a time: the
-/// bilinear colour was about 110 instructions a pixel); each lane is the same IEEE operations in
-/// the same order, so the same bits.
-#[inline(always)]
-fn lerp4(a: f32x4, b: f32x4, t: f32) -> f32x4 {
-    a + (b - a) * f32x4::splat(t)
-}
-
 /// A fingerprint of the heights' bits (a multiply-xor hash per row, rows combined in order).
 fn fingerprint(h: &[f32]) -> u64 {
     h.par_chunks(4096)
@@ -606,6 +597,7 @@ fn smoothstep(a: f32, b: f32, t: f32) -> f32 {
 
 use super::atmosphere::lerp as mix;
 use crate::simd::floor::{SMALL, floor_small};
+use crate::simd::lanes::lerp4;
 
 fn rgb(c: [u8; 3]) -> [f32; 3] {
     c.map(f32::from)

@@ -22,6 +22,7 @@ use crate::scene::Style;
 use crate::shade::atmosphere::Atmosphere;
 use crate::shade::land::{Corner, Land, faded};
 use crate::shade::ramp::Ramp;
+use crate::simd::lanes::{lanes_set, lanes_where};
 
 fn mix(a: Rgba, b: Rgba, t: f32) -> Rgba {
     [0, 1, 2, 3].map(|i| (f32::from(a[i]) + t * (f32::from(b[i]) - f32::from(a[i]))).round() as u8)
@@ -282,8 +283,8 @@ fn resolve_land_body(
             // pixel in a loop of its own over its lanes' bits: tested pixel by pixel, the
             // surface and the level were branches on data that a crown's leaves against the
             // ground mispredicted, most of this loop's time.
-            let covered = lanes_where::<true>(&st.invw, 0.0);
-            let far = lanes_where::<false>(&st.invw, fine);
+            let covered = lanes_where::<true, LANES>(&st.invw, 0.0);
+            let far = lanes_where::<false, LANES>(&st.invw, fine);
             let other = lanes_set(&st.other);
             // Other surfaces: their colours.
             for k in bits(covered & other) {
@@ -361,64 +362,6 @@ fn bits(mut mask: u64) -> impl Iterator<Item = usize> {
             k
         })
     })
-}
-
-/// Bit `k` set where `values[k] > t` (`ABOVE`) or `values[k] < t` (else), IEEE compares (a NaN
-/// fails both): on x86-64 four lanes to a compare and their bits by `movmskps` (SSE2, which every
-/// x86-64 CPU has).
-#[inline(always)]
-fn lanes_where<const ABOVE: bool>(values: &[f32; LANES], t: f32) -> u64 {
-    #[cfg(target_arch = "x86_64")]
-    #[allow(unsafe_code)]
-    {
-        use std::arch::x86_64::{_mm_cmpgt_ps, _mm_cmplt_ps, _mm_loadu_ps, _mm_movemask_ps, _mm_set1_ps};
-        let mut mask = 0u64;
-        for (j, four) in values.chunks_exact(4).enumerate() {
-            // SAFETY: SSE2 is part of x86-64; `four` holds four `f32`, all the load reads.
-            let bits = unsafe {
-                let (v, t) = (_mm_loadu_ps(four.as_ptr()), _mm_set1_ps(t));
-                _mm_movemask_ps(if ABOVE { _mm_cmpgt_ps(v, t) } else { _mm_cmplt_ps(v, t) })
-            };
-            mask |= u64::from(bits as u32) << (4 * j);
-        }
-        mask
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        let test = |v: f32| if ABOVE { v > t } else { v < t };
-        values
-            .iter()
-            .enumerate()
-            .fold(0u64, |m, (k, &v)| m | u64::from(test(v)) << k)
-    }
-}
-
-/// Bit `k` set where `flags[k]` is not 0: on x86-64 sixteen bytes to a compare and their bits by
-/// `pmovmskb` (SSE2).
-#[inline(always)]
-fn lanes_set(flags: &[u8; LANES]) -> u64 {
-    #[cfg(target_arch = "x86_64")]
-    #[allow(unsafe_code)]
-    {
-        use std::arch::x86_64::{__m128i, _mm_cmpeq_epi8, _mm_loadu_si128, _mm_movemask_epi8, _mm_setzero_si128};
-        let mut zero = 0u64;
-        for (j, sixteen) in flags.chunks_exact(16).enumerate() {
-            // SAFETY: SSE2 is part of x86-64; `sixteen` holds sixteen bytes, all the load reads.
-            let bits = unsafe {
-                let v = _mm_loadu_si128(sixteen.as_ptr().cast::<__m128i>());
-                _mm_movemask_epi8(_mm_cmpeq_epi8(v, _mm_setzero_si128()))
-            };
-            zero |= u64::from(bits as u32 & 0xffff) << (16 * j);
-        }
-        !zero
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        flags
-            .iter()
-            .enumerate()
-            .fold(0u64, |m, (k, &f)| m | u64::from(f != 0) << k)
-    }
 }
 
 /// `v as u8` (NaN and below 0: 0; past 255: 255; else truncated) from the bits of `v` clamped to

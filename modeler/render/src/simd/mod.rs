@@ -1,16 +1,19 @@
-//! Runtime dispatch of the per-pixel loops to AVX2 (issue 14).
+//! The renderer's lane code, all of it: the run-time dispatch of the per-pixel loops to AVX2
+//! (issue 14), and the lane helpers the stages call ([`lanes`], [`floor`]).
 //!
-//! The workspace builds for baseline x86-64 (SSE2: four `f32` lanes, no 32-bit lane multiply,
-//! no variable shifts); the machines the modeler runs on, and CI's, have AVX2. The loops over
-//! every pixel of a frame that vectorise — the land look's resolve ([`crate::shade`], written in
-//! passes for it) and the anaglyph ([`crate::output::stereo`]) — are compiled twice: once for the
+//! **One dispatch idiom.** The workspace builds for baseline x86-64 (SSE2: four `f32` lanes, no
+//! 32-bit lane multiply, no variable shifts); the machines the modeler runs on, and CI's, have
+//! AVX2. The loops over every pixel of a frame that vectorise — the land look's resolve
+//! ([`crate::shade`], written in passes for it), the anaglyph ([`crate::output::stereo`]) and
+//! the reprojection's rows ([`crate::lod::reproject`]) — are compiled twice: once for the
 //! baseline, once inside a `#[target_feature(enable = "avx2")]` function that calls the same
-//! `#[inline(always)]` body, so that LLVM uses eight lanes in that copy. [`avx2`] picks one at
-//! run time, from the terrain engine's choice of copy (`penmodel_terrain::simd`: one detection of
-//! the CPU and one test switch for both crates). (The triangles' pixel loops step their
+//! `#[inline(always)]` body, so that LLVM uses eight lanes in that copy: `dispatch!` in place
+//! of the call. [`avx2`] picks one at run time, from the terrain engine's choice of copy
+//! (`penmodel_terrain::simd`: one detection of the CPU and one test switch for both crates).
+//! Nothing else chooses at run time: the helpers in [`lanes`] are SSE2 (part of x86-64) or
+//! portable, and inlined into whichever copy calls them. (The triangles' pixel loops step their
 //! attributes one addition after another, which no vector width changes, so they are compiled
-//! once; the textured triangles' pixels have an AVX2 path of their own, eight pixels to a group
-//! in intrinsics, `textured/lanes.rs`, chosen by the same [`avx2`].)
+//! once.)
 //!
 //! The two copies give the same bytes: AVX2 adds no operation the baseline copy lacks, and an
 //! IEEE addition, multiplication, division, square root or conversion gives the same result in
@@ -20,6 +23,7 @@
 //! (`tests/simd.rs`), so the baseline copy stays tested on an AVX2 machine.
 
 pub(crate) mod floor;
+pub(crate) mod lanes;
 
 use std::sync::OnceLock;
 
