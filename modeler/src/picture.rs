@@ -338,7 +338,7 @@ impl Picture {
             trees: &self.trees,
             time: self.time,
             looking_at: self.pen_tip.and_then(|(g, h)| {
-                let h = h.or_else(|| penmodel_render::overlay::surface_height(terrain, g[0], g[1]))?;
+                let h = h.or_else(|| penmodel_render::surface_height(terrain, g[0], g[1]))?;
                 Some([g[0], h * f64::from(self.vertical_scale), g[1]])
             }),
             ..Scene::new(terrain, self.camera)

@@ -1,21 +1,34 @@
 //! The CPU rasteriser: a [`Scene`] in, a [`Frame`] out.
 //!
-//! One module per stage, in pipeline order:
+//! One folder per stage, in pipeline order:
 //!
-//! 1. [`camera`]: eyes and screens — an orbit camera or a tracked head in front of a display, the
-//!    off-axis projection, stereo eyes, the ground plane's tilt.
-//! 2. [`transform`]: the grid's vertices projected and snapped once per eye; chunks of quads with
-//!    screen bounds, near to far.
-//! 3. [`clip`]: triangles and lines crossing the near plane or the guard band, cut.
-//! 4. [`rasterise`]: triangles into a depth buffer, fixed point, top-left rule.
-//! 5. [`shade`]: per-vertex light ([`light`]), the elevation ramp per pixel ([`ramp`]), the sky;
-//!    or the land look's ground colours ([`land`]) and the sky, table and haze around them
-//!    ([`atmosphere`]).
-//! 6. [`overlay`]: figures and boundaries draped on the surface, depth-tested with a bias.
-//! 7. [`ui`] and [`text`]: the slope bar and the mode line.
-//! 8. [`stereo`]: anaglyph and side-by-side.
+//! 1. `scene/`: the input as plain data ([`Scene`], [`Style`]); the light per vertex its style
+//!    calls for (`light`); what stands on the terrain — rocks, water and trees as meshes
+//!    (`meshes`, a rock field's level of detail `rock_lod`), the trees' simplified shapes
+//!    (`impostor`) and the trees chosen per frame (`forest`).
+//! 2. `raster/`: eyes and screens (`camera`: an orbit camera or a tracked head in front of a
+//!    display, the off-axis projection, stereo eyes, the ground plane's tilt); the grid's vertices
+//!    projected and snapped once per eye, in chunks with screen bounds (`transform`); triangles and
+//!    lines crossing the near plane or the guard band cut (`clip`); triangles into a depth buffer,
+//!    fixed point, top-left rule (`rasterise`); triangles and quads binned by bands of rows
+//!    (`binned`); textured, alpha-tested polygons (`textured`) and texture levels (`mips`).
+//! 3. `lod/`: drawing less — the terrain's level-of-detail quadtree and its chosen nodes
+//!    (`nodes`); an eye's picture moved to a newer pose by its depth (`reproject`).
+//! 4. `shade/`: samples become colours — per-vertex light, the elevation ramp per pixel
+//!    (`ramp`), the sky; or the land look's ground colours (`land`) and the sky, table and haze
+//!    around them (`atmosphere`).
+//! 5. `ui/`: figures and boundaries draped on the surface, depth-tested with a bias (`overlay`);
+//!    the slope bar, the mode line and panels, in a built-in font (`text`).
+//! 6. `output/`: the frame buffer ([`Frame`]), stereo's anaglyph and side-by-side (`stereo`), and
+//!    where frames go: PNG, APNG, a window.
 //!
-//! [`tiles`] runs stages 4–6 per band of rows in parallel (rayon). A [`Renderer`] keeps its
+//! `simd/` holds the lane code of every stage: the AVX2 copies' dispatch and the vector helpers.
+//!
+//! The stages are private to the crate: what callers use is re-exported here, flat, with
+//! [`land`] (the land look's maps, palette and materials) and [`impostor`] (the trees' simplified
+//! shapes) as namespaces, and [`output`] a module of its own.
+//!
+//! `tiles` runs stages 2, 4 and 5 per band of rows in parallel (rayon). A [`Renderer`] keeps its
 //! buffers between frames, so a live session calls [`Renderer::render`] once per pen report
 //! without allocating. `docs/renderer.md` gives the maths and the measured figures behind the
 //! decisions.
@@ -25,45 +38,45 @@
 //! height leaves a hole (the triangles touching it are skipped, and [`RenderStats`] counts such
 //! vertices); a grid smaller than 2 × 2 has no triangles and shows only sky, overlays and UI.
 
-pub mod atmosphere;
-pub mod binned;
-pub mod camera;
-pub mod clip;
-mod floor;
-pub mod forest;
-pub mod frame;
-pub mod impostor;
-pub mod land;
-pub mod light;
-pub mod lod;
-pub mod meshes;
-mod mips;
-pub mod nodes;
-pub mod overlay;
-pub mod ramp;
-pub mod rasterise;
-pub mod reproject;
-pub mod rock_lod;
-pub mod scene;
-pub mod shade;
+mod lod;
+pub mod output;
+mod raster;
+mod scene;
+mod shade;
 #[doc(hidden)]
 pub mod simd;
-pub mod stereo;
-pub mod text;
-pub mod textured;
-pub mod tiles;
-pub mod transform;
-pub mod ui;
+mod tiles;
+mod ui;
 
-pub mod output;
-
-pub use camera::{Camera, Eye, Orbit, Projection, Tracked, View, Viewport};
-pub use frame::{Frame, RenderError, Rgba};
+pub use lod::{Area, DEFAULT_PIXELS as DEFAULT_LOD_PIXELS, Pick, Pyramid};
+pub use output::frame::{Frame, MAX_SIDE, RenderError, Rgba};
+pub use output::stereo::luma;
+pub use raster::camera::{Camera, Eye, Orbit, Projection, Tracked, View, Viewpoint, Viewport};
+pub use raster::rasterise::{Bounds, Sample};
+pub use raster::textured::{Quad, Texture};
+pub use raster::transform::Affine;
+pub use scene::forest::{TreeStats, eye_and_gaze};
+pub use scene::meshes::{Paint, Projected as ProjectedMeshes};
 pub use scene::{Look, Overlay, Scene, SlopeBar, Stereo, Style};
+pub use ui::overlay::surface_height;
+pub use ui::text::glyph;
+pub use ui::{BarLayout, Place, panel};
 
-use meshes::Paint;
-use rasterise::{Bounds, Capsule, Surface};
-use transform::{Affine, Projected};
+/// The trees' simplified shapes (seed 004, §5.2.3): which side faces an eye, the quads and the
+/// opaque part of a texture.
+pub use scene::impostor;
+/// The land look's maps, its palette and its materials.
+pub use shade::land;
+
+use lod::{nodes, reproject};
+use output::{frame, stereo};
+use raster::{rasterise, textured, transform};
+use scene::{forest, light, meshes};
+use shade::{atmosphere, ramp};
+use ui::overlay;
+
+use rasterise::{Capsule, Surface};
+use transform::Projected;
 
 /// What a render found in its input.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]

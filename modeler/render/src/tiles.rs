@@ -15,17 +15,17 @@ use std::cell::RefCell;
 
 use rayon::prelude::*;
 
-use super::frame::Rgba;
-use super::nodes;
-use super::rasterise::{self, Bounds, Capsule, Sample, Sink};
-use super::scene::Style;
-use super::shade::{self, Shading};
-use super::transform::{self, Affine, ChunkState, Projected};
+use crate::lod::nodes;
+use crate::output::frame::Rgba;
+use crate::raster::rasterise::{self, Bounds, Capsule, Sample, Sink};
+use crate::raster::transform::{self, Affine, ChunkState, Projected};
+use crate::scene::Style;
+use crate::shade::{self, Shading};
 use penmodel_terrain::Heightmap;
 
 /// What the tiles of one eye share.
 #[allow(missing_docs)] // fields named for what they hold.
-pub struct EyePass<'a> {
+pub(crate) struct EyePass<'a> {
     pub map: &'a Heightmap,
     /// Per-vertex light.
     pub light: &'a [f32],
@@ -53,7 +53,7 @@ impl EyePass<'_> {
     }
 
     /// Draws the terrain's triangles over `bounds` into `sink`.
-    pub fn terrain<S: Sink>(&self, bounds: &Bounds, sink: &mut S) {
+    pub(crate) fn terrain<S: Sink>(&self, bounds: &Bounds, sink: &mut S) {
         if let Some(nodes) = self.nodes {
             nodes::draw(nodes, self.near, bounds, sink);
             return;
@@ -122,10 +122,13 @@ thread_local! {
 /// `depths` (a frame's worth), each pixel's `1/w` is kept there too (0: no surface), for the
 /// reprojection of a held frame.
 #[allow(clippy::too_many_arguments)]
-pub fn render(
+pub(crate) fn render(
     pass: &EyePass,
-    meshes: &[super::meshes::Projected],
-    (textured, textures): (&[super::textured::Projected], &[&super::textured::Texture]),
+    meshes: &[crate::scene::meshes::Projected],
+    (textured, textures): (
+        &[crate::raster::textured::Projected],
+        &[&crate::raster::textured::Texture],
+    ),
     capsules: &[Capsule],
     shading: &Shading,
     style: &Style,
@@ -211,7 +214,7 @@ pub fn render(
 }
 
 /// Counts the terrain's coverage of each pixel of the viewport (no depth test).
-pub fn coverage(pass: &EyePass, counts: &mut [u16], width: usize, tile_rows: usize) {
+pub(crate) fn coverage(pass: &EyePass, counts: &mut [u16], width: usize, tile_rows: usize) {
     let tile = tile_rows.max(1) * width;
     counts.par_chunks_mut(tile).enumerate().for_each(|(i, cnt)| {
         let y0 = (i * tile_rows.max(1)) as i32;

@@ -2,7 +2,7 @@
 //! here, its update by rectangle against a rebuild, the image at LOD against full detail, and no
 //! crack between levels.
 
-use penmodel_render::lod::{Area, Pyramid};
+use penmodel_render::{Area, Pyramid};
 use penmodel_render::{Camera, Frame, Renderer, Scene, Style};
 use penmodel_terrain::Heightmap;
 

@@ -2,11 +2,9 @@
 //! colour, coverage, clipping, stereo, tiles, degenerate input, and the 2D layer.
 
 use glam::DVec3;
-use penmodel_render::camera::Viewpoint;
-use penmodel_render::ui::BarLayout;
 use penmodel_render::{
-    self, Camera, Eye, Frame, Orbit, Overlay, Projection, RenderError, Renderer, Scene, SlopeBar, Stereo, Tracked,
-    View, Viewport,
+    self, BarLayout, Camera, Eye, Frame, Orbit, Overlay, Projection, RenderError, Renderer, Scene, SlopeBar, Stereo,
+    Tracked, View, Viewpoint, Viewport,
 };
 use penmodel_terrain::Heightmap;
 
@@ -323,7 +321,7 @@ fn anaglyph_takes_red_from_the_left_eye_and_cyan_from_the_right() {
     assert_ne!(left, right, "the eyes see different images");
     let a = render(&s, w, h);
     for ((p, l), q) in a.pixels().iter().zip(left.pixels()).zip(right.pixels()) {
-        assert_eq!(p[0], penmodel_render::stereo::luma(*l));
+        assert_eq!(p[0], penmodel_render::luma(*l));
         assert_eq!([p[1], p[2]], [q[1], q[2]]);
     }
 }
@@ -579,7 +577,7 @@ fn the_slope_bar_shows_the_value_at_its_position() {
         });
         let f = render(&s, w, h);
         let layout = BarLayout::of(
-            &penmodel_render::rasterise::Bounds {
+            &penmodel_render::Bounds {
                 x0: 0,
                 x1: w as i32,
                 y0: 0,
@@ -614,7 +612,7 @@ fn the_mode_line_is_drawn_in_the_text_colour() {
     let lit: usize = "grab: figure 2"
         .chars()
         .map(|c| {
-            penmodel_render::text::glyph(c)
+            penmodel_render::glyph(c)
                 .iter()
                 .map(|b| b.count_ones() as usize)
                 .sum::<usize>()
@@ -626,7 +624,7 @@ fn the_mode_line_is_drawn_in_the_text_colour() {
 
 #[test]
 fn every_glyph_is_distinct() {
-    let glyphs: Vec<[u8; 5]> = (32u8..127).map(|c| penmodel_render::text::glyph(c as char)).collect();
+    let glyphs: Vec<[u8; 5]> = (32u8..127).map(|c| penmodel_render::glyph(c as char)).collect();
     for (i, g) in glyphs.iter().enumerate() {
         if i > 0 {
             assert!(g.iter().any(|&b| b != 0), "glyph {:?} is empty", (i as u8 + 32) as char);
@@ -641,5 +639,5 @@ fn every_glyph_is_distinct() {
             );
         }
     }
-    assert_eq!(penmodel_render::text::glyph('é'), penmodel_render::text::glyph('?'));
+    assert_eq!(penmodel_render::glyph('é'), penmodel_render::glyph('?'));
 }

@@ -111,7 +111,7 @@ fn rocks_under_the_level_of_detail_error_are_drawn_as_quads_and_look_the_same() 
     // What was drawn: 2 triangles for a simplified rock; near, every rock is many pixels across
     // and drawn whole.
     let drawn = |lod: f32, distance: f64| {
-        use penmodel_render::{Eye, Projection, Viewport, meshes::Projected, transform::Affine};
+        use penmodel_render::{Affine, Eye, ProjectedMeshes, Projection, Viewport};
         let camera = crate::common::orbit([32.0, 32.0], 20.0, 50.0, distance);
         let viewport = Viewport {
             x: 0.0,
@@ -121,7 +121,7 @@ fn rocks_under_the_level_of_detail_error_are_drawn_as_quads_and_look_the_same() 
         };
         let projection = Projection::new(&camera.viewpoint(Eye::Centre, 640.0 / 360.0), 0.0, viewport);
         let affine = Affine::new(&projection, 1.0, 1.0);
-        let mut projected = Projected::default();
+        let mut projected = ProjectedMeshes::default();
         projected.clear((360, 16));
         let style = Scene::new(&map, camera).style;
         projected.add_rocks(

@@ -5,10 +5,9 @@
 use std::sync::Arc;
 
 use glam::{DAffine3, DVec3, Vec3};
-use penmodel_render::camera::{Eye, Projection, Viewport};
 use penmodel_render::impostor::{self, Side};
-use penmodel_render::textured::{Quad, Texture};
 use penmodel_render::{Camera, Frame, Orbit, Renderer, Scene, View};
+use penmodel_render::{Eye, Projection, Quad, Texture, Viewport};
 use penmodel_terrain::Heightmap;
 use penmodel_terrain::trees::nodes::STOP;
 use penmodel_terrain::trees::{NodeTree, Preset, Roughness, Source, Species, Standing};
@@ -335,7 +334,7 @@ fn near_the_gaze_a_tree_is_full_and_far_in_the_periphery_it_is_simplified() {
         looked.total_polygons() > 3 * lod.total_polygons(),
         "looked at {looked:?}, in the periphery {lod:?}"
     );
-    let (eye, gaze) = penmodel_render::forest::eye_and_gaze(&scene, 160.0 / 120.0);
+    let (eye, gaze) = penmodel_render::eye_and_gaze(&scene, 160.0 / 120.0);
     let to = (glam::DVec3::from_array(middle) - eye).normalize();
     assert!(gaze.dot(to) > 0.999_999, "gaze {gaze} towards {to}");
 }
@@ -343,16 +342,16 @@ fn near_the_gaze_a_tree_is_full_and_far_in_the_periphery_it_is_simplified() {
 /// Draws `mesh` with `paint` into a 160 × 120 depth buffer seen by `camera`.
 fn samples_of(
     mesh: &penmodel_terrain::export::Mesh,
-    paint: penmodel_render::meshes::Paint,
+    paint: penmodel_render::Paint,
     camera: &Camera,
-) -> Vec<penmodel_render::rasterise::Sample> {
-    use penmodel_render::rasterise::{Bounds, Sample};
-    use penmodel_render::transform::Affine;
+) -> Vec<penmodel_render::Sample> {
+    use penmodel_render::Affine;
+    use penmodel_render::{Bounds, Sample};
     let (w, h) = (160u32, 120u32);
     let p = projection(camera, w, h);
     let affine = Affine::new(&p, 1.0, 1.0);
     let style = penmodel_render::Style::default();
-    let mut projected = penmodel_render::meshes::Projected::default();
+    let mut projected = penmodel_render::ProjectedMeshes::default();
     projected.clear((h as usize, h as usize));
     projected.add([mesh], paint, &affine, 1.0, p.near as f32, &style);
     let mut samples = vec![Sample::default(); (w * h) as usize];
@@ -368,7 +367,7 @@ fn samples_of(
 
 #[test]
 fn a_branchs_frustum_is_drawn_from_its_front_only_with_the_same_pixels() {
-    use penmodel_render::meshes::Paint;
+    use penmodel_render::Paint;
     use penmodel_terrain::trees::shapes::{self, Parts};
     // A bark frustum, leaning towards the eye so that its open top shows, and a leaf.
     let mut parts = Parts::default();

@@ -4,8 +4,10 @@
 //! ([`window::Viewer`]) loads X11 or Wayland only when it is opened, and says so with an error
 //! when there is no display.
 
+pub(crate) mod frame;
 pub mod png;
 pub mod sequence;
+pub(crate) mod stereo;
 #[cfg(feature = "window")]
 pub mod window;
 

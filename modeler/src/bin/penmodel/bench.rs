@@ -73,7 +73,7 @@ pub struct Args {
     look: crate::render::LookArg,
     /// The terrain's level of detail in the pulls' frames and the still frames' second run: the
     /// largest error on screen, pixels (0: every cell).
-    #[arg(long, value_name = "PX", default_value_t = penmodel_render::lod::DEFAULT_PIXELS, value_parser = crate::render::lod_error)]
+    #[arg(long, value_name = "PX", default_value_t = penmodel_render::DEFAULT_LOD_PIXELS, value_parser = crate::render::lod_error)]
     lod_error: f32,
     /// Measure only the still frames (`frames.rs`: LOD off and on, mono and stereo); grids above
     /// 1024 are measured this way only.

@@ -36,8 +36,8 @@ pub fn size(s: &str) -> Result<(u32, u32), String> {
         .ok_or_else(|| format!("expected WIDTHxHEIGHT, got {s:?}"))?;
     let parse = |v: &str| v.trim().parse::<u32>().map_err(|e| format!("{v:?}: {e}"));
     let (w, h) = (parse(w)?, parse(h)?);
-    if w == 0 || h == 0 || w > render::frame::MAX_SIDE || h > render::frame::MAX_SIDE {
-        return Err(format!("each side must be 1 to {}", render::frame::MAX_SIDE));
+    if w == 0 || h == 0 || w > render::MAX_SIDE || h > render::MAX_SIDE {
+        return Err(format!("each side must be 1 to {}", render::MAX_SIDE));
     }
     Ok((w, h))
 }
@@ -194,7 +194,7 @@ pub struct Args {
     repeat: Option<u32>,
     /// The terrain's level of detail: the largest error, in pixels, a coarser level of the
     /// heightfield may make on screen; 0 draws every cell (docs/renderer.md).
-    #[arg(long, value_name = "PX", default_value_t = penmodel_render::lod::DEFAULT_PIXELS, value_parser = lod_error)]
+    #[arg(long, value_name = "PX", default_value_t = penmodel_render::DEFAULT_LOD_PIXELS, value_parser = lod_error)]
     pub lod_error: f32,
 }
 

@@ -12,7 +12,7 @@ use penmodel::painter::{Overview, Painter};
 use penmodel::picture::Look;
 use penmodel::session::Session;
 use penmodel_render::output::{Viewer, ViewerEvent};
-use penmodel_render::ui::{self, Place};
+use penmodel_render::{Place, panel};
 
 use super::{Written, say};
 
@@ -137,14 +137,14 @@ pub fn run(
                 painter.view_frame().width() as i32,
                 painter.view_frame().height() as i32,
             );
-            let viewport = penmodel_render::rasterise::Bounds {
+            let viewport = penmodel_render::Bounds {
                 x0: 0,
                 x1: w,
                 y0: 0,
                 y1: h,
             };
             let style = &look.style;
-            ui::panel(
+            panel(
                 &mut frame,
                 &viewport,
                 &Notice::lines(&notice),
@@ -152,7 +152,7 @@ pub fn run(
                 style,
             );
             if help {
-                ui::panel(
+                panel(
                     &mut frame,
                     &viewport,
                     &keys::help_lines(&session.interaction.help()),
