@@ -76,6 +76,7 @@ use crate::change::{FigureList, Scope};
 use crate::detail;
 use crate::document::{Document, Figure, Grid, Region};
 use crate::erosion;
+use crate::fluvial;
 use crate::heightmap::Heightmap;
 use crate::river::layer::{Layer, Water};
 use crate::validate::{self, ValidationError};
@@ -102,7 +103,15 @@ pub struct TerrainEngine {
     erosion: Option<erosion::Layer>,
     /// The ridgelines (seed 002) and the ground they make with `map`.
     ridges: crate::ridge::layer::Layer,
+    /// The fluvial erosion's settings and the land it made of the ridges' ground, if the
+    /// document has it.
+    fluvial: Option<(crate::document::Fluvial, Heightmap)>,
     rivers: Layer,
+}
+
+/// The land `settings` erode out of `ground`.
+fn eroded(settings: crate::document::Fluvial, ground: &Heightmap) -> Heightmap {
+    fluvial::erode(settings, ground)
 }
 
 /// The node that owns figure list `list`, with that list's figures, base and outer slope.
@@ -176,23 +185,40 @@ impl TerrainEngine {
             layer.apply(whole(&grid), &mut map);
         }
         let ridges = crate::ridge::layer::Layer::new(doc, &map);
+        let fluvial = doc
+            .terrain
+            .erosion
+            .and_then(|e| e.fluvial)
+            .map(|f| (f, eroded(f, ridges.ground(&map))));
         let mut rivers = Layer::default();
-        rivers.sync(doc, ridges.ground(&map), Rect::EMPTY);
+        let ground = fluvial.as_ref().map_or(ridges.ground(&map), |(_, land)| land);
+        rivers.sync(doc, ground, Rect::EMPTY);
         TerrainEngine {
             regions,
             map,
             detail,
             erosion,
             ridges,
+            fluvial,
             rivers,
         }
     }
 
+    /// The land before the fluvial erosion: the ridges' ground.
+    pub fn sketch(&self) -> &Heightmap {
+        self.ridges.ground(&self.map)
+    }
+
+    /// The land the rivers are carved into: the fluvial erosion's, or the ridges' ground.
+    pub fn land(&self) -> &Heightmap {
+        self.fluvial
+            .as_ref()
+            .map_or(self.ridges.ground(&self.map), |(_, land)| land)
+    }
+
     /// The terrain as of the last update.
     pub fn heightmap(&self) -> &Heightmap {
-        self.rivers
-            .carved()
-            .map_or(self.ridges.ground(&self.map), |(carved, _)| carved)
+        self.rivers.carved().map_or(self.land(), |(carved, _)| carved)
     }
 
     /// The ridgelines' layer (its DTM, and the terrain before the rivers).
@@ -213,11 +239,16 @@ impl TerrainEngine {
     /// The terrain, without the caches.
     pub fn into_heightmap(self) -> Heightmap {
         let TerrainEngine {
-            map, ridges, rivers, ..
+            map,
+            ridges,
+            fluvial,
+            rivers,
+            ..
         } = self;
-        match rivers.carved() {
-            Some((carved, _)) => carved.clone(),
-            None => ridges.ground(&map).clone(),
+        match (rivers.carved(), fluvial) {
+            (Some((carved, _)), _) => carved.clone(),
+            (None, Some((_, land))) => land,
+            (None, None) => ridges.ground(&map).clone(),
         }
     }
 
@@ -244,8 +275,21 @@ impl TerrainEngine {
                 };
                 // The ridges follow their entry and join the regions' terrain that changed; the
                 // rivers follow their entries and the ground that changed under them.
-                let rect = rect.union(self.ridges.sync(doc, &self.map, rect));
-                match self.rivers.sync(doc, self.ridges.ground(&self.map), rect) {
+                let mut rect = rect.union(self.ridges.sync(doc, &self.map, rect));
+                // Fluvial erosion is not local (a cell's drainage is its whole catchment): any
+                // change of the ground re-erodes the whole grid.
+                if let Some((settings, land)) = &mut self.fluvial
+                    && rect.width > 0
+                    && rect.height > 0
+                {
+                    *land = eroded(*settings, self.ridges.ground(&self.map));
+                    rect = whole(&doc.grid);
+                }
+                let ground = self
+                    .fluvial
+                    .as_ref()
+                    .map_or(self.ridges.ground(&self.map), |(_, land)| land);
+                match self.rivers.sync(doc, ground, rect) {
                     Some(more) => rect.union(more),
                     None => rect,
                 }
