@@ -29,6 +29,9 @@
 //! - with the document's erosion, [`crate::erosion`] erodes the terrain (with detail) after that
 //!   (the regions, or the detail, write the terrain before it; the erosion follows the rectangle
 //!   that changed, grown by its steps).
+//! - with the document's fluvial erosion, [`crate::fluvial`] erodes the ridges' ground before
+//!   the rivers are carved: not local, so a change re-erodes the whole grid, at once or
+//!   progressively ([`TerrainEngine::set_progressive_erosion`]).
 //!
 //! Distances move through every cell of the region, including cells a nested region covers. A
 //! cell that no figure can reach (`dp` infinite for all) stays at the base height: an unreachable
@@ -103,15 +106,65 @@ pub struct TerrainEngine {
     erosion: Option<erosion::Layer>,
     /// The ridgelines (seed 002) and the ground they make with `map`.
     ridges: crate::ridge::layer::Layer,
-    /// The fluvial erosion's settings and the land it made of the ridges' ground, if the
-    /// document has it.
-    fluvial: Option<(crate::document::Fluvial, Heightmap)>,
+    /// The fluvial erosion, if the document has it.
+    fluvial: Option<FluvialLayer>,
+    /// Whether a change of the land under the fluvial erosion is followed progressively
+    /// ([`TerrainEngine::set_progressive_erosion`]).
+    progressive: bool,
     rivers: Layer,
 }
 
-/// The land `settings` erode out of `ground`.
-fn eroded(settings: crate::document::Fluvial, ground: &Heightmap) -> Heightmap {
-    fluvial::erode(settings, ground)
+/// The fluvial erosion's settings, the land shown and the ground it was made from.
+struct FluvialLayer {
+    settings: crate::document::Fluvial,
+    /// The eroded land shown: exact when `run` is `None`.
+    land: Heightmap,
+    /// The ground (the ridges') `land` follows.
+    ground: Heightmap,
+    /// The exact erosion of `ground` while it runs, a few steps at a time.
+    run: Option<fluvial::Model>,
+}
+
+impl FluvialLayer {
+    fn new(settings: crate::document::Fluvial, ground: &Heightmap) -> FluvialLayer {
+        FluvialLayer {
+            settings,
+            land: fluvial::erode(settings, ground),
+            ground: ground.clone(),
+            run: None,
+        }
+    }
+
+    /// Follows a change of the ground in `rect`: exactly (the whole grid eroded again), or,
+    /// `progressive`, by adding the ground's change in `rect` to the land shown and starting
+    /// the exact run, which [`TerrainEngine::settle_erosion`] advances. Returns what changed.
+    fn follow(&mut self, ground: &Heightmap, rect: Rect, progressive: bool) -> Rect {
+        if !progressive {
+            *self = FluvialLayer::new(self.settings, ground);
+            return whole_of(ground);
+        }
+        let cols = ground.cols() as usize;
+        let (new, old, land) = (ground.heights(), self.ground.heights_mut(), self.land.heights_mut());
+        for r in rect.r0..rect.r0 + rect.height {
+            for c in rect.c0..rect.c0 + rect.width {
+                let i = r as usize * cols + c as usize;
+                land[i] += new[i] - old[i];
+                old[i] = new[i];
+            }
+        }
+        self.run = Some(fluvial::Model::new(self.settings, ground));
+        rect
+    }
+}
+
+/// Every cell of `map`'s grid.
+fn whole_of(map: &Heightmap) -> Rect {
+    Rect {
+        c0: 0,
+        r0: 0,
+        width: map.cols(),
+        height: map.rows(),
+    }
 }
 
 /// The node that owns figure list `list`, with that list's figures, base and outer slope.
@@ -189,9 +242,9 @@ impl TerrainEngine {
             .terrain
             .erosion
             .and_then(|e| e.fluvial)
-            .map(|f| (f, eroded(f, ridges.ground(&map))));
+            .map(|f| FluvialLayer::new(f, ridges.ground(&map)));
         let mut rivers = Layer::default();
-        let ground = fluvial.as_ref().map_or(ridges.ground(&map), |(_, land)| land);
+        let ground = fluvial.as_ref().map_or(ridges.ground(&map), |f| &f.land);
         rivers.sync(doc, ground, Rect::EMPTY);
         TerrainEngine {
             regions,
@@ -200,8 +253,40 @@ impl TerrainEngine {
             erosion,
             ridges,
             fluvial,
+            progressive: false,
             rivers,
         }
+    }
+
+    /// Whether a change under the fluvial erosion is followed progressively: the change is
+    /// added to the eroded land at once (the cells it touches, as without erosion), and the
+    /// exact erosion runs a few steps per [`TerrainEngine::settle_erosion`] and replaces it when
+    /// done. Off (the default), every update re-erodes the whole grid before it returns. The
+    /// live modeler turns it on so the hand never waits.
+    pub fn set_progressive_erosion(&mut self, on: bool) {
+        self.progressive = on;
+    }
+
+    /// Whether an exact erosion is still running ([`TerrainEngine::set_progressive_erosion`]).
+    pub fn erosion_pending(&self) -> bool {
+        self.fluvial.as_ref().is_some_and(|f| f.run.is_some())
+    }
+
+    /// Advances a running exact erosion by up to `steps` steps; when it finishes, it replaces
+    /// the land shown, the rivers are carved into it again, and the whole grid is returned as
+    /// changed. `doc` is the document of the last update.
+    pub fn settle_erosion(&mut self, doc: &Document, steps: u32) -> Rect {
+        let Some(f) = &mut self.fluvial else { return Rect::EMPTY };
+        let Some(run) = &mut f.run else { return Rect::EMPTY };
+        run.advance(steps);
+        if !run.finished() {
+            return Rect::EMPTY;
+        }
+        run.write(&mut f.land);
+        f.run = None;
+        let all = whole(&doc.grid);
+        self.rivers.sync(doc, &f.land, all);
+        all
     }
 
     /// The land before the fluvial erosion: the ridges' ground.
@@ -211,9 +296,7 @@ impl TerrainEngine {
 
     /// The land the rivers are carved into: the fluvial erosion's, or the ridges' ground.
     pub fn land(&self) -> &Heightmap {
-        self.fluvial
-            .as_ref()
-            .map_or(self.ridges.ground(&self.map), |(_, land)| land)
+        self.fluvial.as_ref().map_or(self.ridges.ground(&self.map), |f| &f.land)
     }
 
     /// The terrain as of the last update.
@@ -247,7 +330,7 @@ impl TerrainEngine {
         } = self;
         match (rivers.carved(), fluvial) {
             (Some((carved, _)), _) => carved.clone(),
-            (None, Some((_, land))) => land,
+            (None, Some(f)) => f.land,
             (None, None) => ridges.ground(&map).clone(),
         }
     }
@@ -278,24 +361,22 @@ impl TerrainEngine {
                 let mut rect = rect.union(self.ridges.sync(doc, &self.map, rect));
                 // Fluvial erosion is not local (a cell's drainage is its whole catchment): any
                 // change of the ground re-erodes the whole grid.
-                if let Some((settings, land)) = &mut self.fluvial
+                if let Some(f) = &mut self.fluvial
                     && rect.width > 0
                     && rect.height > 0
                 {
-                    *land = eroded(*settings, self.ridges.ground(&self.map));
-                    rect = whole(&doc.grid);
+                    rect = f.follow(self.ridges.ground(&self.map), rect, self.progressive);
                 }
-                let ground = self
-                    .fluvial
-                    .as_ref()
-                    .map_or(self.ridges.ground(&self.map), |(_, land)| land);
+                let ground = self.fluvial.as_ref().map_or(self.ridges.ground(&self.map), |f| &f.land);
                 match self.rivers.sync(doc, ground, rect) {
                     Some(more) => rect.union(more),
                     None => rect,
                 }
             }
             None => {
+                let progressive = self.progressive;
                 *self = TerrainEngine::build(doc);
+                self.progressive = progressive;
                 whole(&doc.grid)
             }
         }

@@ -184,3 +184,37 @@ fn older_documents_load_unchanged_and_cannot_ask_for_it() {
     let doc = Document::from_json(&v5).unwrap();
     assert_eq!(doc.terrain.erosion.and_then(|e| e.fluvial), Some(Fluvial::default()));
 }
+
+#[test]
+fn a_progressive_pull_shows_at_once_and_settles_on_the_exact_land() {
+    let (_, doc) = examples().remove(3);
+    let doc = with_fluvial(
+        doc,
+        Fluvial {
+            steps: 12,
+            ..Fluvial::default()
+        },
+    );
+    let mut editor = penmodel_terrain::Editor::new(doc).unwrap();
+    editor.set_progressive_erosion(true);
+    let at = penmodel_terrain::FigurePath::new(0, 0);
+    let height = editor.document().regions[0].figures[0].height + 5.0;
+    editor
+        .preview(&penmodel_terrain::Edit::SetHeight { at, height })
+        .unwrap();
+    // At once: the pull's change on the old land (the cells it reaches), the exact run
+    // pending.
+    let exact = generate(editor.document()).unwrap();
+    assert_ne!(editor.heightmap(), &exact);
+    assert!(editor.terrain().erosion_pending());
+    let mut settled = penmodel_terrain::Rect::EMPTY;
+    for _ in 0..12 {
+        settled = editor.settle_erosion(1);
+        if settled.width > 0 {
+            break;
+        }
+    }
+    assert_eq!(settled.width, editor.document().grid.cols);
+    assert!(!editor.terrain().erosion_pending());
+    assert_eq!(editor.heightmap(), &exact);
+}
