@@ -126,10 +126,10 @@ struct FluvialLayer {
 }
 
 impl FluvialLayer {
-    fn new(settings: crate::document::Fluvial, ground: &Heightmap) -> FluvialLayer {
+    fn new(settings: crate::document::Fluvial, ground: &Heightmap, doc: &Document) -> FluvialLayer {
         FluvialLayer {
             settings,
-            land: fluvial::erode(settings, ground),
+            land: fluvial::erode(settings, ground, Some(fluvial::held_cells(doc))),
             ground: ground.clone(),
             run: None,
         }
@@ -138,9 +138,9 @@ impl FluvialLayer {
     /// Follows a change of the ground in `rect`: exactly (the whole grid eroded again), or,
     /// `progressive`, by adding the ground's change in `rect` to the land shown and starting
     /// the exact run, which [`TerrainEngine::settle_erosion`] advances. Returns what changed.
-    fn follow(&mut self, ground: &Heightmap, rect: Rect, progressive: bool) -> Rect {
+    fn follow(&mut self, ground: &Heightmap, doc: &Document, rect: Rect, progressive: bool) -> Rect {
         if !progressive {
-            *self = FluvialLayer::new(self.settings, ground);
+            *self = FluvialLayer::new(self.settings, ground, doc);
             return whole_of(ground);
         }
         let cols = ground.cols() as usize;
@@ -152,7 +152,7 @@ impl FluvialLayer {
                 old[i] = new[i];
             }
         }
-        self.run = Some(fluvial::Model::new(self.settings, ground));
+        self.run = Some(fluvial::Model::new(self.settings, ground).holding(fluvial::held_cells(doc)));
         rect
     }
 }
@@ -242,7 +242,7 @@ impl TerrainEngine {
             .terrain
             .erosion
             .and_then(|e| e.fluvial)
-            .map(|f| FluvialLayer::new(f, ridges.ground(&map)));
+            .map(|f| FluvialLayer::new(f, ridges.ground(&map), doc));
         let mut rivers = Layer::default();
         let ground = fluvial.as_ref().map_or(ridges.ground(&map), |f| &f.land);
         rivers.sync(doc, ground, Rect::EMPTY);
@@ -365,7 +365,7 @@ impl TerrainEngine {
                     && rect.width > 0
                     && rect.height > 0
                 {
-                    rect = f.follow(self.ridges.ground(&self.map), rect, self.progressive);
+                    rect = f.follow(self.ridges.ground(&self.map), doc, rect, self.progressive);
                 }
                 let ground = self.fluvial.as_ref().map_or(self.ridges.ground(&self.map), |f| &f.land);
                 match self.rivers.sync(doc, ground, rect) {

@@ -87,7 +87,7 @@ fn extreme_settings_never_give_nan_and_stay_within_the_sketch() {
             ..Fluvial::default()
         },
     ] {
-        let land = fluvial::erode(f, &sketch);
+        let land = fluvial::erode(f, &sketch, Some(fluvial::held_cells(&doc)));
         for &v in land.heights() {
             assert!(v.is_finite(), "{f:?}");
             // Raised toward the sketch, worn down toward receivers, diffused between

@@ -62,7 +62,7 @@ pub fn run(args: &Args) -> Result<()> {
             .unwrap_or_else(|_| ProgressStyle::default_bar()),
     );
     let t = Instant::now();
-    let mut model = fluvial::Model::new(settings, sketch);
+    let mut model = fluvial::Model::new(settings, sketch).holding(fluvial::held_cells(doc));
     while !model.finished() {
         model.advance(1);
         bar.inc(1);

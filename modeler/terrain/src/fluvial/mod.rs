@@ -53,7 +53,35 @@ pub struct Model {
     diffusion: diffuse::Diffusion,
     /// `(a·dx²)^m` for drainage areas of `a` cells below the table's length.
     area_pow: Vec<f64>,
+    /// Cells held at the sketch's height: the control figures' ([`held_cells`]).
+    held: Vec<bool>,
     done: u32,
+}
+
+/// The cells the document's raised point and polyline figures stand on (a height above their
+/// region's base), nested ones too: the erosion holds them at the sketch's height, so a pulled
+/// peak or ridge stays where the user put it and the land around it is carved. Closed figures
+/// are not held (a plateau's or a crater's rim wears and may be breached, as real ones do), nor
+/// are figures at or below their base (a valley line, a crater's floor), which water may fill.
+pub fn held_cells(doc: &crate::document::Document) -> Vec<bool> {
+    fn walk(grid: &crate::document::Grid, figures: &[crate::document::Figure], base: f64, out: &mut [bool]) {
+        for f in figures {
+            let cells = match f.kind {
+                crate::document::FigureKind::Closed => Vec::new(),
+                _ if f.height <= base => Vec::new(),
+                _ => crate::cells::polyline_cells(grid, &f.points),
+            };
+            for (c, r) in cells {
+                out[r as usize * grid.cols as usize + c as usize] = true;
+            }
+            walk(grid, &f.figures, f.height, out);
+        }
+    }
+    let mut held = vec![false; doc.grid.cells()];
+    for region in &doc.regions {
+        walk(&doc.grid, &region.figures, 0.0, &mut held);
+    }
+    held
 }
 
 /// Drainage areas (in cells) whose `A^m` is looked up rather than computed.
@@ -99,8 +127,20 @@ impl Model {
             routing: route::Routing::new(cols, rows),
             diffusion: diffuse::Diffusion::new(cols, rows),
             area_pow,
+            held: Vec::new(),
             done: 0,
         }
+    }
+
+    /// Holds the cells `held` marks (row-major, one per cell) at the sketch's height.
+    pub fn holding(mut self, held: Vec<bool>) -> Model {
+        for (i, &on) in held.iter().enumerate() {
+            if on && let Some(v) = self.h.get_mut(i) {
+                *v = self.target[i];
+            }
+        }
+        self.held = held;
+        self
     }
 
     /// Steps run so far.
@@ -147,6 +187,9 @@ impl Model {
             if r == i {
                 continue;
             }
+            if self.held.get(i).copied().unwrap_or(false) {
+                continue;
+            }
             let old = self.h[i];
             let raised = old + a * self.target[i];
             let hr = self.h[r];
@@ -174,6 +217,11 @@ impl Model {
         }
         let r = s.diffusion * dt / (self.cell * self.cell);
         self.diffusion.step(&mut self.h, r);
+        for (i, &on) in self.held.iter().enumerate() {
+            if on {
+                self.h[i] = self.target[i];
+            }
+        }
         self.done += 1;
     }
 }
@@ -211,9 +259,13 @@ fn newton(b: f64, c: f64, f: f64, n: f64) -> f64 {
     x
 }
 
-/// The land after the whole run: `sketch` eroded by `settings`.
-pub fn erode(settings: Fluvial, sketch: &Heightmap) -> Heightmap {
+/// The land after the whole run: `sketch` eroded by `settings`, the cells `held` marks (if any)
+/// kept at the sketch's height.
+pub fn erode(settings: Fluvial, sketch: &Heightmap, held: Option<Vec<bool>>) -> Heightmap {
     let mut model = Model::new(settings, sketch);
+    if let Some(held) = held {
+        model = model.holding(held);
+    }
     model.advance(settings.steps);
     let mut out = sketch.clone();
     model.write(&mut out);
