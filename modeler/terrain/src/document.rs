@@ -8,7 +8,7 @@
 use serde::{Deserialize, Serialize};
 
 /// The format version this build writes (and reads).
-pub const VERSION: u32 = 4;
+pub const VERSION: u32 = 5;
 
 /// The oldest version this build reads: a version 1 to 3 document (no rock fields, no rivers, no
 /// terrain settings) loads as the current version, with seed 000's taxicab distances.
@@ -154,6 +154,9 @@ pub struct Erosion {
     /// The share of the excess over the talus moved per step, 0 to 1.
     #[serde(default = "default_erosion_amount")]
     pub amount: f64,
+    /// Fluvial erosion after the ridgelines join the terrain (version 5); none when left out.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub fluvial: Option<Fluvial>,
 }
 
 fn default_erosion_talus() -> f64 {
@@ -174,6 +177,50 @@ impl Default for Erosion {
             talus: default_erosion_talus(),
             iterations: default_erosion_iterations(),
             amount: default_erosion_amount(),
+            fluvial: None,
+        }
+    }
+}
+
+/// Fluvial erosion (`crate::fluvial`, `docs/erosion.md`): the sketched land is the target a
+/// landscape-evolution model raises the land toward while running water and soil creep wear
+/// it. `{}` means on, with every default.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Fluvial {
+    /// Steps, 1 to [`MAX_FLUVIAL_STEPS`](crate::validate::MAX_FLUVIAL_STEPS).
+    pub steps: u32,
+    /// Years per step (1 to 10⁶).
+    pub dt: f64,
+    /// Erodibility `K` of the stream-power law, m^(1−2m)/yr (0 to 1).
+    pub k: f64,
+    /// Drainage-area exponent `m` (0 to 2).
+    pub m: f64,
+    /// Slope exponent `n` (0.5 to 4).
+    pub n: f64,
+    /// Hillslope diffusivity `D`, m²/yr (0 to 100).
+    pub diffusion: f64,
+    /// Response time `T`, years: how fast the land is raised back toward the sketch (at least
+    /// `dt`); shorter keeps the sketch closer, longer lets water cut deeper.
+    pub response: f64,
+    /// Amplitude of the seeded noise added to the first surface, metres (0 to 100).
+    pub noise: f64,
+    /// The noise's seed.
+    pub seed: u64,
+}
+
+impl Default for Fluvial {
+    fn default() -> Fluvial {
+        Fluvial {
+            steps: 100,
+            dt: 1000.0,
+            k: 2.5e-4,
+            m: 0.5,
+            n: 1.0,
+            diffusion: 3e-4,
+            response: 10000.0,
+            noise: 1.0,
+            seed: 1,
         }
     }
 }

@@ -401,6 +401,25 @@ impl Editor {
         })
     }
 
+    /// Follow changes under the fluvial erosion progressively
+    /// ([`TerrainEngine::set_progressive_erosion`]); [`Editor::settle_erosion`] advances it.
+    pub fn set_progressive_erosion(&mut self, on: bool) {
+        self.terrain.set_progressive_erosion(on);
+    }
+
+    /// Advances a running exact erosion by up to `steps` steps; when it replaces the land shown,
+    /// the rocks and trees are seated on it again and the whole grid is returned as changed.
+    pub fn settle_erosion(&mut self, steps: u32) -> Rect {
+        let changed = self.terrain.settle_erosion(&self.doc, steps);
+        if changed.width > 0 && changed.height > 0 {
+            self.revisions.record(changed);
+            let cells = (changed.c0, changed.r0, changed.width, changed.height);
+            self.rocks.follow(&self.doc, self.terrain.heightmap(), Some(cells));
+            self.trees.follow(&self.doc, self.terrain.heightmap(), Some(cells));
+        }
+        changed
+    }
+
     /// The document's file, if it has one.
     pub fn path(&self) -> Option<&Path> {
         self.store.as_ref().map(|s| s.path.as_path())

@@ -29,6 +29,9 @@
 //! - with the document's erosion, [`crate::erosion`] erodes the terrain (with detail) after that
 //!   (the regions, or the detail, write the terrain before it; the erosion follows the rectangle
 //!   that changed, grown by its steps).
+//! - with the document's fluvial erosion, [`crate::fluvial`] erodes the ridges' ground before
+//!   the rivers are carved: not local, so a change re-erodes the whole grid, at once or
+//!   progressively ([`TerrainEngine::set_progressive_erosion`]).
 //!
 //! Distances move through every cell of the region, including cells a nested region covers. A
 //! cell that no figure can reach (`dp` infinite for all) stays at the base height: an unreachable
@@ -76,6 +79,7 @@ use crate::change::{FigureList, Scope};
 use crate::detail;
 use crate::document::{Document, Figure, Grid, Region};
 use crate::erosion;
+use crate::fluvial;
 use crate::heightmap::Heightmap;
 use crate::river::layer::{Layer, Water};
 use crate::validate::{self, ValidationError};
@@ -102,7 +106,65 @@ pub struct TerrainEngine {
     erosion: Option<erosion::Layer>,
     /// The ridgelines (seed 002) and the ground they make with `map`.
     ridges: crate::ridge::layer::Layer,
+    /// The fluvial erosion, if the document has it.
+    fluvial: Option<FluvialLayer>,
+    /// Whether a change of the land under the fluvial erosion is followed progressively
+    /// ([`TerrainEngine::set_progressive_erosion`]).
+    progressive: bool,
     rivers: Layer,
+}
+
+/// The fluvial erosion's settings, the land shown and the ground it was made from.
+struct FluvialLayer {
+    settings: crate::document::Fluvial,
+    /// The eroded land shown: exact when `run` is `None`.
+    land: Heightmap,
+    /// The ground (the ridges') `land` follows.
+    ground: Heightmap,
+    /// The exact erosion of `ground` while it runs, a few steps at a time.
+    run: Option<fluvial::Model>,
+}
+
+impl FluvialLayer {
+    fn new(settings: crate::document::Fluvial, ground: &Heightmap, doc: &Document) -> FluvialLayer {
+        FluvialLayer {
+            settings,
+            land: fluvial::erode(settings, ground, Some(fluvial::held_cells(doc))),
+            ground: ground.clone(),
+            run: None,
+        }
+    }
+
+    /// Follows a change of the ground in `rect`: exactly (the whole grid eroded again), or,
+    /// `progressive`, by adding the ground's change in `rect` to the land shown and starting
+    /// the exact run, which [`TerrainEngine::settle_erosion`] advances. Returns what changed.
+    fn follow(&mut self, ground: &Heightmap, doc: &Document, rect: Rect, progressive: bool) -> Rect {
+        if !progressive {
+            *self = FluvialLayer::new(self.settings, ground, doc);
+            return whole_of(ground);
+        }
+        let cols = ground.cols() as usize;
+        let (new, old, land) = (ground.heights(), self.ground.heights_mut(), self.land.heights_mut());
+        for r in rect.r0..rect.r0 + rect.height {
+            for c in rect.c0..rect.c0 + rect.width {
+                let i = r as usize * cols + c as usize;
+                land[i] += new[i] - old[i];
+                old[i] = new[i];
+            }
+        }
+        self.run = Some(fluvial::Model::new(self.settings, ground).holding(fluvial::held_cells(doc)));
+        rect
+    }
+}
+
+/// Every cell of `map`'s grid.
+fn whole_of(map: &Heightmap) -> Rect {
+    Rect {
+        c0: 0,
+        r0: 0,
+        width: map.cols(),
+        height: map.rows(),
+    }
 }
 
 /// The node that owns figure list `list`, with that list's figures, base and outer slope.
@@ -176,23 +238,70 @@ impl TerrainEngine {
             layer.apply(whole(&grid), &mut map);
         }
         let ridges = crate::ridge::layer::Layer::new(doc, &map);
+        let fluvial = doc
+            .terrain
+            .erosion
+            .and_then(|e| e.fluvial)
+            .map(|f| FluvialLayer::new(f, ridges.ground(&map), doc));
         let mut rivers = Layer::default();
-        rivers.sync(doc, ridges.ground(&map), Rect::EMPTY);
+        let ground = fluvial.as_ref().map_or(ridges.ground(&map), |f| &f.land);
+        rivers.sync(doc, ground, Rect::EMPTY);
         TerrainEngine {
             regions,
             map,
             detail,
             erosion,
             ridges,
+            fluvial,
+            progressive: false,
             rivers,
         }
     }
 
+    /// Whether a change under the fluvial erosion is followed progressively: the change is
+    /// added to the eroded land at once (the cells it touches, as without erosion), and the
+    /// exact erosion runs a few steps per [`TerrainEngine::settle_erosion`] and replaces it when
+    /// done. Off (the default), every update re-erodes the whole grid before it returns. The
+    /// live modeler turns it on so the hand never waits.
+    pub fn set_progressive_erosion(&mut self, on: bool) {
+        self.progressive = on;
+    }
+
+    /// Whether an exact erosion is still running ([`TerrainEngine::set_progressive_erosion`]).
+    pub fn erosion_pending(&self) -> bool {
+        self.fluvial.as_ref().is_some_and(|f| f.run.is_some())
+    }
+
+    /// Advances a running exact erosion by up to `steps` steps; when it finishes, it replaces
+    /// the land shown, the rivers are carved into it again, and the whole grid is returned as
+    /// changed. `doc` is the document of the last update.
+    pub fn settle_erosion(&mut self, doc: &Document, steps: u32) -> Rect {
+        let Some(f) = &mut self.fluvial else { return Rect::EMPTY };
+        let Some(run) = &mut f.run else { return Rect::EMPTY };
+        run.advance(steps);
+        if !run.finished() {
+            return Rect::EMPTY;
+        }
+        run.write(&mut f.land);
+        f.run = None;
+        let all = whole(&doc.grid);
+        self.rivers.sync(doc, &f.land, all);
+        all
+    }
+
+    /// The land before the fluvial erosion: the ridges' ground.
+    pub fn sketch(&self) -> &Heightmap {
+        self.ridges.ground(&self.map)
+    }
+
+    /// The land the rivers are carved into: the fluvial erosion's, or the ridges' ground.
+    pub fn land(&self) -> &Heightmap {
+        self.fluvial.as_ref().map_or(self.ridges.ground(&self.map), |f| &f.land)
+    }
+
     /// The terrain as of the last update.
     pub fn heightmap(&self) -> &Heightmap {
-        self.rivers
-            .carved()
-            .map_or(self.ridges.ground(&self.map), |(carved, _)| carved)
+        self.rivers.carved().map_or(self.land(), |(carved, _)| carved)
     }
 
     /// The ridgelines' layer (its DTM, and the terrain before the rivers).
@@ -213,11 +322,16 @@ impl TerrainEngine {
     /// The terrain, without the caches.
     pub fn into_heightmap(self) -> Heightmap {
         let TerrainEngine {
-            map, ridges, rivers, ..
+            map,
+            ridges,
+            fluvial,
+            rivers,
+            ..
         } = self;
-        match rivers.carved() {
-            Some((carved, _)) => carved.clone(),
-            None => ridges.ground(&map).clone(),
+        match (rivers.carved(), fluvial) {
+            (Some((carved, _)), _) => carved.clone(),
+            (None, Some(f)) => f.land,
+            (None, None) => ridges.ground(&map).clone(),
         }
     }
 
@@ -244,14 +358,25 @@ impl TerrainEngine {
                 };
                 // The ridges follow their entry and join the regions' terrain that changed; the
                 // rivers follow their entries and the ground that changed under them.
-                let rect = rect.union(self.ridges.sync(doc, &self.map, rect));
-                match self.rivers.sync(doc, self.ridges.ground(&self.map), rect) {
+                let mut rect = rect.union(self.ridges.sync(doc, &self.map, rect));
+                // Fluvial erosion is not local (a cell's drainage is its whole catchment): any
+                // change of the ground re-erodes the whole grid.
+                if let Some(f) = &mut self.fluvial
+                    && rect.width > 0
+                    && rect.height > 0
+                {
+                    rect = f.follow(self.ridges.ground(&self.map), doc, rect, self.progressive);
+                }
+                let ground = self.fluvial.as_ref().map_or(self.ridges.ground(&self.map), |f| &f.land);
+                match self.rivers.sync(doc, ground, rect) {
                     Some(more) => rect.union(more),
                     None => rect,
                 }
             }
             None => {
+                let progressive = self.progressive;
                 *self = TerrainEngine::build(doc);
+                self.progressive = progressive;
                 whole(&doc.grid)
             }
         }

@@ -29,6 +29,7 @@ pub mod engine;
 pub mod erosion;
 pub mod export;
 pub mod fastmath;
+pub mod fluvial;
 // The fuzz targets' properties, shared with the stable test that replays their corpora.
 #[doc(hidden)]
 pub mod fuzzing;
@@ -53,7 +54,7 @@ pub mod validate;
 
 pub use address::{CurvePath, FigurePath};
 pub use document::{
-    Detail, Document, Erosion, Figure, FigureKind, Grid, Metric, Point, Region, River, TerrainSettings,
+    Detail, Document, Erosion, Figure, FigureKind, Fluvial, Grid, Metric, Point, Region, River, TerrainSettings,
 };
 pub use edit::{Edit, EditError};
 pub use editor::{Editor, Outcome};

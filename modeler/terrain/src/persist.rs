@@ -117,6 +117,9 @@ impl Document {
         if doc.version < 4 && !doc.groves.is_empty() {
             return Err(ValidationError::new("groves", Defect::NeedsVersion(4)).into());
         }
+        if doc.version < 5 && doc.terrain.erosion.is_some_and(|e| e.fluvial.is_some()) {
+            return Err(ValidationError::new("terrain.erosion.fluvial", Defect::NeedsVersion(5)).into());
+        }
         doc.version = VERSION;
         validate::document(&doc)?;
         Ok(doc)

@@ -165,6 +165,7 @@ pub(crate) fn erosion() -> impl Strategy<Value = Option<Erosion>> {
             talus,
             iterations,
             amount,
+            fluvial: None,
         }),
     )
 }

@@ -9,6 +9,7 @@ mod erosion;
 mod examples;
 mod exports;
 mod faults;
+mod fluvial;
 mod fuzz_corpus;
 mod limits;
 mod properties;

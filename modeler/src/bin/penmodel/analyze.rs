@@ -9,6 +9,7 @@ use std::time::Instant;
 use anyhow::{Context, Result, bail};
 use penmodel_terrain::editor::Editor;
 use penmodel_terrain::export;
+use penmodel_terrain::fluvial::{measure, route};
 use penmodel_terrain::ridge::rain::{self, Classes};
 use penmodel_terrain::ridge::sun::{self, Field, Sun};
 use penmodel_terrain::{Heightmap, ridge::RidgeError};
@@ -16,12 +17,13 @@ use penmodel_terrain::{Heightmap, ridge::RidgeError};
 /// Arguments of `penmodel analyze`: at least one map.
 #[derive(clap::Args)]
 #[command(
-    group(clap::ArgGroup::new("maps").args(["flow", "ridges", "valleys", "direct", "sky", "insolation", "hillshade"]).required(true).multiple(true)),
+    group(clap::ArgGroup::new("maps").args(["flow", "ridges", "valleys", "direct", "sky", "insolation", "hillshade", "area", "directions", "json"]).required(true).multiple(true)),
     after_help = "Give at least one map. A FILE ending in .png is a 16-bit PNG, any other raw float32 (rows × cols).\n\
     Examples (from the repository's folder):\n  \
     penmodel analyze modeler/examples/ridges/ridgelines.json --flow flow.png --valleys valleys.f32\n  \
     penmodel analyze modeler/examples/ridges/ridgelines.json --sun 135,25 --direct sun.png --sky sky.png --insolation ins.f32\n  \
-    penmodel analyze modeler/examples/04-volcano.json --hillshade volcano-shade.png"
+    penmodel analyze modeler/examples/04-volcano.json --hillshade volcano-shade.png\n  \
+    penmodel analyze modeler/examples/04-volcano.json --json --area area.png --directions d8.png"
 )]
 pub struct Args {
     /// The document (JSON). A pending journal beside it is replayed, read-only.
@@ -57,6 +59,15 @@ pub struct Args {
     /// Hillshade: Lambert's cos of the angle to the sun (--sun, default 225,45: from the map's upper left) with no shadows, 0..1; the terrain's shape at a glance.
     #[arg(long, value_name = "FILE")]
     hillshade: Option<PathBuf>,
+    /// Drainage area, m², by D8 on the depression-filled terrain (docs/erosion.md). The PNG shows log10 of it.
+    #[arg(long, value_name = "FILE")]
+    area: Option<PathBuf>,
+    /// Flow direction: each cell's D8 receiver as 1 (east) to 8 counter-clockwise (45° steps), 0 at the grid's edge.
+    #[arg(long, value_name = "FILE")]
+    directions: Option<PathBuf>,
+    /// Print the drainage signatures (area_tau, hack_h, slope_mode_share, pits, pit_depth_max; docs/erosion.md) as JSON on stdout.
+    #[arg(long)]
+    json: bool,
     /// Azimuths of the sky view's horizon sweeps.
     #[arg(long, value_name = "K", default_value_t = 32, value_parser = clap::value_parser!(u32).range(1..=4096))]
     sky_directions: u32,
@@ -84,8 +95,9 @@ fn write_map(map: &Heightmap, path: &Path) -> Result<()> {
     std::fs::write(path, bytes).with_context(|| format!("cannot write {}", path.display()))
 }
 
-/// Writes `values` (one per cell) to `path`; `png` replaces them for a PNG.
-fn write(like: &Heightmap, path: &Option<PathBuf>, values: &[f32], png: impl Fn(f32) -> f32) -> Result<()> {
+/// Writes `values` (one per cell) to `path`; `png` replaces them for a PNG. With `json` (stdout
+/// is the JSON) it says so on stderr.
+fn write(json: bool, like: &Heightmap, path: &Option<PathBuf>, values: &[f32], png: impl Fn(f32) -> f32) -> Result<()> {
     let Some(path) = path else { return Ok(()) };
     let is_png = path.extension().is_some_and(|e| e.eq_ignore_ascii_case("png"));
     let v: Vec<f32> = if is_png {
@@ -96,7 +108,49 @@ fn write(like: &Heightmap, path: &Option<PathBuf>, values: &[f32], png: impl Fn(
     let map = Heightmap::from_heights(like.cols(), like.rows(), like.cell_size(), v)
         .context("a map of another size than the grid")?;
     write_map(&map, path)?;
-    pen_host::outln!("wrote {}", path.display());
+    if json {
+        eprintln!("wrote {}", path.display());
+    } else {
+        pen_host::outln!("wrote {}", path.display());
+    }
+    Ok(())
+}
+
+/// The drainage maps and signatures (`--area`, `--directions`, `--json`).
+fn drainage(map: &Heightmap, water: Option<&penmodel_terrain::river::layer::Water>, args: &Args) -> Result<()> {
+    if args.area.is_some() || args.directions.is_some() {
+        let h: Vec<f64> = map
+            .heights()
+            .iter()
+            .map(|&v| if v.is_finite() { f64::from(v) } else { 0.0 })
+            .collect();
+        let mut w = route::Routing::new(map.cols() as usize, map.rows() as usize);
+        w.route(&h);
+        let cell2 = map.cell_size() * map.cell_size();
+        let area: Vec<f32> = w.area.iter().map(|&a| (a * cell2) as f32).collect();
+        write(args.json, map, &args.area, &area, |a| a.log10())?;
+        let cols = map.cols() as i64;
+        let dirs: Vec<f32> = (0..h.len())
+            .map(|i| {
+                let r = i64::from(w.receiver[i]);
+                let (dc, dr) = (r % cols - i as i64 % cols, r / cols - i as i64 / cols);
+                // Counter-clockwise from east, y (rows) pointing up the map.
+                let angle = f64::atan2(-dr as f64, dc as f64).to_degrees().rem_euclid(360.0);
+                if (dc, dr) == (0, 0) {
+                    0.0
+                } else {
+                    1.0 + (angle / 45.0).round() as f32 % 8.0
+                }
+            })
+            .collect();
+        write(args.json, map, &args.directions, &dirs, |d| d)?;
+    }
+    if args.json {
+        // Water the user drew (rivers and their lakes) is not a pit.
+        let wet: Option<Vec<bool>> = water.map(|w| w.level.iter().map(|l| !l.is_nan()).collect());
+        let s = measure::signatures(map, wet.as_deref());
+        pen_host::outln!("{}", serde_json::to_string_pretty(&s)?);
+    }
     Ok(())
 }
 
@@ -111,6 +165,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let (editor, _) = Editor::open_read_only(&args.doc)?;
     let map = editor.heightmap();
+    drainage(map, editor.water(), args)?;
     let field = Field::of(map);
     if args.flow.is_some() || args.ridges.is_some() || args.valleys.is_some() {
         let t = Instant::now();
@@ -118,13 +173,13 @@ pub fn run(args: &Args) -> Result<()> {
         let counts = rain::accumulate(&next);
         eprintln!("rain counts: {:.1} ms", t.elapsed().as_secs_f64() * 1e3);
         let as_f32: Vec<f32> = counts.iter().map(|&n| n as f32).collect();
-        write(map, &args.flow, &as_f32, |n| (1.0 + n).log2())?;
+        write(args.json, map, &args.flow, &as_f32, |n| (1.0 + n).log2())?;
         let classes = Classes {
             ridge_max: args.ridge_max,
             valley_min: args.valley_min,
         };
-        write(map, &args.ridges, &classes.ridges(&counts, &next), |v| v)?;
-        write(map, &args.valleys, &classes.valleys(&counts), |v| v)?;
+        write(args.json, map, &args.ridges, &classes.ridges(&counts, &next), |v| v)?;
+        write(args.json, map, &args.valleys, &classes.valleys(&counts), |v| v)?;
     }
     let direct = match sun {
         Some(s) if args.direct.is_some() || args.insolation.is_some() => {
@@ -148,20 +203,20 @@ pub fn run(args: &Args) -> Result<()> {
         None
     };
     if let Some(d) = &direct {
-        write(map, &args.direct, d, |v| v)?;
+        write(args.json, map, &args.direct, d, |v| v)?;
     }
     if let Some(s) = &sky {
-        write(map, &args.sky, s, |v| v)?;
+        write(args.json, map, &args.sky, s, |v| v)?;
     }
     if let (Some(d), Some(s)) = (&direct, &sky) {
-        write(map, &args.insolation, &sun::insolation(d, s), |v| v)?;
+        write(args.json, map, &args.insolation, &sun::insolation(d, s), |v| v)?;
     }
     if args.hillshade.is_some() {
         let light = match sun {
             Some(s) => s,
             None => Sun::degrees(225.0, 45.0, "the hillshade's light").map_err(|e: RidgeError| anyhow::anyhow!(e))?,
         };
-        write(map, &args.hillshade, &sun::hillshade(field, light), |v| v)?;
+        write(args.json, map, &args.hillshade, &sun::hillshade(field, light), |v| v)?;
     }
     Ok(())
 }

@@ -23,6 +23,7 @@
 //!   N × N grid (default 100 figures on 1024², cell size 1 m), beside the bound validation
 //!   computes for it ([`validate::engine_bytes`], at most [`validate::MAX_ENGINE_BYTES`]).
 
+mod erosion;
 mod still;
 
 use std::io::IsTerminal;
@@ -94,6 +95,13 @@ pub struct Args {
     /// show).
     #[arg(long, value_name = "DIR")]
     still_png: Option<std::path::PathBuf>,
+    /// Measure only the fluvial erosion's time per step on a cone (`bench/erosion.rs`; default
+    /// grids 512 and 1024), as `scripts/erosion_peer.py` runs fastscapelib.
+    #[arg(long)]
+    erosion: bool,
+    /// Steps per --erosion run (the best of three runs' mean is reported).
+    #[arg(long, value_name = "N", default_value_t = 20, value_parser = clap::value_parser!(u32).range(1..=5000))]
+    erosion_steps: u32,
 }
 
 /// The memory case: `k` point figures on a lattice in one square region over most of an n × n
@@ -349,6 +357,40 @@ pub fn run(args: &Args) -> Result<()> {
     } else {
         args.grids.clone()
     };
+    if args.erosion {
+        let grids = if args.grids.is_empty() {
+            vec![512, 1024]
+        } else {
+            args.grids.clone()
+        };
+        let bar = if std::io::stderr().is_terminal() {
+            ProgressBar::with_draw_target(
+                Some(grids.len() as u64 * 3 * u64::from(args.erosion_steps)),
+                ProgressDrawTarget::stderr(),
+            )
+        } else {
+            ProgressBar::hidden()
+        };
+        let figures = erosion::measure(&grids, args.erosion_steps, &bar)?;
+        bar.finish_and_clear();
+        if args.json {
+            let list: Vec<_> = figures
+                .iter()
+                .map(|f| serde_json::json!({"grid": f.grid, "ms_per_step": f.ms_per_step, "steps": f.steps}))
+                .collect();
+            pen_host::outln!("{}", serde_json::json!({ "erosion": list }));
+        } else {
+            for f in &figures {
+                pen_host::outln!(
+                    "erosion {0}×{0}: {1:.1} ms a step ({2} steps)",
+                    f.grid,
+                    f.ms_per_step,
+                    f.steps
+                );
+            }
+        }
+        return Ok(());
+    }
     if args.still_only {
         let still = still_figures(&grids, args)?;
         if args.json {

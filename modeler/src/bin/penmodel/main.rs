@@ -8,6 +8,7 @@
 
 mod analyze;
 mod bench;
+mod erode;
 mod generate;
 mod live;
 mod out;
@@ -77,6 +78,8 @@ enum Command {
     River(river::Args),
     /// Fractal trees (seed 004): counts per roughness Q, a tree or grove as a mesh, a fit to silhouettes.
     Trees(trees::Args),
+    /// Erode a document's sketched land by running water and soil creep, with its drainage signatures.
+    Erode(erode::Args),
 }
 
 fn main() -> ExitCode {
@@ -92,6 +95,7 @@ fn main() -> ExitCode {
         Some(Command::Ridges(args)) => ridges::run(&args),
         Some(Command::River(args)) => river::run(&args),
         Some(Command::Trees(args)) => trees::run(&args),
+        Some(Command::Erode(args)) => erode::run(&args),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

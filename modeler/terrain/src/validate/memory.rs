@@ -36,9 +36,16 @@ pub fn engine_bytes(doc: &Document) -> (u64, u64, u64) {
         }
     }
     // The heightmap, and with detail its noise, gates and the terrain before it; with erosion
-    // the terrain before it and two f64 windows as large as the grid (a full rebuild's).
-    let per_cell =
-        if doc.terrain.detail.is_some() { 16 } else { 4 } + if doc.terrain.erosion.is_some() { 20 } else { 0 };
+    // the terrain before it and two f64 windows as large as the grid (a full rebuild's); with
+    // fluvial erosion its model and its output.
+    let fluvial = doc.terrain.erosion.is_some_and(|e| e.fluvial.is_some());
+    let per_cell = if doc.terrain.detail.is_some() { 16 } else { 4 }
+        + if doc.terrain.erosion.is_some() { 20 } else { 0 }
+        + if fluvial {
+            crate::fluvial::BYTES_PER_CELL as u64 + 4
+        } else {
+            0
+        };
     let mut acc = (per_cell * doc.grid.cells() as u64, 0, 0);
     for r in &doc.regions {
         region(&doc.grid, &r.boundary, &r.figures, &mut acc);

@@ -3,7 +3,7 @@
 use thiserror::Error;
 
 use super::{Num, ValidationError, finite};
-use crate::document::Document;
+use crate::document::{Document, Fluvial};
 
 /// What is wrong with a terrain setting.
 #[allow(missing_docs)] // fields named for what they hold; the message shows them.
@@ -85,6 +85,41 @@ pub fn erosion(doc: &Document) -> Result<(), ValidationError> {
     }
     if !(0.0..=1.0).contains(&e.amount) {
         return range("the erosion's amount", "from 0 to 1".into(), e.amount);
+    }
+    match &e.fluvial {
+        Some(f) => fluvial(f),
+        None => Ok(()),
+    }
+}
+
+/// The most steps of fluvial erosion: each re-routes the whole grid.
+pub const MAX_FLUVIAL_STEPS: u32 = 5000;
+
+/// Checks the fluvial erosion's settings against the ranges `docs/erosion.md` gives.
+fn fluvial(f: &Fluvial) -> Result<(), ValidationError> {
+    let checks: [(&'static str, f64, f64, f64); 8] = [
+        ("dt", f.dt, 1.0, 1e6),
+        ("k", f.k, 0.0, 1.0),
+        ("m", f.m, 0.0, 2.0),
+        ("n", f.n, 0.5, 4.0),
+        ("diffusion", f.diffusion, 0.0, 100.0),
+        ("response", f.response, f.dt.max(1.0), 1e9),
+        ("noise", f.noise, 0.0, 100.0),
+        ("steps", f64::from(f.steps), 1.0, f64::from(MAX_FLUVIAL_STEPS)),
+    ];
+    for (name, value, lo, hi) in checks {
+        let path = || format!("terrain.erosion.fluvial.{name}");
+        finite(value, path)?;
+        if !(lo..=hi).contains(&value) {
+            return Err(ValidationError::new(
+                path(),
+                TerrainDefect::DetailRange {
+                    what: name,
+                    range: format!("from {} to {}", Num(lo), Num(hi)),
+                    value,
+                },
+            ));
+        }
     }
     Ok(())
 }
