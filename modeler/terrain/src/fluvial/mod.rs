@@ -37,9 +37,10 @@ pub mod route;
 use crate::document::Fluvial;
 use crate::heightmap::Heightmap;
 
-/// Bytes of memory per cell while eroding (heights, sketch, fill, receivers, distances, stack,
-/// areas, donors, the diffusion's scratch, the priority queue at its largest).
-pub const BYTES_PER_CELL: usize = 8 * 8 + 4 * 4 + 1 + 16;
+/// Bytes of memory per cell while eroding: eight `f64` arrays (heights, sketch, fill,
+/// distances, areas, the diffusion's three scratch rows), five `u32` (receivers, stack, donors
+/// and two donor offsets), the closed flags and the priority queue at its largest.
+pub const BYTES_PER_CELL: usize = 8 * 8 + 5 * 4 + 1 + 16;
 
 /// The state of an erosion run on one grid.
 pub struct Model {
