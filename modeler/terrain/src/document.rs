@@ -198,8 +198,10 @@ pub struct Fluvial {
     pub m: f64,
     /// Slope exponent `n` (0.5 to 4).
     pub n: f64,
-    /// Hillslope diffusivity `D`, m²/yr (0 to 100).
-    pub diffusion: f64,
+    /// Hillslope diffusivity `D`, m²/yr (0 to 100); left out,
+    /// [`Fluvial::diffusivity`]'s default for the grid's cell size.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub diffusion: Option<f64>,
     /// Response time `T`, years: how fast the land is raised back toward the sketch (at least
     /// `dt`); shorter keeps the sketch closer, longer lets water cut deeper.
     pub response: f64,
@@ -217,11 +219,25 @@ impl Default for Fluvial {
             k: 2.5e-4,
             m: 0.5,
             n: 1.0,
-            diffusion: 3e-4,
+            diffusion: None,
             response: 10000.0,
             noise: 1.0,
             seed: 1,
         }
+    }
+}
+
+/// The default hillslope diffusivity per square metre of cell, 1/yr: `D = 7.5·10⁻⁵ · dx²`
+/// smooths a fifteenth of a cell's width per 1000-year step on any grid, so a 2 m grid and a
+/// 12.5 m one look alike (3·10⁻⁴ and 0.0117 m²/yr).
+pub const DIFFUSION_PER_CELL_AREA: f64 = 7.5e-5;
+
+impl Fluvial {
+    /// The hillslope diffusivity `D` on cells of `cell_size` metres, m²/yr: the document's, or
+    /// [`DIFFUSION_PER_CELL_AREA`] times the cell's area.
+    pub fn diffusivity(&self, cell_size: f64) -> f64 {
+        self.diffusion
+            .unwrap_or(DIFFUSION_PER_CELL_AREA * cell_size * cell_size)
     }
 }
 

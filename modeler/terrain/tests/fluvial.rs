@@ -67,7 +67,7 @@ fn extreme_settings_never_give_nan_and_stay_within_the_sketch() {
             k: 1.0,
             n: 4.0,
             m: 2.0,
-            diffusion: 100.0,
+            diffusion: Some(100.0),
             steps: 20,
             ..Fluvial::default()
         },
@@ -151,7 +151,7 @@ fn bad_settings_are_refused_by_path() {
         ),
         (
             Fluvial {
-                diffusion: f64::NAN,
+                diffusion: Some(f64::NAN),
                 ..Fluvial::default()
             },
             "terrain.erosion.fluvial.diffusion",

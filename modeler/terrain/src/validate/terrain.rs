@@ -102,7 +102,7 @@ fn fluvial(f: &Fluvial) -> Result<(), ValidationError> {
         ("k", f.k, 0.0, 1.0),
         ("m", f.m, 0.0, 2.0),
         ("n", f.n, 0.5, 4.0),
-        ("diffusion", f.diffusion, 0.0, 100.0),
+        ("diffusion", f.diffusion.unwrap_or(0.0), 0.0, 100.0),
         ("response", f.response, f.dt.max(1.0), 1e9),
         ("noise", f.noise, 0.0, 100.0),
         ("steps", f64::from(f.steps), 1.0, f64::from(MAX_FLUVIAL_STEPS)),
