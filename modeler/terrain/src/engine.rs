@@ -123,6 +123,9 @@ struct FluvialLayer {
     ground: Heightmap,
     /// The exact erosion of `ground` while it runs, a few steps at a time.
     run: Option<fluvial::Model>,
+    /// Whether `ground` changed since `run` started: the next settle starts it again (once
+    /// for any number of updates between two frames).
+    restart: bool,
 }
 
 impl FluvialLayer {
@@ -132,6 +135,7 @@ impl FluvialLayer {
             land: fluvial::erode(settings, ground, Some(fluvial::held_cells(doc))),
             ground: ground.clone(),
             run: None,
+            restart: false,
         }
     }
 
@@ -152,7 +156,8 @@ impl FluvialLayer {
                 old[i] = new[i];
             }
         }
-        self.run = Some(fluvial::Model::new(self.settings, ground).holding(fluvial::held_cells(doc)));
+        self.run = None;
+        self.restart = true;
         rect
     }
 }
@@ -269,7 +274,7 @@ impl TerrainEngine {
 
     /// Whether an exact erosion is still running ([`TerrainEngine::set_progressive_erosion`]).
     pub fn erosion_pending(&self) -> bool {
-        self.fluvial.as_ref().is_some_and(|f| f.run.is_some())
+        self.fluvial.as_ref().is_some_and(|f| f.restart || f.run.is_some())
     }
 
     /// Advances a running exact erosion by up to `steps` steps; when it finishes, it replaces
@@ -277,6 +282,9 @@ impl TerrainEngine {
     /// changed. `doc` is the document of the last update.
     pub fn settle_erosion(&mut self, doc: &Document, steps: u32) -> Rect {
         let Some(f) = &mut self.fluvial else { return Rect::EMPTY };
+        if std::mem::take(&mut f.restart) {
+            f.run = Some(fluvial::Model::new(f.settings, &f.ground).holding(fluvial::held_cells(doc)));
+        }
         let Some(run) = &mut f.run else { return Rect::EMPTY };
         run.advance(steps);
         if !run.finished() {

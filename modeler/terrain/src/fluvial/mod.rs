@@ -120,6 +120,9 @@ impl Model {
         let area_pow = (0..AREA_TABLE)
             .map(|a| (a as f64 * cell * cell).powf(settings.m))
             .collect();
+        // A sketch with nothing raised (a new document) is its own steady state: no water runs,
+        // nothing to carve; the run is done before it starts.
+        let flat = target.iter().all(|&v| v <= lowest);
         Model {
             settings,
             cell,
@@ -129,7 +132,7 @@ impl Model {
             diffusion: diffuse::Diffusion::new(cols, rows),
             area_pow,
             held: Vec::new(),
-            done: 0,
+            done: if flat { settings.steps } else { 0 },
         }
     }
 
@@ -216,7 +219,7 @@ impl Model {
             };
             self.h[i] = hr + x;
         }
-        let r = s.diffusion * dt / (self.cell * self.cell);
+        let r = s.diffusivity(self.cell) * dt / (self.cell * self.cell);
         self.diffusion.step(&mut self.h, r);
         for (i, &on) in self.held.iter().enumerate() {
             if on {
