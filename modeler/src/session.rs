@@ -7,17 +7,24 @@ use crate::feed::{Calibrating, Feed};
 use crate::head_prediction::HeadPredictor;
 use crate::interaction::{Interaction, Tuning, View};
 use crate::latency::{HeadLatency, LatencySummary};
-use penmodel_terrain::document::{Document, Grid};
+use penmodel_terrain::document::{Document, Erosion, Fluvial, Grid};
 use penmodel_terrain::editor::Editor;
 
 /// A new session's document: a 6 × 3.4 km map of 12.5 m cells (480 × 272), which the reference
 /// display (600 × 340 mm) shows at 1:10 000 — a millimetre on the display is 10 m, a cell 1.25 mm.
+/// Its land is eroded (`"erosion": {"fluvial": {}}`: the thermal and the fluvial erosion with
+/// their defaults, `docs/erosion.md`), so what the pen pulls up drains like land.
 pub fn blank_document() -> Document {
-    Document::new(Grid {
+    let mut doc = Document::new(Grid {
         cols: 480,
         rows: 272,
         cell_size: 12.5,
-    })
+    });
+    doc.terrain.erosion = Some(Erosion {
+        fluvial: Some(Fluvial::default()),
+        ..Erosion::default()
+    });
+    doc
 }
 
 /// How the feed stands.

@@ -420,6 +420,12 @@ impl Editor {
         changed
     }
 
+    /// Runs a pending exact erosion to its end ([`Editor::settle_erosion`]): the land is then
+    /// the document's, as `generate` makes it. Returns what changed.
+    pub fn finish_erosion(&mut self) -> Rect {
+        self.settle_erosion(u32::MAX)
+    }
+
     /// The document's file, if it has one.
     pub fn path(&self) -> Option<&Path> {
         self.store.as_ref().map(|s| s.path.as_path())

@@ -242,6 +242,8 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
             }
         };
     }
+    // The results show the document's land: the erosion a last edit started runs to its end.
+    session.editor.finish_erosion();
     session
         .editor
         .save()
