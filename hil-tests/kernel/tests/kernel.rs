@@ -2,7 +2,7 @@
 //! and the firmware core's reports through uhid, evdev read back. Skipped with a message where
 //! Debian's kernel package cannot be had, except under CI (`CI` set), where that fails.
 
-use std::time::Duration;
+use std::time::{Duration, Instant};
 
 use pen_kernel::{Accel, Guest, Kernel, Unavailable, boot, build_guest_programs, initramfs};
 use pen_sim::{Simulation, scenarios};
@@ -62,11 +62,15 @@ fn the_real_kernel_makes_one_pen_and_delivers_every_change_in_order() {
     };
     let image = initramfs(&kernel, &guest).expect("initramfs");
     let mut accel = Accel::detect();
+    let tried = Instant::now();
     let run = match boot(&kernel, &image, accel, Duration::from_secs(900)) {
         Ok(run) => run,
         // /dev/kvm opened but QEMU could not start the machine with it (a nested KVM): TCG.
         Err(e) if accel == Accel::Kvm => {
-            eprintln!("KVM did not start the machine ({e:#}); booting with TCG");
+            eprintln!(
+                "KVM did not start the machine ({e:#}); {:.1} s lost, booting with TCG",
+                tried.elapsed().as_secs_f64()
+            );
             accel = Accel::Tcg;
             boot(&kernel, &image, accel, Duration::from_secs(900)).expect("the virtual machine runs")
         }
