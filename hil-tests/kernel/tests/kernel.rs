@@ -1,6 +1,8 @@
 //! The pen as a real kernel sees it: Debian's kernel in QEMU (hil-tests/kernel), the descriptor
-//! and the firmware core's reports through uhid, evdev read back. Skipped with a message where
-//! Debian's kernel package cannot be had, except under CI (`CI` set), where that fails.
+//! and the firmware core's reports through uhid, evdev read back; `pend --source hid` on the
+//! hidraw node with the device destroyed mid-stroke and created again; `pend --virtual-tablet`
+//! read back through evdev. Skipped with a message where Debian's kernel package cannot be had,
+//! except under CI (`CI` set), where that fails.
 
 use std::time::{Duration, Instant};
 
@@ -57,6 +59,7 @@ fn the_real_kernel_makes_one_pen_and_delivers_every_change_in_order() {
         data: vec![("reports.bin".into(), reports)],
         steps: vec![
             "/bin/pen-kernel-guest uhid".into(),
+            "/bin/pen-kernel-guest pend-hid".into(),
             "/bin/pen-kernel-guest virtual-tablet".into(),
         ],
     };
@@ -95,7 +98,7 @@ fn the_real_kernel_makes_one_pen_and_delivers_every_change_in_order() {
     );
     let failed: Vec<&str> = run.with("FAIL").collect();
     assert!(failed.is_empty(), "{failed:?}\n{}", run.console);
-    for step in ["uhid:", "virtual-tablet:"] {
+    for step in ["uhid:", "pend-hid:", "virtual-tablet:"] {
         assert!(run.with("PASS").any(|l| l.starts_with(step)), "{step}\n{}", run.console);
     }
     // One pen from the uhid device, one virtual tablet.

@@ -5,24 +5,29 @@
 //!
 //! * `uhid`: the descriptor and the firmware core's reports (`/data/reports.bin`, from the
 //!   simulated pen) through `/dev/uhid`; evdev read back after every report.
-//! * `pend-hid`: `pend --source hid` on the uhid device's hidraw node, a socket client reading
-//!   its events, the device destroyed mid-stroke and created again.
+//! * `pend-hid`: `pend --source hid` (hidapi's enumeration from sysfs, its hidraw reads) on the
+//!   uhid device, a socket client reading its events, the device destroyed mid-stroke and
+//!   created again; every event compared with what docs/events.md promises for the reports sent.
 //! * `virtual-tablet`: `pend --virtual-tablet`, its uinput device read back through evdev.
 
 use std::collections::BTreeMap;
 use std::fs::File;
-use std::io::{Read, Write};
+use std::io::{BufRead, BufReader, Read, Write};
+use std::os::unix::net::UnixStream;
 use std::path::{Path, PathBuf};
-use std::process::{Command, ExitCode, Stdio};
+use std::process::{Child, Command, ExitCode, Stdio};
 use std::sync::Arc;
 use std::sync::atomic::{AtomicU32, Ordering};
+use std::sync::mpsc::{Receiver, RecvTimeoutError, channel};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context, Result, anyhow, bail, ensure};
 use evdev::{AbsoluteAxisCode, Device, EventType, KeyCode, PropType};
+use pen_host::client::{Line, parse_line};
+use pen_host::events::{EventKind, PenEvent};
 use pen_protocol::{
-    DeviceInfo, FirmwareVersion, Message, OsPenReport, PROTOCOL_VERSION, Report, USB_PID, USB_VID, os_extent,
-    report_descriptor,
+    DeviceInfo, FirmwareVersion, Message, OsPenReport, PROTOCOL_VERSION, PenReport, Report, USB_PID, USB_VID,
+    os_extent, report_descriptor,
 };
 
 /// The README's pen report (`penctl decode`): SW1 and SW3, in range, (123.4, −56.7, 89.0) mm.
@@ -481,6 +486,387 @@ fn step_uhid() -> Result<String> {
     ))
 }
 
+/// An event as the test compares it: its `type`, the report's sequence number (none for the
+/// events pend makes itself) and the switches after it.
+type Seen = (&'static str, Option<u16>, Option<[bool; 3]>);
+
+fn seen(e: &PenEvent) -> Seen {
+    (e.kind.name(), e.seq.map(|(s, _)| s), e.sw)
+}
+
+/// The events docs/events.md promises for `reports`, sent in order to a device pend has just
+/// attached (nothing pressed, out of range), written from the docs' rules, not from pend's
+/// code: per report `proximity_in`; a down or up per switch changed (SW1 as `tip_*`, SW2 and
+/// SW3 as `button_*`); `motion` while in range; `proximity_out`. Returns the pen's state after.
+fn promised(reports: &[PenReport], out: &mut Vec<Seen>) -> (bool, [bool; 3]) {
+    let (mut in_range, mut sw) = (false, [false; 3]);
+    for r in reports {
+        let now = [r.sw1, r.sw2, r.sw3];
+        let ev = |kind| (kind, Some(r.seq), Some(now));
+        if r.in_range && !in_range {
+            out.push(ev("proximity_in"));
+        }
+        for i in 0..3 {
+            if sw[i] != now[i] {
+                out.push(ev(match (i, now[i]) {
+                    (0, true) => "tip_down",
+                    (0, false) => "tip_up",
+                    (_, true) => "button_down",
+                    (_, false) => "button_up",
+                }));
+            }
+        }
+        if r.in_range {
+            out.push(ev("motion"));
+        }
+        if !r.in_range && in_range {
+            out.push(ev("proximity_out"));
+        }
+        (in_range, sw) = (r.in_range, now);
+    }
+    (in_range, sw)
+}
+
+/// What the docs promise at a loss with the pen in `in_range` and `sw`: `device_lost`, then an
+/// up for each switch pressed (tip first), then `proximity_out`; none has a sequence number.
+fn promised_loss(in_range: bool, mut sw: [bool; 3], out: &mut Vec<Seen>) {
+    out.push(("device_lost", None, None));
+    for i in 0..3 {
+        if sw[i] {
+            sw[i] = false;
+            out.push((if i == 0 { "tip_up" } else { "button_up" }, None, Some(sw)));
+        }
+    }
+    if in_range {
+        out.push(("proximity_out", None, Some(sw)));
+    }
+}
+
+/// pend's socket, read on a thread: each line parsed strictly (`pen_host::client::parse_line`),
+/// as every client of pend reads it.
+struct SocketClient {
+    lines: Receiver<Result<Line, String>>,
+    hello: Option<Option<String>>,
+    events: Vec<PenEvent>,
+}
+
+impl SocketClient {
+    fn connect(path: &Path) -> Result<SocketClient> {
+        let start = Instant::now();
+        let stream = loop {
+            match UnixStream::connect(path) {
+                Ok(s) => break s,
+                Err(e) if start.elapsed() > Duration::from_secs(20) => {
+                    return Err(e).with_context(|| format!("pend's socket {}", path.display()));
+                }
+                Err(_) => std::thread::sleep(Duration::from_millis(50)),
+            }
+        };
+        stream.set_read_timeout(Some(Duration::from_secs(120)))?;
+        let (tx, rx) = channel();
+        std::thread::spawn(move || {
+            let mut reader = BufReader::new(stream);
+            loop {
+                let mut line = String::new();
+                let sent = match reader.read_line(&mut line) {
+                    Ok(0) => tx.send(Err("pend closed the socket".into())),
+                    Ok(_) => tx.send(parse_line(line.trim_end()).map_err(|e| format!("{e}"))),
+                    Err(e) => tx.send(Err(format!("reading pend's socket: {e}"))),
+                };
+                if sent.is_err() || line.is_empty() {
+                    return;
+                }
+            }
+        });
+        Ok(SocketClient {
+            lines: rx,
+            hello: None,
+            events: Vec::new(),
+        })
+    }
+
+    /// Takes the lines that came, waiting at most `wait` for the first.
+    fn take(&mut self, wait: Duration) -> Result<()> {
+        let mut wait = wait;
+        loop {
+            match self.lines.recv_timeout(wait) {
+                Ok(Ok(Line::Hello { device })) => {
+                    ensure!(self.hello.is_none(), "a second greeting");
+                    self.hello = Some(device);
+                }
+                Ok(Ok(Line::Event(e))) => {
+                    ensure!(self.hello.is_some(), "an event before the greeting: {e:?}");
+                    self.events.push(e);
+                }
+                Ok(Err(why)) => bail!("{why}"),
+                Err(RecvTimeoutError::Timeout) => return Ok(()),
+                Err(RecvTimeoutError::Disconnected) => bail!("the socket's reader ended"),
+            }
+            wait = Duration::ZERO;
+        }
+    }
+
+    /// Reads until `done` holds of the events, at most `limit`.
+    fn until(&mut self, what: &str, limit: Duration, done: impl Fn(&[PenEvent]) -> bool) -> Result<()> {
+        let start = Instant::now();
+        while !done(&self.events) {
+            ensure!(
+                start.elapsed() < limit,
+                "{what}: not within {limit:?}; the last events: {:?}",
+                self.events.iter().rev().take(8).map(seen).collect::<Vec<_>>()
+            );
+            self.take(Duration::from_millis(20))?;
+        }
+        Ok(())
+    }
+}
+
+/// pend's log so far.
+fn pend_log(path: &str) -> String {
+    std::fs::read_to_string(path).unwrap_or_default()
+}
+
+/// Waits at most `limit` for a line of pend's log after its first `after` lines to contain
+/// `what`; returns that line.
+fn wait_log(path: &str, after: usize, what: &str, limit: Duration) -> Result<String> {
+    let start = Instant::now();
+    loop {
+        if let Some(l) = pend_log(path).lines().skip(after).find(|l| l.contains(what)) {
+            return Ok(l.to_string());
+        }
+        ensure!(
+            start.elapsed() < limit,
+            "pend logged no {what:?} within {limit:?}:\n{}",
+            pend_log(path)
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// pend is still running.
+fn alive(pend: &mut Child, when: &str) -> Result<()> {
+    match pend.try_wait()? {
+        None => Ok(()),
+        Some(status) => bail!("pend exited {when}: {status}"),
+    }
+}
+
+/// Sends `reports` (pen reports and the OS pen reports after them) at the device's own pace:
+/// each pen report at its device time after the first's.
+fn send_paced(uhid: &uhid::Uhid, reports: &[Vec<u8>]) -> Result<()> {
+    let start = Instant::now();
+    let mut first_us: Option<u32> = None;
+    for r in reports {
+        if let Ok(Message::Pen(p)) = Message::decode(r) {
+            let t0 = *first_us.get_or_insert(p.timestamp_us);
+            let due = start + Duration::from_micros(u64::from(p.timestamp_us.wrapping_sub(t0)));
+            if let Some(wait) = due.checked_duration_since(Instant::now()) {
+                std::thread::sleep(wait);
+            }
+        }
+        uhid.input(r)?;
+    }
+    Ok(())
+}
+
+const PEND_HID_LOG: &str = "/tmp/pend-hid.log";
+
+/// Step 2: `pend --source hid` (hidapi's enumeration and its hidraw reads) on the uhid device,
+/// a socket client, the device destroyed mid-stroke and created again.
+fn step_pend_hid() -> Result<String> {
+    let log = File::create(PEND_HID_LOG)?;
+    // Started before the device exists: it says what it waits for. Notices every 0.5 s
+    // instead of 5 s, so the wait after the loss is logged soon.
+    let mut pend = Command::new("/bin/pend")
+        .args(["--source", "hid", "--socket", "/tmp/pend-hid.sock"])
+        .env("XDG_CONFIG_HOME", "/tmp/config")
+        .env("PENSCAPE_NOTICE_SECS", "0.5")
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(log)
+        .spawn()
+        .context("starting pend")?;
+    let result = pend_hid(&mut pend);
+    // SIGTERM: pend removes its socket and exits 0.
+    let stopped = Command::new("kill")
+        .args(["-TERM", &pend.id().to_string()])
+        .status()
+        .map_err(anyhow::Error::from)
+        .and_then(|_| {
+            let start = Instant::now();
+            loop {
+                if let Some(status) = pend.try_wait()? {
+                    return Ok(status);
+                }
+                if start.elapsed() > Duration::from_secs(10) {
+                    let _ = pend.kill();
+                    bail!("pend did not stop within 10 s of SIGTERM");
+                }
+                std::thread::sleep(Duration::from_millis(20));
+            }
+        });
+    for line in pend_log(PEND_HID_LOG).lines() {
+        println!("KT LOG {line}");
+    }
+    let summary = result?;
+    let status = stopped?;
+    ensure!(status.success(), "pend ended {status} at SIGTERM");
+    let end = wait_log(PEND_HID_LOG, 0, "pend: stopped;", Duration::from_secs(1))?;
+    ensure!(end.contains(" 0 missed"), "{end}");
+    Ok(summary)
+}
+
+fn pend_hid(pend: &mut Child) -> Result<String> {
+    let reports = read_reports(Path::new("/data/reports.bin"))?;
+    let pens: Vec<(usize, PenReport)> = reports
+        .iter()
+        .enumerate()
+        .filter_map(|(i, r)| match Message::decode(r) {
+            Ok(Message::Pen(p)) => Some((i, p)),
+            _ => None,
+        })
+        .collect();
+    // The unplug: halfway through the first stroke, after that pen report's OS pen report.
+    let down = pens
+        .iter()
+        .position(|(_, p)| p.sw1)
+        .ok_or_else(|| anyhow!("the reports have no stroke"))?;
+    let stroke = pens[down..].iter().take_while(|(_, p)| p.sw1).count();
+    ensure!(stroke >= 10, "the first stroke is {stroke} reports long");
+    let last_before = down + stroke / 2;
+    let cut = pens.get(last_before + 1).map(|&(i, _)| i).unwrap_or(reports.len());
+    let (before, after) = reports.split_at(cut);
+    let pens_before: Vec<PenReport> = pens[..=last_before].iter().map(|(_, p)| *p).collect();
+    let pens_after: Vec<PenReport> = pens[last_before + 1..].iter().map(|(_, p)| *p).collect();
+
+    let mut expected: Vec<Seen> = vec![("device_found", None, None)];
+    let (in_range, sw) = promised(&pens_before, &mut expected);
+    ensure!(sw[0], "the unplug is not mid-stroke");
+    let until_loss = expected.len();
+    promised_loss(in_range, sw, &mut expected);
+    let until_found = expected.len();
+    expected.push(("device_found", None, None));
+    promised(&pens_after, &mut expected);
+
+    let mut client = SocketClient::connect(Path::new("/tmp/pend-hid.sock"))?;
+    client.take(Duration::from_secs(5))?;
+    ensure!(
+        client.hello == Some(None),
+        "the greeting before the device exists: {:?}",
+        client.hello
+    );
+    let waiting = wait_log(PEND_HID_LOG, 0, "waiting for", Duration::from_secs(20))?;
+
+    let extent = os_extent(DISPLAY_MM).ok_or_else(|| anyhow!("display size"))?;
+    let descriptor = report_descriptor(Some(extent));
+    let uhid = uhid::Uhid::open(device_info())?;
+    uhid.create(descriptor.bytes())?;
+    client.until(
+        "device_found after the device was created",
+        Duration::from_secs(20),
+        |e| !e.is_empty(),
+    )?;
+    let found = match &client.events[0].kind {
+        EventKind::DeviceFound { device } => device.clone(),
+        other => bail!("the first event is {other:?}, not device_found"),
+    };
+    ensure!(found.starts_with("hid /dev/hidraw"), "attached {found:?}");
+
+    let started = Instant::now();
+    send_paced(&uhid, before)?;
+    let last_seq = pens_before[last_before].seq;
+    // Every report sent has reached pend before the unplug: it cannot lose what the kernel
+    // still holds for it (a real unplug loses what is on the wire).
+    client.until("the last report before the unplug", Duration::from_secs(20), |e| {
+        e.iter().any(|e| e.seq.map(|(s, _)| s) == Some(last_seq))
+    })?;
+    client.take(Duration::from_millis(100))?;
+    let delivered_before = client.events.len();
+    ensure!(
+        delivered_before == until_loss,
+        "{delivered_before} events before the unplug, {until_loss} promised"
+    );
+    alive(pend, "before the unplug")?;
+    let log_lines = pend_log(PEND_HID_LOG).lines().count();
+    let unplugged = Instant::now();
+    uhid.destroy()?;
+    client.until("the stroke ended by the loss", Duration::from_secs(20), |e| {
+        e.len() >= until_found
+    })?;
+    let released_in = unplugged.elapsed();
+    let lost = wait_log(PEND_HID_LOG, log_lines, "device lost", Duration::from_secs(5))?;
+    let still = wait_log(PEND_HID_LOG, log_lines, "still waiting", Duration::from_secs(10))?;
+    alive(pend, "after the unplug")?;
+    let reason = match &client.events[until_loss].kind {
+        EventKind::DeviceLost { reason } => reason.clone(),
+        other => bail!("the first event after the unplug is {other:?}"),
+    };
+
+    uhid.create(descriptor.bytes())?;
+    client.until(
+        "device_found after the device came back",
+        Duration::from_secs(20),
+        |e| e.len() > until_found,
+    )?;
+    let refound = match &client.events[until_found].kind {
+        EventKind::DeviceFound { device } => device.clone(),
+        other => bail!("the first event after the device came back is {other:?}"),
+    };
+    send_paced(&uhid, after)?;
+    client.until("every event promised", Duration::from_secs(30), |e| {
+        e.len() >= expected.len()
+    })?;
+    // Nothing more comes.
+    client.take(Duration::from_millis(500))?;
+    alive(pend, "after the device came back")?;
+
+    let got: Vec<Seen> = client.events.iter().map(seen).collect();
+    if let Some(i) = (0..got.len().max(expected.len())).find(|&i| got.get(i) != expected.get(i)) {
+        let near = |v: &[Seen]| v[i.saturating_sub(3)..(i + 3).min(v.len())].to_vec();
+        bail!(
+            "event {i} differs: got {:?}, promised {:?} ({} got, {} promised); got near it {:?}, promised {:?}",
+            got.get(i),
+            expected.get(i),
+            got.len(),
+            expected.len(),
+            near(&got),
+            near(&expected)
+        );
+    }
+    let motions = |v: &[Seen]| v.iter().filter(|e| e.0 == "motion").count();
+    let missed = got.iter().filter(|e| e.0 == "missed").count();
+    ensure!(missed == 0, "{missed} missed");
+    let answered = uhid.answered.load(Ordering::Relaxed);
+    ensure!(
+        answered >= 2,
+        "{answered} feature reads: pend reads the device information at each attach"
+    );
+    uhid.destroy()?;
+    println!("KT PENDLOG {waiting}");
+    println!("KT PENDLOG {lost}");
+    println!("KT PENDLOG {still}");
+    println!(
+        "KT EVENTS pend-hid: before the unplug {} pen reports → {} events ({} motions); at the unplug {}; after {} pen reports → {} events ({} motions); in {:.1} s",
+        pens_before.len(),
+        until_loss - 1,
+        motions(&got[..until_loss]),
+        got[until_loss..until_found]
+            .iter()
+            .map(|e| e.0)
+            .collect::<Vec<_>>()
+            .join(" "),
+        pens_after.len(),
+        got.len() - until_found - 1,
+        motions(&got[until_found..]),
+        started.elapsed().as_secs_f64()
+    );
+    Ok(format!(
+        "{found}, then {refound}: {} events as promised, none missed; lost ({reason}), stroke released {} ms after the unplug; {answered} device-information reads answered",
+        got.len(),
+        released_in.as_millis()
+    ))
+}
+
 /// Step 3: `pend --virtual-tablet` with the simulated pen drawing figures; its uinput pen read
 /// back through evdev.
 fn step_virtual_tablet() -> Result<String> {
@@ -599,6 +985,7 @@ fn main() -> ExitCode {
     let step = std::env::args().nth(1).unwrap_or_default();
     let result = match step.as_str() {
         "uhid" => step_uhid(),
+        "pend-hid" => step_pend_hid(),
         "virtual-tablet" => step_virtual_tablet(),
         other => Err(anyhow!("unknown step {other:?}")),
     };
@@ -612,5 +999,65 @@ fn main() -> ExitCode {
             println!("KT FAIL {step}: {e:#}");
             ExitCode::FAILURE
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The README's report with these switches, range and sequence number.
+    fn pen(seq: u16, in_range: bool, sw1: bool, sw3: bool) -> PenReport {
+        let Ok(Message::Pen(readme)) = Message::decode(&README_PEN_REPORT) else {
+            panic!("the README's report is a pen report");
+        };
+        PenReport {
+            sw1,
+            sw2: false,
+            sw3,
+            in_range,
+            seq,
+            ..readme
+        }
+    }
+
+    #[test]
+    fn the_promised_events_follow_the_docs_order() {
+        let mut out = Vec::new();
+        let end = promised(
+            &[
+                pen(1, false, false, false),
+                pen(2, true, true, false),
+                pen(3, true, true, true),
+                pen(4, false, false, false),
+            ],
+            &mut out,
+        );
+        let on = |sw1, sw3| Some([sw1, false, sw3]);
+        assert_eq!(
+            out,
+            [
+                ("proximity_in", Some(2), on(true, false)),
+                ("tip_down", Some(2), on(true, false)),
+                ("motion", Some(2), on(true, false)),
+                ("button_down", Some(3), on(true, true)),
+                ("motion", Some(3), on(true, true)),
+                ("tip_up", Some(4), on(false, false)),
+                ("button_up", Some(4), on(false, false)),
+                ("proximity_out", Some(4), on(false, false)),
+            ]
+        );
+        assert_eq!(end, (false, [false; 3]));
+        let mut loss = Vec::new();
+        promised_loss(true, [true, false, true], &mut loss);
+        assert_eq!(
+            loss,
+            [
+                ("device_lost", None, None),
+                ("tip_up", None, on(false, true)),
+                ("button_up", None, on(false, false)),
+                ("proximity_out", None, on(false, false)),
+            ]
+        );
     }
 }
