@@ -2,11 +2,12 @@
 # Idempotent and quiet when everything is already there.
 
 # Debian packages the scripts need: binutils for `size` (firmware image figures), QEMU for the
-# firmware core's run on an emulated Cortex-M4F (hil-tests/tests/qemu.rs).
-DEB_PACKAGES=(binutils qemu-system-arm)
-# The board's target, the bench rig's (Raspberry Pi Pico, hil-tests/rig); clippy and rustfmt for
-# the checks.
-RUST_TARGETS=(thumbv7em-none-eabihf thumbv6m-none-eabi)
+# firmware core's run on an emulated Cortex-M4F (hil-tests/tests/qemu.rs) and for Debian's own
+# kernel on x86-64 (hil-tests/kernel, which fetches the kernel and busybox with apt-get download).
+DEB_PACKAGES=(binutils qemu-system-arm qemu-system-x86)
+# The board's target, the bench rig's (Raspberry Pi Pico, hil-tests/rig), static x86-64 programs
+# for the real-kernel test's initramfs; clippy and rustfmt for the checks.
+RUST_TARGETS=(thumbv7em-none-eabihf thumbv6m-none-eabi x86_64-unknown-linux-musl)
 RUST_COMPONENTS=(clippy rustfmt)
 # SETUP=firmware (scripts/firmware-bin.sh): only what building the board's image needs, the
 # target — no Debian packages, no emulator.

@@ -399,7 +399,19 @@ pub fn accept(bound: socket::Bound, hub: Arc<Hub>, queue_len: usize, stop: Arc<A
 }
 
 /// Reads the device and publishes its events until `stop` is set.
-pub fn run_device(mut pipeline: Pipeline, hub: Arc<Hub>, stop: Arc<AtomicBool>, log: impl Fn(&str)) {
+pub fn run_device(pipeline: Pipeline, hub: Arc<Hub>, stop: Arc<AtomicBool>, log: impl Fn(&str)) {
+    run_device_with(pipeline, hub, stop, log, |_| {})
+}
+
+/// [`run_device`], with `each` called with every event after it is published (the virtual
+/// tablet follows them so).
+pub fn run_device_with(
+    mut pipeline: Pipeline,
+    hub: Arc<Hub>,
+    stop: Arc<AtomicBool>,
+    log: impl Fn(&str),
+    mut each: impl FnMut(&PenEvent),
+) {
     let mut events = Vec::new();
     while !stop.load(Ordering::Relaxed) {
         events.clear();
@@ -414,6 +426,7 @@ pub fn run_device(mut pipeline: Pipeline, hub: Arc<Hub>, stop: Arc<AtomicBool>, 
                 _ => {}
             }
             hub.publish(e);
+            each(e);
         }
     }
 }

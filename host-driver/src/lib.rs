@@ -37,4 +37,5 @@ pub mod sample;
 pub mod socket;
 pub mod source;
 pub mod transport;
+pub mod virtual_tablet;
 pub mod wire;

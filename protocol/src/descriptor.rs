@@ -15,10 +15,12 @@
 //!   calibrated display's width and height in 0.1 mm, so the descriptor is built for the
 //!   display ([`report_descriptor`]) when the device starts.
 //! * Vendor 0xFF00 / 0x01: the project's own pen report 0x01 (3D, tracker or display frame,
-//!   with its quality), described field by field as before but where no OS pen stack binds
-//!   (Windows and Linux take input only from Generic Desktop, Digitizer and Consumer
-//!   application collections); the diagnostics input report 0x02, the head report 0x08 and the
-//!   feature reports 0x03–0x06, opaque byte arrays whose layout the report codecs define.
+//!   with its quality), described field by field with vendor usages only; the diagnostics input
+//!   report 0x02, the head report 0x08 and the feature reports 0x03–0x06, opaque byte arrays
+//!   whose layout the report codecs define. Linux's hid-input maps every input field by its
+//!   usage, whatever its collection (a real kernel made a second pen of report 0x01 while its
+//!   fields had Digitizer and Generic Desktop usages): only vendor usages keep the reports meant
+//!   for our host away from the OS's input devices (docs/protocol.md, hil-tests/kernel).
 
 use usbd_hid::descriptor::{AsInputReport, BufferOverflow, SerializedDescriptor};
 use usbd_hid_descriptors::{GlobalItemKind as G, ItemType, LocalItemKind as L, MainItemKind as M};
@@ -76,6 +78,20 @@ pub mod usage {
     pub const VENDOR_RESIDUAL: u16 = 0x14;
     /// Vendor: dilution of precision.
     pub const VENDOR_DOP: u16 = 0x15;
+    /// Vendor: the pen report's SW1 (tip).
+    pub const VENDOR_SW1: u16 = 0x16;
+    /// Vendor: the pen report's SW2 (barrel).
+    pub const VENDOR_SW2: u16 = 0x17;
+    /// Vendor: the pen report's SW3 (second barrel).
+    pub const VENDOR_SW3: u16 = 0x18;
+    /// Vendor: the pen report's in-range bit.
+    pub const VENDOR_IN_RANGE: u16 = 0x19;
+    /// Vendor: the pen report's X (tracker or display frame).
+    pub const VENDOR_X: u16 = 0x1A;
+    /// Vendor: the pen report's Y.
+    pub const VENDOR_Y: u16 = 0x1B;
+    /// Vendor: the pen report's Z.
+    pub const VENDOR_Z: u16 = 0x1C;
     /// Vendor usages of the vendor collection's reports are 0x20 + the report ID.
     pub const VENDOR_REPORT_BASE: u16 = 0x20;
 }
@@ -293,37 +309,37 @@ impl Builder {
             .usage(VENDOR_COLLECTION)
             .collection(collection::APPLICATION)
             .report_id(ReportId::Pen)
+            // The page is the vendor's: this is usage 0xFF00:0x20, not the Digitizer's Stylus.
             .usage(STYLUS)
             .collection(collection::PHYSICAL)
+            // Every usage of this report is a vendor one (page 0xFF00 from here on): hid-input
+            // maps Digitizer and Generic Desktop usages in any collection, and would make a
+            // second pen of the tracker frame.
             // Byte 1: SW1, SW2, SW3, In Range, display-frame flag, 3 bits padding.
-            .usage_page(PAGE_DIGITIZER)
-            .usage(TIP_SWITCH)
-            .usage(BARREL_SWITCH)
-            .usage(SECONDARY_BARREL_SWITCH)
-            .usage(IN_RANGE)
+            .usage(VENDOR_SW1)
+            .usage(VENDOR_SW2)
+            .usage(VENDOR_SW3)
+            .usage(VENDOR_IN_RANGE)
             .logical(0, 1)
             .physical(0, 0)
             .unit(unit::NONE, 0)
             .fields(1, 4)
             .input(flags::DATA_VAR_ABS)
-            .usage_page(PAGE_VENDOR)
             .usage(VENDOR_DISPLAY_FRAME)
             .fields(1, 1)
             .input(flags::DATA_VAR_ABS)
             .fields(1, 3)
             .input(flags::CONST_VAR_ABS)
             // Bytes 2–7: X, Y, Z, signed 16-bit, 0.1 mm (centimetres × 10⁻²).
-            .usage_page(PAGE_GENERIC_DESKTOP)
-            .usage(X)
-            .usage(Y)
-            .usage(Z)
+            .usage(VENDOR_X)
+            .usage(VENDOR_Y)
+            .usage(VENDOR_Z)
             .logical(-max, max)
             .physical(-max, max)
             .unit(unit::CENTIMETRE, -2)
             .fields(16, 3)
             .input(flags::DATA_VAR_ABS)
             // Bytes 8–9: sequence number.
-            .usage_page(PAGE_VENDOR)
             .usage(VENDOR_SEQUENCE)
             .logical(0, 0xFFFF)
             .physical(0, 0)

@@ -79,14 +79,14 @@ fn pen_fields_have_the_documented_usages_and_units() {
     assert_eq!(
         usages,
         [
-            (PAGE_DIGITIZER, TIP_SWITCH),
-            (PAGE_DIGITIZER, BARREL_SWITCH),
-            (PAGE_DIGITIZER, SECONDARY_BARREL_SWITCH),
-            (PAGE_DIGITIZER, IN_RANGE),
+            (PAGE_VENDOR, VENDOR_SW1),
+            (PAGE_VENDOR, VENDOR_SW2),
+            (PAGE_VENDOR, VENDOR_SW3),
+            (PAGE_VENDOR, VENDOR_IN_RANGE),
             (PAGE_VENDOR, VENDOR_DISPLAY_FRAME),
-            (PAGE_GENERIC_DESKTOP, X),
-            (PAGE_GENERIC_DESKTOP, Y),
-            (PAGE_GENERIC_DESKTOP, Z),
+            (PAGE_VENDOR, VENDOR_X),
+            (PAGE_VENDOR, VENDOR_Y),
+            (PAGE_VENDOR, VENDOR_Z),
             (PAGE_VENDOR, VENDOR_SEQUENCE),
             (PAGE_VENDOR, VENDOR_TIMESTAMP),
             (PAGE_VENDOR, VENDOR_RECEIVERS_USED),
@@ -94,8 +94,8 @@ fn pen_fields_have_the_documented_usages_and_units() {
             (PAGE_VENDOR, VENDOR_DOP),
         ]
     );
-    // The project's own report sits in the vendor application collection, where no OS pen
-    // stack binds: its tracker-frame X/Y/Z never reach the OS's pointer.
+    // The project's own report sits in the vendor application collection, with vendor usages
+    // only (see below why both).
     let app = &fields[0].collections[0];
     assert_eq!(app.usages()[0].usage_page, 0xFF00.into());
     assert_eq!(app.usages()[0].usage_id, 0x01.into());
@@ -178,6 +178,59 @@ fn every_pen_field_sits_where_the_codec_writes_it() {
     }
     // The fields plus 3 padding bits fill the report after the ID byte.
     assert_eq!(covered + 3, (PenReport::LEN - 1) * 8);
+}
+
+/// Linux's hid-input maps an input field by its usage whatever collection holds it: a Digitizer
+/// or Generic Desktop usage in the vendor collection made a second pen device of the 3D report
+/// on a real kernel (hil-tests/kernel). Every report but the OS pen's must carry vendor usages
+/// only — fields and collections alike — so that the OS makes exactly one pen.
+#[test]
+fn only_the_os_pen_report_carries_usages_an_os_binds() {
+    let rd = parsed();
+    let mut checked = 0;
+    let reports = rd
+        .input_reports()
+        .iter()
+        .map(|r| r as &dyn HidReport)
+        .chain(rd.feature_reports().iter().map(|r| r as &dyn HidReport));
+    for r in reports {
+        let id = r.report_id().map(u8::from).expect("every report has an ID");
+        for f in r.fields() {
+            let (usages, collections): (Vec<_>, _) = match f {
+                Field::Variable(v) => (vec![v.usage], &v.collections),
+                Field::Array(a) => (a.usages().to_vec(), &a.collections),
+                Field::Constant(_) => continue,
+            };
+            let pages: Vec<u16> = usages
+                .iter()
+                .map(|u| u16::from(u.usage_page))
+                .chain(
+                    collections
+                        .iter()
+                        .flat_map(|c| c.usages().iter().map(|u| u16::from(u.usage_page))),
+                )
+                .collect();
+            if id == ReportId::OsPen as u8 {
+                assert!(pages.iter().all(|&p| p != usage::PAGE_VENDOR), "{pages:x?}");
+            } else {
+                assert!(
+                    pages.iter().all(|&p| p >= usage::PAGE_VENDOR),
+                    "report {id:#04x} has a usage on a page an OS binds: {pages:x?}"
+                );
+            }
+            checked += 1;
+        }
+    }
+    // 6 OS pen fields, 13 pen fields, a field per body byte of the other reports.
+    let bytes = [
+        TofReport::LEN,
+        HeadReport::LEN,
+        DeviceInfo::LEN,
+        Config::LEN,
+        Status::LEN,
+        Command::LEN,
+    ];
+    assert_eq!(checked, 6 + 13 + bytes.iter().map(|l| l - 1).sum::<usize>());
 }
 
 #[test]

@@ -17,7 +17,7 @@ use pen_core::{
     Clock, ConfigStore, CycleResult, Emitter, Engine, HeadSettings, Ranging, ReportSink, Saved, SharedEngine, Station,
     StoreError, Switches,
 };
-use pen_protocol::{Config, FirmwareVersion, HeadReport, MAX_RECEIVERS, PenReport, Report, TofReport};
+use pen_protocol::{Config, FirmwareVersion, HeadReport, MAX_RECEIVERS, OsPenReport, PenReport, Report, TofReport};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
@@ -154,6 +154,8 @@ struct World {
     sent: Vec<Sent>,
     samples: Vec<u8>,
     pacer: Option<Pacer>,
+    /// Send the OS pen report after each pen report, as the USB HID sink does.
+    os_pen: bool,
     /// The listening window of the slot being fired, µs.
     listen_us: u64,
     /// The previous burst: when, and from where (for the room's reverberation).
@@ -251,6 +253,12 @@ impl ReportSink for SimSink {
     async fn head(&mut self, report: &HeadReport) {
         self.push(report);
     }
+
+    async fn os_pen(&mut self, report: &OsPenReport) {
+        if self.0.borrow().os_pen {
+            self.push(report);
+        }
+    }
 }
 
 /// The simulated device's configuration storage: memory that lasts as long as the simulation.
@@ -330,6 +338,7 @@ impl Simulation {
             sent: Vec::new(),
             samples: Vec::new(),
             pacer: None,
+            os_pen: false,
         }));
         let mut device = Engine::new(Some(scenario.config), SIM_FIRMWARE, scenario.unique_id);
         // A viewer wears the glasses: their emitter is fitted, and tracked from the start unless
@@ -372,6 +381,12 @@ impl Simulation {
     /// records [`step`](Self::step) returns no longer list them.
     pub fn set_pacer(&mut self, pacer: Pacer) {
         self.world.borrow_mut().pacer = Some(pacer);
+    }
+
+    /// Sends the OS pen report (`0x07`) after every pen report from now on, as the base
+    /// station does on USB HID; the serial link's byte stream, the default, has none.
+    pub fn send_os_pen(&mut self) {
+        self.world.borrow_mut().os_pen = true;
     }
 
     /// Runs one measurement cycle.

@@ -15,6 +15,7 @@ use pen_host::calibration::{Calibration, DisplaySize};
 use pen_host::daemon::{self, DEFAULT_MAX_CLIENTS, DEFAULT_QUEUE, Hub};
 use pen_host::pipeline::Pipeline;
 use pen_host::source::{DeviceArgs, SimScenario, SourceError};
+use pen_host::virtual_tablet::{self, Extent, VirtualTablet};
 
 /// `pend --help`'s end: what the defaults mean, and examples.
 #[cfg(feature = "sim")]
@@ -25,7 +26,8 @@ const AFTER_HELP: &str = "The simulated pen (--source sim) plays `modeling-sessi
     pend                                     # the first base station on USB\n  \
     pend --source serial:/dev/ttyACM0        # its serial link\n  \
     pend --source sim                        # the simulated pen, in real time\n  \
-    pend --source sim:hold --speed 0 --socket /tmp/pend.sock\n\
+    pend --source sim:hold --speed 0 --socket /tmp/pend.sock\n  \
+    pend --virtual-tablet                    # and a uinput pen for every program\n\
     docs/events.md (the socket's lines) and docs/cli.md (the flags every tool shares).";
 /// `pend --help`'s end, in a build without the simulated pen.
 #[cfg(not(feature = "sim"))]
@@ -34,6 +36,7 @@ root: host-driver/udev/70-penscape.rules.\n\
 Examples:\n  \
 pend                                     # the first base station on USB\n  \
 pend --source serial:/dev/ttyACM0        # its serial link\n\
+pend --virtual-tablet                    # and a uinput pen for every program\n\
 docs/events.md (the socket's lines) and docs/cli.md (the flags every tool shares).";
 
 #[derive(Parser)]
@@ -61,6 +64,11 @@ struct Cli {
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_CLIENTS as u16,
           value_parser = clap::value_parser!(u16).range(1..))]
     max_clients: u16,
+    /// Also move a uinput pen, "penscape pen", with the calibrated events, for programs that
+    /// read the OS's pen (Krita, Blender, GIMP): needs write access to /dev/uinput
+    /// (host-driver/udev/70-penscape.rules); docs/events.md.
+    #[arg(long)]
+    virtual_tablet: bool,
 }
 
 fn run(cli: Cli) -> Result<()> {
@@ -83,6 +91,26 @@ fn run(cli: Cli) -> Result<()> {
             Calibration::identity(DisplaySize::REFERENCE)
         }
     };
+    // Made before anything is served, so that a refusal (no access to /dev/uinput) ends pend
+    // at once with the reason.
+    let mut tablet = match cli.virtual_tablet {
+        true => {
+            let extent = Extent {
+                width_mm: calibration.display.width_mm,
+                height_mm: calibration.display.height_mm,
+            };
+            let t = VirtualTablet::open(extent)?;
+            eprintln!(
+                "pend: virtual tablet \"{}\": {:.0} × {:.0} mm of the display, {} units per mm",
+                virtual_tablet::NAME,
+                extent.width_mm,
+                extent.height_mm,
+                virtual_tablet::UNITS_PER_MM
+            );
+            Some(t)
+        }
+        false => None,
+    };
     let socket = cli.socket.unwrap_or_else(daemon::default_socket);
     let listener = daemon::bind(&socket)?;
     eprintln!("pend: serving {source} on {}", socket.display());
@@ -98,7 +126,23 @@ fn run(cli: Cli) -> Result<()> {
     let (h, s) = (hub.clone(), stop.clone());
     // The transport lives on the device thread: the simulated pen is not Send.
     std::thread::spawn(move || {
-        daemon::run_device(Pipeline::new(source, calibration), h, s, |m| eprintln!("pend: {m}"))
+        let mut failed = false;
+        daemon::run_device_with(
+            Pipeline::new(source, calibration),
+            h,
+            s,
+            |m| eprintln!("pend: {m}"),
+            |e| {
+                if let Some(t) = tablet.as_mut()
+                    && let Err(err) = t.event(e)
+                    && !failed
+                {
+                    // Said once; the socket's clients are served on.
+                    eprintln!("pend: the virtual tablet failed: {err}");
+                    failed = true;
+                }
+            },
+        )
     });
 
     while !stop.load(Ordering::Relaxed) {
