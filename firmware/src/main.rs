@@ -79,6 +79,7 @@ const FIRMWARE: FirmwareVersion = FirmwareVersion {
 async fn main(_spawner: Spawner) {
     // A restart into the ROM bootloader must happen before anything is initialised.
     bootloader::enter_if_requested();
+    bootloader::map_flash_at_zero();
     // Before anything else runs deep: the stack's high-water mark is logged every 10 s.
     stack::paint();
 

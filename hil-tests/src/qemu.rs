@@ -88,6 +88,10 @@ pub struct QemuRun {
     pub worst_counts: u32,
     /// Calibration: instructions executed and the SysTick counts they took.
     pub calibration: (u64, u32),
+    /// After a jump to the reset vector with VTOR at a foreign table (as the ROM DFU bootloader
+    /// leaves it): VTOR as `main` found it, the image's vector table, and whether an exception
+    /// pended in `main` ran the image's handler.
+    pub vector_table: Option<(u32, u32, bool)>,
 }
 
 impl QemuRun {
@@ -138,6 +142,7 @@ fn parse(stdout: &str) -> Result<QemuRun, QemuError> {
         total_counts: 0,
         worst_counts: 0,
         calibration: (0, 0),
+        vector_table: None,
     };
     let bad = |line: &str| QemuError::Emulated(format!("unexpected output line {line:?}"));
     let mut finished = false;
@@ -160,6 +165,16 @@ fn parse(stdout: &str) -> Result<QemuRun, QemuError> {
                     [insns, counts] => (insns, counts as u32),
                     _ => return Err(bad(line)),
                 };
+            }
+            Some("V") => {
+                let mut hex = || f.next().and_then(|v| u32::from_str_radix(v, 16).ok());
+                let (vtor, table) = (hex().ok_or_else(|| bad(line))?, hex().ok_or_else(|| bad(line))?);
+                let taken = match f.next() {
+                    Some("1") => true,
+                    Some("0") => false,
+                    _ => return Err(bad(line)),
+                };
+                run.vector_table = Some((vtor, table, taken));
             }
             Some("F") => {
                 let n: Vec<u64> = f.filter_map(|v| v.parse().ok()).collect();

@@ -27,6 +27,14 @@ fn the_emulated_core_sends_the_host_builds_reports() {
             Duration::from_secs(300),
         )
         .unwrap_or_else(|e| panic!("{name}: {e}"));
+        // Started as the ROM DFU bootloader starts an image (VTOR at its own table): the reset
+        // handler took VTOR back before main pended an exception, which ran the image's handler.
+        let (vtor, table, taken) = run.vector_table.expect("pen-qemu reports its vector table");
+        assert_eq!(
+            vtor, table,
+            "{name}: VTOR {vtor:#x} is not the image's table {table:#x}"
+        );
+        assert!(taken, "{name}: the exception pended in main did not run");
         assert_eq!(run.cycles as usize, records.len(), "{name}: cycles replayed");
         assert_eq!(run.reports.len(), host.len(), "{name}: report count");
         if let Some(i) = host.iter().zip(&run.reports).position(|(a, b)| a != b) {
