@@ -80,8 +80,6 @@ async fn main(_spawner: Spawner) {
     // A restart into the ROM bootloader must happen before anything is initialised.
     bootloader::enter_if_requested();
     bootloader::map_flash_at_zero();
-    // Before anything else runs deep: the stack's high-water mark is logged every 10 s.
-    stack::paint();
 
     // Clocks: 25 MHz crystal → PLL: 96 MHz system clock, 48 MHz for USB; APB1 48 MHz (its
     // timers 96 MHz), APB2 96 MHz.
