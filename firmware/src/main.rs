@@ -11,6 +11,7 @@
 mod bootloader;
 mod capture;
 mod clock;
+mod fault;
 mod flash_store;
 mod stack;
 mod switches;
@@ -19,6 +20,7 @@ mod usb;
 use core::cell::RefCell;
 
 use defmt::{debug, info, warn};
+use defmt_rtt as _;
 use embassy_executor::Spawner;
 use embassy_futures::join::{join, join3};
 use embassy_futures::select::{Either, select};
@@ -35,7 +37,6 @@ use embassy_usb::class::cdc_acm::{self, CdcAcmClass};
 use embassy_usb::class::hid::{self, HidBootProtocol, HidSubclass, HidWriter};
 use pen_core::{ConfigStore, Engine, LogStore, Station, WakeOnPress};
 use pen_protocol::{FirmwareVersion, PROTOCOL_VERSION, USB_PID, USB_VID, report_descriptor};
-use {defmt_rtt as _, panic_probe as _};
 
 use crate::capture::{BoardRanging, Pins, burst_pin, capture_pin, glasses_pin};
 use crate::clock::BoardClock;
@@ -80,6 +81,8 @@ async fn main(_spawner: Spawner) {
     // A restart into the ROM bootloader must happen before anything is initialised.
     bootloader::enter_if_requested();
     bootloader::map_flash_at_zero();
+    // What ended the previous run, if a panic, a fault or the watchdog did.
+    let last_reset = fault::take_last();
 
     // Clocks: 25 MHz crystal → PLL: 96 MHz system clock, 48 MHz for USB; APB1 48 MHz (its
     // timers 96 MHz), APB2 96 MHz.
@@ -105,6 +108,10 @@ async fn main(_spawner: Spawner) {
     }
     let p = embassy_stm32::init(config);
     info!("pen base station, firmware {}, protocol {}", FIRMWARE, PROTOCOL_VERSION);
+    if let Some(record) = &last_reset {
+        warn!("the previous run ended unasked:");
+        fault::log(record);
+    }
     // The flash accelerator: embassy sets the wait states (3 at 96 MHz) and nothing else. Without
     // prefetch and the instruction and data caches, every fetch waits them out and the core runs
     // about half as fast as docs/firmware.md's figures assume (RM0383 §3.4).
@@ -131,6 +138,9 @@ async fn main(_spawner: Spawner) {
     let (receivers, head) = engine.lock(|e| {
         let mut e = e.borrow_mut();
         e.set_head_emitter_fitted(true);
+        if let Some(record) = last_reset {
+            e.set_last_reset(record);
+        }
         (e.settings().count, e.resume_head(saved.is_some_and(|s| s.head)))
     });
     if head {

@@ -30,6 +30,7 @@ use crate::head::HeadReport;
 use crate::info::DeviceInfo;
 
 use crate::pen::{POSITION_LOGICAL_MAX, PenReport};
+use crate::reset::ResetRecord;
 use crate::status::{Command, Status};
 use crate::tof::TofReport;
 
@@ -361,6 +362,7 @@ impl Builder {
             .vendor_bytes(ReportId::Config, Config::LEN, true)
             .vendor_bytes(ReportId::Status, Status::LEN, true)
             .vendor_bytes(ReportId::Command, Command::LEN, true)
+            .vendor_bytes(ReportId::ResetRecord, ResetRecord::LEN, true)
             .end_collection()
     }
 

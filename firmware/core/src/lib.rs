@@ -12,8 +12,9 @@
 //!
 //! around them the measurement loop and its emitter schedule with the tracked head's filter
 //! ([`head`]), over the hardware seams ([`station`]), the settings a
-//! configuration report turns into ([`settings`]), configuration storage ([`store`]), the replay
-//! format of recorded cycles ([`replay`]) and the correctly rounded arithmetic ([`math`]).
+//! configuration report turns into ([`settings`]), configuration storage ([`store`]), the panic
+//! record kept across a reset ([`reset`]), the replay format of recorded cycles ([`replay`]) and
+//! the correctly rounded arithmetic ([`math`]).
 //! `no_std`, no allocation; the board runs it, the host tests it, the simulated pen drives it.
 //!
 //! Numbers are `f32` (the Cortex-M4F's FPU is single precision) and only correctly rounded
@@ -32,6 +33,7 @@ pub mod math;
 pub mod ranging;
 pub mod replay;
 pub mod report;
+pub mod reset;
 pub mod settings;
 pub mod solve;
 pub mod station;

@@ -6,6 +6,7 @@ mod fuzz_corpus;
 mod head;
 mod replay;
 mod report;
+mod reset;
 mod solve;
 mod station;
 mod store;
