@@ -6,11 +6,10 @@
 //! answers it as feature report 0x09 (`penctl info` prints it). A watchdog reset with no record
 //! is reported as one.
 //!
-//! A stack overflow runs into the end of RAM (the stack is at its bottom, stm32f411ce.x): the
-//! push faults, and so does the HardFault entry's own stacking. The HardFault vector is
-//! therefore a few instructions of assembly that move the stack pointer back to the top of the
-//! stack before any Rust code runs; the record then says *stack overflow* (CFSR's stacking-error
-//! bits).
+//! A stack overflow runs off the end of RAM (the stack is at its bottom, stm32f411ce.x) and
+//! faults; the HardFault vector (`hard_fault.rs`) moves the stack pointer back to the top of the
+//! stack before [`fault_on_fresh_stack`] runs, and the record says *stack overflow* (CFSR's
+//! stacking-error bits).
 //!
 //! With a debugger attached, a panic also stops at a breakpoint after logging, so that
 //! `probe-rs run` prints the backtrace; without one, nothing waits.
@@ -72,25 +71,10 @@ fn panic(info: &PanicInfo) -> ! {
     record_and_reset(&record)
 }
 
-// The HardFault vector (cortex-m-rt calls the symbol `HardFault`; a definition here replaces its
-// default). r0 = the stack pointer the fault left (where the exception frame is, if stacking
-// worked); then the stack pointer is set to the top of the stack, so the Rust handler runs on a
-// stack that has room even when the fault was the stack overflowing.
-core::arch::global_asm!(
-    ".section .HardFault.user, \"ax\"",
-    ".global HardFault",
-    ".type HardFault, %function",
-    ".thumb_func",
-    "HardFault:",
-    "mrs r0, msp",
-    "ldr r1, =_stack_start",
-    "msr msp, r1",
-    "b {handler}",
-    handler = sym on_hard_fault,
-);
-
-/// The HardFault's Rust half: `frame` is the stack pointer at the fault.
-unsafe extern "C" fn on_hard_fault(frame: u32) -> ! {
+/// The HardFault's Rust half, run on a fresh stack by `hard_fault.rs`'s vector: `frame` is the
+/// stack pointer at the fault.
+#[unsafe(no_mangle)]
+extern "C" fn fault_on_fresh_stack(frame: u32) -> ! {
     // SAFETY: a read of a system control register.
     let cfsr = unsafe { CFSR.read_volatile() };
     let stacked = cfsr & CFSR_STACKING == 0 && frame >= RAM_START;

@@ -13,6 +13,7 @@ mod capture;
 mod clock;
 mod fault;
 mod flash_store;
+mod hard_fault;
 mod stack;
 mod switches;
 mod usb;

@@ -60,6 +60,22 @@ fn the_emulated_core_sends_the_host_builds_reports() {
     }
 }
 
+/// The stack guard: the stack sits at the bottom of RAM (pen-qemu's layout is the board's,
+/// firmware/stm32f411ce.x), so running it out faults instead of overwriting the statics, and the
+/// board's own HardFault vector (firmware/src/hard_fault.rs) runs its handler on a fresh stack.
+#[test]
+fn a_stack_overflow_faults_into_the_handler_and_spares_the_statics() {
+    let elf = qemu::build_pen_qemu().expect("pen-qemu builds");
+    let fault = qemu::run_stack_overflow(&elf, Duration::from_secs(60)).expect("the overflow is caught");
+    assert!(
+        fault.stack_pointer < 0x2000_0000,
+        "the fault came at {:#x}, not past the bottom of RAM",
+        fault.stack_pointer
+    );
+    assert_ne!(fault.cfsr, 0, "no fault status recorded");
+    assert_eq!(fault.canary, qemu::CANARY, "the overflow reached the statics");
+}
+
 /// Writes the replay fuzz target's seeds from real traffic: the cycles the simulated pen records
 /// (capture times with the acoustics' noise, echoes and dropouts, switch samples), as the QEMU
 /// replay format, into `firmware/core/fuzz/corpus/replay/sim-*` (docs/reliability.md). Run once

@@ -13,6 +13,10 @@
 //! `:leave` does. The reset handler must point VTOR back at the image's table (cortex-m-rt's
 //! `set-vtor`) before `main` takes an exception: `V <VTOR> <image's table> <taken>` says so, and
 //! an exception taken through the foreign table ends the run with a failure.
+//!
+//! With a file `overflow` beside it, it then overflows its stack on purpose (the stack is at the
+//! bottom of RAM, as on the board): the board's HardFault vector must catch it on a fresh stack
+//! with the statics intact, `S <CFSR> <stack pointer at the fault> <canary>`.
 #![no_std]
 #![no_main]
 
@@ -20,7 +24,7 @@ use core::cell::RefCell;
 use core::fmt::Write;
 use core::mem::MaybeUninit;
 use core::ptr::addr_of_mut;
-use core::sync::atomic::{AtomicBool, Ordering};
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use cortex_m::peripheral::SCB;
 use cortex_m::peripheral::SYST;
@@ -113,6 +117,40 @@ fn check_vector_table(out: &mut hio::HostStream) {
     cortex_m::asm::isb();
     let taken = PENDSV_TAKEN.load(Ordering::SeqCst);
     let _ = writeln!(out, "V {vtor:08x} {:08x} {}", table as u32, u8::from(taken));
+}
+
+// The board's HardFault vector, which moves the stack pointer to the top of the stack before
+// `fault_on_fresh_stack` runs.
+#[path = "../../src/hard_fault.rs"]
+mod hard_fault;
+
+/// The configurable fault status register.
+const CFSR: *const u32 = 0xE000_ED28 as *const u32;
+
+/// A static the stack must never reach: with the stack below the statics, an overflow leaves it.
+static CANARY: AtomicU32 = AtomicU32::new(0xC0FF_EE11);
+
+/// Run by the HardFault vector on a fresh stack: prints `S <CFSR> <stack pointer at the fault>
+/// <canary>`. The stack-overflow run ends here with success; any other run has no final figures
+/// and fails.
+#[unsafe(no_mangle)]
+extern "C" fn fault_on_fresh_stack(frame: u32) -> ! {
+    // SAFETY: a read of a system control register.
+    let cfsr = unsafe { CFSR.read_volatile() };
+    if let Ok(mut out) = hio::hstdout() {
+        let canary = CANARY.load(Ordering::SeqCst);
+        let _ = writeln!(out, "S {cfsr:08x} {frame:08x} {canary:08x}");
+    }
+    debug::exit(debug::EXIT_SUCCESS);
+    halt()
+}
+
+/// Recurses until the stack runs out, 256 bytes a call.
+#[inline(never)]
+#[allow(unconditional_recursion)] // on purpose: it ends in the fault
+fn overflow(depth: u32) -> u32 {
+    let frame = core::hint::black_box([depth; 64]);
+    overflow(depth + 1).wrapping_add(frame[depth as usize % 64])
 }
 
 /// A file on the host, read through semihosting.
@@ -309,6 +347,10 @@ fn main() -> ! {
         }
     };
     check_vector_table(&mut out);
+    // The stack guard's test: with a file `overflow` beside it, the run overflows its stack.
+    if HostFile::open("overflow").is_some() {
+        core::hint::black_box(overflow(0));
+    }
     let mut cp = cortex_m::Peripherals::take().unwrap_or_else(|| fail(&mut out, "peripherals taken"));
     cp.SYST.set_clock_source(SystClkSource::Core);
     cp.SYST.set_reload(0x00FF_FFFF);
