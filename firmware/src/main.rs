@@ -11,11 +11,13 @@
 mod bootloader;
 mod capture;
 mod clock;
+mod crystal;
 mod fault;
 mod flash_store;
 mod hard_fault;
 mod stack;
 mod switches;
+mod time_driver;
 mod usb;
 
 use core::cell::RefCell;
@@ -49,6 +51,7 @@ bind_interrupts!(struct Irqs {
     OTG_FS => embassy_stm32::usb::InterruptHandler<peripherals::USB_OTG_FS>;
     TIM2 => capture::Tim2Captures;
     TIM3 => capture::Tim3Captures;
+    TIM5 => time_driver::Tim5Interrupt;
 });
 
 /// The watchdog resets the board if the station stops for this long. The longest the CPU ever
@@ -85,19 +88,21 @@ async fn main(_spawner: Spawner) {
     // What ended the previous run, if a panic, a fault or the watchdog did.
     let last_reset = fault::take_last();
 
-    // Clocks: 25 MHz crystal → PLL: 96 MHz system clock, 48 MHz for USB; APB1 48 MHz (its
-    // timers 96 MHz), APB2 96 MHz.
+    // Clocks: the crystal, measured (8 or 25 MHz; anything else blinks the LED for ever) → PLL:
+    // 96 MHz system clock, 48 MHz for USB; APB1 48 MHz (its timers 96 MHz), APB2 96 MHz.
+    let crystal = crystal::measure().unwrap_or_else(|fault| crystal::fault_blink(fault));
     let mut config = Config::default();
     {
         use embassy_stm32::rcc::*;
+        let (m, n) = crystal.pll();
         config.rcc.hse = Some(Hse {
-            freq: Hertz(25_000_000),
+            freq: Hertz(crystal.hz()),
             mode: HseMode::Oscillator,
         });
         config.rcc.pll_src = PllSource::HSE;
         config.rcc.pll = Some(Pll {
-            prediv: PllPreDiv::DIV25,
-            mul: PllMul::MUL192,
+            prediv: PllPreDiv::from_bits(m as u8),
+            mul: PllMul::from_bits(n as u16),
             divp: Some(PllPDiv::DIV2),
             divq: Some(PllQDiv::DIV4),
             divr: None,
@@ -108,7 +113,9 @@ async fn main(_spawner: Spawner) {
         config.rcc.sys = Sysclk::PLL1_P;
     }
     let p = embassy_stm32::init(config);
+    time_driver::init();
     info!("pen base station, firmware {}, protocol {}", FIRMWARE, PROTOCOL_VERSION);
+    info!("crystal: {} Hz", crystal.hz());
     if let Some(record) = &last_reset {
         warn!("the previous run ended unasked:");
         fault::log(record);

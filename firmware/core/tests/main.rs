@@ -1,4 +1,5 @@
 //! The integration tests of pen-core, in one binary: a module per area.
+mod board;
 mod common;
 mod debounce;
 mod filter;
