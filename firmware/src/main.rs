@@ -324,7 +324,7 @@ async fn main(_spawner: Spawner) {
         join3(usb_task, station_task, bootloader_task),
         join3(
             usb::hid_writer(hid_writer, &hid_queue),
-            usb::serial_writer(cdc_sender, &serial_queue),
+            usb::serial_writer(cdc_sender, &cdc_control, &serial_queue),
             usb::serial_reader(cdc_receiver, &engine, &store, &serial_queue),
         ),
     )
