@@ -28,7 +28,7 @@ use embassy_executor::Spawner;
 use embassy_futures::join::{join, join3};
 use embassy_futures::select::{Either, select};
 use embassy_stm32::flash::Flash;
-use embassy_stm32::gpio::{Input, Pull};
+use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
 use embassy_stm32::time::Hertz;
 use embassy_stm32::usb::Driver;
 use embassy_stm32::wdg::IndependentWatchdog;
@@ -155,6 +155,10 @@ async fn main(_spawner: Spawner) {
         info!("head tracking on, as saved");
     }
 
+    // The boost converter's soft-start switch (docs/hardware.md, PB13): off until the host has
+    // configured the device, and in suspend; USB allows no more before configuration.
+    let mut boost = Output::new(p.PB13, Level::Low, Speed::Low);
+
     // The front end, the switches, the clock.
     let pins = Pins {
         burst: burst_pin(p.PA8),
@@ -194,7 +198,8 @@ async fn main(_spawner: Spawner) {
     // The chip's unique ID, so that the host can tell two base stations apart (and a
     // calibration can name the one it belongs to).
     device.serial_number = Some(uid::uid_hex());
-    device.max_power = 100;
+    // The budget for the configured receivers (pen_core::board), not a flat 100 mA.
+    device.max_power = pen_core::board::usb_current_ma(receivers);
     device.max_packet_size_0 = 64;
     device.supports_remote_wakeup = true;
     // Interface association descriptors for the CDC function in a composite device.
@@ -272,6 +277,16 @@ async fn main(_spawner: Spawner) {
         let mut was_suspended = false;
         loop {
             watchdog.pet();
+            // 12 V only while configured and not suspended; after switching it on, the soft
+            // start (24 ms) and the converter's start-up before the next burst.
+            let powered = usb::CONFIGURED.load(core::sync::atomic::Ordering::Relaxed)
+                && !usb::SUSPENDED.load(core::sync::atomic::Ordering::Relaxed);
+            if powered != boost.is_set_high() {
+                boost.set_level(Level::from(powered));
+                if powered {
+                    Timer::after_millis(100).await;
+                }
+            }
             if usb::SUSPENDED.load(core::sync::atomic::Ordering::Relaxed) {
                 // No bursts during suspend; a new press of the tip wakes the host.
                 use pen_core::Switches;

@@ -57,6 +57,8 @@ pub static BAD_FRAMES: AtomicU32 = AtomicU32::new(0);
 
 /// Set while the bus is suspended: the station stops firing bursts.
 pub static SUSPENDED: AtomicBool = AtomicBool::new(false);
+/// Set while the host has configured the device: only then may it draw its declared current.
+pub static CONFIGURED: AtomicBool = AtomicBool::new(false);
 /// Raised by the station when SW1 is pressed during suspend: wake the host.
 pub static WAKE_HOST: Signal<ThreadModeRawMutex, ()> = Signal::new();
 /// Raised when a request asked for the bootloader; main restarts once the answer is out.
@@ -113,6 +115,7 @@ impl Handler for BusState {
     }
 
     fn configured(&mut self, configured: bool) {
+        CONFIGURED.store(configured, Ordering::Relaxed);
         info!("USB {}", if configured { "configured" } else { "not configured" });
     }
 }

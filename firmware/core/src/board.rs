@@ -64,3 +64,22 @@ pub fn crystal_from(hsi_ticks: u32, hse_cycles: u32) -> Option<Crystal> {
 pub const fn ticks(half_periods: u32, counter: u32) -> u64 {
     ((half_periods as u64) << 31) + ((counter ^ ((half_periods & 1) << 31)) as u64)
 }
+
+/// The base station's current budget from USB, mA, without the receivers: the Black Pill at
+/// 96 MHz with its LEDs and regulator, the two TC4427s at rest and the boost converter's share
+/// of the bursts, with room to spare.
+pub const BASE_CURRENT_MA: u16 = 40;
+/// Each receiver module's budget, mA: its OPA2365's two amplifiers (4.6 mA typical, 5 mA at
+/// most each: TI OPA2365 datasheet, SBOS365) and its TLV3501 comparator (3.2 mA typical: TI
+/// TLV3501 datasheet, SBOS321), rounded up to 15.
+pub const RECEIVER_CURRENT_MA: u16 = 15;
+
+/// What the device declares to USB (bMaxPower) for `receivers` receivers: the budget rounded up
+/// to 10 mA, at most USB 2.0's 500 mA. Measured on the bench (issue 45): about 75 mA with four
+/// receivers and 100–125 mA with six, so 100 and 130 cover them.
+pub const fn usb_current_ma(receivers: usize) -> u16 {
+    let n = if receivers > 8 { 8 } else { receivers as u16 };
+    let ma = BASE_CURRENT_MA + RECEIVER_CURRENT_MA * n;
+    let rounded = ma.div_ceil(10) * 10;
+    if rounded > 500 { 500 } else { rounded }
+}

@@ -1,7 +1,7 @@
 //! The board's arithmetic: which crystal a measurement shows, and device time from a 32-bit
 //! counter and its half periods.
 
-use pen_core::board::{Crystal, crystal_from, ticks};
+use pen_core::board::{Crystal, crystal_from, ticks, usb_current_ma};
 
 /// HSI ticks for `cycles` crystal cycles at `hse_hz`, with the HSI `hsi_error` off (0.01 = +1 %).
 fn measure(hse_hz: f64, cycles: u32, hsi_error: f64) -> u32 {
@@ -77,4 +77,21 @@ fn time_counts_on_across_both_boundaries_and_a_late_interrupt() {
         assert!(t >= last, "({half}, {counter:#x}): {t} after {last}");
         last = t;
     }
+}
+
+#[test]
+fn the_declared_current_covers_the_measured_draw_per_receiver_count() {
+    // The bench's figures (issue 45): about 75 mA with four receivers, up to 125 with six.
+    assert!(usb_current_ma(4) >= 75, "{}", usb_current_ma(4));
+    assert!(usb_current_ma(6) >= 125, "{}", usb_current_ma(6));
+    // More receivers, more current; USB's limit never passed; whole 10 mA.
+    for n in 0..8 {
+        assert!(usb_current_ma(n + 1) > usb_current_ma(n));
+    }
+    assert!(usb_current_ma(8) <= 500 && usb_current_ma(usize::MAX) <= 500);
+    assert!((0..=8).all(|n| usb_current_ma(n).is_multiple_of(10)));
+    assert_eq!(
+        (usb_current_ma(4), usb_current_ma(6), usb_current_ma(8)),
+        (100, 130, 160)
+    );
 }
