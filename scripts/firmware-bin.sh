@@ -7,8 +7,9 @@
 # no emulator, no Debian package. The ELF → binary step is LLVM's objcopy as the toolchain
 # ships it (`rust-objcopy` in rustc's sysroot, which rustc itself uses to strip binaries); a
 # toolchain without it gets the `llvm-tools` rustup component, which has `llvm-objcopy`.
-# Checks the image before it is flashed: its vector table must start with the stack at the top
-# of the STM32F411CE's RAM and a reset vector in its flash.
+# Checks the image before it is flashed: its vector table must start with the stack's top (the
+# stack is the bottom 16 KiB of RAM, firmware/stm32f411ce.x) and a reset vector in the program's
+# flash, and the image must fit sectors 0-5.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 SETUP=firmware source scripts/setup.sh
@@ -29,17 +30,17 @@ bin=firmware/target/pen-firmware.bin
 # The tool links against the toolchain's own LLVM library, which lives in the sysroot.
 LD_LIBRARY_PATH="$sysroot/lib${LD_LIBRARY_PATH:+:$LD_LIBRARY_PATH}" "$objcopy" -O binary "$elf" "$bin"
 
-# Word 0: the initial stack pointer, the top of the RAM the linker gives the program
+# Word 0: the initial stack pointer, the top of the stack at the bottom of RAM
 # (0x2000_0000 + 16 KiB, firmware/stm32f411ce.x); word 1: the reset handler, a Thumb address
-# (odd) inside the program's flash, sectors 0–3 (below 0x0801_0000).
+# (odd) inside the program's flash, sectors 0–5 (below 0x0804_0000).
 read -r sp reset < <(od -A n -t x4 -N 8 --endian=little "$bin")
 size=$(stat -c %s "$bin")
-if [ "$sp" != 20004000 ] || (( (16#$reset & 1) == 0 || 16#$reset < 0x08000000 || 16#$reset >= 0x08010000 )); then
+if [ "$sp" != 20004000 ] || (( (16#$reset & 1) == 0 || 16#$reset < 0x08000000 || 16#$reset >= 0x08040000 )); then
     echo "firmware-bin: $bin does not start with the board's vector table (stack $sp, reset $reset)" >&2
     exit 1
 fi
-if (( size > 0x10000 )); then
-    echo "firmware-bin: $bin is $size bytes, more than sectors 0–3 (64 KiB) hold" >&2
+if (( size > 0x40000 )); then
+    echo "firmware-bin: $bin is $size bytes, more than sectors 0–5 (256 KiB) hold" >&2
     exit 1
 fi
 echo "$bin: $size bytes (stack 0x$sp, reset 0x$reset)"

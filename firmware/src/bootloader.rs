@@ -24,6 +24,14 @@ pub fn restart_into_bootloader() -> ! {
     cortex_m::peripheral::SCB::sys_reset()
 }
 
+/// Maps the main flash at address 0 again. After `dfu-util … :leave` the ROM bootloader jumps to
+/// the image with system memory still mapped there (AN2606, STM32F411); VTOR is set by the reset
+/// handler (cortex-m-rt's `set-vtor`), but anything that reads address 0 would read the ROM.
+pub fn map_flash_at_zero() {
+    pac::RCC.apb2enr().modify(|w| w.set_syscfgen(true));
+    pac::SYSCFG.memrm().modify(|w| w.set_mem_mode(0));
+}
+
 /// At the very start of `main`: jumps to the bootloader if it was requested before the reset.
 pub fn enter_if_requested() {
     // SAFETY: the word may hold anything after a power-up; reading it as a u32 is fine.

@@ -1,6 +1,6 @@
 //! The configuration's flash regions: sectors 6 and 7, the last 256 KiB of the STM32F411CE's
 //! 512 KiB, used in turn by the store (pen-core's `store.rs`). The linker script gives the
-//! program the first 64 KiB only, so the two can never overlap.
+//! program sectors 0–5 (256 KiB) only, so the two can never overlap.
 
 use core::cell::RefCell;
 

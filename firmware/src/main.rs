@@ -11,19 +11,24 @@
 mod bootloader;
 mod capture;
 mod clock;
+mod crystal;
+mod fault;
 mod flash_store;
+mod hard_fault;
 mod stack;
 mod switches;
+mod time_driver;
 mod usb;
 
 use core::cell::RefCell;
 
 use defmt::{debug, info, warn};
+use defmt_rtt as _;
 use embassy_executor::Spawner;
 use embassy_futures::join::{join, join3};
 use embassy_futures::select::{Either, select};
 use embassy_stm32::flash::Flash;
-use embassy_stm32::gpio::{Input, Pull};
+use embassy_stm32::gpio::{Input, Level, Output, Pull, Speed};
 use embassy_stm32::time::Hertz;
 use embassy_stm32::usb::Driver;
 use embassy_stm32::wdg::IndependentWatchdog;
@@ -35,7 +40,6 @@ use embassy_usb::class::cdc_acm::{self, CdcAcmClass};
 use embassy_usb::class::hid::{self, HidBootProtocol, HidSubclass, HidWriter};
 use pen_core::{ConfigStore, Engine, LogStore, Station, WakeOnPress};
 use pen_protocol::{FirmwareVersion, PROTOCOL_VERSION, USB_PID, USB_VID, report_descriptor};
-use {defmt_rtt as _, panic_probe as _};
 
 use crate::capture::{BoardRanging, Pins, burst_pin, capture_pin, glasses_pin};
 use crate::clock::BoardClock;
@@ -47,6 +51,7 @@ bind_interrupts!(struct Irqs {
     OTG_FS => embassy_stm32::usb::InterruptHandler<peripherals::USB_OTG_FS>;
     TIM2 => capture::Tim2Captures;
     TIM3 => capture::Tim3Captures;
+    TIM5 => time_driver::Tim5Interrupt;
 });
 
 /// The watchdog resets the board if the station stops for this long. The longest the CPU ever
@@ -79,22 +84,25 @@ const FIRMWARE: FirmwareVersion = FirmwareVersion {
 async fn main(_spawner: Spawner) {
     // A restart into the ROM bootloader must happen before anything is initialised.
     bootloader::enter_if_requested();
-    // Before anything else runs deep: the stack's high-water mark is logged every 10 s.
-    stack::paint();
+    bootloader::map_flash_at_zero();
+    // What ended the previous run, if a panic, a fault or the watchdog did.
+    let last_reset = fault::take_last();
 
-    // Clocks: 25 MHz crystal → PLL: 96 MHz system clock, 48 MHz for USB; APB1 48 MHz (its
-    // timers 96 MHz), APB2 96 MHz.
+    // Clocks: the crystal, measured (8 or 25 MHz; anything else blinks the LED for ever) → PLL:
+    // 96 MHz system clock, 48 MHz for USB; APB1 48 MHz (its timers 96 MHz), APB2 96 MHz.
+    let crystal = crystal::measure().unwrap_or_else(|fault| crystal::fault_blink(fault));
     let mut config = Config::default();
     {
         use embassy_stm32::rcc::*;
+        let (m, n) = crystal.pll();
         config.rcc.hse = Some(Hse {
-            freq: Hertz(25_000_000),
+            freq: Hertz(crystal.hz()),
             mode: HseMode::Oscillator,
         });
         config.rcc.pll_src = PllSource::HSE;
         config.rcc.pll = Some(Pll {
-            prediv: PllPreDiv::DIV25,
-            mul: PllMul::MUL192,
+            prediv: PllPreDiv::from_bits(m as u8),
+            mul: PllMul::from_bits(n as u16),
             divp: Some(PllPDiv::DIV2),
             divq: Some(PllQDiv::DIV4),
             divr: None,
@@ -105,7 +113,13 @@ async fn main(_spawner: Spawner) {
         config.rcc.sys = Sysclk::PLL1_P;
     }
     let p = embassy_stm32::init(config);
+    time_driver::init();
     info!("pen base station, firmware {}, protocol {}", FIRMWARE, PROTOCOL_VERSION);
+    info!("crystal: {} Hz", crystal.hz());
+    if let Some(record) = &last_reset {
+        warn!("the previous run ended unasked:");
+        fault::log(record);
+    }
     // The flash accelerator: embassy sets the wait states (3 at 96 MHz) and nothing else. Without
     // prefetch and the instruction and data caches, every fetch waits them out and the core runs
     // about half as fast as docs/firmware.md's figures assume (RM0383 §3.4).
@@ -132,11 +146,18 @@ async fn main(_spawner: Spawner) {
     let (receivers, head) = engine.lock(|e| {
         let mut e = e.borrow_mut();
         e.set_head_emitter_fitted(true);
+        if let Some(record) = last_reset {
+            e.set_last_reset(record);
+        }
         (e.settings().count, e.resume_head(saved.is_some_and(|s| s.head)))
     });
     if head {
         info!("head tracking on, as saved");
     }
+
+    // The boost converter's soft-start switch (docs/hardware.md, PB13): off until the host has
+    // configured the device, and in suspend; USB allows no more before configuration.
+    let mut boost = Output::new(p.PB13, Level::Low, Speed::Low);
 
     // The front end, the switches, the clock.
     let pins = Pins {
@@ -177,7 +198,8 @@ async fn main(_spawner: Spawner) {
     // The chip's unique ID, so that the host can tell two base stations apart (and a
     // calibration can name the one it belongs to).
     device.serial_number = Some(uid::uid_hex());
-    device.max_power = 100;
+    // The budget for the configured receivers (pen_core::board), not a flat 100 mA.
+    device.max_power = pen_core::board::usb_current_ma(receivers);
     device.max_packet_size_0 = 64;
     device.supports_remote_wakeup = true;
     // Interface association descriptors for the CDC function in a composite device.
@@ -255,6 +277,16 @@ async fn main(_spawner: Spawner) {
         let mut was_suspended = false;
         loop {
             watchdog.pet();
+            // 12 V only while configured and not suspended; after switching it on, the soft
+            // start (24 ms) and the converter's start-up before the next burst.
+            let powered = usb::CONFIGURED.load(core::sync::atomic::Ordering::Relaxed)
+                && !usb::SUSPENDED.load(core::sync::atomic::Ordering::Relaxed);
+            if powered != boost.is_set_high() {
+                boost.set_level(Level::from(powered));
+                if powered {
+                    Timer::after_millis(100).await;
+                }
+            }
             if usb::SUSPENDED.load(core::sync::atomic::Ordering::Relaxed) {
                 // No bursts during suspend; a new press of the tip wakes the host.
                 use pen_core::Switches;
@@ -307,7 +339,7 @@ async fn main(_spawner: Spawner) {
         join3(usb_task, station_task, bootloader_task),
         join3(
             usb::hid_writer(hid_writer, &hid_queue),
-            usb::serial_writer(cdc_sender, &serial_queue),
+            usb::serial_writer(cdc_sender, &cdc_control, &serial_queue),
             usb::serial_reader(cdc_receiver, &engine, &store, &serial_queue),
         ),
     )

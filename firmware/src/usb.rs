@@ -5,6 +5,7 @@ use core::cell::RefCell;
 use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
 use defmt::{info, warn};
+use embassy_futures::select::select;
 use embassy_sync::blocking_mutex::Mutex;
 use embassy_sync::blocking_mutex::raw::ThreadModeRawMutex;
 use embassy_sync::channel::Channel;
@@ -56,6 +57,8 @@ pub static BAD_FRAMES: AtomicU32 = AtomicU32::new(0);
 
 /// Set while the bus is suspended: the station stops firing bursts.
 pub static SUSPENDED: AtomicBool = AtomicBool::new(false);
+/// Set while the host has configured the device: only then may it draw its declared current.
+pub static CONFIGURED: AtomicBool = AtomicBool::new(false);
 /// Raised by the station when SW1 is pressed during suspend: wake the host.
 pub static WAKE_HOST: Signal<ThreadModeRawMutex, ()> = Signal::new();
 /// Raised when a request asked for the bootloader; main restarts once the answer is out.
@@ -112,6 +115,7 @@ impl Handler for BusState {
     }
 
     fn configured(&mut self, configured: bool) {
+        CONFIGURED.store(configured, Ordering::Relaxed);
         info!("USB {}", if configured { "configured" } else { "not configured" });
     }
 }
@@ -191,23 +195,55 @@ pub async fn hid_writer<'d, D: Driver<'d>>(mut writer: HidWriter<'d, D, HID_PACK
     }
 }
 
-/// Writes queued frames to the serial link in packets.
-pub async fn serial_writer<'d, D: Driver<'d>>(mut sender: Sender<'d, D>, queue: &SerialQueue) -> ! {
+/// Writes queued frames to the serial link in packets, to the session that queued them. When
+/// the host closes the port (DTR drops) the frame being written is abandoned; when one opens it,
+/// whatever is still queued belongs to the last session and is dropped (and counted), so the
+/// first frames a new session reads are fresh, not reports up to 8 frames old.
+pub async fn serial_writer<'d, D: Driver<'d>>(
+    mut sender: Sender<'d, D>,
+    control: &ControlChanged<'_>,
+    queue: &SerialQueue,
+) -> ! {
     loop {
-        let frame = queue.receive().await;
-        let packet = sender.max_packet_size() as usize;
-        let bytes = &frame.buf[..frame.len];
-        let mut ok = true;
-        for chunk in bytes.chunks(packet) {
-            ok &= sender.write_packet(chunk).await.is_ok();
+        while !control.dtr() {
+            control.control_changed().await;
         }
-        // A transfer that ends on a full packet needs a zero-length packet to end it.
-        if bytes.len() % packet == 0 {
-            ok &= sender.write_packet(&[]).await.is_ok();
-        }
-        if !ok {
-            DROPPED_SERIAL.fetch_add(1, Ordering::Relaxed);
-        }
+        let stale = queue.len() as u32;
+        queue.clear();
+        DROPPED_SERIAL.fetch_add(stale, Ordering::Relaxed);
+        let closed = async {
+            loop {
+                control.control_changed().await;
+                if !control.dtr() {
+                    break;
+                }
+            }
+        };
+        let session = async {
+            loop {
+                let frame = queue.receive().await;
+                write_frame(&mut sender, &frame).await;
+            }
+        };
+        // The session never ends by itself: this returns when the port closes.
+        select(closed, session).await;
+    }
+}
+
+/// One frame in packets; a failed packet counts the frame as dropped.
+async fn write_frame<'d, D: Driver<'d>>(sender: &mut Sender<'d, D>, frame: &SerialFrame) {
+    let packet = sender.max_packet_size() as usize;
+    let bytes = &frame.buf[..frame.len];
+    let mut ok = true;
+    for chunk in bytes.chunks(packet) {
+        ok &= sender.write_packet(chunk).await.is_ok();
+    }
+    // A transfer that ends on a full packet needs a zero-length packet to end it.
+    if bytes.len().is_multiple_of(packet) {
+        ok &= sender.write_packet(&[]).await.is_ok();
+    }
+    if !ok {
+        DROPPED_SERIAL.fetch_add(1, Ordering::Relaxed);
     }
 }
 

@@ -88,6 +88,10 @@ pub struct QemuRun {
     pub worst_counts: u32,
     /// Calibration: instructions executed and the SysTick counts they took.
     pub calibration: (u64, u32),
+    /// After a jump to the reset vector with VTOR at a foreign table (as the ROM DFU bootloader
+    /// leaves it): VTOR as `main` found it, the image's vector table, and whether an exception
+    /// pended in `main` ran the image's handler.
+    pub vector_table: Option<(u32, u32, bool)>,
 }
 
 impl QemuRun {
@@ -138,6 +142,7 @@ fn parse(stdout: &str) -> Result<QemuRun, QemuError> {
         total_counts: 0,
         worst_counts: 0,
         calibration: (0, 0),
+        vector_table: None,
     };
     let bad = |line: &str| QemuError::Emulated(format!("unexpected output line {line:?}"));
     let mut finished = false;
@@ -161,6 +166,16 @@ fn parse(stdout: &str) -> Result<QemuRun, QemuError> {
                     _ => return Err(bad(line)),
                 };
             }
+            Some("V") => {
+                let mut hex = || f.next().and_then(|v| u32::from_str_radix(v, 16).ok());
+                let (vtor, table) = (hex().ok_or_else(|| bad(line))?, hex().ok_or_else(|| bad(line))?);
+                let taken = match f.next() {
+                    Some("1") => true,
+                    Some("0") => false,
+                    _ => return Err(bad(line)),
+                };
+                run.vector_table = Some((vtor, table, taken));
+            }
             Some("F") => {
                 let n: Vec<u64> = f.filter_map(|v| v.parse().ok()).collect();
                 let [cycles, timed, total, worst] = n[..] else {
@@ -183,11 +198,14 @@ fn parse(stdout: &str) -> Result<QemuRun, QemuError> {
     }
 }
 
-/// Runs `elf` under QEMU `mps2-an386` with `replay` as its `cycles.bin`.
-pub fn run(elf: &Path, replay: &[u8], timeout: Duration) -> Result<QemuRun, QemuError> {
+/// Runs `elf` under QEMU `mps2-an386` in a fresh folder holding `files`; returns whether it
+/// exited with success, and its standard output and error.
+fn run_with(elf: &Path, files: &[(&str, &[u8])], timeout: Duration) -> Result<(bool, String, String), QemuError> {
     let dir = std::env::temp_dir().join(format!("pen-qemu-{}-{}", std::process::id(), rand::random::<u32>()));
     std::fs::create_dir_all(&dir)?;
-    std::fs::write(dir.join("cycles.bin"), replay)?;
+    for (name, bytes) in files {
+        std::fs::write(dir.join(name), bytes)?;
+    }
     let program = "qemu-system-arm";
     let mut child = Command::new(program)
         .args(["-M", "mps2-an386", "-nographic", "-monitor", "none", "-serial", "none"])
@@ -235,12 +253,57 @@ pub fn run(elf: &Path, replay: &[u8], timeout: Duration) -> Result<QemuRun, Qemu
         let _ = e.read_to_string(&mut stderr);
     }
     let _ = std::fs::remove_dir_all(&dir);
+    Ok((status.success(), stdout, stderr))
+}
+
+/// Runs `elf` under QEMU `mps2-an386` with `replay` as its `cycles.bin`.
+pub fn run(elf: &Path, replay: &[u8], timeout: Duration) -> Result<QemuRun, QemuError> {
+    let (success, stdout, stderr) = run_with(elf, &[("cycles.bin", replay)], timeout)?;
     let run = parse(&stdout);
-    if !status.success() {
+    if !success {
         return Err(match run {
             Err(e) => e,
-            Ok(_) => QemuError::Emulated(format!("exit status {status}: {stderr}")),
+            Ok(_) => QemuError::Emulated(format!("exit status: failure: {stderr}")),
         });
     }
     run
+}
+
+/// What the HardFault vector saw when `pen-qemu` overflowed its stack on purpose.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct StackFault {
+    /// The configurable fault status register.
+    pub cfsr: u32,
+    /// The stack pointer when the fault came.
+    pub stack_pointer: u32,
+    /// The static placed above the stack, as the fault handler read it.
+    pub canary: u32,
+}
+
+/// The value `pen-qemu`'s canary static starts with.
+pub const CANARY: u32 = 0xC0FF_EE11;
+
+/// Runs `elf` with a file `overflow` beside it: it overflows its stack, and its HardFault
+/// vector (the board's) reports the fault from a fresh stack.
+pub fn run_stack_overflow(elf: &Path, timeout: Duration) -> Result<StackFault, QemuError> {
+    let (success, stdout, stderr) = run_with(elf, &[("overflow", b"")], timeout)?;
+    let line = stdout
+        .lines()
+        .find_map(|l| l.strip_prefix("S "))
+        .ok_or_else(|| QemuError::Emulated(format!("no fault reported: {stdout}{stderr}")))?;
+    let hex: Vec<u32> = line
+        .split_whitespace()
+        .filter_map(|v| u32::from_str_radix(v, 16).ok())
+        .collect();
+    let [cfsr, stack_pointer, canary] = hex[..] else {
+        return Err(QemuError::Emulated(format!("unexpected fault line {line:?}")));
+    };
+    if !success {
+        return Err(QemuError::Emulated(format!("exit status: failure: {stderr}")));
+    }
+    Ok(StackFault {
+        cfsr,
+        stack_pointer,
+        canary,
+    })
 }

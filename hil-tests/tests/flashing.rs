@@ -33,6 +33,18 @@ fn the_firmware_toolchain_file_names_the_boards_target() {
     assert_eq!(toml_value(&toolchain, "channel").as_deref(), Some("\"stable\""));
 }
 
+#[test]
+fn the_firmware_sets_vtor_and_the_stack_pointer_at_reset() {
+    // After `dfu-util … :leave` the ROM bootloader jumps to the image with VTOR at its own
+    // table: without cortex-m-rt's set-vtor the first interrupt would run the ROM's handler.
+    // (hil-tests/tests/qemu.rs checks the mechanism on pen-qemu, started the way the ROM does.)
+    let manifest = repo("firmware/Cargo.toml");
+    let rt = toml_value(&manifest, "cortex-m-rt").expect("firmware/Cargo.toml depends on cortex-m-rt");
+    for feature in ["\"set-vtor\"", "\"set-sp\"", "\"paint-stack\""] {
+        assert!(rt.contains(feature), "cortex-m-rt lacks {feature}: {rt}");
+    }
+}
+
 /// One `KEY{attr}OP"value"` of a rule.
 #[derive(Debug)]
 struct Pair {

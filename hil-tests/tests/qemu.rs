@@ -27,6 +27,14 @@ fn the_emulated_core_sends_the_host_builds_reports() {
             Duration::from_secs(300),
         )
         .unwrap_or_else(|e| panic!("{name}: {e}"));
+        // Started as the ROM DFU bootloader starts an image (VTOR at its own table): the reset
+        // handler took VTOR back before main pended an exception, which ran the image's handler.
+        let (vtor, table, taken) = run.vector_table.expect("pen-qemu reports its vector table");
+        assert_eq!(
+            vtor, table,
+            "{name}: VTOR {vtor:#x} is not the image's table {table:#x}"
+        );
+        assert!(taken, "{name}: the exception pended in main did not run");
         assert_eq!(run.cycles as usize, records.len(), "{name}: cycles replayed");
         assert_eq!(run.reports.len(), host.len(), "{name}: report count");
         if let Some(i) = host.iter().zip(&run.reports).position(|(a, b)| a != b) {
@@ -50,6 +58,22 @@ fn the_emulated_core_sends_the_host_builds_reports() {
             run.worst_instructions()
         );
     }
+}
+
+/// The stack guard: the stack sits at the bottom of RAM (pen-qemu's layout is the board's,
+/// firmware/stm32f411ce.x), so running it out faults instead of overwriting the statics, and the
+/// board's own HardFault vector (firmware/src/hard_fault.rs) runs its handler on a fresh stack.
+#[test]
+fn a_stack_overflow_faults_into_the_handler_and_spares_the_statics() {
+    let elf = qemu::build_pen_qemu().expect("pen-qemu builds");
+    let fault = qemu::run_stack_overflow(&elf, Duration::from_secs(60)).expect("the overflow is caught");
+    assert!(
+        fault.stack_pointer < 0x2000_0000,
+        "the fault came at {:#x}, not past the bottom of RAM",
+        fault.stack_pointer
+    );
+    assert_ne!(fault.cfsr, 0, "no fault status recorded");
+    assert_eq!(fault.canary, qemu::CANARY, "the overflow reached the statics");
 }
 
 /// Writes the replay fuzz target's seeds from real traffic: the cycles the simulated pen records

@@ -102,7 +102,7 @@ fn invalid_input_fails_with_a_reason_on_stderr() {
             &["decode", "010dd204c9fd7a033412040302010507120000"],
             "oversized pen report: 19 bytes, expected 17",
         ),
-        (&["decode", "090102"], "unknown report ID 0x09"),
+        (&["decode", "0a0102"], "unknown report ID 0x0a"),
         (&["decode", "01zz"], "'z' at position 2 is not a hex digit"),
         (
             &["decode", "01fdd204c9fd7a03341204030201050712"],
@@ -459,4 +459,18 @@ fn a_display_size_out_of_range_is_refused_naming_it() {
         err.contains("`display.width_mm` must be between 20 and 10000 mm, is 1e-300"),
         "{err}"
     );
+}
+
+#[test]
+fn info_shows_the_reset_record() {
+    // The simulated base station has run without a panic: its record says so, in words and in
+    // JSON (feature report 0x09, protocol 2.2).
+    let out = penctl(&["info", "--sim"]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("last reset   no panic or fault recorded"), "{text}");
+    let out = penctl(&["info", "--sim", "--json"]);
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    assert_eq!(v["last_reset"]["report_id"], 9, "{v}");
+    assert_eq!(v["last_reset"]["kind"], "None", "{v}");
 }

@@ -32,6 +32,7 @@ use crate::head::HeadReport;
 use crate::info::DeviceInfo;
 
 use crate::pen::{POSITION_LOGICAL_MAX, PenReport};
+use crate::reset::ResetRecord;
 use crate::status::{Command, Status};
 use crate::tof::TofReport;
 
@@ -377,6 +378,7 @@ impl Builder {
             .vendor_bytes(ReportId::Config, Config::LEN, true)
             .vendor_bytes(ReportId::Status, Status::LEN, true)
             .vendor_bytes(ReportId::Command, Command::LEN, true)
+            .vendor_bytes(ReportId::ResetRecord, ResetRecord::LEN, true)
             .end_collection()
     }
 

@@ -27,7 +27,9 @@ impl fmt::Display for Version {
 /// The protocol version this crate implements. 2: the configuration report carries the display's
 /// size (195 bytes, was 187) and the operating system's pen has its own report (0x07) in the
 /// display frame; version 1's configuration would be misread, so a version 1 host refuses it.
-pub const PROTOCOL_VERSION: Version = Version { major: 2, minor: 1 };
+/// 2.1 added the head report (0x08) and the HeadOn/HeadOff commands; 2.2 the reset record
+/// (0x09), which a 2.1 device does not answer.
+pub const PROTOCOL_VERSION: Version = Version { major: 2, minor: 2 };
 
 /// The protocol major versions a host built from this crate understands.
 pub const SUPPORTED_MAJOR_VERSIONS: &[u8] = &[2];

@@ -20,6 +20,7 @@ use serde::{Deserialize, Serialize};
 use crate::config::{Config, ConfigField, DisplayPose, Filter};
 use crate::info::DeviceInfo;
 use crate::pen::{MAX_RECEIVERS, PenReport, Quality};
+use crate::reset::{ResetKind, ResetRecord};
 use crate::status::{Command, GetFeature, Status};
 use crate::tof::{NO_ARRIVAL, TofReport};
 use crate::wide::{tenths, wide, wide_list, wide_opt};
@@ -371,6 +372,20 @@ impl Serialize for GetFeature {
     }
 }
 
+/// The reset record: its fields, the text as a string, and the record in words.
+#[derive(Serialize)]
+struct ResetJson<'a> {
+    report_id: u8,
+    report: &'static str,
+    kind: ResetKind,
+    line: u32,
+    column: u32,
+    uptime_ms: u32,
+    text: &'a str,
+    #[serde(serialize_with = "display")]
+    message: &'a ResetRecord,
+}
+
 /// The report's fields after `report_id` and `report`.
 impl Serialize for Message {
     fn serialize<S: Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
@@ -410,6 +425,17 @@ impl Serialize for Message {
                 seq: r.seq,
                 timestamp_us: r.timestamp_us,
                 quality: &r.quality,
+            }
+            .serialize(s),
+            Message::ResetRecord(r) => ResetJson {
+                report_id: ReportId::ResetRecord as u8,
+                report: ReportId::ResetRecord.name(),
+                kind: r.kind,
+                line: r.line,
+                column: r.column,
+                uptime_ms: r.uptime_ms,
+                text: r.text(),
+                message: r,
             }
             .serialize(s),
             Message::GetFeature(r) => r.json(tag).serialize(s),

@@ -16,6 +16,7 @@ mod info;
 mod json;
 mod os_pen;
 mod pen;
+mod reset;
 mod status;
 mod tof;
 #[cfg(feature = "serde")]
@@ -35,6 +36,7 @@ pub use info::{DeviceInfo, FirmwareVersion, PROTOCOL_VERSION, UnsupportedVersion
 pub use json::{ConfigChanges, PerReceiver};
 pub use os_pen::OsPenReport;
 pub use pen::{MAX_RECEIVERS, POSITION_LOGICAL_MAX, PenReport, Position, Quality, UNITS_PER_MM};
+pub use reset::{CFSR_STACKING, RESET_TEXT_LEN, ResetKind, ResetRecord};
 pub use status::{Command, GetFeature, Status, StatusCode};
 pub use tof::{NO_ARRIVAL, TofReport};
 
@@ -65,13 +67,15 @@ pub enum ReportId {
     OsPen = 0x07,
     /// Input (protocol 2.1): [`HeadReport`], the tracked head.
     Head = 0x08,
+    /// Feature, read-only (protocol 2.2): [`ResetRecord`], the last panic or fault.
+    ResetRecord = 0x09,
     /// Serial only, host to device: [`GetFeature`].
     GetFeature = 0x80,
 }
 
 impl ReportId {
     /// All IDs, in order.
-    pub const ALL: [ReportId; 9] = [
+    pub const ALL: [ReportId; 10] = [
         ReportId::Pen,
         ReportId::Tof,
         ReportId::DeviceInfo,
@@ -80,6 +84,7 @@ impl ReportId {
         ReportId::Command,
         ReportId::OsPen,
         ReportId::Head,
+        ReportId::ResetRecord,
         ReportId::GetFeature,
     ];
 
@@ -92,7 +97,7 @@ impl ReportId {
     pub fn is_feature(self) -> bool {
         matches!(
             self,
-            ReportId::DeviceInfo | ReportId::Config | ReportId::Status | ReportId::Command
+            ReportId::DeviceInfo | ReportId::Config | ReportId::Status | ReportId::Command | ReportId::ResetRecord
         )
     }
 
@@ -107,6 +112,7 @@ impl ReportId {
             ReportId::Command => "command",
             ReportId::OsPen => "OS pen",
             ReportId::Head => "head",
+            ReportId::ResetRecord => "reset record",
             ReportId::GetFeature => "get-feature request",
         }
     }
@@ -131,6 +137,7 @@ pub enum Message {
     Command(Command),
     OsPen(OsPenReport),
     Head(HeadReport),
+    ResetRecord(ResetRecord),
     GetFeature(GetFeature),
 }
 
@@ -148,6 +155,7 @@ impl Message {
             ReportId::Command => Message::Command(Command::decode(bytes)?),
             ReportId::OsPen => Message::OsPen(OsPenReport::decode(bytes)?),
             ReportId::Head => Message::Head(HeadReport::decode(bytes)?),
+            ReportId::ResetRecord => Message::ResetRecord(ResetRecord::decode(bytes)?),
             ReportId::GetFeature => Message::GetFeature(GetFeature::decode(bytes)?),
         })
     }
@@ -163,6 +171,7 @@ impl Message {
             Message::Command(r) => r.encode(out),
             Message::OsPen(r) => r.encode(out),
             Message::Head(r) => r.encode(out),
+            Message::ResetRecord(r) => r.encode(out),
             Message::GetFeature(r) => r.encode(out),
         }
     }
@@ -178,6 +187,7 @@ impl Message {
             Message::Command(_) => ReportId::Command,
             Message::OsPen(_) => ReportId::OsPen,
             Message::Head(_) => ReportId::Head,
+            Message::ResetRecord(_) => ReportId::ResetRecord,
             Message::GetFeature(_) => ReportId::GetFeature,
         }
     }

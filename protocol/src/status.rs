@@ -219,7 +219,9 @@ impl Report for GetFeature {
     fn read_body(r: &mut Reader<'_>) -> Result<Self, DecodeError> {
         let id = r.u8()?;
         match ReportId::from_u8(id) {
-            Some(report @ (ReportId::DeviceInfo | ReportId::Config | ReportId::Status)) => Ok(GetFeature { report }),
+            Some(report @ (ReportId::DeviceInfo | ReportId::Config | ReportId::Status | ReportId::ResetRecord)) => {
+                Ok(GetFeature { report })
+            }
             _ => Err(DecodeError::OutOfRange {
                 report: ReportId::GetFeature,
                 field: "report (not a readable feature report)",

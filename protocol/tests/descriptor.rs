@@ -59,7 +59,7 @@ fn every_report_has_the_codec_length() {
     let inputs: Vec<&dyn HidReport> = rd.input_reports().iter().map(|r| r as &dyn HidReport).collect();
     let features: Vec<&dyn HidReport> = rd.feature_reports().iter().map(|r| r as &dyn HidReport).collect();
     assert_eq!(inputs.len(), 4);
-    assert_eq!(features.len(), 4);
+    assert_eq!(features.len(), 5);
     assert!(rd.output_reports().is_empty());
     assert_eq!(len(&inputs, ReportId::Pen), PenReport::LEN);
     assert_eq!(len(&inputs, ReportId::Tof), TofReport::LEN);
@@ -68,6 +68,7 @@ fn every_report_has_the_codec_length() {
     assert_eq!(len(&features, ReportId::DeviceInfo), DeviceInfo::LEN);
     assert_eq!(len(&features, ReportId::Config), Config::LEN);
     assert_eq!(len(&features, ReportId::Status), Status::LEN);
+    assert_eq!(len(&features, ReportId::ResetRecord), ResetRecord::LEN);
     assert_eq!(len(&features, ReportId::Command), Command::LEN);
 }
 
@@ -229,6 +230,7 @@ fn only_the_os_pen_report_carries_usages_an_os_binds() {
         Config::LEN,
         Status::LEN,
         Command::LEN,
+        ResetRecord::LEN,
     ];
     assert_eq!(checked, 6 + 13 + bytes.iter().map(|l| l - 1).sum::<usize>());
 }
@@ -250,6 +252,7 @@ fn vendor_reports_are_byte_arrays_covering_the_codec_bytes() {
             ReportId::Config => Config::LEN,
             ReportId::Status => Status::LEN,
             ReportId::Command => Command::LEN,
+            ReportId::ResetRecord => ResetRecord::LEN,
             other => panic!("{other} is not a feature report"),
         };
         check(r, len);

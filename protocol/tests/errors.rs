@@ -9,7 +9,7 @@ use pen_protocol::*;
 fn empty_and_unknown() {
     assert_eq!(Message::decode(&[]), Err(DecodeError::Empty));
     assert_eq!(PenReport::decode(&[]), Err(DecodeError::Empty));
-    assert_eq!(Message::decode(&[0x09, 1, 2]), Err(DecodeError::UnknownReportId(0x09)));
+    assert_eq!(Message::decode(&[0x0a, 1, 2]), Err(DecodeError::UnknownReportId(0x0a)));
     assert_eq!(Message::decode(&[0x00]), Err(DecodeError::UnknownReportId(0x00)));
     let tof = [0x02u8; TofReport::LEN];
     assert_eq!(

@@ -113,7 +113,7 @@ fn a_version_2_0_host_reads_it_as_an_unknown_report() {
     // the major it supports, so it keeps the device.
     let bytes = sample_head().to_bytes();
     assert!(PenReport::decode(&bytes).is_err());
-    assert_eq!(PROTOCOL_VERSION, Version { major: 2, minor: 1 });
+    assert_eq!(PROTOCOL_VERSION, Version { major: 2, minor: 2 });
     assert!(check_version(Version { major: 2, minor: 1 }).is_ok());
 }
 

@@ -9,4 +9,5 @@ mod golden;
 mod head;
 #[cfg(feature = "serde")]
 mod json;
+mod reset;
 mod roundtrip;

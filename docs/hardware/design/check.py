@@ -76,6 +76,11 @@ def check_comparator():
 
 
 def check_power_and_switches():
+    slope, inrush, ramp = v.soft_start()
+    check("soft start: the switched 146 µF charge below USB's 100 mA unit load", inrush < v.USB_UNIT_LOAD_A,
+          f"{slope:.0f} V/s, {inrush * 1e3:.0f} mA, 5 V in {ramp * 1e3:.0f} ms")
+    check("soft start: the ramp ends within 100 ms (the firmware waits that long before bursts)", ramp < 0.1,
+          f"{ramp * 1e3:.0f} ms")
     vout = v.boost_vout()
     check("boost: 12 V ± 3 %", abs(vout - 12) <= 0.36, f"{vout:.2f} V")
     swing = v.tx_swing()
@@ -144,6 +149,9 @@ def check_pins(pill):
           captures == circuit.PINS_CAPTURE, f"main.rs {captures}")
     check("firmware: switch pins (SW1–SW3, in order) are the schematic's",
           switches == circuit.PINS_SWITCH, f"main.rs {switches}")
+    boost_en = re.findall(r"Output::new\(p\.(P[A-C]\d+),\s*Level::Low", (ROOT / "firmware/src/main.rs").read_text())
+    check("firmware: the boost's enable pin is the schematic's", boost_en == [circuit.PIN_BOOST_EN],
+          f"main.rs {boost_en}")
     # In the netlist: the burst reaches the driver, each capture pin its connector and module,
     # each switch pin its filter.
     parts = {p.ref: p for p in circuit.parts()}
@@ -166,6 +174,7 @@ def check_pins(pill):
     expected = {circuit.PIN_BURST: "burst", circuit.PIN_GLASSES: "glasses' burst"}
     expected.update({pin: f"receiver {k}" for k, pin in enumerate(circuit.PINS_CAPTURE)})
     expected.update({pin: f"SW{i + 1}" for i, pin in enumerate(circuit.PINS_SWITCH)})
+    expected.update({circuit.PIN_BOOST_EN: "boost enable", circuit.PIN_BOOT_UART_RX: "pulled down"})
     bad = [f"{pin} ({what}): docs say {docs.get(pin)!r}" for pin, what in expected.items()
            if what not in (docs.get(pin) or "")]
     check("docs/hardware.md: the pin map lists the same pins", not bad, "; ".join(bad))

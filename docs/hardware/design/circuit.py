@@ -93,7 +93,7 @@ def black_pill_pins():
 
 
 BLACK_PILL = template("WeAct_BlackPill_F411CE", "A", "penscape:WeAct_BlackPill_2x20_P2.54",
-                      black_pill_pins(), "WeAct Black Pill STM32F411CEU6 (25 MHz crystal, USB-C)",
+                      black_pill_pins(), "WeAct Black Pill STM32F411CEU6 (25 or 8 MHz crystal, USB-C)",
                       "WeAct STM32F411CEU6 Core Board V3.0", "WeAct V2.0 (same pins); not the F401 (less RAM, 84 MHz)",
                       4.50)
 
@@ -113,10 +113,17 @@ INVERTER = template("74LVC1G04", "U", "Package_TO_SOT_SMD:SOT-23-5",
                     [(1, "NC", P.NOCONNECT), (2, "A", P.INPUT), (3, "GND", P.PWRIN), (4, "Y", P.OUTPUT),
                      (5, "VCC", P.PWRIN)],
                     "single inverter", "TI SN74LVC1G04DBVR", "Nexperia 74LVC1G04GW", 0.10)
+PMOS = template("AO3401A", "Q", "Package_TO_SOT_SMD:SOT-23",
+                [(1, "G", P.INPUT), (2, "S", P.PASSIVE), (3, "D", P.PASSIVE)],
+                "P-MOSFET −30 V −4 A, SOT-23 (the boost's soft-start switch)", "Alpha & Omega AO3401A",
+                "Diodes DMP3099L, Vishay Si2301CDS", 0.08)
+NMOS = template("2N7002", "Q", "Package_TO_SOT_SMD:SOT-23",
+                [(1, "G", P.INPUT), (2, "S", P.PASSIVE), (3, "D", P.PASSIVE)],
+                "N-MOSFET 60 V 0.3 A, SOT-23", "Nexperia 2N7002", "onsemi BSS138", 0.03)
 TRANSDUCER_TX = two_pin("MA40S4S", "LS", "penscape:Murata_MA40S4", "ultrasonic transmitter 40 kHz, 10 mm",
-                        "Murata MA40S4S", "any 40 kHz 10 mm open transmitter (e.g. from an HC-SR04, weaker)", 3.50)
+                        "Murata MA40S4S", "any 40 kHz open transmitter 10 mm across (not an HC-SR04's: 16 mm, fits neither the footprint nor the 14 mm pen)", 3.50)
 TRANSDUCER_RX = two_pin("MA40S4R", "LS", "penscape:Murata_MA40S4", "ultrasonic receiver 40 kHz, 10 mm",
-                        "Murata MA40S4R", "any 40 kHz 10 mm open receiver (e.g. from an HC-SR04)", 3.50)
+                        "Murata MA40S4R", "any 40 kHz open receiver 10 mm across (not an HC-SR04's: 16 mm, fits neither the footprint nor the post's cup)", 3.50)
 TACT = two_pin("SW_Push", "SW", "Button_Switch_SMD:SW_SPST_B3U-1000P", "tact switch 3 × 2.5 mm, 1.2 N",
                "Omron B3U-1000P", "Panasonic EVQ-P7 (side push, for the barrel)", 0.60)
 def _alternative_opamp():
@@ -183,6 +190,8 @@ PIN_BURST = "PA8"
 PIN_GLASSES = "PA9"
 PINS_CAPTURE = ["PA15", "PB3", "PB10", "PA3", "PA6", "PA7", "PB0", "PB1"]
 PINS_SWITCH = ["PB12", "PB14", "PB15"]
+PIN_BOOST_EN = "PB13"
+PIN_BOOT_UART_RX = "PA10"
 RECEIVERS_BUILT = 4
 
 
@@ -277,12 +286,30 @@ def build():
         for i, name in enumerate(side, start=1):
             socket[i] += pill[name]
 
-    # 12 V from USB 5 V: MT3608, VOUT = 0.6 V · (1 + RFB_TOP / RFB_BOT).
+    # The boost converter's 5 V through a soft-start switch (values.py, "USB"): off at plug-in,
+    # in reset, in the ROM bootloader and in suspend; on, ramping, when PB13 drives BOOST_EN.
+    v5_sw, gate, en, q2_d = Net("+5V_BOOST"), Net("SS_GATE"), Net("BOOST_EN"), Net("SS_PULL")
+    v5_sw.drive = POWER  # through Q1
+    q1 = add(PMOS, "Q1")
+    q1["S", "D", "G"] += v5, v5_sw, gate
+    rc("R40", v.R_GS)[1, 2] += v5, gate
+    cc("C40", v.C_SS)[1, 2] += gate, v5_sw
+    rc("R41", v.R_SS)[1, 2] += gate, q2_d
+    q2 = add(NMOS, "Q2")
+    q2["D", "S", "G"] += q2_d, gnd, en
+    rc("R42", v.R_EN_PD)[1, 2] += en, gnd
+    pill[PIN_BOOST_EN] += en
+    # PA10 held low for the ROM bootloader (values.py).
+    boot_rx = Net("BOOT_UART_RX")
+    pill[PIN_BOOT_UART_RX] += boot_rx
+    rc("R43", v.R_PA10_PULLDOWN)[1, 2] += boot_rx, gnd
+
+    # 12 V from the switched 5 V: MT3608, VOUT = 0.6 V · (1 + RFB_TOP / RFB_BOT).
     boost = add(MT3608, "U1")
     sw, fb = Net("BOOST_SW"), Net("BOOST_FB")
-    boost["IN", "EN", "GND", "SW", "FB"] += v5, v5, gnd, sw, fb
-    cc("C1", v.C_BOOST_IN, CAP_BULK)[1, 2] += v5, gnd
-    add(L_BOOST, "L1", "22µH")[1, 2] += v5, sw
+    boost["IN", "EN", "GND", "SW", "FB"] += v5_sw, v5_sw, gnd, sw, fb
+    cc("C1", v.C_BOOST_IN, CAP_BULK)[1, 2] += v5_sw, gnd
+    add(L_BOOST, "L1", "22µH")[1, 2] += v5_sw, sw
     d = add(SCHOTTKY, "D1", "SS34")
     d["A"] += sw
     d["K"] += v12

@@ -180,6 +180,42 @@ def tx_swing():
 # transducer is not driven before the firmware runs.
 R_BURST_PULLDOWN = 100e3
 
+# --- USB: the boost converter behind a soft-start switch -------------------------------------
+
+# Behind the boost's inductor and diode the transmitter's capacitors (C1 22 µF, C2 22 µF, C3
+# 100 µF, C5 and C13 1 µF each: 146 µF) would charge straight from VBUS at plug-in; USB 2.0
+# (§7.2.4.1) allows a device 10 µF there. A P-MOSFET (Q1) in front of the converter keeps them
+# off VBUS until the firmware, once the host has configured the device, drives BOOST_EN (PB13)
+# high, and takes them off again in suspend. Q2 (an N-MOSFET) then pulls Q1's gate down through
+# R_SS; C_SS from Q1's gate to its drain holds the gate at Q1's Miller plateau while the drain
+# rises, so the drain rises at dV/dt = I / C_SS with I = (V5 − |V_PLATEAU|) / R_SS − |V_PLATEAU|
+# / R_GS, and the capacitors charge at C · dV/dt. R_EN_PD holds Q2 off while the Black Pill is
+# in reset or in its ROM bootloader.
+C_SWITCHED = 22e-6 + 22e-6 + 100e-6 + 1e-6 + 1e-6
+# The gate-source voltage at the plateau: AO3401A (Alpha & Omega datasheet, gate charge curve:
+# about −2 V at a few hundred mA; its threshold is −0.5 to −1.3 V).
+V_PLATEAU = 2.0
+R_GS = 100e3
+R_SS = 100e3
+C_SS = 47e-9
+R_EN_PD = 100e3
+# USB 2.0's unconfigured current, which the ramp must stay below.
+USB_UNIT_LOAD_A = 0.100
+
+
+def soft_start():
+    """The drain's slope (V/s), the switched capacitors' charging current (A) and the ramp's
+    length to 5 V (s)."""
+    i_gate = (V5 - V_PLATEAU) / R_SS - V_PLATEAU / R_GS
+    slope = i_gate / C_SS
+    return slope, C_SWITCHED * slope, V5 / slope
+
+
+# PA10 (USART1_RX) is one of the ROM bootloader's interfaces: floating, noise on it can make the
+# bootloader take the USART instead of USB (AN2606, STM32F411 boot loader: the first interface
+# to see activity wins). 10 k holds it low; the firmware leaves it an input.
+R_PA10_PULLDOWN = 10e3
+
 # --- Switch inputs ---------------------------------------------------------------------------
 
 # Per switch: 1 k in series and 100 nF to ground at the pin (τ = 100 µs as the switch closes:

@@ -12,8 +12,10 @@
 //!
 //! around them the measurement loop and its emitter schedule with the tracked head's filter
 //! ([`head`]), over the hardware seams ([`station`]), the settings a
-//! configuration report turns into ([`settings`]), configuration storage ([`store`]), the replay
-//! format of recorded cycles ([`replay`]) and the correctly rounded arithmetic ([`math`]).
+//! configuration report turns into ([`settings`]), configuration storage ([`store`]), the panic
+//! record kept across a reset ([`reset`]), the arithmetic of the board's crystal and time base
+//! ([`board`]), the replay format of recorded cycles ([`replay`]) and the correctly rounded
+//! arithmetic ([`math`]).
 //! `no_std`, no allocation; the board runs it, the host tests it, the simulated pen drives it.
 //!
 //! Numbers are `f32` (the Cortex-M4F's FPU is single precision) and only correctly rounded
@@ -22,6 +24,7 @@
 #![no_std]
 #![cfg_attr(not(test), warn(clippy::unwrap_used))]
 
+pub mod board;
 pub mod debounce;
 pub mod filter;
 // The fuzz target's property, shared with the stable test that replays its corpus.
@@ -32,6 +35,7 @@ pub mod math;
 pub mod ranging;
 pub mod replay;
 pub mod report;
+pub mod reset;
 pub mod settings;
 pub mod solve;
 pub mod station;

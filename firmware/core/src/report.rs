@@ -6,8 +6,8 @@
 
 use pen_protocol::{
     Command, Config, DeviceInfo, Filter, FirmwareVersion, GetFeature, HeadReport, MAX_PREDICTION_MS, MAX_RECEIVERS,
-    Message, NO_ARRIVAL, OsPenReport, PROTOCOL_VERSION, PenReport, Position, Quality, Report, ReportId, Status,
-    StatusCode, TofReport, os_extent,
+    Message, NO_ARRIVAL, OsPenReport, PROTOCOL_VERSION, PenReport, Position, Quality, Report, ReportId, ResetRecord,
+    Status, StatusCode, TofReport, os_extent,
 };
 
 use crate::debounce::Debouncer;
@@ -218,6 +218,8 @@ pub struct Engine {
     head: Option<HeadState>,
     /// The glasses' emitter is wired to this base station: the HeadOn command may start it.
     head_fitted: bool,
+    /// Why the previous run ended, when a panic or a fault ended it (the reset record, 0x09).
+    last_reset: ResetRecord,
 }
 
 /// The OS pen's extent for a configuration's display, if its size is known.
@@ -279,6 +281,7 @@ impl Engine {
             counters: Counters::default(),
             head: None,
             head_fitted: false,
+            last_reset: ResetRecord::NONE,
         }
     }
 
@@ -697,8 +700,15 @@ impl Engine {
             ReportId::DeviceInfo => self.device_info().encode(out).ok(),
             ReportId::Config => self.settings.config.encode(out).ok(),
             ReportId::Status => self.status.encode(out).ok(),
+            ReportId::ResetRecord => self.last_reset.encode(out).ok(),
             _ => None,
         }
+    }
+
+    /// Sets what the reset record (0x09) answers: the panic or fault that ended the previous
+    /// run, as the board found it in RAM at start-up.
+    pub fn set_last_reset(&mut self, record: ResetRecord) {
+        self.last_reset = record;
     }
 
     /// The status of the last request.
@@ -713,7 +723,9 @@ impl Engine {
         let (status, action) = match Message::decode(bytes) {
             Ok(Message::Config(config)) => (self.apply_config(config), None),
             Ok(Message::Command(command)) => self.command(command, store),
-            Ok(Message::DeviceInfo(_) | Message::Status(_)) => (Status::failed(request, StatusCode::ReadOnly), None),
+            Ok(Message::DeviceInfo(_) | Message::Status(_) | Message::ResetRecord(_)) => {
+                (Status::failed(request, StatusCode::ReadOnly), None)
+            }
             Ok(_) => (Status::failed(request, StatusCode::UnknownReport), None),
             Err(pen_protocol::DecodeError::UnknownReportId(_)) => {
                 (Status::failed(request, StatusCode::UnknownReport), None)

@@ -1,4 +1,5 @@
 //! The integration tests of pen-core, in one binary: a module per area.
+mod board;
 mod common;
 mod debounce;
 mod filter;
@@ -6,6 +7,7 @@ mod fuzz_corpus;
 mod head;
 mod replay;
 mod report;
+mod reset;
 mod solve;
 mod station;
 mod store;

@@ -7,15 +7,29 @@
 //! straight into the engine, timing each with SysTick, and prints the cost per fix. Run with
 //! `-icount shift=0`, QEMU's virtual clock advances one nanosecond per instruction, so the
 //! counts are instructions. It ends with a semihosting exit: status 0, or 1 on a bad replay.
+//!
+//! First of all it plays the ROM DFU bootloader's part (docs/flashing.md): VTOR pointed at a
+//! table that is not the image's, then a jump to the image's reset vector, as the ROM's
+//! `:leave` does. The reset handler must point VTOR back at the image's table (cortex-m-rt's
+//! `set-vtor`) before `main` takes an exception: `V <VTOR> <image's table> <taken>` says so, and
+//! an exception taken through the foreign table ends the run with a failure.
+//!
+//! With a file `overflow` beside it, it then overflows its stack on purpose (the stack is at the
+//! bottom of RAM, as on the board): the board's HardFault vector must catch it on a fresh stack
+//! with the statics intact, `S <CFSR> <stack pointer at the fault> <canary>`.
 #![no_std]
 #![no_main]
 
 use core::cell::RefCell;
 use core::fmt::Write;
+use core::mem::MaybeUninit;
+use core::ptr::addr_of_mut;
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering};
 
+use cortex_m::peripheral::SCB;
 use cortex_m::peripheral::SYST;
 use cortex_m::peripheral::syst::SystClkSource;
-use cortex_m_rt::entry;
+use cortex_m_rt::{entry, exception};
 use cortex_m_semihosting::{debug, hio, syscall};
 use embassy_futures::block_on;
 use embassy_sync::blocking_mutex::Mutex;
@@ -42,6 +56,101 @@ fn panic(info: &core::panic::PanicInfo) -> ! {
     }
     debug::exit(debug::EXIT_FAILURE);
     halt()
+}
+
+/// Set in RAM the reset handler does not clear: the bootloader's jump has been played.
+const JUMPED: u32 = 0x0B00_7ED0;
+#[unsafe(link_section = ".uninit.STAGE")]
+static mut STAGE: MaybeUninit<u32> = MaybeUninit::uninit();
+
+/// A vector table that is not the image's, as the ROM bootloader leaves VTOR pointing at its own:
+/// every exception through it is a failure.
+#[repr(C, align(128))]
+struct ForeignTable([unsafe extern "C" fn(); 32]);
+static FOREIGN: ForeignTable = ForeignTable([foreign_exception; 32]);
+
+unsafe extern "C" fn foreign_exception() {
+    if let Ok(mut out) = hio::hstdout() {
+        let _ = writeln!(
+            out,
+            "E an exception was taken through the bootloader's vector table: VTOR was not set"
+        );
+    }
+    debug::exit(debug::EXIT_FAILURE);
+    halt()
+}
+
+/// Taken through the image's own table.
+static PENDSV_TAKEN: AtomicBool = AtomicBool::new(false);
+
+#[exception]
+fn PendSV() {
+    PENDSV_TAKEN.store(true, Ordering::SeqCst);
+}
+
+unsafe extern "C" {
+    /// The image's vector table, from cortex-m-rt's link.x.
+    static __vector_table: u32;
+}
+
+/// The first time: VTOR at a foreign table and a jump to the reset vector, as the ROM DFU
+/// bootloader leaves the core. The second: VTOR checked and an exception taken.
+fn check_vector_table(out: &mut hio::HostStream) {
+    let table = core::ptr::addr_of!(__vector_table);
+    // SAFETY: a word this function owns, which may hold anything at power-up.
+    let stage = unsafe { addr_of_mut!(STAGE).cast::<u32>().read_volatile() };
+    if stage != JUMPED {
+        // SAFETY: as above.
+        unsafe { addr_of_mut!(STAGE).cast::<u32>().write_volatile(JUMPED) };
+        // SAFETY: VTOR takes any 128-byte aligned table; the jump restarts the image from its
+        // reset vector with its initial stack pointer, as the bootloader's would.
+        unsafe {
+            (*SCB::PTR).vtor.write(core::ptr::addr_of!(FOREIGN) as u32);
+            cortex_m::asm::bootload(table)
+        }
+    }
+    // SAFETY: as above.
+    unsafe { addr_of_mut!(STAGE).cast::<u32>().write_volatile(0) };
+    // SAFETY: a read of a core register.
+    let vtor = unsafe { (*SCB::PTR).vtor.read() };
+    SCB::set_pendsv();
+    cortex_m::asm::isb();
+    let taken = PENDSV_TAKEN.load(Ordering::SeqCst);
+    let _ = writeln!(out, "V {vtor:08x} {:08x} {}", table as u32, u8::from(taken));
+}
+
+// The board's HardFault vector, which moves the stack pointer to the top of the stack before
+// `fault_on_fresh_stack` runs.
+#[path = "../../src/hard_fault.rs"]
+mod hard_fault;
+
+/// The configurable fault status register.
+const CFSR: *const u32 = 0xE000_ED28 as *const u32;
+
+/// A static the stack must never reach: with the stack below the statics, an overflow leaves it.
+static CANARY: AtomicU32 = AtomicU32::new(0xC0FF_EE11);
+
+/// Run by the HardFault vector on a fresh stack: prints `S <CFSR> <stack pointer at the fault>
+/// <canary>`. The stack-overflow run ends here with success; any other run has no final figures
+/// and fails.
+#[unsafe(no_mangle)]
+extern "C" fn fault_on_fresh_stack(frame: u32) -> ! {
+    // SAFETY: a read of a system control register.
+    let cfsr = unsafe { CFSR.read_volatile() };
+    if let Ok(mut out) = hio::hstdout() {
+        let canary = CANARY.load(Ordering::SeqCst);
+        let _ = writeln!(out, "S {cfsr:08x} {frame:08x} {canary:08x}");
+    }
+    debug::exit(debug::EXIT_SUCCESS);
+    halt()
+}
+
+/// Recurses until the stack runs out, 256 bytes a call.
+#[inline(never)]
+#[allow(unconditional_recursion)] // on purpose: it ends in the fault
+fn overflow(depth: u32) -> u32 {
+    let frame = core::hint::black_box([depth; 64]);
+    overflow(depth + 1).wrapping_add(frame[depth as usize % 64])
 }
 
 /// A file on the host, read through semihosting.
@@ -237,6 +346,11 @@ fn main() -> ! {
             halt()
         }
     };
+    check_vector_table(&mut out);
+    // The stack guard's test: with a file `overflow` beside it, the run overflows its stack.
+    if HostFile::open("overflow").is_some() {
+        core::hint::black_box(overflow(0));
+    }
     let mut cp = cortex_m::Peripherals::take().unwrap_or_else(|| fail(&mut out, "peripherals taken"));
     cp.SYST.set_clock_source(SystClkSource::Core);
     cp.SYST.set_reload(0x00FF_FFFF);

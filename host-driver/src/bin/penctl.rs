@@ -275,6 +275,11 @@ struct InfoJson<'a> {
     /// The device information report, tagged like `penctl decode` prints it.
     info: &'a Message,
     config: &'a Config,
+    /// The reset record (protocol 2.2), tagged like `penctl decode` prints it: the panic, fault
+    /// or watchdog reset that ended the device's previous run. Absent where the firmware does
+    /// not answer it.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    last_reset: Option<Message>,
     /// The calibration pend would apply to this device by default.
     calibration: CalibrationJson,
 }
@@ -356,12 +361,18 @@ fn info(args: &DeviceArgs, as_json: bool) -> Result<()> {
     };
     pen_protocol::check_version(info.protocol)?;
     let config = get_config(t)?;
+    // Firmware before protocol 2.2 does not answer it: that is no error.
+    let last_reset = match t.get_feature(ReportId::ResetRecord) {
+        Ok(Message::ResetRecord(r)) => Some(r),
+        _ => None,
+    };
     let calibration = calibration_status(args.is_sim(), &info);
     if as_json {
         print_json(&InfoJson {
             device: t.describe(),
             info: &Message::DeviceInfo(info),
             config: &config,
+            last_reset: last_reset.map(Message::ResetRecord),
             calibration,
         })?;
     } else {
@@ -372,6 +383,10 @@ fn info(args: &DeviceArgs, as_json: bool) -> Result<()> {
         outln!("fix rate     {} Hz", info.fix_rate_hz);
         outln!("unique ID    {}", hex::to_hex(&info.unique_id));
         outln!("display pose {}", if config.display.is_some() { "set" } else { "none" });
+        match last_reset {
+            Some(r) => outln!("last reset   {r}"),
+            None => outln!("last reset   not reported (firmware before protocol 2.2)"),
+        }
         match &calibration.path {
             Some(p) => outln!("calibration  {p}: {}", calibration.status),
             None => outln!("calibration  {}", calibration.status),
