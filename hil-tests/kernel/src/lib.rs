@@ -6,8 +6,8 @@
 //! `x86_64-unknown-linux-musl`) and their data, and QEMU boots it: KVM where `/dev/kvm` opens,
 //! TCG otherwise. Inside, `/init` loads the modules and runs `pen-kernel-guest`'s steps (the
 //! descriptor and the firmware core's reports through uhid read back from evdev, `pend` on the
-//! hidraw node, pend's virtual tablet); each step prints `KT` lines on the serial console, which
-//! [`boot`] collects.
+//! hidraw node, pend's virtual tablet refused without `/dev/uinput` and then made); each step
+//! prints `KT` lines on the serial console, which [`boot`] collects.
 //!
 //! The host side is this library; the guest side is `src/bin/pen-kernel-guest.rs`. The lines
 //! the guest prints are parsed by [`Run::parse`].

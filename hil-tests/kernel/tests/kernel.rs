@@ -1,8 +1,9 @@
 //! The pen as a real kernel sees it: Debian's kernel in QEMU (hil-tests/kernel), the descriptor
 //! and the firmware core's reports through uhid, evdev read back; `pend --source hid` on the
 //! hidraw node with the device destroyed mid-stroke and created again; `pend --virtual-tablet`
-//! read back through evdev. Skipped with a message where Debian's kernel package cannot be had,
-//! except under CI (`CI` set), where that fails.
+//! refused where /dev/uinput is not there, then read back through evdev. Skipped with a
+//! message where Debian's kernel package cannot be had, except under CI (`CI` set), where that
+//! fails.
 
 use std::time::{Duration, Instant};
 
@@ -60,6 +61,8 @@ fn the_real_kernel_makes_one_pen_and_delivers_every_change_in_order() {
         steps: vec![
             "/bin/pen-kernel-guest uhid".into(),
             "/bin/pen-kernel-guest pend-hid".into(),
+            // Before virtual-tablet: the node it removes is made again, and that step uses it.
+            "/bin/pen-kernel-guest uinput-refused".into(),
             "/bin/pen-kernel-guest virtual-tablet".into(),
         ],
     };
@@ -98,7 +101,7 @@ fn the_real_kernel_makes_one_pen_and_delivers_every_change_in_order() {
     );
     let failed: Vec<&str> = run.with("FAIL").collect();
     assert!(failed.is_empty(), "{failed:?}\n{}", run.console);
-    for step in ["uhid:", "pend-hid:", "virtual-tablet:"] {
+    for step in ["uhid:", "pend-hid:", "uinput-refused:", "virtual-tablet:"] {
         assert!(run.with("PASS").any(|l| l.starts_with(step)), "{step}\n{}", run.console);
     }
     // One pen from the uhid device, one virtual tablet.

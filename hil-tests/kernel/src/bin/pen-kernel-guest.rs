@@ -8,6 +8,8 @@
 //! * `pend-hid`: `pend --source hid` (hidapi's enumeration from sysfs, its hidraw reads) on the
 //!   uhid device, a socket client reading its events, the device destroyed mid-stroke and
 //!   created again; every event compared with what docs/events.md promises for the reports sent.
+//! * `uinput-refused`: `pend --virtual-tablet` with `/dev/uinput` removed: it exits 1 at once
+//!   naming the node and the udev rule, and serves nothing; the node is made again.
 //! * `virtual-tablet`: `pend --virtual-tablet`, its uinput device read back through evdev.
 
 use std::collections::BTreeMap;
@@ -867,7 +869,132 @@ fn pend_hid(pend: &mut Child) -> Result<String> {
     ))
 }
 
-/// Step 3: `pend --virtual-tablet` with the simulated pen drawing figures; its uinput pen read
+/// Where the refusal step's pend is told to serve: it must not.
+const REFUSED_SOCKET: &str = "/tmp/pend-refused.sock";
+
+/// The uinput node as devtmpfs made it: the misc device's number (from
+/// `/sys/class/misc/uinput/dev`) and its permission bits.
+fn uinput_node() -> Result<(u32, u32, u32)> {
+    use std::os::unix::fs::{FileTypeExt, MetadataExt};
+    let dev = std::fs::read_to_string("/sys/class/misc/uinput/dev").context("/sys/class/misc/uinput/dev")?;
+    let (major, minor) = dev
+        .trim()
+        .split_once(':')
+        .and_then(|(a, b)| Some((a.parse::<u32>().ok()?, b.parse::<u32>().ok()?)))
+        .ok_or_else(|| anyhow!("/sys/class/misc/uinput/dev reads {dev:?}"))?;
+    let meta = std::fs::metadata("/dev/uinput").context("/dev/uinput before the step")?;
+    ensure!(
+        meta.file_type().is_char_device(),
+        "/dev/uinput is not a character device"
+    );
+    let rdev = meta.rdev();
+    // Linux's encoding of dev_t (glibc's and musl's gnu_dev_makedev).
+    let (node_major, node_minor) = (
+        ((rdev >> 32) & 0xffff_f000) | ((rdev >> 8) & 0xfff),
+        ((rdev >> 12) & 0xffff_ff00) | (rdev & 0xff),
+    );
+    ensure!(
+        (node_major, node_minor) == (u64::from(major), u64::from(minor)),
+        "/dev/uinput is {node_major}:{node_minor}, sysfs says {major}:{minor}"
+    );
+    Ok((major, minor, meta.mode() & 0o7777))
+}
+
+/// Step 3: `pend --virtual-tablet` where `/dev/uinput` is not there (removed from devtmpfs; as
+/// root, mode bits would not stop the open): refused at once, with the reason, nothing served.
+/// The node is made again afterwards, as it was, for the virtual-tablet step.
+fn step_uinput_refused() -> Result<String> {
+    let (major, minor, mode) = uinput_node()?;
+    std::fs::remove_file("/dev/uinput").context("removing /dev/uinput")?;
+    let result = pend_refused();
+    let made = Command::new("mknod")
+        .args(["-m", format!("{mode:o}").as_str(), "/dev/uinput", "c"])
+        .args([major.to_string(), minor.to_string()])
+        .status()
+        .context("running mknod");
+    let summary = result?;
+    let made = made?;
+    ensure!(made.success(), "mknod /dev/uinput c {major} {minor}: {made}");
+    ensure!(uinput_node()? == (major, minor, mode), "/dev/uinput made again differs");
+    File::options()
+        .read(true)
+        .write(true)
+        .open("/dev/uinput")
+        .context("/dev/uinput made again does not open")?;
+    Ok(format!(
+        "{summary}; /dev/uinput made again ({major}:{minor}, mode {mode:o})"
+    ))
+}
+
+fn pend_refused() -> Result<String> {
+    ensure!(!Path::new("/dev/uinput").exists(), "/dev/uinput is still there");
+    let started = Instant::now();
+    let mut pend = Command::new("/bin/pend")
+        .args([
+            "--source",
+            "sim:draw-figures",
+            "--speed",
+            "4",
+            "--socket",
+            REFUSED_SOCKET,
+            "--virtual-tablet",
+        ])
+        .env("XDG_CONFIG_HOME", "/tmp/config")
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .context("starting pend")?;
+    let mut stderr = pend.stderr.take().ok_or_else(|| anyhow!("no stderr"))?;
+    let reader = std::thread::spawn(move || {
+        let mut s = String::new();
+        let _ = stderr.read_to_string(&mut s);
+        s
+    });
+    let status = loop {
+        if let Some(status) = pend.try_wait()? {
+            break status;
+        }
+        if started.elapsed() > Duration::from_secs(20) {
+            let _ = pend.kill();
+            let _ = pend.wait();
+            bail!("pend --virtual-tablet without /dev/uinput still runs after 20 s");
+        }
+        std::thread::sleep(Duration::from_millis(10));
+    };
+    let took = started.elapsed();
+    let log = reader.join().map_err(|_| anyhow!("the stderr reader panicked"))?;
+    for line in log.lines() {
+        println!("KT LOG {line}");
+    }
+    ensure!(status.code() == Some(1), "pend ended {status}, not with exit status 1");
+    ensure!(
+        took < Duration::from_secs(5),
+        "pend took {} ms to refuse",
+        took.as_millis()
+    );
+    let refusal = log
+        .lines()
+        .find(|l| l.starts_with("pend: cannot open /dev/uinput: No such file or directory"))
+        .ok_or_else(|| anyhow!("no \"pend: cannot open /dev/uinput: No such file or directory\" line"))?;
+    ensure!(
+        refusal.contains("host-driver/udev/70-penscape.rules"),
+        "the refusal names no udev rule: {refusal}"
+    );
+    ensure!(!log.contains("serving"), "pend served before it refused");
+    let left: Vec<String> = std::fs::read_dir("/tmp")?
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with("pend-refused"))
+        .collect();
+    ensure!(left.is_empty(), "pend left {left:?} in /tmp");
+    Ok(format!(
+        "exit status 1 after {} ms, /dev/uinput and host-driver/udev/70-penscape.rules named, no socket",
+        took.as_millis()
+    ))
+}
+
+/// Step 4: `pend --virtual-tablet` with the simulated pen drawing figures; its uinput pen read
 /// back through evdev.
 fn step_virtual_tablet() -> Result<String> {
     let log = File::create("/tmp/pend-vt.log")?;
@@ -986,6 +1113,7 @@ fn main() -> ExitCode {
     let result = match step.as_str() {
         "uhid" => step_uhid(),
         "pend-hid" => step_pend_hid(),
+        "uinput-refused" => step_uinput_refused(),
         "virtual-tablet" => step_virtual_tablet(),
         other => Err(anyhow!("unknown step {other:?}")),
     };
