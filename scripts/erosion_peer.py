@@ -17,8 +17,10 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 VENV = os.path.join(ROOT, "target", "peer-venv")
 PY = os.path.join(VENV, "bin", "python")
 
-# penmodel's defaults (modeler/terrain/src/document.rs, Fluvial::default).
-DT, K, M, N, D, T, NOISE, SEED = 1000.0, 2.5e-4, 0.5, 1.0, 3e-4, 1e4, 1.0, 1
+# penmodel's defaults (modeler/terrain/src/document.rs, Fluvial::default); the diffusivity's
+# default is DIFFUSION_PER_CELL_AREA times the cell's area.
+DT, K, M, N, T, NOISE, SEED = 1000.0, 2.5e-4, 0.5, 1.0, 1e4, 1.0, 1
+DIFFUSION_PER_CELL_AREA = 7.5e-5
 MASK = (1 << 64) - 1
 
 
@@ -60,7 +62,7 @@ def peer(n, steps):
     grid = fs.RasterGrid([n, n], [cell, cell], fs.NodeStatus.FIXED_VALUE)
     graph = fs.FlowGraph(grid, [fs.SingleFlowRouter(), fs.MSTSinkResolver()])
     spl = fs.SPLEroder(graph, K, M, N, 1e-5)
-    diffusion = fs.DiffusionADIEroder(grid, D)
+    diffusion = fs.DiffusionADIEroder(grid, DIFFUSION_PER_CELL_AREA * cell * cell)
     inner = np.zeros((n, n), bool)
     inner[1:-1, 1:-1] = True
     times = []
