@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
-# Runs every check and test: formatting, lints, the host workspace's tests, the firmware's
-# release image for the board, the bench rig's image (hil-tests/rig), and the maker pack's
-# design checks (scripts/hardware.sh). Exits non-zero on the first failure.
+# Runs every check and test: formatting, lints, the host workspace's tests, the real-kernel
+# test, the firmware's release image for the board, the bench rig's image (hil-tests/rig), and
+# the maker pack's design checks (scripts/hardware.sh). Exits non-zero on the first failure.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 source scripts/setup.sh
@@ -17,7 +17,11 @@ step "lint (host workspace)"
 cargo clippy --workspace --all-targets --locked -- -D warnings
 
 step "tests (host workspace)"
-cargo test --workspace --locked
+cargo test --workspace --locked --exclude pen-kernel
+
+step "real kernel: Debian's kernel in QEMU, the descriptor through uhid, pend on hidraw, uinput"
+# On its own so its boot mode, time and per-step results are in the log.
+cargo test -p pen-kernel --locked -- --nocapture
 
 step "firmware: lint and release image for thumbv7em-none-eabihf"
 (cd firmware && cargo clippy --release --locked --workspace -- -D warnings && cargo build --release --locked)
