@@ -12,8 +12,9 @@ use penmodel_terrain::editor::Editor;
 
 /// A new session's document: a 6 × 3.4 km map of 12.5 m cells (480 × 272), which the reference
 /// display (600 × 340 mm) shows at 1:10 000 — a millimetre on the display is 10 m, a cell 1.25 mm.
-/// Its land is eroded (`"erosion": {"fluvial": {}}`: the thermal and the fluvial erosion with
-/// their defaults, `docs/erosion.md`), so what the pen pulls up drains like land.
+/// Its land is eroded by the fluvial erosion with its defaults (`docs/erosion.md`), so what the
+/// pen pulls up drains like land; no thermal pass (`"iterations": 0`), which would redo a
+/// pulled figure's whole window 16 times per pen move.
 pub fn blank_document() -> Document {
     let mut doc = Document::new(Grid {
         cols: 480,
@@ -21,6 +22,7 @@ pub fn blank_document() -> Document {
         cell_size: 12.5,
     });
     doc.terrain.erosion = Some(Erosion {
+        iterations: 0,
         fluvial: Some(Fluvial::default()),
         ..Erosion::default()
     });

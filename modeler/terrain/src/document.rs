@@ -147,8 +147,8 @@ pub struct Erosion {
     /// The talus angle, degrees (1 to 89): ground steeper than this sheds material.
     #[serde(default = "default_erosion_talus")]
     pub talus: f64,
-    /// Steps, 1 to [`MAX_EROSION_ITERATIONS`](crate::validate::MAX_EROSION_ITERATIONS): material
-    /// moves at most one cell per step.
+    /// Steps, 0 to [`MAX_EROSION_ITERATIONS`](crate::validate::MAX_EROSION_ITERATIONS): material
+    /// moves at most one cell per step; 0 is no thermal pass (the fluvial erosion alone).
     #[serde(default = "default_erosion_iterations")]
     pub iterations: u32,
     /// The share of the excess over the talus moved per step, 0 to 1.

@@ -191,6 +191,11 @@ fn locate<'a, 'd>(
     }
 }
 
+/// The document's erosion settings if they ask for a thermal pass (`iterations` 0: none).
+fn thermal(doc: &Document) -> Option<crate::document::Erosion> {
+    doc.terrain.erosion.filter(|e| e.iterations > 0)
+}
+
 /// Every cell of the grid.
 fn whole(grid: &Grid) -> Rect {
     Rect {
@@ -224,7 +229,7 @@ impl TerrainEngine {
         let regions: Vec<RegionNode> = doc.regions.iter().map(|r| region_node(doc, r)).collect();
         let mut map = Heightmap::new(&grid);
         let mut detail = doc.terrain.detail.map(|d| detail::Layer::new(&grid, d));
-        let mut erosion = doc.terrain.erosion.map(|e| erosion::Layer::new(&grid, e));
+        let mut erosion = thermal(doc).map(|e| erosion::Layer::new(&grid, e));
         // The terrain before erosion: the erosion's, or the map itself.
         let before = erosion.as_mut().map_or(&mut map, |e| &mut e.before);
         for (node, r) in regions.iter().zip(&doc.regions) {
@@ -402,7 +407,7 @@ impl TerrainEngine {
         } = self;
         // Settings are not edits with a scope: a change of them regenerates everything.
         if detail.as_ref().map(|l| *l.settings()) != doc.terrain.detail
-            || erosion.as_ref().map(|l| *l.settings()) != doc.terrain.erosion
+            || erosion.as_ref().map(|l| *l.settings()) != thermal(doc)
             || (regions.len() == doc.regions.len()
                 && regions
                     .iter()

@@ -206,8 +206,8 @@ fn settings_load_with_defaults_and_bad_ones_are_refused_by_name() {
         "terrain.erosion.talus: the erosion's talus must be from 1 to 89 degrees, got 95",
     );
     refused(
-        &swap("\"iterations\": 6", "\"iterations\": 0"),
-        "terrain.erosion.iterations: the erosion's iterations must be from 1 to 200, got 0",
+        &swap("\"iterations\": 6", "\"iterations\": 201"),
+        "terrain.erosion.iterations: the erosion's iterations must be from 0 to 200, got 201",
     );
     refused(
         &swap("\"amount\": 0.5", "\"amount\": -0.1"),

@@ -218,3 +218,21 @@ fn a_progressive_pull_shows_at_once_and_settles_on_the_exact_land() {
     assert!(!editor.terrain().erosion_pending());
     assert_eq!(editor.heightmap(), &exact);
 }
+
+#[test]
+fn no_thermal_iterations_is_no_thermal_pass() {
+    // `"iterations": 0` (what new documents carry beside `"fluvial"`) leaves the thermal pass
+    // out: the terrain is the one without erosion, to the bit.
+    let (_, doc) = examples().remove(3);
+    let mut off = doc.clone();
+    off.terrain.erosion = Some(Erosion {
+        iterations: 0,
+        ..Erosion::default()
+    });
+    let bits = |m: &Heightmap| m.heights().iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+    assert_eq!(bits(&generate(&off).unwrap()), bits(&generate(&doc).unwrap()));
+    // And 16, the default, does change it: the comparison could fail.
+    let mut on = doc.clone();
+    on.terrain.erosion = Some(Erosion::default());
+    assert_ne!(bits(&generate(&on).unwrap()), bits(&generate(&doc).unwrap()));
+}

@@ -93,13 +93,12 @@ pub fn run(args: &Args) -> Result<()> {
     } else {
         let (lo, hi) = land.range();
         pen_host::outln!(
-            "eroded {}×{} cells by {} steps ({:.1} ms a step); land {:.0} to {:.0} m",
+            "eroded {}×{} cells by {} steps ({:.1} ms a step); land {}",
             land.cols(),
             land.rows(),
             settings.steps,
             ms_per_step,
-            lo,
-            hi
+            crate::out::metres_range(lo, hi)
         );
         for (name, s) in [("before", before), ("after", after)] {
             pen_host::outln!(

@@ -343,9 +343,10 @@ fn summary(
         pen_host::outln!("{summary}");
     } else {
         pen_host::outln!(
-            "{state}: {}; {}; terrain {lo:.0} to {hi:.0} m",
+            "{state}: {}; {}; terrain {}",
             count(session.events(), "pen event"),
             stats.summary(),
+            crate::out::metres_range(lo, hi),
         );
         let what = match (written.shown, &written.animation) {
             (true, _) => format!("showed {}; wrote", count(written.frames as u64, "frame")),

@@ -61,8 +61,8 @@ pub fn terrain(doc: &Document) -> Result<(), ValidationError> {
     Ok(())
 }
 
-/// Checks the terrain settings' thermal erosion: a talus angle from 1° to 89°, 1 to
-/// [`MAX_EROSION_ITERATIONS`] steps, an amount from 0 to 1.
+/// Checks the terrain settings' thermal erosion: a talus angle from 1° to 89°, 0 (no thermal
+/// pass) to [`MAX_EROSION_ITERATIONS`] steps, an amount from 0 to 1.
 pub fn erosion(doc: &Document) -> Result<(), ValidationError> {
     let Some(e) = &doc.terrain.erosion else { return Ok(()) };
     let range = |what: &'static str, range: String, value: f64| {
@@ -76,10 +76,10 @@ pub fn erosion(doc: &Document) -> Result<(), ValidationError> {
     if !(1.0..=89.0).contains(&e.talus) {
         return range("the erosion's talus", "from 1 to 89 degrees".into(), e.talus);
     }
-    if !(1..=MAX_EROSION_ITERATIONS).contains(&e.iterations) {
+    if e.iterations > MAX_EROSION_ITERATIONS {
         return range(
             "the erosion's iterations",
-            format!("from 1 to {MAX_EROSION_ITERATIONS}"),
+            format!("from 0 to {MAX_EROSION_ITERATIONS}"),
             f64::from(e.iterations),
         );
     }

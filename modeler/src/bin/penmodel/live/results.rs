@@ -50,7 +50,7 @@ pub fn write(
         ..*session.interaction.view()
     };
     let (lo, hi) = map.range();
-    let mode = format!("penmodel: final terrain, {lo:.0} to {hi:.0} m");
+    let mode = format!("penmodel: final terrain, {}", crate::out::metres_range(lo, hi));
     // The trees at the last event's time, as the last frame drew them.
     let picture = Picture::document(session.editor.document(), &view, mode, look)
         .with_rocks(session.editor.rocks().shared())
