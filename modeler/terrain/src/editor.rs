@@ -26,6 +26,7 @@ use crate::edit::{Edit, EditError};
 use crate::engine::{Rect, TerrainEngine};
 use crate::heightmap::Heightmap;
 use crate::journal::{self, Entry, JournalError, Replay, UndoStep, Writer};
+use crate::lock::{self, DocumentLock, LockError};
 use crate::persist::{self, LoadError, SaveError};
 use crate::revision::Revisions;
 use crate::rocks::cache::Seated;
@@ -65,6 +66,9 @@ pub enum EditorError {
     /// The editor has no file to save to.
     #[error("the document has no file yet: use save_as")]
     NoFile,
+    /// Another writer has the document open ([`crate::lock`]); nothing was read or written.
+    #[error(transparent)]
+    Locked(#[from] LockError),
 }
 
 /// What [`Editor::open`] found in the journal.
@@ -131,6 +135,8 @@ pub struct Outcome {
 struct Store {
     path: PathBuf,
     journal: Writer,
+    /// This editor is the document's only writer while it holds this.
+    lock: DocumentLock,
 }
 
 /// A document being edited: terrain, undo and redo, journal.
@@ -243,6 +249,12 @@ impl Editor {
     }
 
     fn open_with(path: &Path, write: bool) -> Result<(Editor, OpenReport), EditorError> {
+        // A writer locks before reading: another one's save or journal line cannot come between
+        // what this one reads and what it appends.
+        let held = match write {
+            true => Some(DocumentLock::acquire(path, lock::mode_of(path))?),
+            false => None,
+        };
         let (doc, bytes) = persist::read_document(path)?;
         let base = journal::fingerprint(&bytes);
         let mut editor = Editor::new(doc).map_err(LoadError::from)?;
@@ -279,7 +291,7 @@ impl Editor {
                 valid_len = Some(len);
             }
         }
-        if write {
+        if let Some(lock) = held {
             let writer = match valid_len {
                 Some(len) => Writer::append_to(&jpath, len),
                 None => Writer::create(&jpath, &base, &[], &[]),
@@ -288,6 +300,7 @@ impl Editor {
             editor.store = Some(Store {
                 path: path.to_owned(),
                 journal: writer,
+                lock,
             });
         }
         Ok((editor, report))
@@ -741,16 +754,31 @@ impl Editor {
     /// journal afresh; the undo history carries over.
     pub fn save_as(&mut self, path: &Path) -> Result<(), EditorError> {
         self.cancel_preview()?;
+        // Writing another file than this editor's own needs that file's lock first; the old one
+        // is released once the new file is this editor's.
+        let same = self.store.as_ref().is_some_and(|s| s.lock.document() == path);
+        let new_lock = match same {
+            true => None,
+            false => Some(DocumentLock::acquire(path, lock::mode_of(path))?),
+        };
         // Document first: a crash between the two leaves a journal whose base no longer matches,
         // which is then set aside rather than replayed twice.
         let bytes = self.doc.save(path)?;
         let jpath = journal::path_for(path);
         let writer = Writer::create(&jpath, &journal::fingerprint(&bytes), &self.undo, &self.redo)
             .map_err(journal_io(&jpath))?;
-        self.store = Some(Store {
-            path: path.to_owned(),
-            journal: writer,
-        });
+        match (new_lock, &mut self.store) {
+            (None, Some(store)) => store.journal = writer,
+            (Some(lock), _) => {
+                self.store = Some(Store {
+                    path: path.to_owned(),
+                    journal: writer,
+                    lock,
+                })
+            }
+            // `same` means there is a store.
+            (None, None) => return Err(EditorError::NoFile),
+        }
         Ok(())
     }
 }

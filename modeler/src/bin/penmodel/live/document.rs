@@ -39,6 +39,9 @@ impl Created {
         if let Some(doc) = &self.document {
             remove(doc)?;
             remove(&penmodel_terrain::journal::path_for(doc))?;
+            // The session's own lock goes with the document it created (still held: nothing
+            // else can have opened a document this session only just made).
+            remove(&penmodel_terrain::lock::path_for(doc))?;
         }
         if let Some(mark) = &self.demo_mark {
             remove(mark)?;
