@@ -292,9 +292,10 @@ impl Editor {
             }
         }
         if let Some(lock) = held {
+            let mode = lock::mode_of(path);
             let writer = match valid_len {
-                Some(len) => Writer::append_to(&jpath, len),
-                None => Writer::create(&jpath, &base, &[], &[]),
+                Some(len) => Writer::append_to(&jpath, len, mode),
+                None => Writer::create(&jpath, &base, &[], &[], mode),
             }
             .map_err(journal_io(&jpath))?;
             editor.store = Some(Store {
@@ -765,7 +766,8 @@ impl Editor {
         // which is then set aside rather than replayed twice.
         let bytes = self.doc.save(path)?;
         let jpath = journal::path_for(path);
-        let writer = Writer::create(&jpath, &journal::fingerprint(&bytes), &self.undo, &self.redo)
+        let mode = lock::mode_of(path);
+        let writer = Writer::create(&jpath, &journal::fingerprint(&bytes), &self.undo, &self.redo, mode)
             .map_err(journal_io(&jpath))?;
         match (new_lock, &mut self.store) {
             (None, Some(store)) => store.journal = writer,

@@ -25,7 +25,7 @@ use std::path::{Path, PathBuf};
 use serde::{Deserialize, Serialize};
 
 use crate::edit::Edit;
-use crate::persist::{self, write_atomic};
+use crate::persist::{self, write_atomic_with_mode};
 
 /// The journal format version.
 pub const JOURNAL_VERSION: u32 = 1;
@@ -202,8 +202,9 @@ fn line(entry: &Entry) -> Vec<u8> {
 
 impl Writer {
     /// Starts a new journal at `path` for the document with fingerprint `base`, carrying the
-    /// undo and redo stacks over. Atomic: a crash leaves the old journal or the new one.
-    pub fn create(path: &Path, base: &str, undo: &[UndoStep], redo: &[UndoStep]) -> io::Result<Writer> {
+    /// undo and redo stacks over, with the permission bits `mode` (the document's: the journal
+    /// holds its content). Atomic: a crash leaves the old journal or the new one.
+    pub fn create(path: &Path, base: &str, undo: &[UndoStep], redo: &[UndoStep], mode: u32) -> io::Result<Writer> {
         let mut bytes = line(&Entry::Open {
             journal: JOURNAL_VERSION,
             base: base.to_owned(),
@@ -214,14 +215,29 @@ impl Writer {
                 redo: redo.to_vec(),
             }));
         }
-        write_atomic(path, &bytes)?;
-        Writer::append_to(path, bytes.len() as u64)
+        write_atomic_with_mode(path, &bytes, Some(mode))?;
+        Writer::append_to(path, bytes.len() as u64, mode)
     }
 
     /// Opens an existing journal for appending after its first `valid_len` bytes (dropping a torn
-    /// last line).
-    pub fn append_to(path: &Path, valid_len: u64) -> io::Result<Writer> {
+    /// last line), giving it the permission bits `mode` (its document's) if it has others — one
+    /// written before journals followed their documents' modes may be more readable.
+    pub fn append_to(path: &Path, valid_len: u64, mode: u32) -> io::Result<Writer> {
         let file = OpenOptions::new().write(true).open(path)?;
+        #[cfg(unix)]
+        {
+            use std::os::unix::fs::PermissionsExt;
+            let permissions = file.metadata()?.permissions();
+            if permissions.mode() & 0o7777 != mode {
+                match file.set_permissions(fs::Permissions::from_mode(mode)) {
+                    // Someone else's journal, shared through the group: kept as its owner made it.
+                    Err(e) if e.kind() == io::ErrorKind::PermissionDenied => {}
+                    other => other?,
+                }
+            }
+        }
+        #[cfg(not(unix))]
+        let _ = mode;
         if file.metadata()?.len() != valid_len {
             file.set_len(valid_len)?;
             file.sync_all()?;

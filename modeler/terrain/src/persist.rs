@@ -20,7 +20,21 @@ use crate::validate::{self, Defect, ValidationError};
 /// directory flushed so the rename itself is durable. The file keeps the mode and owner of the
 /// one it replaces; a new one gets 0666 less the umask, like a file any editor saves.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
+    write_atomic_with_mode(path, bytes, None)
+}
+
+/// [`write_atomic`], the file given the permission bits `mode` when there is one (exactly: no
+/// umask applies), as a journal is given its document's.
+pub fn write_atomic_with_mode(path: &Path, bytes: &[u8], mode: Option<u32>) -> io::Result<()> {
     let mut file = AtomicWriteFile::open(path)?;
+    #[cfg(unix)]
+    if let Some(mode) = mode {
+        use std::os::unix::fs::PermissionsExt;
+        // Before anything is written into it: the content is never readable more widely.
+        file.as_file().set_permissions(fs::Permissions::from_mode(mode))?;
+    }
+    #[cfg(not(unix))]
+    let _ = mode;
     file.write_all(bytes)?;
     file.commit()
 }

@@ -5,9 +5,11 @@
 
 use crate::common;
 
+use std::fs;
+
 use common::*;
 use penmodel_terrain::editor::{Editor, EditorError};
-use penmodel_terrain::{Document, Edit, FigurePath, lock};
+use penmodel_terrain::{Document, Edit, FigurePath, journal, lock};
 
 fn sample() -> Document {
     document(
@@ -62,4 +64,41 @@ fn a_second_writer_is_refused_naming_the_holder() {
     let (again, _) = Editor::open(&path).expect("free again once the first is gone");
     assert_eq!(height(again.document()), 60.0);
     assert!(lock::path_for(&path).exists());
+}
+
+fn mode(path: &std::path::Path) -> u32 {
+    use std::os::unix::fs::PermissionsExt;
+    fs::metadata(path).unwrap().permissions().mode() & 0o7777
+}
+
+fn set_mode(path: &std::path::Path, mode: u32) {
+    use std::os::unix::fs::PermissionsExt;
+    fs::set_permissions(path, fs::Permissions::from_mode(mode)).unwrap();
+}
+
+#[test]
+fn a_0600_document_gets_a_0600_journal_and_lock() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("secret.json");
+    sample().save(&path).unwrap();
+    set_mode(&path, 0o600);
+    let jpath = journal::path_for(&path);
+
+    let mut editor = Editor::open(&path).unwrap();
+    assert_eq!(mode(&jpath), 0o600, "a new journal");
+    assert_eq!(mode(&lock::path_for(&path)), 0o600, "a new lock file");
+    editor.0.apply(set_height(50.0)).unwrap();
+    editor.0.save().unwrap();
+    assert_eq!(mode(&path), 0o600, "the saved document");
+    assert_eq!(mode(&jpath), 0o600, "the journal started by the save");
+    editor.0.apply(set_height(55.0)).unwrap();
+    drop(editor);
+
+    // A journal left more readable (by an older penmodel) is given the document's mode when
+    // it is continued, its edits kept.
+    set_mode(&jpath, 0o644);
+    let (editor, report) = Editor::open(&path).unwrap();
+    assert_eq!(report.replayed, 1);
+    assert_eq!(height(editor.document()), 55.0);
+    assert_eq!(mode(&jpath), 0o600, "a continued journal");
 }
