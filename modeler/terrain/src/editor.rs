@@ -251,15 +251,21 @@ impl Editor {
     fn open_with(path: &Path, write: bool) -> Result<(Editor, OpenReport), EditorError> {
         // A writer locks before reading: another one's save or journal line cannot come between
         // what this one reads and what it appends.
+        // A link is resolved: the document is its target, and its lock and journal are beside
+        // it, whichever link (or none) it is opened by.
+        let target = persist::resolve_link(path).map_err(|cause| LoadError::Io {
+            path: path.to_owned(),
+            cause,
+        })?;
         let held = match write {
-            true => Some(DocumentLock::acquire(path, lock::mode_of(path))?),
+            true => Some(DocumentLock::acquire(&target, lock::mode_of(&target))?),
             false => None,
         };
-        let (doc, bytes) = persist::read_document(path)?;
+        let (doc, bytes) = persist::read_document(&target)?;
         let base = journal::fingerprint(&bytes);
         let mut editor = Editor::new(doc).map_err(LoadError::from)?;
         let mut report = OpenReport::default();
-        let jpath = journal::path_for(path);
+        let jpath = journal::path_for(&target);
         let mut valid_len = None;
         match journal::read(&jpath, &base)? {
             Replay::Missing => {}
@@ -292,7 +298,7 @@ impl Editor {
             }
         }
         if let Some(lock) = held {
-            let mode = lock::mode_of(path);
+            let mode = lock::mode_of(&target);
             let writer = match valid_len {
                 Some(len) => Writer::append_to(&jpath, len, mode),
                 None => Writer::create(&jpath, &base, &[], &[], mode),
@@ -757,16 +763,22 @@ impl Editor {
         self.cancel_preview()?;
         // Writing another file than this editor's own needs that file's lock first; the old one
         // is released once the new file is this editor's.
-        let same = self.store.as_ref().is_some_and(|s| s.lock.document() == path);
+        // Through a link, the target is written in place ([`persist::write_atomic`]), and its
+        // lock and journal are beside it.
+        let target = persist::resolve_link(path).map_err(|cause| SaveError::Io {
+            path: path.to_owned(),
+            cause,
+        })?;
+        let same = self.store.as_ref().is_some_and(|s| s.lock.document() == target);
         let new_lock = match same {
             true => None,
-            false => Some(DocumentLock::acquire(path, lock::mode_of(path))?),
+            false => Some(DocumentLock::acquire(&target, lock::mode_of(&target))?),
         };
         // Document first: a crash between the two leaves a journal whose base no longer matches,
         // which is then set aside rather than replayed twice.
-        let bytes = self.doc.save(path)?;
-        let jpath = journal::path_for(path);
-        let mode = lock::mode_of(path);
+        let bytes = self.doc.save(&target)?;
+        let jpath = journal::path_for(&target);
+        let mode = lock::mode_of(&target);
         let writer = Writer::create(&jpath, &journal::fingerprint(&bytes), &self.undo, &self.redo, mode)
             .map_err(journal_io(&jpath))?;
         match (new_lock, &mut self.store) {

@@ -25,8 +25,15 @@ pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
 
 /// [`write_atomic`], the file given the permission bits `mode` when there is one (exactly: no
 /// umask applies), as a journal is given its document's.
+///
+/// A `path` that is a symbolic link is resolved and its target written in place, as vim and
+/// emacs save through a link: the temporary file goes into the target's directory and is
+/// renamed over the target, which keeps its mode; the link stays a link. (Renamed over the link
+/// itself, the link would become a regular file with the link's own mode, 0777, and the target
+/// would never change.)
 pub fn write_atomic_with_mode(path: &Path, bytes: &[u8], mode: Option<u32>) -> io::Result<()> {
-    let mut file = AtomicWriteFile::open(path)?;
+    let target = resolve_link(path)?;
+    let mut file = AtomicWriteFile::open(&target)?;
     #[cfg(unix)]
     if let Some(mode) = mode {
         use std::os::unix::fs::PermissionsExt;
@@ -37,6 +44,31 @@ pub fn write_atomic_with_mode(path: &Path, bytes: &[u8], mode: Option<u32>) -> i
     let _ = mode;
     file.write_all(bytes)?;
     file.commit()
+}
+
+/// The links a path may go through before [`resolve_link`] gives up (Linux's own limit).
+const MAX_LINKS: usize = 40;
+
+/// The file `path` names once every symbolic link in its last component is followed: `path`
+/// itself when it is no link (or does not exist), else the link's target, resolved in turn. The
+/// target need not exist (saving through a dangling link creates it, as an editor does).
+pub fn resolve_link(path: &Path) -> io::Result<PathBuf> {
+    let mut at = path.to_owned();
+    for _ in 0..MAX_LINKS {
+        match fs::symlink_metadata(&at) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let target = fs::read_link(&at)?;
+                at = match at.parent() {
+                    Some(dir) if target.is_relative() => dir.join(target),
+                    _ => target,
+                };
+            }
+            _ => return Ok(at),
+        }
+    }
+    Err(io::Error::other(format!(
+        "more than {MAX_LINKS} symbolic links to follow (a loop?)"
+    )))
 }
 
 /// Why a document could not be read.

@@ -49,8 +49,7 @@ fn a_second_writer_is_refused_naming_the_holder() {
     let mut other = Editor::new(sample()).unwrap();
     let err = other
         .save_as(&path)
-        .err()
-        .expect("save_as over a held document is refused");
+        .expect_err("save_as over a held document is refused");
     assert!(err.to_string().contains(&pid), "{err}");
     // Readers are not blocked, and see the first's journaled edit.
     let (reader, _) = Editor::open_read_only(&path).unwrap();
@@ -101,4 +100,54 @@ fn a_0600_document_gets_a_0600_journal_and_lock() {
     assert_eq!(report.replayed, 1);
     assert_eq!(height(editor.document()), 55.0);
     assert_eq!(mode(&jpath), 0o600, "a continued journal");
+}
+
+#[test]
+fn a_save_through_a_link_writes_the_0600_target_in_place() {
+    let dir = tempfile::tempdir().unwrap();
+    let real_dir = dir.path().join("real");
+    fs::create_dir(&real_dir).unwrap();
+    let target = real_dir.join("doc.json");
+    sample().save(&target).unwrap();
+    set_mode(&target, 0o600);
+    let link = dir.path().join("link.json");
+    std::os::unix::fs::symlink("real/doc.json", &link).unwrap();
+
+    let (mut editor, _) = Editor::open(&link).unwrap();
+    editor.apply(set_height(50.0)).unwrap();
+    editor.save().unwrap();
+    // The link is still a link to the same target, which holds the edit and kept its mode.
+    assert!(
+        fs::symlink_metadata(&link).unwrap().file_type().is_symlink(),
+        "the link was replaced"
+    );
+    assert_eq!(fs::read_link(&link).unwrap(), std::path::Path::new("real/doc.json"));
+    assert_eq!(mode(&target), 0o600);
+    assert_eq!(height(&Document::load(&target).unwrap()), 50.0);
+    // Its journal and lock are beside the target (one document, whichever name opens it), and
+    // a second writer by the target's own name is refused.
+    assert_eq!(mode(&journal::path_for(&target)), 0o600);
+    assert!(!journal::path_for(&link).exists());
+    assert!(matches!(Editor::open(&target), Err(EditorError::Locked(_))));
+    drop(editor);
+
+    // A journal that is a link: followed, its target written in place, the link kept.
+    let jtarget = real_dir.join("elsewhere.journal");
+    fs::rename(journal::path_for(&target), &jtarget).unwrap();
+    std::os::unix::fs::symlink(&jtarget, journal::path_for(&target)).unwrap();
+    let (mut editor, _) = Editor::open(&link).unwrap();
+    editor.apply(set_height(60.0)).unwrap();
+    editor.save().unwrap();
+    let jlink = journal::path_for(&target);
+    assert!(
+        fs::symlink_metadata(&jlink).unwrap().file_type().is_symlink(),
+        "the journal link was replaced"
+    );
+    assert_eq!(mode(&jtarget), 0o600);
+    editor.apply(set_height(70.0)).unwrap();
+    drop(editor);
+    let journal_text = fs::read_to_string(&jtarget).unwrap();
+    assert!(journal_text.contains("70.0"), "{journal_text}");
+    let (reopened, report) = Editor::open_read_only(&link).unwrap();
+    assert_eq!((report.replayed, height(reopened.document())), (1, 70.0));
 }
