@@ -76,7 +76,8 @@ fn the_deepest_document_the_editor_allows_saves_and_loads_back() {
     editor.save().unwrap();
     let saved = editor.document().clone();
     assert_eq!(Document::load(&path).unwrap(), saved);
-    let (reopened, _) = Editor::open(&path).unwrap();
+    // Read-only: the editor that saved it still has it open for writing.
+    let (reopened, _) = Editor::open_read_only(&path).unwrap();
     assert_eq!(reopened.document(), &saved);
     assert!(reopened.can_undo());
     drop(reopened);
