@@ -118,7 +118,7 @@ pub enum JournalError {
 
 /// Reads the journal at `path` for the document whose fingerprint is `base`.
 pub fn read(path: &Path, base: &str) -> Result<Replay, JournalError> {
-    let bytes = match fs::read(path) {
+    let bytes = match persist::read_input(path, persist::MAX_JOURNAL_BYTES) {
         Ok(b) => b,
         Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Replay::Missing),
         Err(cause) => {

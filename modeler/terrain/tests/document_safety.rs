@@ -151,3 +151,59 @@ fn a_save_through_a_link_writes_the_0600_target_in_place() {
     let (reopened, report) = Editor::open_read_only(&link).unwrap();
     assert_eq!((report.replayed, height(reopened.document())), (1, 70.0));
 }
+
+/// `load(path)`'s error, or a failure if it takes more than 5 s (a FIFO blocking, /dev/zero
+/// being read whole).
+fn refused_quickly(path: &std::path::Path) -> String {
+    let (tx, rx) = std::sync::mpsc::channel();
+    let owned = path.to_owned();
+    std::thread::spawn(move || {
+        let _ = tx.send(Editor::open_read_only(&owned).err().map(|e| e.to_string()));
+    });
+    match rx.recv_timeout(std::time::Duration::from_secs(5)) {
+        Ok(Some(msg)) => msg,
+        Ok(None) => panic!("{} opened as a document", path.display()),
+        Err(_) => panic!("reading {} did not return within 5 s", path.display()),
+    }
+}
+
+#[test]
+fn dev_zero_a_fifo_and_a_folder_are_refused_before_reading() {
+    let msg = refused_quickly(std::path::Path::new("/dev/zero"));
+    assert_eq!(
+        msg,
+        "cannot read /dev/zero: a character device, not a regular file: penmodel reads regular files only"
+    );
+
+    let dir = tempfile::tempdir().unwrap();
+    let fifo = dir.path().join("pipe.json");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
+    assert!(made.success());
+    let msg = refused_quickly(&fifo);
+    assert!(msg.contains("a FIFO (named pipe), not a regular file"), "{msg}");
+
+    let msg = refused_quickly(dir.path());
+    assert!(msg.contains("a directory, not a regular file"), "{msg}");
+
+    // A journal that is a FIFO is refused the same way, naming the journal.
+    let doc = dir.path().join("d.json");
+    sample().save(&doc).unwrap();
+    let made = std::process::Command::new("mkfifo")
+        .arg(journal::path_for(&doc))
+        .status()
+        .unwrap();
+    assert!(made.success());
+    let msg = refused_quickly(&doc);
+    assert!(msg.contains("d.json.journal") && msg.contains("a FIFO"), "{msg}");
+}
+
+#[test]
+fn a_document_over_the_limit_is_refused_by_its_size() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("huge.json");
+    // Sparse: the size is there without the bytes.
+    let file = fs::File::create(&path).unwrap();
+    file.set_len(penmodel_terrain::persist::MAX_DOCUMENT_BYTES + 1).unwrap();
+    let msg = refused_quickly(&path);
+    assert!(msg.contains("268435457 bytes, more than the 256 MiB"), "{msg}");
+}

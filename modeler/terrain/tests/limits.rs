@@ -332,7 +332,7 @@ fn messages_say_what_is_expected_in_the_document_s_words() {
 
     // An OS error is said once, and not again as the source.
     let dir = tempfile::tempdir().unwrap();
-    let e = Document::load(dir.path()).unwrap_err();
+    let e = Document::load(&dir.path().join("missing.json")).unwrap_err();
     let text = e.to_string();
     assert_eq!(text.matches("os error").count(), 1, "{text}");
     assert!(std::error::Error::source(&e).is_none());
