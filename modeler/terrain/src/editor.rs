@@ -83,6 +83,17 @@ pub struct OpenReport {
     /// A journal that belongs to another version of the document, left where it is and not
     /// replayed ([`Editor::open_read_only`] moves nothing), so that the caller can say so.
     pub ignored_stale_journal: Option<PathBuf>,
+    /// What [`Editor::open_recovering`] left out of a journal with a bad line.
+    pub recovered: Option<Recovered>,
+}
+
+/// A journal opened up to its last good line ([`Editor::open_recovering`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recovered {
+    /// The first line left out, how many were, and what is wrong with the first.
+    pub dropped: journal::Dropped,
+    /// Where the journal as it was, bad lines included, was copied before they were cut off.
+    pub copy: PathBuf,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -161,17 +172,23 @@ pub struct Editor {
 /// Moves a stale journal to `JOURNAL.stale`, or `.stale.2`, `.stale.3`, … when one set aside
 /// earlier is there: a rename would replace it, and the edits it holds with it.
 fn set_aside(jpath: &Path) -> io::Result<PathBuf> {
+    let aside = free_name(jpath, "stale");
+    fs::rename(jpath, &aside)?;
+    Ok(aside)
+}
+
+/// `JOURNAL.SUFFIX`, or `.SUFFIX.2`, `.SUFFIX.3`, …: the first name not taken.
+fn free_name(jpath: &Path, suffix: &str) -> PathBuf {
     let mut n = 1u32;
     loop {
         let mut aside = jpath.as_os_str().to_owned();
         match n {
-            1 => aside.push(".stale"),
-            _ => aside.push(format!(".stale.{n}")),
+            1 => aside.push(format!(".{suffix}")),
+            _ => aside.push(format!(".{suffix}.{n}")),
         }
         let aside = PathBuf::from(aside);
         if fs::symlink_metadata(&aside).is_err() {
-            fs::rename(jpath, &aside)?;
-            return Ok(aside);
+            return aside;
         }
         n += 1;
     }
@@ -239,16 +256,25 @@ impl Editor {
 
     /// Opens the document at `path` and replays its journal; later edits are journaled there.
     pub fn open(path: &Path) -> Result<(Editor, OpenReport), EditorError> {
-        Editor::open_with(path, true)
+        Editor::open_with(path, true, false)
+    }
+
+    /// [`Editor::open`] for a journal with a bad line (a changed bit, a lost line, an entry
+    /// that does not apply): the edits before the first bad line are replayed, the journal as
+    /// it was is copied to `JOURNAL.corrupt` (`.corrupt.2`, …), and the bad lines are cut off
+    /// so that later edits follow the good ones; [`OpenReport::recovered`] says what was left
+    /// out. A journal without a bad line opens as with [`Editor::open`].
+    pub fn open_recovering(path: &Path) -> Result<(Editor, OpenReport), EditorError> {
+        Editor::open_with(path, true, true)
     }
 
     /// The document at `path` with its journal replayed, without writing anything (no journal is
     /// kept: edits to this editor are in memory only).
     pub fn open_read_only(path: &Path) -> Result<(Editor, OpenReport), EditorError> {
-        Editor::open_with(path, false)
+        Editor::open_with(path, false, false)
     }
 
-    fn open_with(path: &Path, write: bool) -> Result<(Editor, OpenReport), EditorError> {
+    fn open_with(path: &Path, write: bool, recover: bool) -> Result<(Editor, OpenReport), EditorError> {
         // A writer locks before reading: another one's save or journal line cannot come between
         // what this one reads and what it appends.
         // A link is resolved: the document is its target, and its lock and journal are beside
@@ -266,8 +292,12 @@ impl Editor {
         let mut editor = Editor::new(doc).map_err(LoadError::from)?;
         let mut report = OpenReport::default();
         let jpath = journal::path_for(&target);
-        let mut valid_len = None;
-        match journal::read(&jpath, &base)? {
+        let mut continued = None;
+        let replay = match recover {
+            true => journal::read_recovering(&jpath, &base)?,
+            false => journal::read(&jpath, &base)?,
+        };
+        match replay {
             Replay::Missing => {}
             Replay::Stale(_) => {
                 if write {
@@ -279,28 +309,64 @@ impl Editor {
             }
             Replay::Entries {
                 entries,
-                valid_len: len,
+                starts,
+                valid_len,
                 torn,
+                version,
+                mut dropped,
             } => {
+                let mut len = valid_len;
+                let count = entries.len();
                 for (i, entry) in entries.into_iter().enumerate() {
                     // The undo history saved with the document is not a change to it.
                     let change = !matches!(entry, Entry::History { .. });
                     // Line numbers: the open line is 1.
-                    editor.replay(entry).map_err(|reason| EditorError::Replay {
-                        path: jpath.clone(),
-                        line: i + 2,
-                        reason,
-                    })?;
-                    report.replayed += usize::from(change);
+                    let line = i + 2;
+                    match editor.replay(entry) {
+                        Ok(()) => report.replayed += usize::from(change),
+                        Err(reason) if recover => {
+                            // A failed replay changes nothing: the editor is as after the line before.
+                            let after = dropped.take().map_or(0, |d| d.lines);
+                            dropped = Some(journal::Dropped {
+                                line,
+                                lines: count - i + after,
+                                reason: format!("cannot replay: {reason}"),
+                            });
+                            len = starts[i];
+                            break;
+                        }
+                        Err(reason) => {
+                            return Err(EditorError::Replay {
+                                path: jpath.clone(),
+                                line,
+                                reason,
+                            });
+                        }
+                    }
                 }
                 report.dropped_torn_line = torn;
-                valid_len = Some(len);
+                if let Some(dropped) = dropped {
+                    // The bad lines are cut off only by a writer, after they are copied aside.
+                    let copy = free_name(&jpath, "corrupt");
+                    if write {
+                        let bytes = persist::read_input(&jpath, persist::MAX_JOURNAL_BYTES)
+                            .and_then(|bytes| {
+                                persist::write_atomic_with_mode(&copy, &bytes, Some(lock::mode_of(&target)))
+                            })
+                            .map_err(journal_io(&jpath));
+                        bytes?;
+                    }
+                    report.recovered = Some(Recovered { dropped, copy });
+                }
+                // Lines kept: the open line and one per entry replayed or carried.
+                let kept = report.recovered.as_ref().map_or(count, |r| r.dropped.line - 2);
+                continued = Some((len, version, kept as u64 + 2));
             }
         }
         if let Some(lock) = held {
             let mode = lock::mode_of(&target);
-            let writer = match valid_len {
-                Some(len) => Writer::append_to(&jpath, len, mode),
+            let writer = match continued {
+                Some((len, version, next)) => Writer::append_to(&jpath, len, mode, version, next),
                 None => Writer::create(&jpath, &base, &[], &[], mode),
             }
             .map_err(journal_io(&jpath))?;

@@ -207,3 +207,126 @@ fn a_document_over_the_limit_is_refused_by_its_size() {
     let msg = refused_quickly(&path);
     assert!(msg.contains("268435457 bytes, more than the 256 MiB"), "{msg}");
 }
+
+/// A document with three journaled edits (heights 50, 109 and 130, lines 2 to 4) and its journal.
+fn three_edits(dir: &std::path::Path) -> (std::path::PathBuf, std::path::PathBuf) {
+    let path = dir.join("d.json");
+    let mut editor = Editor::create(&path, sample()).unwrap();
+    for h in [50.0, 109.0, 130.0] {
+        editor.apply(set_height(h)).unwrap();
+    }
+    drop(editor);
+    (path.clone(), journal::path_for(&path))
+}
+
+#[test]
+fn a_flipped_bit_in_a_journal_line_is_refused_naming_the_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let (path, jpath) = three_edits(dir.path());
+    let text = fs::read_to_string(&jpath).unwrap();
+    assert!(text.lines().all(|l| l.starts_with("{\"seq\":")), "{text}");
+    // 109.0 → 108.0 is one bit ('9' is 0x39, '8' 0x38): valid JSON, a valid edit.
+    fs::write(&jpath, text.replace("109.0", "108.0")).unwrap();
+    let err = Editor::open(&path).err().expect("refused");
+    let msg = err.to_string();
+    assert!(
+        msg.starts_with(&format!("journal {} line 3: checksum mismatch", jpath.display())),
+        "{msg}"
+    );
+    // Readers refuse it too, rather than show a terrain that was never modeled.
+    assert!(Editor::open_read_only(&path).is_err());
+
+    // A line lost: the sequence numbers say so.
+    let lines: Vec<&str> = text.lines().collect();
+    fs::write(&jpath, format!("{}\n{}\n{}\n", lines[0], lines[1], lines[3])).unwrap();
+    let msg = Editor::open(&path).err().expect("refused").to_string();
+    assert!(msg.contains("line 3: sequence number 4 where 3 belongs"), "{msg}");
+}
+
+#[test]
+fn recovering_keeps_the_edits_before_the_bad_line() {
+    let dir = tempfile::tempdir().unwrap();
+    let (path, jpath) = three_edits(dir.path());
+    let original = fs::read_to_string(&jpath).unwrap().replace("109.0", "108.0");
+    fs::write(&jpath, &original).unwrap();
+
+    let (mut editor, report) = Editor::open_recovering(&path).unwrap();
+    assert_eq!(height(editor.document()), 50.0, "the edit before the bad line");
+    assert_eq!(report.replayed, 1);
+    let recovered = report.recovered.expect("says what it dropped");
+    assert_eq!((recovered.dropped.line, recovered.dropped.lines), (3, 2));
+    assert!(
+        recovered.dropped.reason.starts_with("checksum mismatch"),
+        "{:?}",
+        recovered.dropped
+    );
+    // The journal as it was is kept; the bad lines are cut off, and later edits follow the
+    // good ones with the next sequence number.
+    assert_eq!(fs::read_to_string(&recovered.copy).unwrap(), original);
+    editor.apply(set_height(77.0)).unwrap();
+    drop(editor);
+    let (mut editor, report) = Editor::open(&path).expect("a clean journal again");
+    assert_eq!((report.replayed, height(editor.document())), (2, 77.0));
+    assert!(report.recovered.is_none());
+    editor.undo().unwrap();
+    assert_eq!(height(editor.document()), 50.0);
+}
+
+#[test]
+fn a_version_1_journal_still_replays_and_is_continued_as_such() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("old.json");
+    let bytes = sample().save(&path).unwrap();
+    let jpath = journal::path_for(&path);
+    let v1 = format!(
+        "{{\"op\":\"open\",\"journal\":1,\"base\":\"{}\"}}\n{}\n",
+        journal::fingerprint(&bytes),
+        r#"{"op":"do","edit":{"op":"set_height","at":"regions[0].figures[0]","height":42.5}}"#
+    );
+    fs::write(&jpath, &v1).unwrap();
+    let (mut editor, report) = Editor::open(&path).unwrap();
+    assert_eq!((report.replayed, height(editor.document())), (1, 42.5));
+    editor.apply(set_height(43.0)).unwrap();
+    drop(editor);
+    let text = fs::read_to_string(&jpath).unwrap();
+    assert!(
+        text.starts_with(&v1) && text.lines().nth(2).is_some_and(|l| l.starts_with("{\"op\":\"do\"")),
+        "{text}"
+    );
+    let (mut editor, report) = Editor::open(&path).unwrap();
+    assert_eq!((report.replayed, height(editor.document())), (2, 43.0));
+    // Saving starts a version-2 journal.
+    editor.save().unwrap();
+    let text = fs::read_to_string(&jpath).unwrap();
+    assert!(
+        text.starts_with("{\"seq\":1,\"crc32\":\"") && text.contains("\"journal\":2"),
+        "{text}"
+    );
+}
+
+#[test]
+fn the_version_2_example_of_docs_document_md_reads() {
+    // docs/document.md's example, whose checksums were computed apart (zlib's crc32).
+    let text = concat!(
+        r#"{"seq":1,"crc32":"b7cdd160","op":"open","journal":2,"base":"fnv1a64:3c0a5e6f4b2d9e11"}"#,
+        "\n",
+        r#"{"seq":2,"crc32":"42c10edc","op":"do","edit":{"op":"set_height","at":"regions[0].figures[1]","height":42.5}}"#,
+        "\n",
+        r#"{"seq":3,"crc32":"3b8b156e","op":"undo"}"#,
+        "\n",
+        r#"{"seq":4,"crc32":"3493be07","op":"redo"}"#,
+        "\n",
+    );
+    let docs = include_str!("../../../docs/document.md");
+    assert!(docs.contains(text), "docs/document.md's example changed");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("example.journal");
+    fs::write(&path, text).unwrap();
+    match journal::read(&path, "fnv1a64:3c0a5e6f4b2d9e11").unwrap() {
+        journal::Replay::Entries { entries, version, .. } => {
+            assert_eq!((entries.len(), version), (3, 2));
+            assert_eq!(entries[1], journal::Entry::Undo);
+        }
+        other => panic!("{other:?}"),
+    }
+}

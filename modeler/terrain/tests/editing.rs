@@ -453,6 +453,7 @@ fn torn_last_line_is_dropped_and_stale_journal_set_aside() {
             dropped_torn_line: true,
             stale_journal: None,
             ignored_stale_journal: None,
+            recovered: None,
         }
     );
     assert_eq!(editor.document(), &after_one);
