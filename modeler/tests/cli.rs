@@ -368,9 +368,19 @@ fn generate_messages_name_the_problem_once() {
         err.starts_with("penmodel: regions[0].boundary[0]: a point is [x, y]: two numbers, found more"),
         "{err}"
     );
-    // A directory as the document: the OS's reason once.
+    // A directory as the document: refused before reading, said once.
     let dir = tempfile::tempdir().unwrap();
     let out = penmodel(&["generate", s(dir.path()), "--raw", s(&dir.path().join("o.f32"))]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(err.matches("a directory, not a regular file").count(), 1, "{err}");
+    // A missing one: the OS's reason once.
+    let out = penmodel(&[
+        "generate",
+        s(&dir.path().join("no.json")),
+        "--raw",
+        s(&dir.path().join("o.f32")),
+    ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1));
     assert_eq!(err.matches("os error").count(), 1, "{err}");

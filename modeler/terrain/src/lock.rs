@@ -43,7 +43,7 @@ pub enum LockError {
         holder: String,
     },
     /// The lock file could not be created, read or locked.
-    #[error("cannot lock {} ({}): {cause}", doc.display(), lock.display())]
+    #[error("cannot write {}: its lock file {}: {cause}", doc.display(), lock.display())]
     Io {
         doc: PathBuf,
         lock: PathBuf,
