@@ -368,9 +368,19 @@ fn generate_messages_name_the_problem_once() {
         err.starts_with("penmodel: regions[0].boundary[0]: a point is [x, y]: two numbers, found more"),
         "{err}"
     );
-    // A directory as the document: the OS's reason once.
+    // A directory as the document: refused before reading, said once.
     let dir = tempfile::tempdir().unwrap();
     let out = penmodel(&["generate", s(dir.path()), "--raw", s(&dir.path().join("o.f32"))]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1));
+    assert_eq!(err.matches("a directory, not a regular file").count(), 1, "{err}");
+    // A missing one: the OS's reason once.
+    let out = penmodel(&[
+        "generate",
+        s(&dir.path().join("no.json")),
+        "--raw",
+        s(&dir.path().join("o.f32")),
+    ]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(1));
     assert_eq!(err.matches("os error").count(), 1, "{err}");
@@ -411,4 +421,82 @@ fn a_reader_that_goes_away_ends_penmodel_quietly() {
     assert_eq!(out.status.code(), Some(0), "{err}");
     assert!(!err.contains("panicked"), "{err}");
     assert!(png.exists(), "the work is done before the summary line");
+}
+
+/// `penmodel open` of a document whose journal has a flipped bit: refused naming the line and
+/// suggesting --recover; with --recover, opened up to the last good line, saying what it left
+/// out, the journal as it was kept beside it.
+#[test]
+fn open_refuses_a_corrupt_journal_and_recover_opens_up_to_the_bad_line() {
+    use penmodel_terrain::{Edit, FigurePath, editor::Editor, journal};
+    let dir = tempfile::tempdir().unwrap();
+    let doc = dir.path().join("d.json");
+    let volcano = penmodel_terrain::Document::load(Path::new(&example("04-volcano.json"))).unwrap();
+    let mut editor = Editor::create(&doc, volcano).unwrap();
+    for height in [50.0, 109.0, 130.0] {
+        let at = FigurePath::new(0, 0);
+        editor.apply(Edit::SetHeight { at, height }).unwrap();
+    }
+    drop(editor);
+    let jpath = journal::path_for(&doc);
+    let flipped = std::fs::read_to_string(&jpath).unwrap().replace("109.0", "108.0");
+    std::fs::write(&jpath, &flipped).unwrap();
+    let out = dir.path().join("out");
+    // A pen that never comes (a serial port that is no port): the session waits until stopped.
+    let open = |recover: bool| {
+        let mut args = vec!["open", s(&doc)];
+        if recover {
+            args.push("--recover");
+        }
+        args.extend(["--source", "serial:/dev/null", "--fps", "0", "--size", "64x36"]);
+        args.extend(["--show", "headless", "--out", s(&out)]);
+        Command::new(env!("CARGO_BIN_EXE_penmodel"))
+            .args(&args)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .env("XDG_RUNTIME_DIR", dir.path())
+            .stdout(std::process::Stdio::null())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+
+    let refused = open(false).wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&refused.stderr);
+    assert_eq!(refused.status.code(), Some(1), "{stderr}");
+    assert!(stderr.contains("d.json.journal line 3: checksum mismatch"), "{stderr}");
+    assert!(stderr.contains("penmodel open --recover"), "{stderr}");
+    assert_eq!(
+        std::fs::read_to_string(&jpath).unwrap(),
+        flipped,
+        "refused: nothing touched"
+    );
+
+    let child = open(true);
+    let copy = format!("{}.corrupt", s(&jpath));
+    let start = std::time::Instant::now();
+    while !Path::new(&copy).exists() && start.elapsed().as_secs() < 60 {
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    // Stopped (as a user stops it): the session saves what it has.
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    let killed = Command::new("kill")
+        .args(["-TERM", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let recovered = child.wait_with_output().unwrap();
+    let stderr = String::from_utf8_lossy(&recovered.stderr);
+    assert!(recovered.status.success(), "{stderr}");
+    assert!(
+        stderr.contains("recovered: journal lines 3 to 4 left out (2 lines; line 3: checksum mismatch"),
+        "{stderr}"
+    );
+    assert_eq!(std::fs::read_to_string(&copy).unwrap(), flipped);
+    // The edit before the bad line is in the saved document.
+    let saved = penmodel_terrain::Document::load(&doc).unwrap();
+    assert_eq!(saved.regions[0].figures[0].height, 50.0);
+    // The session went on from the good lines and saved: the document opens cleanly.
+    let (_, report) = Editor::open_read_only(&doc).expect("opens without --recover now");
+    assert!(report.recovered.is_none());
 }

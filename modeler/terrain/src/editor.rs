@@ -26,6 +26,7 @@ use crate::edit::{Edit, EditError};
 use crate::engine::{Rect, TerrainEngine};
 use crate::heightmap::Heightmap;
 use crate::journal::{self, Entry, JournalError, Replay, UndoStep, Writer};
+use crate::lock::{self, DocumentLock, LockError};
 use crate::persist::{self, LoadError, SaveError};
 use crate::revision::Revisions;
 use crate::rocks::cache::Seated;
@@ -65,6 +66,9 @@ pub enum EditorError {
     /// The editor has no file to save to.
     #[error("the document has no file yet: use save_as")]
     NoFile,
+    /// Another writer has the document open ([`crate::lock`]); nothing was read or written.
+    #[error(transparent)]
+    Locked(#[from] LockError),
 }
 
 /// What [`Editor::open`] found in the journal.
@@ -79,6 +83,17 @@ pub struct OpenReport {
     /// A journal that belongs to another version of the document, left where it is and not
     /// replayed ([`Editor::open_read_only`] moves nothing), so that the caller can say so.
     pub ignored_stale_journal: Option<PathBuf>,
+    /// What [`Editor::open_recovering`] left out of a journal with a bad line.
+    pub recovered: Option<Recovered>,
+}
+
+/// A journal opened up to its last good line ([`Editor::open_recovering`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Recovered {
+    /// The first line left out, how many were, and what is wrong with the first.
+    pub dropped: journal::Dropped,
+    /// Where the journal as it was, bad lines included, was copied before they were cut off.
+    pub copy: PathBuf,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -131,6 +146,8 @@ pub struct Outcome {
 struct Store {
     path: PathBuf,
     journal: Writer,
+    /// This editor is the document's only writer while it holds this.
+    lock: DocumentLock,
 }
 
 /// A document being edited: terrain, undo and redo, journal.
@@ -155,17 +172,23 @@ pub struct Editor {
 /// Moves a stale journal to `JOURNAL.stale`, or `.stale.2`, `.stale.3`, … when one set aside
 /// earlier is there: a rename would replace it, and the edits it holds with it.
 fn set_aside(jpath: &Path) -> io::Result<PathBuf> {
+    let aside = free_name(jpath, "stale");
+    fs::rename(jpath, &aside)?;
+    Ok(aside)
+}
+
+/// `JOURNAL.SUFFIX`, or `.SUFFIX.2`, `.SUFFIX.3`, …: the first name not taken.
+fn free_name(jpath: &Path, suffix: &str) -> PathBuf {
     let mut n = 1u32;
     loop {
         let mut aside = jpath.as_os_str().to_owned();
         match n {
-            1 => aside.push(".stale"),
-            _ => aside.push(format!(".stale.{n}")),
+            1 => aside.push(format!(".{suffix}")),
+            _ => aside.push(format!(".{suffix}.{n}")),
         }
         let aside = PathBuf::from(aside);
         if fs::symlink_metadata(&aside).is_err() {
-            fs::rename(jpath, &aside)?;
-            return Ok(aside);
+            return aside;
         }
         n += 1;
     }
@@ -233,23 +256,48 @@ impl Editor {
 
     /// Opens the document at `path` and replays its journal; later edits are journaled there.
     pub fn open(path: &Path) -> Result<(Editor, OpenReport), EditorError> {
-        Editor::open_with(path, true)
+        Editor::open_with(path, true, false)
+    }
+
+    /// [`Editor::open`] for a journal with a bad line (a changed bit, a lost line, an entry
+    /// that does not apply): the edits before the first bad line are replayed, the journal as
+    /// it was is copied to `JOURNAL.corrupt` (`.corrupt.2`, …), and the bad lines are cut off
+    /// so that later edits follow the good ones; [`OpenReport::recovered`] says what was left
+    /// out. A journal without a bad line opens as with [`Editor::open`].
+    pub fn open_recovering(path: &Path) -> Result<(Editor, OpenReport), EditorError> {
+        Editor::open_with(path, true, true)
     }
 
     /// The document at `path` with its journal replayed, without writing anything (no journal is
     /// kept: edits to this editor are in memory only).
     pub fn open_read_only(path: &Path) -> Result<(Editor, OpenReport), EditorError> {
-        Editor::open_with(path, false)
+        Editor::open_with(path, false, false)
     }
 
-    fn open_with(path: &Path, write: bool) -> Result<(Editor, OpenReport), EditorError> {
-        let (doc, bytes) = persist::read_document(path)?;
+    fn open_with(path: &Path, write: bool, recover: bool) -> Result<(Editor, OpenReport), EditorError> {
+        // A writer locks before reading: another one's save or journal line cannot come between
+        // what this one reads and what it appends.
+        // A link is resolved: the document is its target, and its lock and journal are beside
+        // it, whichever link (or none) it is opened by.
+        let target = persist::resolve_link(path).map_err(|cause| LoadError::Io {
+            path: path.to_owned(),
+            cause,
+        })?;
+        let held = match write {
+            true => Some(DocumentLock::acquire(&target, lock::mode_of(&target))?),
+            false => None,
+        };
+        let (doc, bytes) = persist::read_document(&target)?;
         let base = journal::fingerprint(&bytes);
         let mut editor = Editor::new(doc).map_err(LoadError::from)?;
         let mut report = OpenReport::default();
-        let jpath = journal::path_for(path);
-        let mut valid_len = None;
-        match journal::read(&jpath, &base)? {
+        let jpath = journal::path_for(&target);
+        let mut continued = None;
+        let replay = match recover {
+            true => journal::read_recovering(&jpath, &base)?,
+            false => journal::read(&jpath, &base)?,
+        };
+        match replay {
             Replay::Missing => {}
             Replay::Stale(_) => {
                 if write {
@@ -261,33 +309,71 @@ impl Editor {
             }
             Replay::Entries {
                 entries,
-                valid_len: len,
+                starts,
+                valid_len,
                 torn,
+                version,
+                mut dropped,
             } => {
+                let mut len = valid_len;
+                let count = entries.len();
                 for (i, entry) in entries.into_iter().enumerate() {
                     // The undo history saved with the document is not a change to it.
                     let change = !matches!(entry, Entry::History { .. });
                     // Line numbers: the open line is 1.
-                    editor.replay(entry).map_err(|reason| EditorError::Replay {
-                        path: jpath.clone(),
-                        line: i + 2,
-                        reason,
-                    })?;
-                    report.replayed += usize::from(change);
+                    let line = i + 2;
+                    match editor.replay(entry) {
+                        Ok(()) => report.replayed += usize::from(change),
+                        Err(reason) if recover => {
+                            // A failed replay changes nothing: the editor is as after the line before.
+                            let after = dropped.take().map_or(0, |d| d.lines);
+                            dropped = Some(journal::Dropped {
+                                line,
+                                lines: count - i + after,
+                                reason: format!("cannot replay: {reason}"),
+                            });
+                            len = starts[i];
+                            break;
+                        }
+                        Err(reason) => {
+                            return Err(EditorError::Replay {
+                                path: jpath.clone(),
+                                line,
+                                reason,
+                            });
+                        }
+                    }
                 }
                 report.dropped_torn_line = torn;
-                valid_len = Some(len);
+                if let Some(dropped) = dropped {
+                    // The bad lines are cut off only by a writer, after they are copied aside.
+                    let copy = free_name(&jpath, "corrupt");
+                    if write {
+                        let bytes = persist::read_input(&jpath, persist::MAX_JOURNAL_BYTES)
+                            .and_then(|bytes| {
+                                persist::write_atomic_with_mode(&copy, &bytes, Some(lock::mode_of(&target)))
+                            })
+                            .map_err(journal_io(&jpath));
+                        bytes?;
+                    }
+                    report.recovered = Some(Recovered { dropped, copy });
+                }
+                // Lines kept: the open line and one per entry replayed or carried.
+                let kept = report.recovered.as_ref().map_or(count, |r| r.dropped.line - 2);
+                continued = Some((len, version, kept as u64 + 2));
             }
         }
-        if write {
-            let writer = match valid_len {
-                Some(len) => Writer::append_to(&jpath, len),
-                None => Writer::create(&jpath, &base, &[], &[]),
+        if let Some(lock) = held {
+            let mode = lock::mode_of(&target);
+            let writer = match continued {
+                Some((len, version, next)) => Writer::append_to(&jpath, len, mode, version, next),
+                None => Writer::create(&jpath, &base, &[], &[], mode),
             }
             .map_err(journal_io(&jpath))?;
             editor.store = Some(Store {
                 path: path.to_owned(),
                 journal: writer,
+                lock,
             });
         }
         Ok((editor, report))
@@ -741,16 +827,38 @@ impl Editor {
     /// journal afresh; the undo history carries over.
     pub fn save_as(&mut self, path: &Path) -> Result<(), EditorError> {
         self.cancel_preview()?;
+        // Writing another file than this editor's own needs that file's lock first; the old one
+        // is released once the new file is this editor's.
+        // Through a link, the target is written in place ([`persist::write_atomic`]), and its
+        // lock and journal are beside it.
+        let target = persist::resolve_link(path).map_err(|cause| SaveError::Io {
+            path: path.to_owned(),
+            cause,
+        })?;
+        let same = self.store.as_ref().is_some_and(|s| s.lock.document() == target);
+        let new_lock = match same {
+            true => None,
+            false => Some(DocumentLock::acquire(&target, lock::mode_of(&target))?),
+        };
         // Document first: a crash between the two leaves a journal whose base no longer matches,
         // which is then set aside rather than replayed twice.
-        let bytes = self.doc.save(path)?;
-        let jpath = journal::path_for(path);
-        let writer = Writer::create(&jpath, &journal::fingerprint(&bytes), &self.undo, &self.redo)
+        let bytes = self.doc.save(&target)?;
+        let jpath = journal::path_for(&target);
+        let mode = lock::mode_of(&target);
+        let writer = Writer::create(&jpath, &journal::fingerprint(&bytes), &self.undo, &self.redo, mode)
             .map_err(journal_io(&jpath))?;
-        self.store = Some(Store {
-            path: path.to_owned(),
-            journal: writer,
-        });
+        match (new_lock, &mut self.store) {
+            (None, Some(store)) => store.journal = writer,
+            (Some(lock), _) => {
+                self.store = Some(Store {
+                    path: path.to_owned(),
+                    journal: writer,
+                    lock,
+                })
+            }
+            // `same` means there is a store.
+            (None, None) => return Err(EditorError::NoFile),
+        }
         Ok(())
     }
 }

@@ -37,6 +37,7 @@ pub mod geometry;
 mod heightmap;
 pub mod journal;
 mod json;
+pub mod lock;
 pub mod persist;
 mod pool;
 pub mod profile;

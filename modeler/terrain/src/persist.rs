@@ -3,8 +3,8 @@
 //!
 //! The document types ([`crate::document`]) are plain data; their file side is here.
 
-use std::fs;
-use std::io::{self, Write};
+use std::fs::{self, File};
+use std::io::{self, Read, Write};
 use std::path::{Path, PathBuf};
 
 use atomic_write_file::AtomicWriteFile;
@@ -20,9 +20,143 @@ use crate::validate::{self, Defect, ValidationError};
 /// directory flushed so the rename itself is durable. The file keeps the mode and owner of the
 /// one it replaces; a new one gets 0666 less the umask, like a file any editor saves.
 pub fn write_atomic(path: &Path, bytes: &[u8]) -> io::Result<()> {
-    let mut file = AtomicWriteFile::open(path)?;
+    write_atomic_with_mode(path, bytes, None)
+}
+
+/// [`write_atomic`], the file given the permission bits `mode` when there is one (exactly: no
+/// umask applies), as a journal is given its document's.
+///
+/// A `path` that is a symbolic link is resolved and its target written in place, as vim and
+/// emacs save through a link: the temporary file goes into the target's directory and is
+/// renamed over the target, which keeps its mode; the link stays a link. (Renamed over the link
+/// itself, the link would become a regular file with the link's own mode, 0777, and the target
+/// would never change.)
+pub fn write_atomic_with_mode(path: &Path, bytes: &[u8], mode: Option<u32>) -> io::Result<()> {
+    let target = resolve_link(path)?;
+    let mut file = AtomicWriteFile::open(&target)?;
+    #[cfg(unix)]
+    if let Some(mode) = mode {
+        use std::os::unix::fs::PermissionsExt;
+        // Before anything is written into it: the content is never readable more widely.
+        file.as_file().set_permissions(fs::Permissions::from_mode(mode))?;
+    }
+    #[cfg(not(unix))]
+    let _ = mode;
     file.write_all(bytes)?;
     file.commit()
+}
+
+/// The largest document file read: 256 MiB. Documents are kilobytes to a few megabytes (a
+/// figure is some hundred bytes of JSON; the examples are under 100 kB); one of 256 MiB would
+/// already parse into gigabytes of figures, past what the terrain engine may use
+/// ([`crate::validate::MAX_ENGINE_BYTES`]).
+pub const MAX_DOCUMENT_BYTES: u64 = 256 << 20;
+
+/// The largest journal read: 1 GiB. Its `history` line carries up to
+/// [`crate::editor::HISTORY_LIMIT`] undo steps, which may each hold a whole element, so a journal
+/// may outgrow its document; four maximal documents' worth.
+pub const MAX_JOURNAL_BYTES: u64 = 1 << 30;
+
+/// The largest other input penmodel reads (a tree's maps, a silhouette PNG): 256 MiB, like a
+/// document.
+pub const MAX_INPUT_BYTES: u64 = 256 << 20;
+
+/// Opens the input file at `path` for reading, refusing before any byte is read what is not a
+/// regular file (a FIFO, which would block until someone writes to it; a device such as
+/// `/dev/zero`, which never ends; a directory; a socket) and a file of more than `limit` bytes.
+/// The one gate every file penmodel reads goes through; [`read_input`] reads it whole.
+///
+/// The file is opened non-blocking, so that opening a FIFO returns at once, and its type is
+/// checked on the opened file, not on the name, so it cannot be swapped between the check and
+/// the read.
+pub fn open_input(path: &Path, limit: u64) -> io::Result<File> {
+    let mut options = fs::OpenOptions::new();
+    options.read(true);
+    #[cfg(unix)]
+    std::os::unix::fs::OpenOptionsExt::custom_flags(&mut options, libc::O_NONBLOCK);
+    let file = options.open(path)?;
+    let meta = file.metadata()?;
+    if !meta.is_file() {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "{}, not a regular file: penmodel reads regular files only",
+                kind_of(&meta.file_type())
+            ),
+        ));
+    }
+    if meta.len() > limit {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!(
+                "{} bytes, more than the {} MiB this file may have (docs/reliability.md)",
+                meta.len(),
+                limit >> 20
+            ),
+        ));
+    }
+    Ok(file)
+}
+
+/// The whole of the input file at `path`, checked by [`open_input`]; a file that grows past
+/// `limit` while it is read is refused too.
+pub fn read_input(path: &Path, limit: u64) -> io::Result<Vec<u8>> {
+    let file = open_input(path, limit)?;
+    let mut bytes = Vec::new();
+    file.take(limit + 1).read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > limit {
+        return Err(io::Error::new(
+            io::ErrorKind::InvalidInput,
+            format!("grew past the {} MiB this file may have while it was read", limit >> 20),
+        ));
+    }
+    Ok(bytes)
+}
+
+/// What a file that is not a regular one is, in a message.
+fn kind_of(t: &fs::FileType) -> &'static str {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::FileTypeExt;
+        if t.is_fifo() {
+            return "a FIFO (named pipe)";
+        }
+        if t.is_char_device() {
+            return "a character device";
+        }
+        if t.is_block_device() {
+            return "a block device";
+        }
+        if t.is_socket() {
+            return "a socket";
+        }
+    }
+    if t.is_dir() { "a directory" } else { "not a file" }
+}
+
+/// The links a path may go through before [`resolve_link`] gives up (Linux's own limit).
+const MAX_LINKS: usize = 40;
+
+/// The file `path` names once every symbolic link in its last component is followed: `path`
+/// itself when it is no link (or does not exist), else the link's target, resolved in turn. The
+/// target need not exist (saving through a dangling link creates it, as an editor does).
+pub fn resolve_link(path: &Path) -> io::Result<PathBuf> {
+    let mut at = path.to_owned();
+    for _ in 0..MAX_LINKS {
+        match fs::symlink_metadata(&at) {
+            Ok(m) if m.file_type().is_symlink() => {
+                let target = fs::read_link(&at)?;
+                at = match at.parent() {
+                    Some(dir) if target.is_relative() => dir.join(target),
+                    _ => target,
+                };
+            }
+            _ => return Ok(at),
+        }
+    }
+    Err(io::Error::other(format!(
+        "more than {MAX_LINKS} symbolic links to follow (a loop?)"
+    )))
 }
 
 /// Why a document could not be read.
@@ -152,7 +286,7 @@ impl Document {
 /// Reads and validates the document at `path`, returning its bytes too (the journal names the
 /// file it applies to by their fingerprint).
 pub fn read_document(path: &Path) -> Result<(Document, Vec<u8>), LoadError> {
-    let bytes = fs::read(path).map_err(|cause| LoadError::Io {
+    let bytes = read_input(path, MAX_DOCUMENT_BYTES).map_err(|cause| LoadError::Io {
         path: path.to_owned(),
         cause,
     })?;

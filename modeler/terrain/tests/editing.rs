@@ -453,6 +453,7 @@ fn torn_last_line_is_dropped_and_stale_journal_set_aside() {
             dropped_torn_line: true,
             stale_journal: None,
             ignored_stale_journal: None,
+            recovered: None,
         }
     );
     assert_eq!(editor.document(), &after_one);
@@ -468,6 +469,7 @@ fn torn_last_line_is_dropped_and_stale_journal_set_aside() {
     let (editor, report) = Editor::open(&path).unwrap();
     assert_eq!((report.replayed, report.dropped_torn_line), (2, false));
     assert_eq!(editor.document(), &after_two);
+    drop(editor); // the next writer would be refused while this one has it open
 
     // The document saved by someone else (or a crash between saving the document and starting
     // the new journal): the journal's base no longer matches, so it is not replayed again.

@@ -76,7 +76,8 @@ fn the_deepest_document_the_editor_allows_saves_and_loads_back() {
     editor.save().unwrap();
     let saved = editor.document().clone();
     assert_eq!(Document::load(&path).unwrap(), saved);
-    let (reopened, _) = Editor::open(&path).unwrap();
+    // Read-only: the editor that saved it still has it open for writing.
+    let (reopened, _) = Editor::open_read_only(&path).unwrap();
     assert_eq!(reopened.document(), &saved);
     assert!(reopened.can_undo());
     drop(reopened);
@@ -193,6 +194,15 @@ fn heights_slopes_and_cell_sizes_out_of_range_are_refused_everywhere() {
     export::write_obj(&map, &mut Vec::new()).unwrap();
 }
 
+/// The `open` line of a version-1 journal for the document file at `path`.
+fn v1_open_line(path: &std::path::Path) -> String {
+    let bytes = std::fs::read(path).unwrap();
+    format!(
+        "{{\"op\":\"open\",\"journal\":1,\"base\":\"{}\"}}\n",
+        penmodel_terrain::journal::fingerprint(&bytes)
+    )
+}
+
 #[test]
 fn a_journal_with_an_out_of_range_height_does_not_replay() {
     let dir = tempfile::tempdir().unwrap();
@@ -200,7 +210,9 @@ fn a_journal_with_an_out_of_range_height_does_not_replay() {
     let doc = one_region(40, vec![point([20.0, 20.0], 10.0, 0.0)]);
     drop(Editor::create(&path, doc).unwrap());
     let journal = penmodel_terrain::journal::path_for(&path);
-    let mut text = std::fs::read_to_string(&journal).unwrap();
+    // A version-1 journal: a line of version 2 would carry a checksum the test would have to
+    // forge; the replay's checks are the same.
+    let mut text = v1_open_line(&path);
     text.push_str(
         "{\"op\":\"do\",\"edit\":{\"op\":\"set_height\",\"at\":\"regions[0].figures[0]\",\"height\":1e308}}\n",
     );
@@ -331,7 +343,7 @@ fn messages_say_what_is_expected_in_the_document_s_words() {
 
     // An OS error is said once, and not again as the source.
     let dir = tempfile::tempdir().unwrap();
-    let e = Document::load(dir.path()).unwrap_err();
+    let e = Document::load(&dir.path().join("missing.json")).unwrap_err();
     let text = e.to_string();
     assert_eq!(text.matches("os error").count(), 1, "{text}");
     assert!(std::error::Error::source(&e).is_none());
@@ -350,7 +362,11 @@ fn a_journal_s_invalid_utf8_is_reported_at_its_line() {
         .unwrap();
     drop(editor);
     let journal = penmodel_terrain::journal::path_for(&path);
-    let mut bytes = std::fs::read(&journal).unwrap();
+    // Version 1, whose lines have no checksum to catch the byte first (version 2's would).
+    let mut bytes = v1_open_line(&path).into_bytes();
+    bytes.extend_from_slice(
+        b"{\"op\":\"do\",\"edit\":{\"op\":\"set_height\",\"at\":\"regions[0].figures[0]\",\"height\":11.0}}\n",
+    );
     bytes.extend_from_slice(b"{\"op\":\"undo\xff\"}\n");
     std::fs::write(&journal, bytes).unwrap();
     let e = Editor::open(&path).map(|_| ()).unwrap_err().to_string();

@@ -3,6 +3,7 @@ mod baseline;
 mod common;
 mod detail;
 mod docs;
+mod document_safety;
 mod editing;
 mod equations;
 mod erosion;

@@ -222,8 +222,8 @@ fn tree_and_grove_edits_undo_and_journal() {
     assert_eq!(ed.document(), &before);
     let e = ed.apply(Edit::DeleteTree { index: 3 }).expect_err("no tree 3");
     assert_eq!(e.to_string(), "there is no trees[3]");
-    // The journal replays the edits into the same document.
-    let (reopened, report) = Editor::open(&path).expect("reopened");
+    // The journal replays the edits into the same document (read-only: `ed` is its writer).
+    let (reopened, report) = Editor::open_read_only(&path).expect("reopened");
     assert_eq!(report.replayed, 5);
     assert_eq!(reopened.document(), ed.document());
     drop(reopened);

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use penmodel_terrain::editor::Editor;
 use penmodel_terrain::rocks::cache::Rocks;
-use penmodel_terrain::{Heightmap, export, journal};
+use penmodel_terrain::{Heightmap, export, journal, persist};
 
 use crate::out::write;
 
@@ -65,7 +65,7 @@ pub fn run(args: &Args) -> Result<()> {
     if report.dropped_torn_line {
         eprintln!(
             "penmodel: the last line of {} was cut off by a crash and was not replayed",
-            journal::path_for(&args.doc).display()
+            journal::path_for(&persist::resolve_link(&args.doc).unwrap_or_else(|_| args.doc.clone())).display()
         );
     }
     let map = editor.heightmap();

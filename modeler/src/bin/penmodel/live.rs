@@ -158,8 +158,8 @@ fn default_source(open: Option<&Path>, window: bool) -> Result<String> {
     }
 }
 
-/// A new session (`doc` = None) or `penmodel open DOC`.
-pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
+/// A new session (`doc` = None) or `penmodel open DOC` (`--recover`: `recover`).
+pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
     let window_wanted = match args.show {
         Show::Headless => false,
         Show::Window => true,
@@ -174,7 +174,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>) -> Result<()> {
         ..document::Created::default()
     };
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
-    let (editor, doc_path) = document::open(args, open, demo, &mut created)?;
+    let (editor, doc_path) = document::open(args, open, recover, demo, &mut created)?;
     let mut session = Session::new(editor, [600.0, 340.0], Tuning::default());
     session.set_vertical_scale(args.vertical_scale);
     let look = look(args);

@@ -59,6 +59,11 @@ enum Command {
         /// The document (JSON); its journal, if any, is replayed first.
         #[arg(value_name = "DOC.json")]
         document: std::path::PathBuf,
+        /// Open a document whose journal has a bad line (a checksum or sequence number that does
+        /// not match, an edit that does not apply) up to its last good line: the journal as it
+        /// was is kept as DOC.json.journal.corrupt, and what was left out is said.
+        #[arg(long)]
+        recover: bool,
         #[command(flatten)]
         live: live::LiveArgs,
     },
@@ -85,8 +90,12 @@ enum Command {
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let result = match cli.command {
-        None => live::run(&cli.live, None),
-        Some(Command::Open { document, live }) => live::run(&live, Some(&document)),
+        None => live::run(&cli.live, None, false),
+        Some(Command::Open {
+            document,
+            recover,
+            live,
+        }) => live::run(&live, Some(&document), recover),
         Some(Command::Generate(args)) => generate::run(&args),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),

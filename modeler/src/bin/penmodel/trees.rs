@@ -16,7 +16,7 @@ use penmodel_terrain::trees::lod::{self, law};
 use penmodel_terrain::trees::nodes::STOP;
 use penmodel_terrain::trees::silhouette::Image;
 use penmodel_terrain::trees::{Drawn, NodeTree, Preset, Species, planted, wind};
-use penmodel_terrain::validate;
+use penmodel_terrain::{persist, validate};
 use serde_json::{Value, json};
 
 use crate::out::write;
@@ -178,7 +178,9 @@ fn check_q(q: f64, flag: &str) -> Result<()> {
 fn species(args: &SpeciesArgs) -> Result<Species> {
     match &args.maps {
         Some(path) => {
-            let text = std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
+            let bytes = persist::read_input(path, persist::MAX_INPUT_BYTES)
+                .with_context(|| format!("cannot read {}", path.display()))?;
+            let text = String::from_utf8(bytes).with_context(|| format!("{}: not UTF-8 text", path.display()))?;
             let maps: Vec<IfsMap> = serde_json::from_str(&text).with_context(|| {
                 format!(
                     "{}: not a list of maps ({{\"y\", \"s\", \"theta_z\", \"theta_y\"}}, …)",
@@ -473,7 +475,8 @@ fn append(dst: &mut Mesh, src: &Mesh) {
 }
 
 fn read_silhouette(path: &Path) -> Result<Image> {
-    let file = std::fs::File::open(path).with_context(|| format!("cannot read {}", path.display()))?;
+    let file = persist::open_input(path, persist::MAX_INPUT_BYTES)
+        .with_context(|| format!("cannot read {}", path.display()))?;
     Image::read_png(std::io::BufReader::new(file)).with_context(|| format!("{}", path.display()))
 }
 

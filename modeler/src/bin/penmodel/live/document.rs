@@ -5,7 +5,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result, bail};
 use penmodel::session::blank_document;
-use penmodel_terrain::editor::Editor;
+use penmodel_terrain::editor::{Editor, EditorError};
+use penmodel_terrain::journal::JournalError;
 
 use super::LiveArgs;
 
@@ -39,6 +40,9 @@ impl Created {
         if let Some(doc) = &self.document {
             remove(doc)?;
             remove(&penmodel_terrain::journal::path_for(doc))?;
+            // The session's own lock goes with the document it created (still held: nothing
+            // else can have opened a document this session only just made).
+            remove(&penmodel_terrain::lock::path_for(doc))?;
         }
         if let Some(mark) = &self.demo_mark {
             remove(mark)?;
@@ -52,11 +56,45 @@ impl Created {
 }
 
 /// The document `penmodel open` continues (its journal replayed), or a new session's, created
-/// where `--doc` or `--out` says; what it creates goes into `created`.
-pub fn open(args: &LiveArgs, open: Option<&Path>, demo: bool, created: &mut Created) -> Result<(Editor, PathBuf)> {
+/// where `--doc` or `--out` says; what it creates goes into `created`. `recover`: open a journal
+/// with a bad line up to its last good one (`penmodel open --recover`).
+pub fn open(
+    args: &LiveArgs,
+    open: Option<&Path>,
+    recover: bool,
+    demo: bool,
+    created: &mut Created,
+) -> Result<(Editor, PathBuf)> {
     Ok(match open {
         Some(path) => {
-            let (editor, report) = Editor::open(path)?;
+            let opened = match recover {
+                true => Editor::open_recovering(path),
+                false => Editor::open(path),
+            };
+            let (editor, report) = match opened {
+                Ok(opened) => opened,
+                Err(e @ (EditorError::Journal(JournalError::Corrupt { .. }) | EditorError::Replay { .. })) => {
+                    bail!(
+                        "{e}\n`penmodel open --recover {}` opens it up to the last good line (the journal as it is \
+                         is kept beside it)",
+                        path.display()
+                    )
+                }
+                Err(e) => return Err(e.into()),
+            };
+            if let Some(r) = &report.recovered {
+                eprintln!(
+                    "penmodel: recovered: journal lines {} to {} left out ({} line{}; line {}: {}); the journal as it \
+                     was is kept as {}",
+                    r.dropped.line,
+                    r.dropped.line + r.dropped.lines - 1,
+                    r.dropped.lines,
+                    if r.dropped.lines == 1 { "" } else { "s" },
+                    r.dropped.line,
+                    r.dropped.reason,
+                    r.copy.display()
+                );
+            }
             if report.replayed > 0 {
                 eprintln!("penmodel: {} journal entries replayed", report.replayed);
             }
