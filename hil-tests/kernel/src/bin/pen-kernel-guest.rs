@@ -673,15 +673,21 @@ fn send_paced(uhid: &uhid::Uhid, reports: &[Vec<u8>]) -> Result<()> {
 
 const PEND_HID_LOG: &str = "/tmp/pend-hid.log";
 
+/// `pend --source SOURCE --socket SOCKET`, its configuration in a folder of the guest's own.
+fn pend_command(source: &str, socket: &str) -> Command {
+    let mut pend = Command::new("/bin/pend");
+    pend.args(["--source", source, "--socket", socket])
+        .env("XDG_CONFIG_HOME", "/tmp/config");
+    pend
+}
+
 /// Step 2: `pend --source hid` (hidapi's enumeration and its hidraw reads) on the uhid device,
 /// a socket client, the device destroyed mid-stroke and created again.
 fn step_pend_hid() -> Result<String> {
     let log = File::create(PEND_HID_LOG)?;
     // Started before the device exists: it says what it waits for. Notices every 0.5 s
     // instead of 5 s, so the wait after the loss is logged soon.
-    let mut pend = Command::new("/bin/pend")
-        .args(["--source", "hid", "--socket", "/tmp/pend-hid.sock"])
-        .env("XDG_CONFIG_HOME", "/tmp/config")
+    let mut pend = pend_command("hid", "/tmp/pend-hid.sock")
         .env("PENSCAPE_NOTICE_SECS", "0.5")
         .stdin(Stdio::null())
         .stdout(Stdio::null())
@@ -929,17 +935,8 @@ fn step_uinput_refused() -> Result<String> {
 fn pend_refused() -> Result<String> {
     ensure!(!Path::new("/dev/uinput").exists(), "/dev/uinput is still there");
     let started = Instant::now();
-    let mut pend = Command::new("/bin/pend")
-        .args([
-            "--source",
-            "sim:draw-figures",
-            "--speed",
-            "4",
-            "--socket",
-            REFUSED_SOCKET,
-            "--virtual-tablet",
-        ])
-        .env("XDG_CONFIG_HOME", "/tmp/config")
+    let mut pend = pend_command("sim:draw-figures", REFUSED_SOCKET)
+        .args(["--speed", "4", "--virtual-tablet"])
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(Stdio::piped())
@@ -998,17 +995,8 @@ fn pend_refused() -> Result<String> {
 /// back through evdev.
 fn step_virtual_tablet() -> Result<String> {
     let log = File::create("/tmp/pend-vt.log")?;
-    let mut pend = Command::new("/bin/pend")
-        .args([
-            "--source",
-            "sim:draw-figures",
-            "--speed",
-            "4",
-            "--socket",
-            "/tmp/pend-vt.sock",
-        ])
-        .arg("--virtual-tablet")
-        .env("XDG_CONFIG_HOME", "/tmp/config")
+    let mut pend = pend_command("sim:draw-figures", "/tmp/pend-vt.sock")
+        .args(["--speed", "4", "--virtual-tablet"])
         .stdin(Stdio::null())
         .stdout(Stdio::null())
         .stderr(log)
