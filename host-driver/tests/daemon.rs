@@ -358,6 +358,22 @@ fn a_lagging_client_sees_its_loss_where_it_happened_and_the_state_after_it() {
         filled += 1;
         assert!(filled < 1_000_000, "the client's queue never filled");
     }
+    // The first miss can come while the writer thread still has room in the socket to drain the
+    // queue into; the gap below must fall where the writer is blocked. It is once publications
+    // spaced by pauses long enough for a writer to run are all missed.
+    let (mut missed_in_a_row, until) = (0, Instant::now() + GUARD);
+    while missed_in_a_row < 20 {
+        assert!(Instant::now() < until, "the client's writer never blocked");
+        let before = hub.counts();
+        std::thread::sleep(Duration::from_millis(2));
+        pen.sample(&hub, true, down);
+        let after = hub.counts();
+        if after.0 == before.0 && after.1 == before.1 + 1 {
+            missed_in_a_row += 1;
+        } else {
+            missed_in_a_row = 0;
+        }
+    }
     // All lost to it while it does not read: the tip lifted and put down again, SW3 pressed, the
     // device lost and found, the pen back with the tip down and SW2 pressed.
     let gap_from = pen.next_t;
@@ -377,7 +393,9 @@ fn a_lagging_client_sees_its_loss_where_it_happened_and_the_state_after_it() {
         let mut notice = false;
         read_events(theirs, |e| {
             notice |= matches!(e.kind, EventKind::Missed { .. });
-            let done = notice && e.seq.is_some();
+            // Earlier gaps may close while the writer still drains; the one that matters ends
+            // at or after the lost device.
+            let done = notice && e.seq.is_some() && e.t_us >= gap_to;
             if done {
                 flag.store(true, Ordering::Relaxed);
             }
