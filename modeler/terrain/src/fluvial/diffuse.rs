@@ -5,26 +5,36 @@
 
 use rayon::prelude::*;
 
+/// Columns per strip of the column pass: each strip is solved by one thread, its rows read in
+/// order (a strip's row is four cache lines of `f64`).
+const STRIP: usize = 32;
+
 /// Scratch rows for the solves, kept between steps.
 pub struct Diffusion {
     cols: usize,
     rows: usize,
-    /// Per row (or per column) the forward sweep's modified super-diagonal.
+    /// Per row the forward sweep's modified super-diagonal.
     cp: Vec<f64>,
-    /// The column pass's modified super-diagonal and right-hand side, one per cell.
-    col_cp: Vec<f64>,
-    col_dp: Vec<f64>,
+    /// Per strip of columns, the column pass's modified super-diagonal and its solution, a
+    /// strip's row after row (`STRIP` wide, the last strip narrower).
+    strips: Vec<(Vec<f64>, Vec<f64>)>,
 }
 
 impl Diffusion {
     /// Scratch for a `cols × rows` grid.
     pub fn new(cols: usize, rows: usize) -> Diffusion {
+        let inner = cols.saturating_sub(2);
+        let strips = (0..inner.div_ceil(STRIP))
+            .map(|s| {
+                let w = STRIP.min(inner - s * STRIP);
+                (vec![0.0; w * rows], vec![0.0; w * rows])
+            })
+            .collect();
         Diffusion {
             cols,
             rows,
             cp: vec![0.0; cols * rows],
-            col_cp: vec![0.0; cols * rows],
-            col_dp: vec![0.0; cols * rows],
+            strips,
         }
     }
 
@@ -44,32 +54,60 @@ impl Diffusion {
                 }
                 solve_line(line, cp, r);
             });
-        // Columns: every column at once, row after row, so memory is read in order.
-        let (cp, dp) = (&mut self.col_cp, &mut self.col_dp);
-        let b = 1.0 + 2.0 * r;
-        // Row 0 is held: the sweep starts from its heights.
-        for c in 1..cols - 1 {
-            cp[c] = 0.0;
-            dp[c] = h[c];
-        }
-        for y in 1..rows - 1 {
-            let (prev, here) = ((y - 1) * cols, y * cols);
-            let last = y + 2 == rows;
-            for c in 1..cols - 1 {
-                let mut rhs = h[here + c] + r * dp[prev + c];
-                if last {
-                    rhs += r * h[here + cols + c];
-                }
-                let denom = b - r * cp[prev + c];
-                cp[here + c] = if last { 0.0 } else { r / denom };
-                dp[here + c] = rhs / denom;
+        // Columns: a strip of them per task, row after row so memory is read in order; the
+        // solutions wait in the strips until every strip has read the heights.
+        let land: &[f64] = h;
+        self.strips.par_iter_mut().enumerate().for_each(|(s, (cp, x))| {
+            solve_strip(land, cols, rows, 1 + s * STRIP, cp, x, r);
+        });
+        let strips = &self.strips;
+        h.par_chunks_mut(cols).enumerate().for_each(|(y, line)| {
+            if y == 0 || y + 1 == rows {
+                return;
             }
-        }
-        for y in (1..rows - 1).rev() {
-            let here = y * cols;
-            for c in 1..cols - 1 {
-                h[here + c] = dp[here + c] + cp[here + c] * h[here + cols + c];
+            for (s, (_, x)) in strips.iter().enumerate() {
+                let w = x.len() / rows;
+                let from = 1 + s * STRIP;
+                line[from..from + w].copy_from_slice(&x[y * w..(y + 1) * w]);
             }
+        });
+    }
+}
+
+/// The column pass over the columns `from..from + w` (`w = x.len() / rows`): every column's
+/// system (−r, 1 + 2r, −r) over its inner rows, rows 0 and `rows − 1` held; the solution goes
+/// to `x`, row-major in the strip (its first and last rows are not the solution's).
+fn solve_strip(h: &[f64], cols: usize, rows: usize, from: usize, cp: &mut [f64], x: &mut [f64], r: f64) {
+    let w = x.len() / rows;
+    let b = 1.0 + 2.0 * r;
+    // Row 0 is held: the sweep starts from its heights.
+    for c in 0..w {
+        cp[c] = 0.0;
+        x[c] = h[from + c];
+    }
+    for y in 1..rows - 1 {
+        let (prev, here) = ((y - 1) * w, y * w);
+        let last = y + 2 == rows;
+        for c in 0..w {
+            let at = y * cols + from + c;
+            let mut rhs = h[at] + r * x[prev + c];
+            if last {
+                rhs += r * h[at + cols];
+            }
+            let denom = b - r * cp[prev + c];
+            cp[here + c] = if last { 0.0 } else { r / denom };
+            x[here + c] = rhs / denom;
+        }
+    }
+    for y in (1..rows - 1).rev() {
+        let (here, below) = (y * w, (y + 1) * w);
+        for c in 0..w {
+            let next = if y + 2 == rows {
+                h[(y + 1) * cols + from + c]
+            } else {
+                x[below + c]
+            };
+            x[here + c] += cp[here + c] * next;
         }
     }
 }

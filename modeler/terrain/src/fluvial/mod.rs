@@ -25,8 +25,9 @@
 //! parallel.
 //!
 //! **Deterministic**: the same sketch and settings give the same bits, on any number of
-//! threads (the rows of the diffusion run in parallel, each alone; everything else in one
-//! order). **Not incremental**: drainage area makes every cell depend on its whole catchment,
+//! threads: what runs in parallel (receivers, the diffusion's rows and strips of columns, the
+//! stream-power step and the areas on runs of whole edge basins) works on each cell alone or
+//! in the stack's own order. **Not incremental**: drainage area makes every cell depend on its whole catchment,
 //! so any change of the sketch re-erodes the whole grid (the engine says so:
 //! `TerrainEngine::update` returns the whole grid).
 
@@ -34,13 +35,16 @@ pub mod diffuse;
 pub mod measure;
 pub mod route;
 
+use rayon::prelude::*;
+
 use crate::document::Fluvial;
 use crate::heightmap::Heightmap;
 
-/// Bytes of memory per cell while eroding: eight `f64` arrays (heights, sketch, fill,
-/// distances, areas, the diffusion's three scratch rows), five `u32` (receivers, stack, donors
-/// and two donor offsets), the closed flags and the priority queue at its largest.
-pub const BYTES_PER_CELL: usize = 8 * 8 + 5 * 4 + 1 + 16;
+/// Bytes of memory per cell while eroding: ten `f64` arrays (heights, sketch, fill, distances,
+/// areas, the diffusion's three scratch rows, the stack's heights and areas), one pair of `f64`
+/// (the stack's coefficients), seven `u32` (receivers, stack, places in it, receivers' places,
+/// donors and two donor offsets) and the priority queue at its largest.
+pub const BYTES_PER_CELL: usize = 10 * 8 + 16 + 7 * 4 + 16;
 
 /// The state of an erosion run on one grid.
 pub struct Model {
@@ -51,6 +55,10 @@ pub struct Model {
     /// The sketch it is raised toward.
     target: Vec<f64>,
     routing: route::Routing,
+    /// By place in the stack: heights while the stream-power step solves them.
+    stack_h: Vec<f64>,
+    /// By place in the stack: the raised height and the water's coefficient.
+    coefficients: Vec<(f64, f64)>,
     diffusion: diffuse::Diffusion,
     /// `(a·dx²)^m` for drainage areas of `a` cells below the table's length.
     area_pow: Vec<f64>,
@@ -129,6 +137,8 @@ impl Model {
             h,
             target,
             routing: route::Routing::new(cols, rows),
+            stack_h: vec![0.0; cols * rows],
+            coefficients: vec![(0.0, 0.0); cols * rows],
             diffusion: diffuse::Diffusion::new(cols, rows),
             area_pow,
             held: Vec::new(),
@@ -185,40 +195,56 @@ impl Model {
         self.routing.route(&self.h);
         let w = &self.routing;
         let kdt = s.k * dt;
-        for &i in &w.stack {
-            let i = i as usize;
-            let r = w.receiver[i] as usize;
-            if r == i {
-                continue;
+        let cell = self.cell;
+        let (h, target, held, area_pow) = (&self.h, &self.target, &self.held, &self.area_pow);
+        // By place in the stack, in parallel: each cell's height, the height it is raised to and
+        // the water's coefficient `f` in `(1 + a)·x + f·x^n = b` (negative: the cell is left as
+        // it is, an outlet or held).
+        self.stack_h
+            .par_iter_mut()
+            .zip(self.coefficients.par_iter_mut())
+            .zip(w.stack.par_iter().zip(w.receiver_pos.par_iter()))
+            .enumerate()
+            .for_each(|(p, ((hs, co), (&i, &q)))| {
+                let i = i as usize;
+                *hs = h[i];
+                if q as usize == p || held.get(i).copied().unwrap_or(false) {
+                    *co = (0.0, -1.0);
+                    return;
+                }
+                let area = w.stack_area[p];
+                let am = match area_pow.get(area as usize) {
+                    Some(&v) => v,
+                    None => (area * cell * cell).powf(s.m),
+                };
+                let d = w.dist[i] * cell;
+                let f = kdt * am / if s.n == 1.0 { d } else { d.powf(s.n) };
+                *co = (h[i] + a * target[i], f);
+            });
+        // Then up the stack from the outlets, each run of basins on its own thread (a cell's
+        // receiver is in its run), then the flooded cells, which may drain into any run.
+        let (co, rpos) = (&self.coefficients, &w.receiver_pos);
+        let flooded = w.flooded_from();
+        route::split_runs(&mut self.stack_h[..flooded], w.runs())
+            .into_par_iter()
+            .for_each(|(start, run)| {
+                for k in 0..run.len() {
+                    let q = rpos[start + k] as usize;
+                    if let Some(v) = solve(co[start + k], run[q - start], a, s.n) {
+                        run[k] = v;
+                    }
+                }
+            });
+        for p in flooded..self.stack_h.len() {
+            if let Some(v) = solve(co[p], self.stack_h[rpos[p] as usize], a, s.n) {
+                self.stack_h[p] = v;
             }
-            if self.held.get(i).copied().unwrap_or(false) {
-                continue;
-            }
-            let old = self.h[i];
-            let raised = old + a * self.target[i];
-            let hr = self.h[r];
-            // The height above the receiver the cell would have without the water's work.
-            let b = raised - (1.0 + a) * hr;
-            if b <= 0.0 {
-                // At or below its receiver (a filled depression): only raised.
-                self.h[i] = raised / (1.0 + a);
-                continue;
-            }
-            let area = w.area[i] as usize;
-            let am = match self.area_pow.get(area) {
-                Some(&v) => v,
-                None => (w.area[i] * self.cell * self.cell).powf(s.m),
-            };
-            let d = w.dist[i] * self.cell;
-            let f = kdt * am / if s.n == 1.0 { d } else { d.powf(s.n) };
-            // The implicit step in x = h − h_r: (1 + a)·x + f·x^n = b.
-            let x = if s.n == 1.0 {
-                b / (1.0 + a + f)
-            } else {
-                newton(b, 1.0 + a, f, s.n)
-            };
-            self.h[i] = hr + x;
         }
+        let stack_h = &self.stack_h;
+        self.h
+            .par_iter_mut()
+            .zip(w.pos.par_iter())
+            .for_each(|(v, &p)| *v = stack_h[p as usize]);
         let r = s.diffusivity(self.cell) * dt / (self.cell * self.cell);
         self.diffusion.step(&mut self.h, r);
         for (i, &on) in self.held.iter().enumerate() {
@@ -228,6 +254,27 @@ impl Model {
         }
         self.done += 1;
     }
+}
+
+/// A cell's new height from its coefficients `(raised, f)` and its receiver's new height `hr`
+/// (none for a cell left as it is): the implicit step in `x = h − h_r`,
+/// `(1 + a)·x + f·x^n = b`, with `b` the height above the receiver the cell would have without
+/// the water's work.
+fn solve((raised, f): (f64, f64), hr: f64, a: f64, n: f64) -> Option<f64> {
+    if f < 0.0 {
+        return None;
+    }
+    let b = raised - (1.0 + a) * hr;
+    if b <= 0.0 {
+        // At or below its receiver (a filled depression): only raised.
+        return Some(raised / (1.0 + a));
+    }
+    let x = if n == 1.0 {
+        b / (1.0 + a + f)
+    } else {
+        newton(b, 1.0 + a, f, n)
+    };
+    Some(hr + x)
 }
 
 /// The root `x` in `[0, b/c]` of `c·x + f·x^n = b` (b > 0, c ≥ 1, f ≥ 0, n > 0): Newton's method

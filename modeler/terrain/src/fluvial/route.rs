@@ -46,8 +46,16 @@ pub struct Routing {
     pub stack: Vec<u32>,
     /// Drainage area in cells (the cell itself included).
     pub area: Vec<f64>,
-    /// Whether a cell is in the stack already (drained, or reached by the flood).
-    closed: Vec<bool>,
+    /// Each cell's place in the stack (`u32::MAX` while it is not in it).
+    pub pos: Vec<u32>,
+    /// By place in the stack: the receiver's place.
+    pub receiver_pos: Vec<u32>,
+    /// By place in the stack: the drainage area.
+    pub stack_area: Vec<f64>,
+    /// Places in the stack where runs of whole edge basins start, then where the basins end
+    /// (the flooded cells follow): no cell in one run drains through another, so the runs can
+    /// be worked on at once.
+    runs: Vec<usize>,
     heap: BinaryHeap<Reverse<(u64, u32)>>,
     pit: VecDeque<u32>,
     donors: Vec<u32>,
@@ -69,7 +77,10 @@ impl Routing {
             dist: vec![1.0; n],
             stack: Vec::with_capacity(n),
             area: vec![0.0; n],
-            closed: vec![false; n],
+            pos: vec![u32::MAX; n],
+            receiver_pos: vec![0; n],
+            stack_area: vec![0.0; n],
+            runs: Vec::new(),
             heap: BinaryHeap::new(),
             pit: VecDeque::new(),
             donors: vec![0; n],
@@ -204,13 +215,19 @@ impl Routing {
         let (cols, rows) = (self.cols, self.rows);
         self.stack.clear();
         self.sinks.clear();
-        self.closed.iter_mut().for_each(|c| *c = false);
+        self.runs.clear();
+        self.runs.push(0);
+        // Runs of a few thousand cells at least, so a thread's task outweighs its hand-over.
+        let run = (cols * rows / 64).max(4096);
         for root in 0..cols * rows {
             if self.receiver[root] as usize != root {
                 continue;
             }
             let (c, r) = (root % cols, root / cols);
             let edge = c == 0 || r == 0 || c + 1 == cols || r + 1 == rows;
+            if edge && self.stack.len() - self.runs[self.runs.len() - 1] >= run {
+                self.runs.push(self.stack.len());
+            }
             let list = if edge { &mut self.stack } else { &mut self.sinks };
             let start = list.len();
             list.push(root as u32);
@@ -222,8 +239,12 @@ impl Routing {
                 k += 1;
             }
         }
-        for &i in &self.stack {
-            self.closed[i as usize] = true;
+        if self.stack.len() > self.runs[self.runs.len() - 1] {
+            self.runs.push(self.stack.len());
+        }
+        self.pos.iter_mut().for_each(|p| *p = u32::MAX);
+        for (p, &i) in self.stack.iter().enumerate() {
+            self.pos[i as usize] = p as u32;
         }
     }
 
@@ -243,7 +264,7 @@ impl Routing {
         // `donors`, marks them).
         for &s in &self.sinks {
             for (_, n) in neighbours(s as usize) {
-                if self.closed[n] && self.fill_at[n] != u32::MAX {
+                if self.pos[n] != u32::MAX && self.fill_at[n] != u32::MAX {
                     self.fill_at[n] = u32::MAX;
                     self.heap.push(Reverse((key(h[n]), n as u32)));
                 }
@@ -259,10 +280,10 @@ impl Routing {
             };
             let spill = next_up(self.filled[c]);
             for (k, n) in neighbours(c) {
-                if self.closed[n] {
+                if self.pos[n] != u32::MAX {
                     continue;
                 }
-                self.closed[n] = true;
+                self.pos[n] = self.stack.len() as u32;
                 self.receiver[n] = c as u32;
                 self.dist[n] = if k < 4 { 1.0 } else { std::f64::consts::SQRT_2 };
                 self.stack.push(n as u32);
@@ -277,15 +298,66 @@ impl Routing {
         }
     }
 
+    /// Places in the stack where runs of whole edge basins start, then where the last ends:
+    /// a cell's receiver is in its own run; the flooded cells (which may drain into any run)
+    /// come after the last.
+    pub fn runs(&self) -> &[usize] {
+        &self.runs
+    }
+
+    /// Where the flooded cells start in the stack.
+    pub fn flooded_from(&self) -> usize {
+        self.runs[self.runs.len() - 1]
+    }
+
+    /// Drainage areas, summed down the stack in its place order (each cell's donors come
+    /// after it): the flooded cells first, then every run of basins on its own thread, and
+    /// always in the stack's reverse order, so the sums are the same bits on any number of
+    /// threads.
     fn accumulate(&mut self) {
-        self.area.iter_mut().for_each(|a| *a = 1.0);
-        for &i in self.stack.iter().rev() {
-            let r = self.receiver[i as usize] as usize;
-            if r != i as usize {
-                self.area[r] += self.area[i as usize];
+        let (stack, pos, receiver) = (&self.stack, &self.pos, &self.receiver);
+        self.receiver_pos
+            .par_iter_mut()
+            .zip(stack.par_iter())
+            .for_each(|(rp, &i)| *rp = pos[receiver[i as usize] as usize]);
+        let rpos = &self.receiver_pos;
+        let areas = &mut self.stack_area;
+        areas.iter_mut().for_each(|a| *a = 1.0);
+        let flooded = self.runs[self.runs.len() - 1];
+        for p in (flooded..stack.len()).rev() {
+            let q = rpos[p] as usize;
+            if q != p {
+                areas[q] += areas[p];
             }
         }
+        split_runs(&mut areas[..flooded], &self.runs)
+            .into_par_iter()
+            .for_each(|(start, run)| {
+                for k in (0..run.len()).rev() {
+                    let q = rpos[start + k] as usize;
+                    if q != start + k {
+                        run[q - start] += run[k];
+                    }
+                }
+            });
+        let areas = &self.stack_area;
+        self.area
+            .par_iter_mut()
+            .zip(pos.par_iter())
+            .for_each(|(a, &p)| *a = areas[p as usize]);
     }
+}
+
+/// `values` (by place in the stack, up to the flooded cells) cut at `runs`' places: each run
+/// with the place it starts at.
+pub fn split_runs<'a, T>(mut values: &'a mut [T], runs: &[usize]) -> Vec<(usize, &'a mut [T])> {
+    let mut out = Vec::with_capacity(runs.len());
+    for w in runs.windows(2) {
+        let (run, rest) = values.split_at_mut(w[1] - w[0]);
+        out.push((w[0], run));
+        values = rest;
+    }
+    out
 }
 
 #[cfg(test)]
@@ -316,6 +388,49 @@ mod tests {
         assert_eq!(w.area[2 * 5 + 4], 10.0);
         // The pit fills to just above the plateau around it.
         assert!(w.filled[2 * 5 + 2] > 5.0 && w.filled[2 * 5 + 2] < 5.0 + 1e-9);
+    }
+
+    /// The runs the stream-power step solves in parallel hold whole basins: every cell's
+    /// receiver is in its own run, or the cell is flooded and comes after every run; the areas
+    /// summed on the runs are the stack's.
+    #[test]
+    fn every_run_holds_its_cells_receivers() {
+        let (cols, rows) = (200, 180);
+        // A cone with noise: it drains to every side.
+        let mut h: Vec<f64> = (0..cols * rows)
+            .map(|i| {
+                let (x, y) = ((i % cols) as f64 - 100.0, (i / cols) as f64 - 90.0);
+                let noise = (super::super::mix(7, i as u64) % 1000) as f64 / 1000.0;
+                200.0 - (x * x + y * y).sqrt() + 0.8 * noise
+            })
+            .collect();
+        // And two pits dug into its flanks.
+        h[50 * cols + 60] -= 10.0;
+        h[130 * cols + 150] -= 4.0;
+        let mut w = Routing::new(cols, rows);
+        w.route(&h);
+        assert!(w.runs().len() > 3, "several runs: {:?}", w.runs());
+        assert!(w.flooded_from() < w.stack.len(), "some cells are flooded");
+        for run in w.runs().windows(2) {
+            for p in run[0]..run[1] {
+                let q = w.receiver_pos[p] as usize;
+                assert!(
+                    (run[0]..=p).contains(&q),
+                    "place {p}'s receiver at {q}, outside {run:?}"
+                );
+            }
+        }
+        for p in w.flooded_from()..w.stack.len() {
+            assert!((w.receiver_pos[p] as usize) < p, "flooded place {p}");
+        }
+        let mut area = vec![1.0; cols * rows];
+        for &i in w.stack.iter().rev() {
+            let r = w.receiver[i as usize] as usize;
+            if r != i as usize {
+                area[r] += area[i as usize];
+            }
+        }
+        assert_eq!(area, w.area);
     }
 
     #[test]
