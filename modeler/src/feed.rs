@@ -9,6 +9,7 @@
 //!   real pen goes through.
 //! - [`PenSource::Daemon`]: events from `pend`'s socket.
 //! - [`PenSource::Device`]: a base station over USB HID or serial, with a calibration file.
+//! - [`PenSource::Mouse`]: the window's pointer as the pen ([`crate::mouse`]).
 //! - [`PenSource::None`]: no pen; the document is looked at and edited from the keyboard.
 //!
 //! The thread sends [`Feed`] messages over a bounded channel: when the modeler is slower than
@@ -148,6 +149,9 @@ pub enum PenSource {
     Daemon(PathBuf),
     /// No pen: the session is looked at and edited from the keyboard.
     None,
+    /// The window's mouse or tablet pointer as the pen ([`crate::mouse`]); the window makes its
+    /// events, the pen thread only says so.
+    Mouse,
     /// A device, and its calibration file (`None`: the default file if it exists).
     Device {
         /// HID, serial, or a named simulated scenario.
@@ -158,18 +162,19 @@ pub enum PenSource {
 }
 
 impl PenSource {
-    /// `sim` (the demo), `none`, `daemon`, `daemon:SOCKET`, `hid`, `hid:PATH`, `serial:PATH` or
+    /// `sim` (the demo), `none`, `mouse`, `daemon`, `daemon:SOCKET`, `hid`, `hid:PATH`, `serial:PATH` or
     /// `sim:SCENARIO` (a named pen-sim scenario with an identity calibration).
     pub fn parse(s: &str, speed: f64) -> Result<PenSource, String> {
         match s.split_once(':') {
             None if s == "sim" => Ok(PenSource::Demo { speed, seed: 1 }),
             None if s == "none" => Ok(PenSource::None),
+            None if s == "mouse" => Ok(PenSource::Mouse),
             None if s == "daemon" => Ok(PenSource::Daemon(pen_host::daemon::default_socket())),
             Some(("daemon", path)) if !path.is_empty() => Ok(PenSource::Daemon(PathBuf::from(path))),
             _ => {
                 let mut source: Source = s.parse().map_err(|e| match e {
                     SourceError::UnknownKind { given } => format!(
-                        "unknown source {given:?}: sim (the built-in demo), sim:SCENARIO, none, daemon, \
+                        "unknown source {given:?}: sim (the built-in demo), sim:SCENARIO, mouse, none, daemon, \
                          daemon:SOCKET, hid, hid:PATH or serial:PATH"
                     ),
                     other => other.to_string(),
@@ -209,6 +214,13 @@ pub fn spawn(source: PenSource, capacity: usize) -> (Receiver<Feed>, JoinHandle<
                 PenSource::Daemon(path) => run_daemon(&tx, &path),
                 // Said once; the channel then closes and the session goes on without a pen.
                 PenSource::None => send(&tx, Feed::Status("no pen: keyboard only".into())),
+                PenSource::Mouse => send(
+                    &tx,
+                    Feed::Status(
+                        "the mouse is the pen: left draws, right grabs, the wheel lifts, middle or Space is SW3 (h: help)"
+                            .into(),
+                    ),
+                ),
                 PenSource::Device { source, calibration } => run_device(&tx, source, calibration),
             };
             // A closed channel means the modeler is gone: nothing to tell.

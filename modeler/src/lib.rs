@@ -6,7 +6,8 @@
 //!   rocks, rivers, ridgelines, trees — with undo, pan and zoom (`docs/modeler.md`).
 //! - [`feed`] and [`session`]: pen events from the built-in demo, `pend` or a device, on a thread
 //!   of their own, into an editor.
-//! - [`keys`]: the live window's keys and the help it shows for them.
+//! - [`keys`]: the live window's keys and the help it shows for them; [`mouse`]: the window's
+//!   pointer as the pen, for users without a base station.
 //! - [`picture`]: what a frame of the session shows — the document and the interaction turned
 //!   into the renderer's plain-data scene.
 //! - [`painter`]: frames of a session — the view, the overview and map, the trees held to the
@@ -20,6 +21,7 @@ pub mod interaction;
 pub mod keys;
 pub mod latch;
 pub mod latency;
+pub mod mouse;
 pub mod painter;
 pub mod picture;
 pub mod session;

@@ -268,7 +268,7 @@ fn a_real_session_never_overwrites_a_document() {
     assert_eq!(bad.status.code(), Some(2));
     let stderr = String::from_utf8_lossy(&bad.stderr);
     assert!(
-        stderr.contains("sim (the built-in demo), sim:SCENARIO, none, daemon"),
+        stderr.contains("sim (the built-in demo), sim:SCENARIO, mouse, none, daemon"),
         "{stderr}"
     );
     assert_eq!(

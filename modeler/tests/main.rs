@@ -5,6 +5,7 @@ mod demo_cli;
 mod help_examples;
 mod interaction;
 mod kill_loop;
+mod mouse_window;
 mod ridges_cli;
 mod river_cli;
 mod rocks_cli;

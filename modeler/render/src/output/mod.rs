@@ -19,7 +19,7 @@ use thiserror::Error;
 pub use png::{encode_png, write_png};
 pub use sequence::Sequence;
 #[cfg(feature = "window")]
-pub use window::{Viewer, ViewerEvent, WindowError};
+pub use window::{Pointer, Viewer, ViewerEvent, WindowError};
 
 /// Why a frame could not be written.
 #[allow(missing_docs)] // the fields say which file or frame and why.

@@ -19,7 +19,7 @@ use std::thread::JoinHandle;
 use thiserror::Error;
 use winit::application::ApplicationHandler;
 use winit::dpi::PhysicalSize;
-use winit::event::{ElementState, WindowEvent};
+use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop, EventLoopProxy};
 use winit::keyboard::{Key, NamedKey};
 use winit::window::{Window, WindowId};
@@ -42,14 +42,29 @@ pub enum WindowError {
 
 /// What the viewer reports.
 #[allow(missing_docs)] // fields named for what they hold.
-#[derive(Debug, Clone, PartialEq, Eq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum ViewerEvent {
     /// The window's drawable area is now this many pixels.
     Resized { width: u32, height: u32 },
     /// A key was pressed: its text (`"u"`, `"+"`) or name (`"Escape"`, `"ArrowLeft"`).
+    /// Space is not a key here: it is the pointer's third button ([`Pointer`]).
     Key(String),
+    /// The mouse (or a tablet's pointer) moved, a button changed or the wheel turned.
+    Pointer(Pointer),
     /// The user closed the window.
     Closed,
+}
+
+/// The pointer over the frame shown.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Pointer {
+    /// Where, as fractions of the frame's width and height from its top-left corner; `None`
+    /// when the pointer is off the frame (outside the window, or on the black bars).
+    pub at: Option<[f64; 2]>,
+    /// Left, right and middle button held (the middle one also while Space is held).
+    pub buttons: [bool; 3],
+    /// Wheel notches turned since the last event, away from the user positive.
+    pub wheel: f64,
 }
 
 enum Command {
@@ -73,6 +88,10 @@ struct App {
     frame: Option<Arc<Frame>>,
     events: Sender<ViewerEvent>,
     failed: Option<Sender<Result<(), WindowError>>>,
+    /// The cursor in window pixels, while it is in the window.
+    cursor: Option<(f64, f64)>,
+    /// Left, right and middle button, and Space.
+    held: [bool; 4],
 }
 
 impl App {
@@ -110,15 +129,28 @@ impl App {
     }
 }
 
-/// Scales `frame` into a `w × h` 0RGB buffer, aspect kept, centred.
-fn blit(frame: &Frame, out: &mut [u32], w: usize, h: usize) {
-    let (fw, fh) = (frame.width() as usize, frame.height() as usize);
+/// Where `frame` goes in a `w × h` window: its top-left corner and drawn size, pixels.
+fn placement(frame: (usize, usize), w: usize, h: usize) -> (usize, usize, usize, usize) {
+    let (fw, fh) = frame;
     let scale = (w as f64 / fw as f64).min(h as f64 / fh as f64);
     let (dw, dh) = (
         ((fw as f64 * scale) as usize).max(1),
         ((fh as f64 * scale) as usize).max(1),
     );
-    let (ox, oy) = ((w.saturating_sub(dw)) / 2, (h.saturating_sub(dh)) / 2);
+    ((w.saturating_sub(dw)) / 2, (h.saturating_sub(dh)) / 2, dw, dh)
+}
+
+/// The window pixel `(x, y)` as fractions of the frame placed by [`placement`], if on it.
+fn on_frame(frame: (usize, usize), window: (usize, usize), (x, y): (f64, f64)) -> Option<[f64; 2]> {
+    let (ox, oy, dw, dh) = placement(frame, window.0, window.1);
+    let (fx, fy) = ((x - ox as f64) / dw as f64, (y - oy as f64) / dh as f64);
+    ((0.0..=1.0).contains(&fx) && (0.0..=1.0).contains(&fy)).then_some([fx, fy])
+}
+
+/// Scales `frame` into a `w × h` 0RGB buffer, aspect kept, centred.
+fn blit(frame: &Frame, out: &mut [u32], w: usize, h: usize) {
+    let (fw, fh) = (frame.width() as usize, frame.height() as usize);
+    let (ox, oy, dw, dh) = placement((fw, fh), w, h);
     let px = frame.pixels();
     for y in 0..dh.min(h) {
         let sy = (y * fh / dh).min(fh - 1);
@@ -137,6 +169,31 @@ fn key_name(key: &Key) -> Option<String> {
         Key::Named(NamedKey::Space) => Some(" ".into()),
         Key::Named(named) => Some(format!("{named:?}")),
         _ => None,
+    }
+}
+
+impl App {
+    /// Tells the pointer's state, `wheel` notches turned with it.
+    fn pointer(&self, wheel: f64) {
+        let Some(window) = &self.window else {
+            return;
+        };
+        // Before the first frame, the one that will come: the window's size when opened.
+        let frame = self.frame.as_ref().map_or(self.size, |f| (f.width(), f.height()));
+        let size = window.inner_size();
+        let at = self.cursor.and_then(|c| {
+            on_frame(
+                (frame.0 as usize, frame.1 as usize),
+                (size.width as usize, size.height as usize),
+                c,
+            )
+        });
+        let h = self.held;
+        let _ = self.events.send(ViewerEvent::Pointer(Pointer {
+            at,
+            buttons: [h[0], h[1], h[2] || h[3]],
+            wheel,
+        }));
     }
 }
 
@@ -183,10 +240,43 @@ impl ApplicationHandler<Command> for App {
                 }
             }
             WindowEvent::RedrawRequested => self.present(),
+            WindowEvent::KeyboardInput { event, .. } if event.logical_key == Key::Named(NamedKey::Space) => {
+                let down = event.state == ElementState::Pressed;
+                if self.held[3] != down {
+                    self.held[3] = down;
+                    self.pointer(0.0);
+                }
+            }
             WindowEvent::KeyboardInput { event, .. } if event.state == ElementState::Pressed => {
                 if let Some(name) = key_name(&event.logical_key) {
                     let _ = self.events.send(ViewerEvent::Key(name));
                 }
+            }
+            WindowEvent::CursorMoved { position, .. } => {
+                self.cursor = Some((position.x, position.y));
+                self.pointer(0.0);
+            }
+            WindowEvent::CursorLeft { .. } => {
+                self.cursor = None;
+                self.pointer(0.0);
+            }
+            WindowEvent::MouseInput { state, button, .. } => {
+                let i = match button {
+                    MouseButton::Left => 0,
+                    MouseButton::Right => 1,
+                    MouseButton::Middle => 2,
+                    _ => return,
+                };
+                self.held[i] = state == ElementState::Pressed;
+                self.pointer(0.0);
+            }
+            WindowEvent::MouseWheel { delta, .. } => {
+                // A line is a notch; a touchpad's pixels count 20 to a notch.
+                let notches = match delta {
+                    MouseScrollDelta::LineDelta(_, y) => f64::from(y),
+                    MouseScrollDelta::PixelDelta(p) => p.y / 20.0,
+                };
+                self.pointer(notches);
             }
             _ => {}
         }
@@ -255,6 +345,8 @@ impl Viewer {
                     frame: None,
                     events: events_tx,
                     failed: Some(created_tx),
+                    cursor: None,
+                    held: [false; 4],
                 };
                 if let Err(e) = event_loop.run_app(&mut app)
                     && let Some(tx) = app.failed.take()
@@ -318,6 +410,14 @@ impl Drop for Viewer {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_window_pixel_is_found_on_the_frame_it_shows() {
+        // A 200 × 100 frame in a 400 × 400 window: drawn 400 × 200 from y = 100.
+        assert_eq!(on_frame((200, 100), (400, 400), (0.0, 100.0)), Some([0.0, 0.0]));
+        assert_eq!(on_frame((200, 100), (400, 400), (100.0, 250.0)), Some([0.25, 0.75]));
+        assert_eq!(on_frame((200, 100), (400, 400), (100.0, 50.0)), None, "on the bar");
+    }
 
     #[test]
     fn blit_keeps_the_aspect_and_centres() {

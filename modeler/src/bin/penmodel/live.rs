@@ -44,10 +44,11 @@ pub enum Show {
 #[derive(clap::Args, Clone)]
 pub struct LiveArgs {
     /// The pen: daemon (pend's), daemon:SOCKET, hid (the first base station on USB), hid:PATH,
-    /// serial:PATH, none (keyboard only), sim (the built-in demo: the simulated pen calibrates on
-    /// nine targets, then plays modeling-session) or sim:SCENARIO (a pen-sim scenario,
-    /// uncalibrated) [default: daemon if pend is running; else sim for a new session, none for
-    /// `open` in a window].
+    /// serial:PATH, mouse (the window's mouse or tablet pointer: left draws, right is SW2, the
+    /// wheel lifts, middle or Space is SW3), none (keyboard only), sim (the built-in demo: the
+    /// simulated pen calibrates on nine targets, then plays modeling-session) or sim:SCENARIO (a
+    /// pen-sim scenario, uncalibrated) [default: daemon if pend is running; else sim for a new
+    /// session, mouse for `open` in a window].
     #[arg(long, value_name = "SOURCE", value_parser = source)]
     source: Option<String>,
     /// Window, files, or a window when there is a display.
@@ -143,11 +144,11 @@ fn default_source(open: Option<&Path>, window: bool) -> Result<String> {
         None => Ok("sim".into()),
         Some(_) if window => {
             eprintln!(
-                "penmodel: no pen (pend is not running at {}): the document is open to look at and to edit \
-                 from the keyboard; start pend, or give --source hid|serial:PATH, to model with the pen",
+                "penmodel: no pen (pend is not running at {}): the mouse is the pen; start pend, or give \
+                 --source hid|serial:PATH, to model with the 3D pen",
                 socket.display()
             );
-            Ok("none".into())
+            Ok("mouse".into())
         }
         Some(doc) => bail!(
             "no pen to model {} with: pend is not running at {}. Start pend (pend --hid, or pend --serial PATH), \
@@ -166,6 +167,14 @@ pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
         Show::Auto => output::window::has_display(),
     };
     let (source_name, source) = pen_source(args, open, window_wanted)?;
+    if matches!(source, PenSource::Mouse) && !window_wanted {
+        // A usage error (2), before anything is created.
+        clap::Error::raw(
+            clap::error::ErrorKind::ArgumentConflict,
+            "--source mouse needs a window (--show window, or a display for --show auto)\n",
+        )
+        .exit();
+    }
     let demo = matches!(source, PenSource::Demo { .. });
     // What this session creates it removes again if nothing is modeled: no empty results.
     let mut created = document::Created {
@@ -195,6 +204,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
     // The pen thread is not joined: it notices the closed channel only at its next message, and
     // a silent pen (pend without a device, a base station unplugged) sends none. It ends with
     // the process; it holds nothing that needs closing beyond what the process's end closes.
+    let mouse_pen = matches!(source, PenSource::Mouse);
     let (rx, _thread) = feed::spawn(source, 256);
     eprintln!("penmodel: pen from {source_name}");
 
@@ -222,7 +232,10 @@ pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
     };
     let mut painter = Painter::new(w, h, layout)?;
     let written = match viewer {
-        Some(v) => window::run(v, &rx, &mut session, &look, &mut painter, &stop)?,
+        Some(v) => {
+            let mouse = mouse_pen.then(penmodel::mouse::MousePen::new);
+            window::run(v, &rx, &mut session, &look, &mut painter, &stop, mouse)?
+        }
         None => headless::run(args, &rx, &mut session, &look, &mut painter, &stop, demo_us)?,
     };
     drop(rx);

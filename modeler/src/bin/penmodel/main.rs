@@ -48,10 +48,10 @@ struct Cli {
 enum Command {
     /// Continue modeling a saved document with the pen.
     #[command(
-        after_help = "Without pend or --source, a window opens the document with no pen (keyboard only); \
-    headless it is refused.\n\
+        after_help = "Without pend or --source, a window opens the document with the mouse as the pen \
+    (docs/modeler.md, Mouse); headless it is refused.\n\
     Examples:\n  \
-    penmodel open out/document.json                         # with pend's pen, or none\n  \
+    penmodel open out/document.json                         # with pend's pen, or the mouse\n  \
     penmodel open out/document.json --source serial:/dev/ttyACM0\n  \
     penmodel open out/document.json --show headless --source daemon --out run2"
     )]

@@ -8,6 +8,7 @@ use std::time::{Duration, Instant};
 use anyhow::Result;
 use penmodel::feed::Feed;
 use penmodel::keys::{self, KeyAction};
+use penmodel::mouse::{MousePen, PointerState};
 use penmodel::painter::{Overview, Painter};
 use penmodel::picture::Look;
 use penmodel::session::Session;
@@ -45,7 +46,15 @@ fn tell(messages: Vec<String>, notice: &mut Option<Notice>) {
     say(messages, None);
 }
 
-/// Runs the session until the window closes (or a signal stops it).
+/// Host time, µs since the Unix epoch, as a pen's events carry it.
+fn now_us() -> u64 {
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| d.as_micros() as u64)
+}
+
+/// Runs the session until the window closes (or a signal stops it); with `mouse`, the window's
+/// pointer is the pen.
 pub fn run(
     mut viewer: Viewer,
     rx: &Receiver<Feed>,
@@ -53,6 +62,7 @@ pub fn run(
     look: &Look,
     painter: &mut Painter,
     stop: &AtomicBool,
+    mut mouse: Option<MousePen>,
 ) -> Result<Written> {
     const FRAME: Duration = Duration::from_millis(16);
     let mut dirty = true;
@@ -62,12 +72,29 @@ pub fn run(
     let mut notice: Option<Notice> = None;
     'session: while viewer.is_open() && !stop.load(Ordering::Relaxed) {
         while let Some(e) = viewer.poll() {
-            let ViewerEvent::Key(k) = &e else {
-                if e == ViewerEvent::Closed {
-                    break 'session;
+            let k = match &e {
+                ViewerEvent::Key(k) => k,
+                ViewerEvent::Closed => break 'session,
+                ViewerEvent::Pointer(p) => {
+                    if let Some(m) = mouse.as_mut() {
+                        let frame = painter.view_frame();
+                        let pointer = PointerState {
+                            at: p.at,
+                            buttons: p.buttons,
+                            wheel: p.wheel,
+                        };
+                        let display = session.interaction.view().display_mm;
+                        for event in m.update(pointer, display, [frame.width(), frame.height()], now_us()) {
+                            tell(session.feed(Feed::Event(event)), &mut notice);
+                        }
+                        dirty = true;
+                    }
+                    continue;
                 }
-                dirty = true;
-                continue;
+                ViewerEvent::Resized { .. } => {
+                    dirty = true;
+                    continue;
+                }
             };
             match keys::action(k, session.interaction.view().display_mm) {
                 Some(KeyAction::Quit) => break 'session,

@@ -1,0 +1,226 @@
+//! The mouse (or a graphics tablet's pointer) as the pen, for users without a base station.
+//!
+//! The window's pointer is turned into the samples a base station in its display-frame mode
+//! would send, and those go through the host's own [`EventDetector`], so the interaction sees
+//! the events a pen makes and nothing in it knows the difference. The mapping
+//! (`docs/modeler.md`, Mouse):
+//!
+//! | mouse | pen |
+//! |---|---|
+//! | over the picture | in range, at that point of the display |
+//! | left button held | SW1: the tip on the surface |
+//! | right button held | SW2 |
+//! | middle button or Space held | SW3 |
+//! | wheel, with SW2 or SW3 held and the tip up | the pen's height above the surface, [`WHEEL_MM`] a notch |
+//!
+//! So a right-drag over a figure grabs it (right held, left pressed and let go), the wheel
+//! lifts it, and releasing the right button commits the pull, as lifting the pen and opening
+//! SW2 does; Space held with sideways motion sets its slope. The height returns to the surface
+//! when SW2 and SW3 are both released.
+
+use glam::DVec3;
+use pen_host::events::{DisplayPoint, EventDetector, PenEvent};
+use pen_host::sample::Sample;
+use pen_protocol::Quality;
+
+/// Height above the surface per wheel notch, mm.
+pub const WHEEL_MM: f64 = 5.0;
+
+/// The highest the wheel lifts the pen, mm: about what the pen's tracker reaches above a display.
+pub const MAX_HEIGHT_MM: f64 = 300.0;
+
+/// The pointer as the window reports it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PointerState {
+    /// Where over the picture, as fractions of its width and height from the top-left
+    /// corner; `None` off the picture.
+    pub at: Option<[f64; 2]>,
+    /// Left, right and middle (or Space) held.
+    pub buttons: [bool; 3],
+    /// Wheel notches since the last state, away from the user positive.
+    pub wheel: f64,
+}
+
+/// The mouse as a pen over a display of `display_mm`, shown in a picture of `picture_px`.
+#[derive(Debug, Clone)]
+pub struct MousePen {
+    detector: EventDetector,
+    height_mm: f64,
+    seq: u16,
+    started_us: u64,
+}
+
+impl Default for MousePen {
+    fn default() -> MousePen {
+        MousePen::new()
+    }
+}
+
+impl MousePen {
+    /// Out of range, nothing held, on the surface.
+    pub fn new() -> MousePen {
+        MousePen {
+            detector: EventDetector::new(),
+            height_mm: 0.0,
+            seq: 0,
+            started_us: 0,
+        }
+    }
+
+    /// The pen's height above the surface now, mm.
+    pub fn height_mm(&self) -> f64 {
+        self.height_mm
+    }
+
+    /// The pen events of the pointer's new state at host time `t_us` (µs since the epoch), for a
+    /// display of `display_mm` (width, height) shown in a picture of `picture_px` pixels.
+    pub fn update(
+        &mut self,
+        pointer: PointerState,
+        display_mm: [f64; 2],
+        picture_px: [u32; 2],
+        t_us: u64,
+    ) -> Vec<PenEvent> {
+        let [tip, sw2, sw3] = pointer.buttons;
+        if self.seq == 0 {
+            self.started_us = t_us;
+        }
+        if sw2 || sw3 {
+            if pointer.wheel.is_finite() {
+                self.height_mm = (self.height_mm + pointer.wheel * WHEEL_MM).clamp(0.0, MAX_HEIGHT_MM);
+            }
+        } else {
+            self.height_mm = 0.0;
+        }
+        // The tip pressed is on the surface whatever the wheel said.
+        let h_mm = if tip { 0.0 } else { self.height_mm };
+        let [fx, fy] = pointer.at.unwrap_or([0.0, 0.0]);
+        let point = DisplayPoint {
+            u_mm: fx * display_mm[0],
+            v_mm: (1.0 - fy) * display_mm[1],
+            h_mm,
+            u_px: fx * f64::from(picture_px[0]),
+            v_px: (1.0 - fy) * f64::from(picture_px[1]),
+        };
+        self.seq = self.seq.wrapping_add(1).max(1);
+        let sample = Sample {
+            seq: self.seq,
+            device_us: t_us.saturating_sub(self.started_us),
+            host_us: t_us,
+            // Off the picture the pen is out of range, and nothing can be held there.
+            sw: if pointer.at.is_some() {
+                [tip, sw2, sw3]
+            } else {
+                [false; 3]
+            },
+            in_range: pointer.at.is_some(),
+            display_frame: true,
+            position_mm: DVec3::new(point.u_mm, point.v_mm, point.h_mm),
+            quality: Quality::NONE,
+        };
+        let mut out = Vec::new();
+        self.detector.on_sample(&sample, point, &mut out);
+        out
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pen_host::events::EventKind;
+
+    fn state(at: [f64; 2], buttons: [bool; 3], wheel: f64) -> PointerState {
+        PointerState {
+            at: Some(at),
+            buttons,
+            wheel,
+        }
+    }
+
+    const DISPLAY: [f64; 2] = [600.0, 340.0];
+    const PICTURE: [u32; 2] = [1280, 720];
+
+    #[test]
+    fn a_left_drag_is_a_stroke_on_the_display() {
+        let mut m = MousePen::new();
+        let mut kinds = Vec::new();
+        let mut last = None;
+        for (i, (at, left)) in [
+            ([0.5, 0.5], false),
+            ([0.5, 0.5], true),
+            ([0.75, 0.25], true),
+            ([0.75, 0.25], false),
+        ]
+        .into_iter()
+        .enumerate()
+        {
+            for e in m.update(state(at, [left, false, false], 0.0), DISPLAY, PICTURE, 1_000 + i as u64) {
+                kinds.push(e.kind.name());
+                last = e.point;
+            }
+        }
+        assert_eq!(
+            kinds,
+            [
+                "proximity_in",
+                "motion",
+                "tip_down",
+                "motion",
+                "motion",
+                "tip_up",
+                "motion"
+            ]
+        );
+        let p = last.expect("a point");
+        assert_eq!(
+            (p.u_mm, p.v_mm, p.h_mm),
+            (450.0, 255.0, 0.0),
+            "v up from the lower edge"
+        );
+        assert_eq!((p.u_px, p.v_px), (960.0, 540.0));
+    }
+
+    #[test]
+    fn the_wheel_lifts_the_pen_only_while_a_barrel_button_is_held() {
+        let mut m = MousePen::new();
+        let at = [0.2, 0.2];
+        m.update(state(at, [false; 3], 3.0), DISPLAY, PICTURE, 1);
+        assert_eq!(m.height_mm(), 0.0, "the wheel alone moves nothing");
+        m.update(state(at, [false, true, false], 0.0), DISPLAY, PICTURE, 2);
+        let events = m.update(state(at, [false, true, false], 4.0), DISPLAY, PICTURE, 3);
+        assert_eq!(
+            events.last().and_then(|e| e.point).map(|p| p.h_mm),
+            Some(4.0 * WHEEL_MM)
+        );
+        // The tip pressed is on the surface; let go, the pen is back at the wheel's height.
+        let events = m.update(state(at, [true, true, false], 0.0), DISPLAY, PICTURE, 4);
+        assert_eq!(events.last().and_then(|e| e.point).map(|p| p.h_mm), Some(0.0));
+        m.update(state(at, [false, true, false], -100.0), DISPLAY, PICTURE, 5);
+        assert_eq!(m.height_mm(), 0.0, "never below the surface");
+        m.update(state(at, [false, true, false], 1e9), DISPLAY, PICTURE, 6);
+        assert_eq!(m.height_mm(), MAX_HEIGHT_MM);
+        m.update(state(at, [false; 3], 0.0), DISPLAY, PICTURE, 7);
+        assert_eq!(m.height_mm(), 0.0, "released, back on the surface");
+    }
+
+    #[test]
+    fn leaving_the_picture_releases_everything() {
+        let mut m = MousePen::new();
+        m.update(state([0.5, 0.5], [true, true, true], 0.0), DISPLAY, PICTURE, 1);
+        let off = PointerState {
+            at: None,
+            buttons: [true, true, true],
+            wheel: 0.0,
+        };
+        let kinds: Vec<EventKind> = m.update(off, DISPLAY, PICTURE, 2).into_iter().map(|e| e.kind).collect();
+        assert_eq!(
+            kinds,
+            [
+                EventKind::TipUp,
+                EventKind::ButtonUp { button: 2 },
+                EventKind::ButtonUp { button: 3 },
+                EventKind::ProximityOut
+            ]
+        );
+    }
+}
