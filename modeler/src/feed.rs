@@ -217,7 +217,7 @@ pub fn spawn(source: PenSource, capacity: usize) -> (Receiver<Feed>, JoinHandle<
                 PenSource::Mouse => send(
                     &tx,
                     Feed::Status(
-                        "the mouse is the pen: left draws, right grabs, the wheel lifts, middle or Space is SW3 (h: help)"
+                        "the mouse is the pen: left draws, right grabs, wheel lifts, middle/Space is SW3; h: help"
                             .into(),
                     ),
                 ),

@@ -500,3 +500,33 @@ fn open_refuses_a_corrupt_journal_and_recover_opens_up_to_the_bad_line() {
     let (_, report) = Editor::open_read_only(&doc).expect("opens without --recover now");
     assert!(report.recovered.is_none());
 }
+
+/// Issue 42: `open DOC` writes its results beside DOC (`DOC`'s name with `.out`), never into
+/// the `./out` another run left.
+#[test]
+fn open_writes_its_results_beside_the_document() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    std::fs::create_dir(dir.path().join("maps")).expect("maps");
+    let doc = dir.path().join("maps/alps.json");
+    std::fs::copy(crate::common::example("02-twin-hills.json"), &doc).expect("copy");
+    // A pen that never comes: the session waits, its results' folder made, until stopped.
+    let mut child = Command::new(env!("CARGO_BIN_EXE_penmodel"))
+        .current_dir(dir.path())
+        .args(["open", "maps/alps.json", "--source", "serial:/dev/null", "--fps", "0"])
+        .args(["--show", "headless"])
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .env("XDG_RUNTIME_DIR", dir.path())
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .expect("penmodel starts");
+    let until = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    while !dir.path().join("maps/alps.out").is_dir() {
+        assert!(std::time::Instant::now() < until, "no maps/alps.out");
+        std::thread::sleep(std::time::Duration::from_millis(20));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    assert!(!dir.path().join("out").exists(), "nothing in ./out");
+}

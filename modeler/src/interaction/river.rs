@@ -390,7 +390,10 @@ impl Tool for Rivers {
         };
         let years = river.iterations;
         if cx.commit(Edit::ReplaceRiver { index, river }, "the river's years") {
-            cx.say(format!("river {index}: {years} years of erosion and deposition"));
+            cx.say(format!(
+                "river {index}: {} of erosion and deposition",
+                self::years(years)
+            ));
         }
         true
     }
@@ -436,8 +439,8 @@ impl Tool for Rivers {
                     .and_then(|r| aged(r, years))
                     .map_or(had, |r| r.iterations);
                 format!(
-                    "river {index}: +{} years ({to} in all) | hold to count on, release to commit, move to pan",
-                    to - had
+                    "river {index}: +{} ({to} in all) | hold to count on, release to commit, move to pan",
+                    self::years(to - had)
                 )
             }
             _ => return None,
@@ -484,4 +487,9 @@ impl Tool for Rivers {
             ("Del", "delete the highlighted river"),
         ]
     }
+}
+
+/// `n` years, in words: "1 year", "3 years".
+fn years(n: u32) -> String {
+    if n == 1 { "1 year".into() } else { format!("{n} years") }
 }

@@ -167,6 +167,19 @@ fn key_name(key: &Key) -> Option<String> {
     match key {
         Key::Character(s) => Some(s.to_string()),
         Key::Named(NamedKey::Space) => Some(" ".into()),
+        // Modifiers change other keys; alone they are not keys a user means.
+        Key::Named(
+            NamedKey::Shift
+            | NamedKey::Control
+            | NamedKey::Alt
+            | NamedKey::AltGraph
+            | NamedKey::Super
+            | NamedKey::Meta
+            | NamedKey::Hyper
+            | NamedKey::CapsLock
+            | NamedKey::NumLock
+            | NamedKey::Fn,
+        ) => None,
         Key::Named(named) => Some(format!("{named:?}")),
         _ => None,
     }

@@ -4,7 +4,8 @@
 //! character set), and bit 7 the descender row below the baseline, which `g j p q y` use — in
 //! the 5 × 7 set they sit on the baseline, and `g` reads as `9`. A glyph cell is 6 × 8 font
 //! pixels (one column of spacing; the eighth row is the descenders' or the line's spacing), drawn
-//! at an integer scale. Characters outside ASCII 32–126 are drawn as `?`.
+//! at an integer scale. Beyond ASCII 32–126 only the symbols the messages use (`°`, `×`, `µ`,
+//! dashes, `±`, `²`) have glyphs; anything else is drawn as `?`.
 
 use crate::output::frame::{Frame, Rgba};
 use crate::raster::rasterise::Bounds;
@@ -113,15 +114,31 @@ const GLYPHS: [[u8; 5]; 95] = [
     [0x08, 0x04, 0x08, 0x10, 0x08], // ~
 ];
 
+/// The symbols beyond ASCII that the modeler's messages use, in the same form.
+#[rustfmt::skip]
+const EXTRA: [(char, [u8; 5]); 10] = [
+    ('°', [0x00, 0x06, 0x09, 0x09, 0x06]),
+    ('×', [0x00, 0x22, 0x14, 0x08, 0x14]),
+    ('µ', [0xFC, 0x40, 0x40, 0x20, 0x7C]),
+    ('—', [0x08, 0x08, 0x08, 0x08, 0x08]),
+    ('–', [0x00, 0x08, 0x08, 0x08, 0x00]),
+    ('−', [0x08, 0x08, 0x08, 0x08, 0x08]),
+    ('·', [0x00, 0x00, 0x08, 0x00, 0x00]),
+    ('…', [0x40, 0x00, 0x40, 0x00, 0x40]),
+    ('±', [0x44, 0x44, 0x5F, 0x44, 0x44]),
+    ('²', [0x00, 0x19, 0x15, 0x12, 0x00]),
+];
+
 /// The five column bytes of `ch` (bit 0 = top row, bit 7 = the descender row).
 pub fn glyph(ch: char) -> [u8; 5] {
     let code = ch as u32;
-    let index = if (32..127).contains(&code) {
-        code - 32
-    } else {
-        u32::from(b'?') - 32
-    };
-    GLYPHS[index as usize]
+    if (32..127).contains(&code) {
+        return GLYPHS[(code - 32) as usize];
+    }
+    EXTRA
+        .iter()
+        .find(|(c, _)| *c == ch)
+        .map_or(GLYPHS[usize::from(b'?' - 32)], |(_, g)| *g)
 }
 
 /// Width in pixels of `text` drawn at `scale`.
@@ -166,6 +183,15 @@ pub(crate) fn draw(frame: &mut Frame, clip: &Bounds, (x, y): (i64, i64), text: &
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_messages_symbols_have_glyphs() {
+        let unknown = glyph('\u{2603}');
+        assert_eq!(unknown, glyph('?'));
+        for ch in "°×µ—–−·…±²".chars() {
+            assert_ne!(glyph(ch), unknown, "{ch}");
+        }
+    }
 
     /// The rows a glyph lights, as a bit set (bit 0 the top row).
     fn rows(ch: char) -> u8 {

@@ -54,9 +54,11 @@ pub struct LiveArgs {
     /// Window, files, or a window when there is a display.
     #[arg(long, value_enum, default_value = "auto")]
     show: Show,
-    /// The folder for frames and results (always a folder: the document, the terrain, renders).
-    #[arg(long, value_name = "DIR", default_value = "out")]
-    out: PathBuf,
+    /// The folder for frames and results (always a folder: the document, the terrain, renders)
+    /// [default: out for a new session; for `open DOC`, DOC's name with `.out` beside it, so
+    /// `open maps/alps.json` writes maps/alps.out/].
+    #[arg(long, value_name = "DIR")]
+    out: Option<PathBuf>,
     /// Frame size in pixels [default: 1280x720 in a window; for files, 640x360 for the
     /// animation's frames and 960x540 for the final renders].
     #[arg(long, value_name = "WxH", value_parser = size)]
@@ -116,6 +118,30 @@ pub struct LiveArgs {
     json: bool,
 }
 
+impl LiveArgs {
+    /// The results' folder: `--out`, or its default for a session on `open`.
+    fn out(&self) -> &Path {
+        self.out.as_deref().unwrap_or(Path::new("out"))
+    }
+
+    /// These options with `--out`'s default for `open` filled in.
+    fn resolved(&self, open: Option<&Path>) -> LiveArgs {
+        let mut args = self.clone();
+        if args.out.is_none()
+            && let Some(doc) = open
+        {
+            let stem = doc
+                .file_stem()
+                .map(|s| s.to_os_string())
+                .unwrap_or_else(|| "document".into());
+            let mut name = stem;
+            name.push(".out");
+            args.out = Some(doc.with_file_name(name));
+        }
+        args
+    }
+}
+
 /// A pen source's name, checked.
 fn source(s: &str) -> Result<String, String> {
     PenSource::parse(s, 0.0).map(|_| s.to_string())
@@ -151,7 +177,7 @@ fn default_source(open: Option<&Path>, window: bool) -> Result<String> {
             Ok("mouse".into())
         }
         Some(doc) => bail!(
-            "no pen to model {} with: pend is not running at {}. Start pend (pend --hid, or pend --serial PATH), \
+            "no pen to model {} with: pend is not running at {}. Start pend (pend --source hid, or pend --source serial:PATH), \
              or give --source hid|serial:PATH; --source sim plays the built-in demo into this document",
             doc.display(),
             socket.display()
@@ -161,6 +187,7 @@ fn default_source(open: Option<&Path>, window: bool) -> Result<String> {
 
 /// A new session (`doc` = None) or `penmodel open DOC` (`--recover`: `recover`).
 pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
+    let args = &args.resolved(open);
     let window_wanted = match args.show {
         Show::Headless => false,
         Show::Window => true,
@@ -178,11 +205,11 @@ pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
     let demo = matches!(source, PenSource::Demo { .. });
     // What this session creates it removes again if nothing is modeled: no empty results.
     let mut created = document::Created {
-        out: (!args.out.exists()).then(|| args.out.clone()),
-        frames: (!args.out.join("frames").exists()).then(|| args.out.join("frames")),
+        out: (!args.out().exists()).then(|| args.out().to_path_buf()),
+        frames: (!args.out().join("frames").exists()).then(|| args.out().join("frames")),
         ..document::Created::default()
     };
-    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    std::fs::create_dir_all(args.out()).with_context(|| format!("cannot create {}", args.out().display()))?;
     let (editor, doc_path) = document::open(args, open, recover, demo, &mut created)?;
     let mut session = Session::new(editor, [600.0, 340.0], Tuning::default());
     session.set_vertical_scale(args.vertical_scale);
@@ -267,7 +294,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
         (None, false) => (960, 540),
     };
     let mut results_painter = Painter::new(results_size.0, results_size.1, Overview::Off)?;
-    let results = results::write(&args.out, args.meshes, &session, &look, &mut results_painter)?;
+    let results = results::write(args.out(), args.meshes, &session, &look, &mut results_painter)?;
     summary(args, &source_name, &doc_path, &session, &painter, &written, results)?;
     if let State::Failed(why) = session.state() {
         bail!("the pen failed: {why}");
@@ -390,7 +417,7 @@ fn summary(
         let meshes = if args.meshes { ", its meshes" } else { "" };
         pen_host::outln!(
             "{what} the terrain{meshes}, its render and the document to {}/ (document: {})",
-            args.out.display(),
+            args.out().display(),
             doc_path.display()
         );
     }

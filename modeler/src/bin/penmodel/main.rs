@@ -35,7 +35,7 @@ use clap::{Parser, Subcommand};
     penmodel --source daemon              # the pen from pend\n  \
     penmodel --source sim:hold --speed 0  # a pen-sim scenario, uncalibrated\n  \
     penmodel open out/document.json       # continue a document\n\
-    Flags every tool shares (--source, --speed, --vertical-scale, --display-mm, --head-mm, --out): docs/cli.md."
+    Flags the tools share (--source, --speed, --vertical-scale, --head-mm, --out; --display-mm for render): docs/cli.md."
 )]
 struct Cli {
     #[command(subcommand)]

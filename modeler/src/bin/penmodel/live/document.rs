@@ -107,10 +107,10 @@ pub fn open(
             (editor, path.to_owned())
         }
         None => {
-            let path = args.doc.clone().unwrap_or_else(|| args.out.join("document.json"));
+            let path = args.doc.clone().unwrap_or_else(|| args.out().join("document.json"));
             // The demo replaces only a document an earlier demo wrote (its mark beside it); a
             // real session never overwrites anything, and no session plays the demo into work.
-            let demo_mark = args.out.join(DEMO_MARK);
+            let demo_mark = args.out().join(DEMO_MARK);
             let replaceable = demo && args.doc.is_none() && demo_mark.exists();
             if path.exists() && !replaceable {
                 let hint = if demo {
@@ -137,7 +137,7 @@ pub fn open(
                 std::fs::write(&demo_mark, DEMO_MARK_TEXT)
                     .with_context(|| format!("cannot write {}", demo_mark.display()))?;
                 created.demo_mark = Some(demo_mark.clone());
-            } else if path == args.out.join("document.json") && demo_mark.exists() {
+            } else if path == args.out().join("document.json") && demo_mark.exists() {
                 // This document is the user's now: the next demo must not replace it.
                 std::fs::remove_file(&demo_mark).with_context(|| format!("cannot remove {}", demo_mark.display()))?;
             }

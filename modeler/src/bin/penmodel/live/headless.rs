@@ -29,7 +29,7 @@ pub fn run(
     // No frames at all with --fps 0: the results alone.
     let mut frames = match args.fps {
         0 => None,
-        fps => Some(Sequence::create(&args.out.join("frames"), fps)?.moving_every(args.moving_every.into())),
+        fps => Some(Sequence::create(&args.out().join("frames"), fps)?.moving_every(args.moving_every.into())),
     };
     let step_us = 1_000_000 / u64::from(args.fps.max(1));
     let mut next_us: Option<u64> = None;

@@ -46,6 +46,18 @@ fn tell(messages: Vec<String>, notice: &mut Option<Notice>) {
     say(messages, None);
 }
 
+/// Feeds `feed` to the session and says what it said; a status the mode line shows already
+/// (before the first event) goes only to stderr, so the window shows it once.
+fn tell_feed(session: &mut Session, feed: Feed, notice: &mut Option<Notice>) {
+    let status = matches!(feed, Feed::Status(_));
+    let said = session.feed(feed);
+    if status && session.events() == 0 {
+        say(said, None);
+    } else {
+        tell(said, notice);
+    }
+}
+
 /// Host time, µs since the Unix epoch, as a pen's events carry it.
 fn now_us() -> u64 {
     std::time::SystemTime::now()
@@ -129,10 +141,10 @@ pub fn run(
         let wait = FRAME.saturating_sub(last.elapsed());
         match rx.recv_timeout(wait.max(Duration::from_millis(1))) {
             Ok(feed) => {
-                tell(session.feed(feed), &mut notice);
+                tell_feed(session, feed, &mut notice);
                 dirty = true;
                 while let Ok(more) = rx.try_recv() {
-                    tell(session.feed(more), &mut notice);
+                    tell_feed(session, more, &mut notice);
                     if last.elapsed() >= FRAME {
                         break;
                     }
