@@ -12,7 +12,7 @@ use std::time::Duration;
 use anyhow::{Context, Result};
 use clap::Parser;
 use pen_host::calibration::{Calibration, DisplaySize};
-use pen_host::daemon::{self, DEFAULT_MAX_CLIENTS, DEFAULT_QUEUE, Hub};
+use pen_host::daemon::{self, DEFAULT_MAX_CLIENTS, DEFAULT_QUEUE, Hub, MAX_QUEUE};
 use pen_host::pipeline::Pipeline;
 use pen_host::source::{DeviceArgs, SimScenario, SourceError};
 use pen_host::virtual_tablet::{self, Extent, VirtualTablet};
@@ -57,9 +57,11 @@ struct Cli {
     /// It is applied only to the base station it records.
     #[arg(long, value_name = "FILE")]
     calibration: Option<PathBuf>,
-    /// Events a client may have waiting before it misses some.
-    #[arg(long, default_value_t = DEFAULT_QUEUE)]
-    queue: usize,
+    /// Events a client may have waiting before it misses some (at most 16384; each queue holds
+    /// at most N × 512 bytes of lines).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_QUEUE as u64,
+          value_parser = clap::value_parser!(u64).range(1..=MAX_QUEUE as u64))]
+    queue: u64,
     /// Clients served at once; one more is sent a `refused` line and closed.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_CLIENTS as u16,
           value_parser = clap::value_parser!(u16).range(1..))]
@@ -121,7 +123,8 @@ fn run(cli: Cli) -> Result<()> {
     }
     let hub = Arc::new(Hub::new(usize::from(cli.max_clients)));
     let (h, s) = (hub.clone(), stop.clone());
-    let queue = cli.queue;
+    // In range by the parser: at most MAX_QUEUE.
+    let queue = usize::try_from(cli.queue).unwrap_or(MAX_QUEUE);
     std::thread::spawn(move || daemon::accept(listener, h, queue, s));
     let (h, s) = (hub.clone(), stop.clone());
     // The transport lives on the device thread: the simulated pen is not Send.
