@@ -26,7 +26,7 @@ const AFTER_HELP: &str = "The simulated pen (--source sim) plays `modeling-sessi
     pend                                     # the first base station on USB\n  \
     pend --source serial:/dev/ttyACM0        # its serial link\n  \
     pend --source sim                        # the simulated pen, in real time\n  \
-    pend --source sim:hold --speed 0 --socket /tmp/pend.sock\n  \
+    pend --source sim:hold --speed 0 --socket $XDG_RUNTIME_DIR/sim.sock\n  \
     pend --virtual-tablet                    # and a uinput pen for every program\n\
     docs/events.md (the socket's lines) and docs/cli.md (the flags every tool shares).";
 /// `pend --help`'s end, in a build without the simulated pen.
