@@ -639,3 +639,52 @@ fn a_stalled_clients_queue_is_bounded_by_bytes_and_freed_when_it_leaves() {
     }
     assert_eq!(hub.queued_bytes(), 0, "its queue freed");
 }
+
+/// Issue 47 item 11: a client that shuts its writing side (as `socat - UNIX-CONNECT:… </dev/null`
+/// does) but reads on is served: reading 0 bytes from it means it asks for nothing more, not that
+/// it left. pend dropped it within milliseconds. A client that closes its socket while the pen is
+/// quiet still frees its place.
+#[test]
+fn a_half_closed_client_is_served_and_a_closed_one_leaves() {
+    const MOTIONS: usize = 200;
+    let hub = Arc::new(Hub::default());
+    let (ours, theirs) = UnixStream::pair().expect("socket pair");
+    theirs
+        .shutdown(std::net::Shutdown::Write)
+        .expect("shut its writing side");
+    assert!(hub.connect(ours, daemon::DEFAULT_QUEUE));
+    let reader = std::thread::spawn(move || {
+        let mut motions = 0;
+        read_events(theirs, |e| {
+            motions += usize::from(e.kind == EventKind::Motion);
+            motions == MOTIONS
+        })
+    });
+    let mut pen = Pen::new();
+    // More than a writer's batch (64 lines): however the threads are scheduled, the writer
+    // looks at the client's side between batches, before the last motions are written.
+    for _ in 0..MOTIONS {
+        pen.sample(&hub, true, [false, false, false]);
+    }
+    let (hello, events) = reader.join().expect("reader");
+    assert_eq!(hello, Some(None), "greeted");
+    let motions = events.iter().filter(|e| e.kind == EventKind::Motion).count();
+    assert_eq!(
+        motions,
+        MOTIONS,
+        "every motion read by the half-closed client: {:?}",
+        names(&events)
+    );
+    assert_eq!(hub.counts().1, 0, "none missed");
+
+    // Closed whole, with no event to write: it leaves at its writer's next look (the first
+    // client closed too, when its reader ended).
+    let (ours, theirs) = UnixStream::pair().expect("socket pair");
+    assert!(hub.connect(ours, daemon::DEFAULT_QUEUE));
+    drop(theirs);
+    let until = Instant::now() + GUARD;
+    while hub.clients() > 0 {
+        assert!(Instant::now() < until, "a closed client kept its place");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
