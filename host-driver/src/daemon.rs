@@ -26,6 +26,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::Duration;
 
+use crate::calibration::Calibration;
 use crate::events::{EventKind, PenEvent, PenState};
 use crate::pipeline::Pipeline;
 use crate::requests::Requests;
@@ -489,14 +490,34 @@ pub fn run_device(pipeline: Pipeline, hub: Arc<Hub>, stop: Arc<AtomicBool>, log:
 /// [`run_device`], with `each` called with every event after it is published (the virtual
 /// tablet follows them so).
 pub fn run_device_with(
+    pipeline: Pipeline,
+    hub: Arc<Hub>,
+    stop: Arc<AtomicBool>,
+    log: impl Fn(&str),
+    each: impl FnMut(&PenEvent),
+) {
+    let (_none, reloads) = std::sync::mpsc::channel();
+    run_device_reloading(pipeline, hub, stop, log, each, &reloads)
+}
+
+/// [`run_device_with`], taking each calibration sent on `reloads` between polls (pend's SIGHUP)
+/// and logging whether it was taken.
+pub fn run_device_reloading(
     mut pipeline: Pipeline,
     hub: Arc<Hub>,
     stop: Arc<AtomicBool>,
     log: impl Fn(&str),
     mut each: impl FnMut(&PenEvent),
+    reloads: &std::sync::mpsc::Receiver<(Calibration, String)>,
 ) {
     let mut events = Vec::new();
     while !stop.load(Ordering::Relaxed) {
+        while let Ok((calibration, what)) = reloads.try_recv() {
+            match pipeline.set_calibration(calibration) {
+                Ok(()) => log(&format!("SIGHUP: reloaded: {what}")),
+                Err(e) => log(&format!("SIGHUP: kept the calibration in use, not {what}: {e}")),
+            }
+        }
         events.clear();
         pipeline.poll(Duration::from_millis(50), &mut events);
         if let Some(notice) = pipeline.take_notice() {

@@ -688,3 +688,98 @@ fn a_half_closed_client_is_served_and_a_closed_one_leaves() {
         std::thread::sleep(Duration::from_millis(10));
     }
 }
+
+/// Issue 47 item 11: SIGHUP reloads the calibration and says so; pend serves on with it. It
+/// used to end pend (the default action), leaving its socket behind.
+#[test]
+fn sighup_reloads_the_calibration_and_pend_serves_on() {
+    let (dir, path) = socket_path("sighup");
+    let file = dir.path().join("calibration.toml");
+    let identity = Calibration::identity(DisplaySize::REFERENCE);
+    identity.save(&file).expect("save");
+    let mut pend = Command::new(env!("CARGO_BIN_EXE_pend"))
+        .args(["--sim", "hold", "--calibration"])
+        .arg(&file)
+        .arg("--socket")
+        .arg(&path)
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("pend starts");
+    let (tx, log) = std::sync::mpsc::channel();
+    let stderr = pend.stderr.take().expect("stderr");
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = tx.send(line);
+        }
+    });
+    let end = Instant::now() + GUARD;
+    let stream = loop {
+        if let Ok(s) = UnixStream::connect(&path) {
+            break s;
+        }
+        assert!(Instant::now() < end, "pend did not listen");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    stream
+        .set_read_timeout(Some(Duration::from_millis(200)))
+        .expect("timeout");
+    let mut reader = BufReader::new(stream);
+    let mut next_u = || loop {
+        assert!(Instant::now() < end, "no motion within {GUARD:?}");
+        let mut line = String::new();
+        match reader.read_line(&mut line) {
+            Ok(0) => panic!("pend closed the socket"),
+            Ok(_) => {}
+            Err(_) => continue,
+        }
+        if let Ok(Line::Event(e)) = parse_line(line.trim_end())
+            && e.kind == EventKind::Motion
+        {
+            return e.point.expect("a motion's point").u_mm;
+        }
+    };
+    let before = next_u();
+
+    let mut moved = identity.clone();
+    moved.transform.translation_mm.x += 100.0;
+    moved.save(&file).expect("save");
+    let status = Command::new("kill")
+        .args(["-HUP", &pend.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(status.success());
+    let reloaded = loop {
+        assert!(Instant::now() < end, "no reload said within {GUARD:?}");
+        if let Some(code) = pend.try_wait().expect("wait") {
+            panic!("pend ended at SIGHUP: {code}");
+        }
+        match log.recv_timeout(Duration::from_millis(100)) {
+            Ok(line) if line.contains("SIGHUP") => break line,
+            _ => {}
+        }
+    };
+    assert!(
+        reloaded.contains("reloaded") && reloaded.contains("calibration.toml"),
+        "{reloaded}"
+    );
+    // A file without fit targets has no RMS to show (issue 47 item 11: it showed "-0.00 mm").
+    assert!(
+        reloaded.contains("no fit targets") && !reloaded.contains("-0.00"),
+        "{reloaded}"
+    );
+    // The events after it are mapped by the new file: 100 mm further along u.
+    let after = loop {
+        let u = next_u();
+        if (u - before - 100.0).abs() < 10.0 {
+            break u;
+        }
+    };
+    assert!(after > before + 90.0);
+    assert!(path.exists(), "its socket stays");
+    let status = Command::new("kill")
+        .args(["-TERM", &pend.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(status.success());
+    assert_eq!(pend.wait().expect("exits").code(), Some(0));
+}

@@ -1,9 +1,9 @@
 //! `pend`: the pen daemon. Attaches to the base station (USB HID by default, `--source
 //! serial:PATH`, or `--source sim` for the simulated pen), applies the calibration, and serves pen events to any number
 //! of clients (a bounded number at once) on a Unix domain socket as JSON lines (docs/events.md). SIGTERM and SIGINT stop it:
-//! the socket is removed and the exit status is 0.
+//! the socket is removed and the exit status is 0. SIGHUP reloads the calibration.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -14,7 +14,7 @@ use clap::Parser;
 use pen_host::calibration::{Calibration, DisplaySize};
 use pen_host::daemon::{self, DEFAULT_MAX_CLIENTS, DEFAULT_QUEUE, Hub, MAX_QUEUE};
 use pen_host::pipeline::Pipeline;
-use pen_host::source::{DeviceArgs, SimScenario, SourceError};
+use pen_host::source::{DeviceArgs, SimScenario, Source, SourceError};
 use pen_host::virtual_tablet::{self, Extent, VirtualTablet};
 
 /// `pend --help`'s end: what the defaults mean, and examples.
@@ -73,26 +73,40 @@ struct Cli {
     virtual_tablet: bool,
 }
 
-fn run(cli: Cli) -> Result<()> {
-    let source = cli.device.source()?;
-    let calibration = match cli
-        .calibration
-        .or_else(|| pen_host::calibration::default_path_for_source(&source).filter(|p| p.exists()))
-    {
+/// The calibration file pend uses: the one given, or the default if it exists (looked for
+/// again at each SIGHUP, so one made since is taken).
+fn calibration_path(given: Option<&Path>, source: &Source) -> Option<PathBuf> {
+    given
+        .map(Path::to_path_buf)
+        .or_else(|| pen_host::calibration::default_path_for_source(source).filter(|p| p.exists()))
+}
+
+/// Loads the calibration at `path`, or the identity without one; says which on stderr.
+fn load_calibration(path: Option<&Path>) -> Result<(Calibration, String)> {
+    match path {
         Some(path) => {
-            let c = Calibration::load(&path)?;
+            let c = Calibration::load(path)?;
             let whose = c.device.map(|d| format!(", base station {d}")).unwrap_or_default();
-            eprintln!("pend: calibration {} (RMS {:.2} mm{whose})", path.display(), c.rms_mm());
-            if let Some(warning) = c.unbound_warning(&path) {
+            let fit = match c.residuals.len() {
+                0 => "no fit targets".to_string(),
+                _ => format!("RMS {:.2} mm", c.rms_mm()),
+            };
+            if let Some(warning) = c.unbound_warning(path) {
                 eprintln!("pend: warning: {warning}");
             }
-            c
+            Ok((c, format!("calibration {} ({fit}{whose})", path.display())))
         }
-        None => {
-            eprintln!("pend: no calibration; tracker coordinates are display coordinates (penctl calibrate)");
-            Calibration::identity(DisplaySize::REFERENCE)
-        }
-    };
+        None => Ok((
+            Calibration::identity(DisplaySize::REFERENCE),
+            "no calibration; tracker coordinates are display coordinates (penctl calibrate)".to_string(),
+        )),
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    let source = cli.device.source()?;
+    let (calibration, what) = load_calibration(calibration_path(cli.calibration.as_deref(), &source).as_deref())?;
+    eprintln!("pend: {what}");
     // Made before anything is served, so that a refusal (no access to /dev/uinput) ends pend
     // at once with the reason.
     let mut tablet = match cli.virtual_tablet {
@@ -121,6 +135,13 @@ fn run(cli: Cli) -> Result<()> {
     for signal in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
         signal_hook::flag::register(signal, stop.clone()).context("installing signal handlers")?;
     }
+    // SIGHUP reloads the calibration, as daemons reread their configuration; by default it
+    // would end pend and leave its socket behind.
+    let reload = Arc::new(AtomicBool::new(false));
+    signal_hook::flag::register(signal_hook::consts::SIGHUP, reload.clone()).context("installing signal handlers")?;
+    let (reloads_tx, reloads) = std::sync::mpsc::channel();
+    let given = cli.calibration.clone();
+    let sources = source.clone();
     let hub = Arc::new(Hub::new(usize::from(cli.max_clients)));
     let (h, s) = (hub.clone(), stop.clone());
     // In range by the parser: at most MAX_QUEUE.
@@ -130,7 +151,7 @@ fn run(cli: Cli) -> Result<()> {
     // The transport lives on the device thread: the simulated pen is not Send.
     std::thread::spawn(move || {
         let mut failed = false;
-        daemon::run_device_with(
+        daemon::run_device_reloading(
             Pipeline::new(source, calibration),
             h,
             s,
@@ -145,11 +166,22 @@ fn run(cli: Cli) -> Result<()> {
                     failed = true;
                 }
             },
+            &reloads,
         )
     });
 
     while !stop.load(Ordering::Relaxed) {
         std::thread::sleep(Duration::from_millis(50));
+        if reload.swap(false, Ordering::Relaxed) {
+            let path = calibration_path(given.as_deref(), &sources);
+            match load_calibration(path.as_deref()) {
+                // The device thread applies it between polls and says whether it took it.
+                Ok(loaded) => {
+                    let _ = reloads_tx.send(loaded);
+                }
+                Err(e) => eprintln!("pend: SIGHUP: kept the calibration in use: {e:#}"),
+            }
+        }
     }
     let _ = std::fs::remove_file(&socket);
     let (delivered, missed) = hub.counts();
