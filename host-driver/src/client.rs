@@ -1,9 +1,12 @@
-//! A client of `pend`: connects to its socket, asks for `head` lines (events version 4), and
-//! reads events.
+//! A client of `pend`: connects to its socket, checks that it is served by its own user (or
+//! root), asks for `head` lines (events version 4), and reads events.
 
 use std::io::{BufRead, BufReader, Write};
 use std::os::unix::net::UnixStream;
 use std::path::Path;
+
+use nix::sys::socket::getsockopt;
+use nix::sys::socket::sockopt::PeerCredentials;
 
 use crate::events::PenEvent;
 use crate::wire::{ClientLine, SocketLine};
@@ -69,6 +72,39 @@ pub fn parse_line(line: &str) -> Result<Line, ClientError> {
     }
 }
 
+/// Whether a client of user `own_uid` may take the events of a server run by `server_uid`: its
+/// own user's pend, or a system-wide one run by root. Anyone else may have put a socket where
+/// pend's belongs (a shared folder), and would see what the client sends and feed it false pen
+/// events.
+pub fn trusted_server(server_uid: u32, own_uid: u32) -> bool {
+    server_uid == own_uid || server_uid == 0
+}
+
+/// Refuses a server that [`trusted_server`] does not trust, by the kernel's word for who it is
+/// (`SO_PEERCRED`: the credentials of the process that bound the socket, which it cannot fake).
+fn check_server(stream: &UnixStream, path: &Path) -> Result<(), ClientError> {
+    let creds = getsockopt(stream, PeerCredentials)?;
+    let (server, own) = (creds.uid(), nix::unistd::getuid().as_raw());
+    if trusted_server(server, own) {
+        return Ok(());
+    }
+    Err(ClientError::Io(std::io::Error::new(
+        std::io::ErrorKind::PermissionDenied,
+        format!(
+            "{} is served by a process of user {server} (PID {}), not by you (user {own}) or root; \
+             not reading it: another user may have put a socket there (pend --socket in a folder of your own)",
+            path.display(),
+            creds.pid()
+        ),
+    )))
+}
+
+impl From<nix::errno::Errno> for ClientError {
+    fn from(e: nix::errno::Errno) -> ClientError {
+        ClientError::Io(std::io::Error::from(e))
+    }
+}
+
 /// A connection to pend.
 pub struct Client {
     reader: BufReader<UnixStream>,
@@ -76,9 +112,13 @@ pub struct Client {
 }
 
 impl Client {
-    /// Connects to the socket at `path` and asks for `head` lines, which this client reads.
+    /// Connects to the socket at `path`, refuses it unless it is served by this user or root
+    /// (an error of kind `PermissionDenied` naming the server's user), and asks for `head`
+    /// lines, which this client reads.
     pub fn connect(path: &Path) -> Result<Client, ClientError> {
         let stream = UnixStream::connect(path)?;
+        // Before a byte is written: the request is nobody else's business either.
+        check_server(&stream, path)?;
         // Unanswered: a pend that refused the client has closed its end, and the refusal's
         // reason is what the client should read next, not a failed write; an older pend
         // ignores what clients write (and sends every line anyway).
@@ -110,6 +150,29 @@ mod tests {
             Err(ClientError::Bad { why, .. }) => why,
             other => panic!("{line}: {other:?}"),
         }
+    }
+
+    #[test]
+    fn only_the_clients_own_user_or_root_may_serve_it() {
+        assert!(trusted_server(1000, 1000));
+        assert!(trusted_server(0, 1000), "a system-wide pend");
+        assert!(trusted_server(0, 0));
+        assert!(!trusted_server(1001, 1000), "another user");
+        assert!(!trusted_server(1000, 0), "root trusts only root");
+        assert!(!trusted_server(65534, 1000));
+    }
+
+    /// The real check on a real socket: served by this process, so by this user.
+    #[test]
+    fn a_socket_served_by_the_clients_own_user_is_taken() {
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let path = tmp.path().join("pend.sock");
+        let listener = std::os::unix::net::UnixListener::bind(&path).expect("bind");
+        let client = Client::connect(&path).expect("our own server is trusted");
+        let (served, _) = listener.accept().expect("accept");
+        let creds = getsockopt(&served, PeerCredentials).expect("peer");
+        assert_eq!(creds.uid(), nix::unistd::getuid().as_raw());
+        drop(client);
     }
 
     #[test]

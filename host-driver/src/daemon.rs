@@ -26,6 +26,7 @@ use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::sync::{Arc, Condvar, Mutex};
 use std::time::Duration;
 
+use crate::calibration::Calibration;
 use crate::events::{EventKind, PenEvent, PenState};
 use crate::pipeline::Pipeline;
 use crate::requests::Requests;
@@ -36,6 +37,16 @@ use crate::wire::{self, Hello, Refused, SocketLine};
 
 /// Events a client may have queued before it starts missing them: about a second at 1 kHz.
 pub const DEFAULT_QUEUE: usize = 1024;
+
+/// The longest queue a client may have (`pend --queue`): 16 s at 1 kHz. Beyond it one stalled
+/// client could hold as much memory as it likes; with [`LINE_BYTES`] a queue holds at most
+/// 8 MiB of lines.
+pub const MAX_QUEUE: usize = 16 * 1024;
+
+/// Bytes of lines a queue holds per event of its length: a motion line is about 300 bytes, so
+/// a queue is bounded by its length in events; a long line (a device's name, a loss's reason)
+/// takes its size from the same budget, so the bytes are bounded too.
+pub const LINE_BYTES: usize = 512;
 
 /// Clients served at once. Each costs a writer thread and, while it lags, up to its queue of
 /// lines (about 300 KB at 1024); 64 is far more than the programs one pen feeds, and small
@@ -49,6 +60,14 @@ const WRITER_STACK: usize = 64 * 1024;
 /// Lines a writer takes from its queue per write: enough to send a burst in one system call,
 /// few enough that the lines in flight stay small beside the queue.
 const BATCH: usize = 64;
+
+/// Bytes a writer takes per batch at most: lines in flight stay small beside the queue however
+/// long they are.
+const BATCH_BYTES: usize = 64 * 1024;
+
+/// A queue that held more than this at its fullest is handed back to the system when its client
+/// leaves (see [`Leaving`]).
+const TRIM_AFTER: usize = 1024 * 1024;
 
 /// How long a writer waits for events before checking that its client is still there, so a
 /// client that leaves while the pen is quiet frees its place.
@@ -75,6 +94,10 @@ struct Queue {
 
 struct QueueState {
     lines: VecDeque<Arc<str>>,
+    /// The bytes of `lines`.
+    bytes: usize,
+    /// The most bytes `lines` held.
+    peak: usize,
     /// The writer has stopped: the client left or its socket failed.
     gone: bool,
     /// The writer is waiting for lines: only then is it worth a wake-up.
@@ -92,8 +115,25 @@ struct Gap {
 
 struct Client {
     queue: Arc<Queue>,
+    /// At most this many lines…
     capacity: usize,
+    /// …and this many bytes of them.
+    capacity_bytes: usize,
     gap: Option<Gap>,
+}
+
+impl QueueState {
+    /// Whether `n` more lines of `bytes` fit beside those queued, within `c`'s bounds. An empty
+    /// queue takes them whatever their size, or a tiny queue or a long line never would be.
+    fn fits(&self, c: &Client, n: usize, bytes: usize) -> bool {
+        self.lines.is_empty() || (self.lines.len() + n <= c.capacity && self.bytes + bytes <= c.capacity_bytes)
+    }
+
+    fn push(&mut self, line: Arc<str>) {
+        self.bytes += line.len();
+        self.peak = self.peak.max(self.bytes);
+        self.lines.push_back(line);
+    }
 }
 
 struct Inner {
@@ -156,8 +196,8 @@ impl Hub {
                 return true;
             }
             let queued = match c.gap.take() {
-                None if q.lines.len() < c.capacity => {
-                    q.lines.push_back(line.clone());
+                None if q.fits(c, 1, line.len()) => {
+                    q.push(line.clone());
                     true
                 }
                 // The queue is full: the gap starts here, after what the client will read.
@@ -170,7 +210,7 @@ impl Hub {
                 }
                 // Not even the notice and this event fit: still in the gap, and cheaply so,
                 // since a lagging client meets this for every event until it reads.
-                Some(mut gap) if !q.lines.is_empty() && q.lines.len() + 2 > c.capacity => {
+                Some(mut gap) if !q.fits(c, 2, line.len()) => {
                     gap.count += 1;
                     c.gap = Some(gap);
                     false
@@ -181,10 +221,11 @@ impl Hub {
                     resync.clear();
                     resync.push(PenEvent::missed(gap.count, event.t_us));
                     gap.seen.resync(state, event.t_us, &mut resync);
-                    // An empty queue takes them whatever its size, or a tiny one never would.
-                    if q.lines.is_empty() || q.lines.len() + resync.len() < c.capacity {
-                        q.lines.extend(resync.iter().map(|e| Arc::from(wire::line(e))));
-                        q.lines.push_back(line.clone());
+                    let lines: Vec<Arc<str>> = resync.iter().map(|e| Arc::from(wire::line(e))).collect();
+                    let bytes = lines.iter().map(|l| l.len()).sum::<usize>() + line.len();
+                    if q.fits(c, lines.len() + 1, bytes) {
+                        lines.into_iter().for_each(|l| q.push(l));
+                        q.push(line.clone());
                         true
                     } else {
                         gap.count += 1;
@@ -227,14 +268,20 @@ impl Hub {
         )
     }
 
+    /// Bytes of lines queued for clients now.
+    pub fn queued_bytes(&self) -> usize {
+        let inner = lock(&self.inner);
+        inner.clients.iter().map(|c| lock(&c.queue.state).bytes).sum()
+    }
+
     /// Clients turned away because `max_clients` were connected, since the start.
     pub fn refused(&self) -> u64 {
         self.refused.load(Ordering::Relaxed)
     }
 
     /// Serves a connected client from its own writer thread, its queue holding at most
-    /// `queue_len` events: the greeting, the events of the pen's current state, then every
-    /// event. When `max_clients` are connected it is sent a `refused` line and closed instead;
+    /// `queue_len` events (at most [`MAX_QUEUE`]) and `queue_len` × [`LINE_BYTES`] bytes of
+    /// lines: the greeting, the events of the pen's current state, then every event. When `max_clients` are connected it is sent a `refused` line and closed instead;
     /// the result says whether it was taken.
     pub fn connect(&self, stream: UnixStream, queue_len: usize) -> bool {
         let mut inner = lock(&self.inner);
@@ -246,20 +293,22 @@ impl Hub {
         }
         // Greeting and state are taken under the lock that publishing holds, so no event falls
         // between them and the first one queued.
-        let mut lines = VecDeque::new();
-        lines.push_back(Arc::from(
+        let mut first = QueueState {
+            lines: VecDeque::new(),
+            bytes: 0,
+            peak: 0,
+            gone: false,
+            waiting: false,
+            head: false,
+        };
+        first.push(Arc::from(
             SocketLine::Hello(Hello::new(now_us(), inner.state.device.clone())).to_text(),
         ));
         let mut join = Vec::new();
         inner.state.greeted().resync(&inner.state, inner.last_t_us, &mut join);
-        lines.extend(join.iter().map(|e| Arc::from(wire::line(e))));
+        join.iter().for_each(|e| first.push(Arc::from(wire::line(e))));
         let queue = Arc::new(Queue {
-            state: Mutex::new(QueueState {
-                lines,
-                gone: false,
-                waiting: false,
-                head: false,
-            }),
+            state: Mutex::new(first),
             wake: Condvar::new(),
         });
         let writer = queue.clone();
@@ -272,9 +321,11 @@ impl Hub {
         if spawned.is_err() {
             return false;
         }
+        let capacity = queue_len.clamp(1, MAX_QUEUE);
         inner.clients.push(Client {
             queue,
-            capacity: queue_len.max(1),
+            capacity,
+            capacity_bytes: capacity * LINE_BYTES,
             gap: None,
         });
         true
@@ -310,8 +361,32 @@ impl Drop for Leaving<'_> {
         let mut q = lock(&self.0.state);
         q.gone = true;
         q.lines = VecDeque::new();
+        q.bytes = 0;
+        let peak = std::mem::take(&mut q.peak);
+        drop(q);
+        // The lines were many small allocations made on the device thread, in its own malloc
+        // arena, which glibc does not shrink on free: a full queue's memory stayed with pend
+        // after its client left (70 of 188 MB, measured) until it is trimmed.
+        if peak > TRIM_AFTER {
+            trim_heap();
+        }
     }
 }
+
+/// Gives the allocator's free memory back to the system.
+#[cfg(all(target_os = "linux", target_env = "gnu"))]
+fn trim_heap() {
+    // SAFETY: malloc_trim takes no pointers and only releases free memory of the allocator's
+    // own arenas; it is thread-safe (it locks each arena).
+    #[allow(unsafe_code)]
+    unsafe {
+        libc::malloc_trim(0);
+    }
+}
+
+/// Other allocators return large frees themselves.
+#[cfg(not(all(target_os = "linux", target_env = "gnu")))]
+fn trim_heap() {}
 
 /// A client's writer: its queue to its socket, a batch per write; between writes, what the
 /// client asks for.
@@ -349,8 +424,17 @@ fn write_client(stream: UnixStream, queue: &Queue) {
                     q.head |= requests.head();
                 }
             }
-            let n = q.lines.len().min(BATCH);
-            batch.extend(q.lines.drain(..n));
+            let mut bytes = 0;
+            while batch.len() < BATCH && bytes < BATCH_BYTES {
+                let Some(line) = q.lines.pop_front() else { break };
+                bytes += line.len();
+                batch.push(line);
+            }
+            q.bytes -= bytes;
+            // A queue that filled keeps its buffer's size once drained: give it back.
+            if q.lines.is_empty() && q.lines.capacity() > 4 * BATCH {
+                q.lines.shrink_to(BATCH);
+            }
         }
         for line in batch.drain(..) {
             if out.write_all(line.as_bytes()).is_err() {
@@ -406,14 +490,34 @@ pub fn run_device(pipeline: Pipeline, hub: Arc<Hub>, stop: Arc<AtomicBool>, log:
 /// [`run_device`], with `each` called with every event after it is published (the virtual
 /// tablet follows them so).
 pub fn run_device_with(
+    pipeline: Pipeline,
+    hub: Arc<Hub>,
+    stop: Arc<AtomicBool>,
+    log: impl Fn(&str),
+    each: impl FnMut(&PenEvent),
+) {
+    let (_none, reloads) = std::sync::mpsc::channel();
+    run_device_reloading(pipeline, hub, stop, log, each, &reloads)
+}
+
+/// [`run_device_with`], taking each calibration sent on `reloads` between polls (pend's SIGHUP)
+/// and logging whether it was taken.
+pub fn run_device_reloading(
     mut pipeline: Pipeline,
     hub: Arc<Hub>,
     stop: Arc<AtomicBool>,
     log: impl Fn(&str),
     mut each: impl FnMut(&PenEvent),
+    reloads: &std::sync::mpsc::Receiver<(Calibration, String)>,
 ) {
     let mut events = Vec::new();
     while !stop.load(Ordering::Relaxed) {
+        while let Ok((calibration, what)) = reloads.try_recv() {
+            match pipeline.set_calibration(calibration) {
+                Ok(()) => log(&format!("SIGHUP: reloaded: {what}")),
+                Err(e) => log(&format!("SIGHUP: kept the calibration in use, not {what}: {e}")),
+            }
+        }
         events.clear();
         pipeline.poll(Duration::from_millis(50), &mut events);
         if let Some(notice) = pipeline.take_notice() {

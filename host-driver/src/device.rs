@@ -65,6 +65,8 @@ pub struct Device {
     head_sampler: HeadSampler,
     next_try: Instant,
     last_error: Option<String>,
+    /// Reports the transport returned as invalid since the last attach.
+    invalid: u64,
     info: Result<DeviceInfo, String>,
     /// Since when the session has been without a device.
     waiting_since: Instant,
@@ -84,6 +86,7 @@ impl Device {
             head_sampler: HeadSampler::new(),
             next_try: Instant::now(),
             last_error: None,
+            invalid: 0,
             info: Err("not attached".into()),
             waiting_since: Instant::now(),
             next_notice: Instant::now(),
@@ -111,6 +114,13 @@ impl Device {
     /// Reports received and lost since the last attach.
     pub fn counts(&self) -> (u64, u64) {
         (self.sampler.received(), self.sampler.lost())
+    }
+
+    /// Invalid reports or frames received and dropped since the last attach: what the
+    /// transport counted (serial frames failing COBS or the CRC, or holding no valid report)
+    /// and reports it refused (HID).
+    pub fn dropped(&self) -> u64 {
+        self.invalid + self.transport.as_ref().map_or(0, |t| t.dropped())
     }
 
     /// Why the last attempt to attach failed, if it did, with what to do.
@@ -174,6 +184,7 @@ impl Device {
                     self.sampler = Sampler::new();
                     self.head_sampler = HeadSampler::new();
                     self.last_error = None;
+                    self.invalid = 0;
                     Some(DeviceEvent::Found(name))
                 }
                 Err(e) => {
@@ -213,8 +224,9 @@ impl Device {
                 Some(DeviceEvent::Lost(why))
             }
             Err(e) => {
-                // A bad report is dropped; the device is still there.
+                // A bad report is dropped and counted; the device is still there.
                 self.last_error = Some(e.to_string());
+                self.invalid += 1;
                 None
             }
         }

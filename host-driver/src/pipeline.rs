@@ -78,6 +78,20 @@ impl Pipeline {
         &self.calibration
     }
 
+    /// Uses `calibration` from the next sample on (pend reloads its file at SIGHUP). One for
+    /// another base station than the one attached is refused, the one in use kept: taking it
+    /// would mean letting the device go mid-stroke.
+    pub fn set_calibration(&mut self, calibration: Calibration) -> Result<(), String> {
+        if self.device.transport().is_some()
+            && let Err(e) = calibration.check_device(self.device.info())
+        {
+            return Err(e.to_string());
+        }
+        self.calibration = calibration;
+        self.told_no_pivot = false;
+        Ok(())
+    }
+
     /// Reports lost (sequence gaps) since the pipeline started.
     pub fn lost(&self) -> u64 {
         self.lost

@@ -25,6 +25,8 @@ pub struct Requests {
     /// The line being written is too long: skipped up to its newline.
     skipping: bool,
     head: bool,
+    /// The client shut its writing side: it will ask for nothing more, but may still read.
+    done_asking: bool,
 }
 
 impl Requests {
@@ -62,19 +64,37 @@ impl Requests {
         }
     }
 
-    /// Takes what the client has written, without waiting for more; whether it left (its end
-    /// of the stream closed, or the socket failed).
+    /// Takes what the client has written, without waiting for more; whether it left (closed
+    /// its socket, or the socket failed). A client that only shut its writing side (`socat -
+    /// UNIX-CONNECT:… </dev/null`, `shutdown(SHUT_WR)`) has not left: it is served until a
+    /// write to it fails.
     pub fn read(&mut self, stream: &UnixStream) -> bool {
         let mut buf = [0u8; 512];
         for _ in 0..MAX_READS {
-            let mut fds = [PollFd::new(stream.as_fd(), PollFlags::POLLIN)];
-            // Readable also when the client closed its end: the read then sees the end.
-            let readable = poll(&mut fds, PollTimeout::ZERO).is_ok_and(|n| n > 0);
-            if !readable {
+            // Once its writing side is shut the socket is always readable (at its end): then
+            // only a hang-up, which the kernel reports whatever is asked, says it left.
+            let wanted = if self.done_asking {
+                PollFlags::empty()
+            } else {
+                PollFlags::POLLIN
+            };
+            let mut fds = [PollFd::new(stream.as_fd(), wanted)];
+            if poll(&mut fds, PollTimeout::ZERO).is_err() {
+                return false;
+            }
+            let events = fds[0].revents().unwrap_or(PollFlags::empty());
+            // POLLHUP: both directions shut, so it closed its socket (a write would fail).
+            if events.intersects(PollFlags::POLLHUP | PollFlags::POLLERR | PollFlags::POLLNVAL) {
+                return true;
+            }
+            if !events.contains(PollFlags::POLLIN) {
                 return false;
             }
             match (&*stream).read(&mut buf) {
-                Ok(0) => return true,
+                Ok(0) => {
+                    self.done_asking = true;
+                    return false;
+                }
                 Ok(n) => self.take(&buf[..n]),
                 Err(e) => {
                     return !matches!(

@@ -9,7 +9,12 @@
 //!   another user's trap.
 //! - For a socket path given on the command line, its directory is created 0700 if missing; an
 //!   existing one must not be a symlink, and must be owned by this user or root and not writable
-//!   by others unless sticky (like `/tmp`), so nobody else can rename or replace the socket.
+//!   by group or others — not even sticky like `/tmp`: the sticky bit stops others renaming the
+//!   socket, but not creating `PATH.lock` or a socket of theirs at the path before pend does
+//!   (pend would then take their squat for "another pend", and clients would talk to theirs).
+//! - The lock file and a socket found at the path must be this user's (a squat in a folder that
+//!   was shared once is named, not taken for another pend). Clients check who serves them too
+//!   ([`crate::client`]).
 //! - The socket is bound under a umask of 0177, so it is owner-only from the moment it exists
 //!   (no window between `bind` and `chmod`).
 //! - Only a *socket* nobody answers on is removed as stale (a crashed pend left it); a regular
@@ -60,6 +65,30 @@ pub enum SocketError {
         path: PathBuf,
         /// Its permission bits.
         mode: u32,
+    },
+    /// A chosen socket folder that other users can create files in.
+    #[error(
+        "{path} has mode {mode:04o}: other users can create files in it and take pend's socket or its lock before pend does; put the socket in a folder of your own (the default, or e.g. --socket {path}/penscape-{uid}/pend.sock, which pend makes 0700)"
+    )]
+    SharedFolder {
+        /// The directory.
+        path: PathBuf,
+        /// Its permission bits.
+        mode: u32,
+        /// This process's uid.
+        uid: u32,
+    },
+    /// A file at pend's socket path or its lock belongs to another user.
+    #[error(
+        "{path} belongs to user {owner}, not to you (user {uid}); pend will not use it (remove it or choose --socket)"
+    )]
+    NotYours {
+        /// The socket or lock file.
+        path: PathBuf,
+        /// Its owner's uid.
+        owner: u32,
+        /// This process's uid.
+        uid: u32,
     },
     /// Something that is not a socket stands at the socket's path.
     #[error("{0} exists and is not a socket; pend will not remove it (choose another --socket)")]
@@ -146,6 +175,22 @@ fn take_lock(path: &Path) -> Result<Flock<File>, SocketError> {
             path: lock_path.clone(),
             cause,
         })?;
+    // O_CREAT opened one that was there already: only ours is ours to hold.
+    let owner = file
+        .metadata()
+        .map_err(|cause| SocketError::Io {
+            what: "inspect",
+            path: lock_path.clone(),
+            cause,
+        })?
+        .uid();
+    if owner != uid() {
+        return Err(SocketError::NotYours {
+            path: lock_path,
+            owner,
+            uid: uid(),
+        });
+    }
     match Flock::lock(file, FlockArg::LockExclusiveNonblock) {
         Ok(lock) => Ok(lock),
         Err((_, Errno::EWOULDBLOCK)) => Err(SocketError::InUse(path.to_path_buf())),
@@ -232,12 +277,12 @@ fn check_dir(dir: &Path, meta: &Metadata, private_dir: bool) -> Result<(), Socke
                 uid: me,
             });
         }
-        // Writable by group or others without the sticky bit: they could rename our socket.
-        let sticky = mode & 0o1000 != 0;
-        if mode & 0o022 != 0 && !sticky {
-            return Err(SocketError::OpenToOthers {
+        // Writable by group or others, sticky or not: they could squat the names pend uses.
+        if mode & 0o022 != 0 {
+            return Err(SocketError::SharedFolder {
                 path: dir.to_path_buf(),
                 mode,
+                uid: me,
             });
         }
     }
@@ -262,6 +307,13 @@ fn clear_stale(path: &Path) -> Result<(), SocketError> {
     }
     if !meta.file_type().is_socket() {
         return Err(SocketError::NotASocket(path.to_path_buf()));
+    }
+    if meta.uid() != uid() {
+        return Err(SocketError::NotYours {
+            path: path.to_path_buf(),
+            owner: meta.uid(),
+            uid: uid(),
+        });
     }
     match UnixStream::connect(path) {
         Ok(_) => Err(SocketError::InUse(path.to_path_buf())),
@@ -360,18 +412,55 @@ mod tests {
         assert!(matches!(e, SocketError::NotOwned { owner: 65534, .. }), "{e}");
     }
 
+    /// Issue 47 item 8: in a shared folder like `/tmp` (sticky) another user could make the lock
+    /// or a socket at the path first; pend took that for another pend. Such a folder is refused
+    /// for what it is, with a folder of one's own suggested; one closed to others is taken.
     #[test]
-    fn a_chosen_path_in_a_shared_sticky_dir_is_allowed_and_in_an_open_one_refused() {
+    fn a_chosen_path_in_a_shared_dir_sticky_or_not_is_refused() {
         let tmp = tempfile::tempdir().expect("tempdir");
-        let sticky = tmp.path().join("sticky");
-        std::fs::create_dir(&sticky).expect("mkdir");
-        std::fs::set_permissions(&sticky, std::fs::Permissions::from_mode(0o1777)).expect("chmod");
-        bind(&sticky.join("pend.sock"), false).expect("like /tmp: others cannot rename our socket");
-        let open = tmp.path().join("open");
-        std::fs::create_dir(&open).expect("mkdir");
-        std::fs::set_permissions(&open, std::fs::Permissions::from_mode(0o777)).expect("chmod");
-        let e = bind(&open.join("pend.sock"), false).expect_err("refused");
-        assert!(matches!(e, SocketError::OpenToOthers { .. }), "{e}");
+        for mode in [0o1777, 0o777, 0o1770, 0o775] {
+            let dir = tmp.path().join(format!("shared-{mode:o}"));
+            std::fs::create_dir(&dir).expect("mkdir");
+            std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(mode)).expect("chmod");
+            let e = bind(&dir.join("pend.sock"), false).expect_err("refused");
+            assert!(
+                matches!(e, SocketError::SharedFolder { mode: m, .. } if m == mode),
+                "{e}"
+            );
+            assert!(e.to_string().contains("folder of your own"), "{e}");
+            assert!(!dir.join("pend.sock.lock").exists(), "nothing made in it");
+        }
+        let own = tmp.path().join("own");
+        std::fs::create_dir(&own).expect("mkdir");
+        std::fs::set_permissions(&own, std::fs::Permissions::from_mode(0o755)).expect("chmod");
+        bind(&own.join("pend.sock"), false).expect("closed to others: taken");
+    }
+
+    /// A lock file or a socket at the path that another user made (as root: chowned) is named as
+    /// theirs, not taken for another pend nor held or removed.
+    #[test]
+    fn a_squatted_lock_or_socket_of_another_user_is_named_as_theirs() {
+        if uid() != 0 {
+            eprintln!("skipped: giving a file to another user needs root");
+            return;
+        }
+        let other = Some(nix::unistd::Uid::from_raw(65534));
+        let tmp = tempfile::tempdir().expect("tempdir");
+        let path = tmp.path().join("pend.sock");
+        let lock = tmp.path().join("pend.sock.lock");
+        std::fs::write(&lock, "").expect("squat the lock");
+        nix::unistd::chown(&lock, other, None).expect("chown");
+        let e = bind(&path, false).expect_err("refused");
+        assert!(matches!(e, SocketError::NotYours { owner: 65534, .. }), "{e}");
+        std::fs::remove_file(&lock).expect("rm");
+
+        let squat = UnixListener::bind(&path).expect("a fake socket");
+        nix::unistd::chown(&path, other, None).expect("chown");
+        let e = bind(&path, false).expect_err("refused");
+        assert!(matches!(e, SocketError::NotYours { owner: 65534, .. }), "{e}");
+        assert!(e.to_string().contains("user 65534"), "{e}");
+        drop(squat);
+        assert!(path.exists(), "not removed");
     }
 
     #[test]

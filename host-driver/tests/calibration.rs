@@ -482,3 +482,16 @@ fn display_sizes_are_checked_on_fit_and_load() {
     );
     assert!(load("scale = 1.0", "scale = 1e300").contains("`transform.scale` must be between 0.5 and 2, is 1e300"));
 }
+
+/// Issue 47 item 11: a calibration without fit targets (the identity, a file with none) has an
+/// RMS of +0, never -0 (an empty float `sum` is -0.0 in Rust, and pend printed "RMS -0.00 mm").
+#[test]
+fn a_calibration_without_targets_has_an_rms_of_plus_zero() {
+    let identity = Calibration::identity(DisplaySize::REFERENCE);
+    let loaded = Calibration::from_toml(&identity.to_toml(), "cal.toml").expect("loads");
+    for c in [identity, loaded] {
+        assert!(c.residuals.is_empty());
+        assert!(c.rms_mm() == 0.0 && c.rms_mm().is_sign_positive(), "{}", c.rms_mm());
+        assert_eq!(format!("{:.2}", c.rms_mm()), "0.00");
+    }
+}

@@ -591,3 +591,195 @@ fn clients_beyond_the_limit_are_refused_and_cost_no_thread() {
     let _ = pend.wait();
     let _ = std::fs::remove_file(&path);
 }
+
+/// Issue 47 item 9: a client's queue is bounded by bytes as well as by events. A stalled client
+/// offered 1,000 lines of 8 KiB (device names; 8 MB in all, fewer events than its queue's 1024)
+/// holds at most the queue's byte budget, beside what its socket and writer have in flight; the
+/// rest it misses. Counted by events only, all 1,000 were queued. Its queue is freed when it
+/// leaves.
+#[test]
+fn a_stalled_clients_queue_is_bounded_by_bytes_and_freed_when_it_leaves() {
+    let hub = Arc::new(Hub::default());
+    let (ours, theirs) = UnixStream::pair().expect("socket pair");
+    assert!(hub.connect(ours, daemon::DEFAULT_QUEUE));
+    let budget = daemon::DEFAULT_QUEUE * daemon::LINE_BYTES;
+    let name = "n".repeat(8 * 1024);
+    for i in 0..1000u64 {
+        let kind = if i % 2 == 0 {
+            EventKind::DeviceFound { device: name.clone() }
+        } else {
+            EventKind::DeviceLost { reason: name.clone() }
+        };
+        hub.publish(&PenEvent {
+            kind,
+            t_us: 1_000_000 + i,
+            point: None,
+            sw: None,
+            seq: None,
+        });
+        assert!(
+            hub.queued_bytes() <= budget,
+            "after {i} lines: {} bytes queued, more than the {budget} budget",
+            hub.queued_bytes()
+        );
+    }
+    let (delivered, missed) = hub.counts();
+    // What is not queued is in the socket (a few hundred KB) or the writer's batch (64 KiB).
+    assert!(
+        delivered * 8 * 1024 <= 4 * 1024 * 1024,
+        "{delivered} lines of 8 KiB taken for a client that never reads"
+    );
+    assert_eq!(delivered + missed, 1000);
+
+    drop(theirs);
+    let until = Instant::now() + GUARD;
+    while hub.clients() > 0 {
+        assert!(Instant::now() < until, "the client that left kept its place");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    assert_eq!(hub.queued_bytes(), 0, "its queue freed");
+}
+
+/// Issue 47 item 11: a client that shuts its writing side (as `socat - UNIX-CONNECT:… </dev/null`
+/// does) but reads on is served: reading 0 bytes from it means it asks for nothing more, not that
+/// it left. pend dropped it within milliseconds. A client that closes its socket while the pen is
+/// quiet still frees its place.
+#[test]
+fn a_half_closed_client_is_served_and_a_closed_one_leaves() {
+    const MOTIONS: usize = 200;
+    let hub = Arc::new(Hub::default());
+    let (ours, theirs) = UnixStream::pair().expect("socket pair");
+    theirs
+        .shutdown(std::net::Shutdown::Write)
+        .expect("shut its writing side");
+    assert!(hub.connect(ours, daemon::DEFAULT_QUEUE));
+    let reader = std::thread::spawn(move || {
+        let mut motions = 0;
+        read_events(theirs, |e| {
+            motions += usize::from(e.kind == EventKind::Motion);
+            motions == MOTIONS
+        })
+    });
+    let mut pen = Pen::new();
+    // More than a writer's batch (64 lines): however the threads are scheduled, the writer
+    // looks at the client's side between batches, before the last motions are written.
+    for _ in 0..MOTIONS {
+        pen.sample(&hub, true, [false, false, false]);
+    }
+    let (hello, events) = reader.join().expect("reader");
+    assert_eq!(hello, Some(None), "greeted");
+    let motions = events.iter().filter(|e| e.kind == EventKind::Motion).count();
+    assert_eq!(
+        motions,
+        MOTIONS,
+        "every motion read by the half-closed client: {:?}",
+        names(&events)
+    );
+    assert_eq!(hub.counts().1, 0, "none missed");
+
+    // Closed whole, with no event to write: it leaves at its writer's next look (the first
+    // client closed too, when its reader ended).
+    let (ours, theirs) = UnixStream::pair().expect("socket pair");
+    assert!(hub.connect(ours, daemon::DEFAULT_QUEUE));
+    drop(theirs);
+    let until = Instant::now() + GUARD;
+    while hub.clients() > 0 {
+        assert!(Instant::now() < until, "a closed client kept its place");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+}
+
+/// Issue 47 item 11: SIGHUP reloads the calibration and says so; pend serves on with it. It
+/// used to end pend (the default action), leaving its socket behind.
+#[test]
+fn sighup_reloads_the_calibration_and_pend_serves_on() {
+    let (dir, path) = socket_path("sighup");
+    let file = dir.path().join("calibration.toml");
+    let identity = Calibration::identity(DisplaySize::REFERENCE);
+    identity.save(&file).expect("save");
+    let mut pend = Command::new(env!("CARGO_BIN_EXE_pend"))
+        .args(["--sim", "hold", "--calibration"])
+        .arg(&file)
+        .arg("--socket")
+        .arg(&path)
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("pend starts");
+    let (tx, log) = std::sync::mpsc::channel();
+    let stderr = pend.stderr.take().expect("stderr");
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = tx.send(line);
+        }
+    });
+    let end = Instant::now() + GUARD;
+    let stream = loop {
+        if let Ok(s) = UnixStream::connect(&path) {
+            break s;
+        }
+        assert!(Instant::now() < end, "pend did not listen");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    stream
+        .set_read_timeout(Some(Duration::from_millis(200)))
+        .expect("timeout");
+    let mut reader = BufReader::new(stream);
+    let mut next_u = || loop {
+        assert!(Instant::now() < end, "no motion within {GUARD:?}");
+        let mut line = String::new();
+        match reader.read_line(&mut line) {
+            Ok(0) => panic!("pend closed the socket"),
+            Ok(_) => {}
+            Err(_) => continue,
+        }
+        if let Ok(Line::Event(e)) = parse_line(line.trim_end())
+            && e.kind == EventKind::Motion
+        {
+            return e.point.expect("a motion's point").u_mm;
+        }
+    };
+    let before = next_u();
+
+    let mut moved = identity.clone();
+    moved.transform.translation_mm.x += 100.0;
+    moved.save(&file).expect("save");
+    let status = Command::new("kill")
+        .args(["-HUP", &pend.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(status.success());
+    let reloaded = loop {
+        assert!(Instant::now() < end, "no reload said within {GUARD:?}");
+        if let Some(code) = pend.try_wait().expect("wait") {
+            panic!("pend ended at SIGHUP: {code}");
+        }
+        match log.recv_timeout(Duration::from_millis(100)) {
+            Ok(line) if line.contains("SIGHUP") => break line,
+            _ => {}
+        }
+    };
+    assert!(
+        reloaded.contains("reloaded") && reloaded.contains("calibration.toml"),
+        "{reloaded}"
+    );
+    // A file without fit targets has no RMS to show (issue 47 item 11: it showed "-0.00 mm").
+    assert!(
+        reloaded.contains("no fit targets") && !reloaded.contains("-0.00"),
+        "{reloaded}"
+    );
+    // The events after it are mapped by the new file: 100 mm further along u.
+    let after = loop {
+        let u = next_u();
+        if (u - before - 100.0).abs() < 10.0 {
+            break u;
+        }
+    };
+    assert!(after > before + 90.0);
+    assert!(path.exists(), "its socket stays");
+    let status = Command::new("kill")
+        .args(["-TERM", &pend.id().to_string()])
+        .status()
+        .expect("kill");
+    assert!(status.success());
+    assert_eq!(pend.wait().expect("exits").code(), Some(0));
+}

@@ -9,6 +9,7 @@ mod head;
 mod install;
 mod penctl;
 mod pend_faults;
+mod reliability_doc;
 mod socket;
 mod vocabulary;
 mod waiting;

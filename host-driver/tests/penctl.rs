@@ -1,7 +1,7 @@
 //! `penctl` as a user runs it: the real binary, its stdout, stderr and exit status.
 
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::{Command, Output, Stdio};
 
 use pen_protocol::{PenReport, Position, Quality, REPORT_DESCRIPTOR};
 
@@ -473,4 +473,64 @@ fn info_shows_the_reset_record() {
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
     assert_eq!(v["last_reset"]["report_id"], 9, "{v}");
     assert_eq!(v["last_reset"]["kind"], "None", "{v}");
+}
+
+/// Issue 47 item 11: `penctl monitor` on a serial line of pure garbage (a pseudo-terminal
+/// written with bytes that never make a frame) warns on stderr with the count dropped; it
+/// printed nothing at all.
+#[test]
+fn monitor_warns_with_a_count_when_the_line_is_garbage() {
+    use std::io::{BufRead, BufReader, Write};
+    let pty = nix::pty::openpty(None, None).expect("a pseudo-terminal");
+    let slave = std::fs::read_link(format!("/proc/self/fd/{}", std::os::fd::AsRawFd::as_raw_fd(&pty.slave)))
+        .expect("the terminal's name");
+    let mut master = std::fs::File::from(pty.master);
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let writer = {
+        let stop = stop.clone();
+        std::thread::spawn(move || {
+            // Zero bytes end frames, none of which checks out.
+            while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+                if master.write_all(b"not a frame at all\0garbage\0").is_err() {
+                    break;
+                }
+                std::thread::sleep(std::time::Duration::from_millis(5));
+            }
+        })
+    };
+    let mut penctl = Command::new(env!("CARGO_BIN_EXE_penctl"))
+        .args(["monitor", "--source"])
+        .arg(format!("serial:{}", slave.display()))
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("penctl starts");
+    let stderr = penctl.stderr.take().expect("stderr");
+    let (tx, lines) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = tx.send(line);
+        }
+    });
+    let end = std::time::Instant::now() + std::time::Duration::from_secs(60);
+    let warning = loop {
+        assert!(std::time::Instant::now() < end, "no warning within 60 s");
+        match lines.recv_timeout(std::time::Duration::from_millis(200)) {
+            Ok(line) if line.contains("dropped") => break line,
+            _ => {}
+        }
+    };
+    let _ = penctl.kill();
+    let _ = penctl.wait();
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    drop(pty.slave);
+    let _ = writer.join();
+    assert!(warning.starts_with("penctl: warning: "), "{warning}");
+    let count: u64 = warning
+        .trim_start_matches("penctl: warning: ")
+        .split(' ')
+        .next()
+        .and_then(|n| n.parse().ok())
+        .unwrap_or_else(|| panic!("a count: {warning}"));
+    assert!(count > 0, "{warning}");
 }

@@ -239,3 +239,40 @@ fn a_second_pend_refuses_and_a_killed_pends_socket_is_replaced() {
     let (_, hello) = first_line(&path);
     assert!(hello.contains(r#""type":"hello""#), "{hello}");
 }
+
+/// Issue 47 item 9: `--queue` has a maximum. Above it pend refuses as a usage error naming the
+/// maximum, before it serves anything; before, any length was taken, and one stalled client
+/// grew pend by tens of MB a second.
+#[test]
+fn a_queue_above_the_maximum_is_a_usage_error_naming_it() {
+    use pen_host::daemon::MAX_QUEUE;
+    let (_dir, path) = socket_path("queue");
+    let too_long = (MAX_QUEUE + 1).to_string();
+    let mut child = Command::new(env!("CARGO_BIN_EXE_pend"))
+        .args(["--source", "sim:hold", "--queue", &too_long, "--socket"])
+        .arg(&path)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("pend starts");
+    let end = Instant::now() + GUARD;
+    let status = loop {
+        if let Some(status) = child.try_wait().expect("wait") {
+            break status;
+        }
+        if Instant::now() > end {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("pend took --queue {too_long} and ran");
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let mut err = String::new();
+    std::io::Read::read_to_string(&mut child.stderr.take().expect("stderr"), &mut err).expect("stderr");
+    assert_eq!(status.code(), Some(2), "a usage error: {err}");
+    assert!(err.contains(&MAX_QUEUE.to_string()), "names the maximum: {err}");
+    assert!(!path.exists(), "nothing served");
+    // The maximum itself is taken.
+    let _pend = start_pend(&path, &["--source", "sim:hold", "--queue", &MAX_QUEUE.to_string()]);
+}

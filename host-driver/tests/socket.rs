@@ -66,3 +66,58 @@ fn a_symlinked_default_directory_is_refused() {
     assert!(stderr.contains("symbolic link"), "{stderr}");
     assert!(!target.join("pend.sock").exists());
 }
+
+/// Issue 47 item 8: a client checks who serves it (`SO_PEERCRED`). A real pend run as another
+/// user (65534, as root can start it) serves a socket this user can reach; `pen_host::client`
+/// refuses it with an error naming that user, before reading a line. Without root this case
+/// cannot be made: the decision itself and the same-user success are unit tests in `client`.
+#[test]
+fn a_client_refuses_a_pend_run_by_another_user() {
+    use std::os::unix::process::CommandExt;
+    if nix::unistd::getuid().as_raw() != 0 {
+        eprintln!("skipped: running pend as another user needs root");
+        return;
+    }
+    let tmp = tempfile::tempdir().expect("tempdir");
+    // The other user must reach its folder: the tempdir is passable, the folder its own.
+    std::fs::set_permissions(tmp.path(), std::fs::Permissions::from_mode(0o711)).expect("chmod");
+    let dir = tmp.path().join("theirs");
+    std::fs::create_dir(&dir).expect("mkdir");
+    std::fs::set_permissions(&dir, std::fs::Permissions::from_mode(0o700)).expect("chmod");
+    nix::unistd::chown(&dir, Some(nix::unistd::Uid::from_raw(65534)), None).expect("chown");
+    let path = dir.join("pend.sock");
+    let child = Command::new(env!("CARGO_BIN_EXE_pend"))
+        .args(["--source", "sim:hold", "--socket"])
+        .arg(&path)
+        .env("XDG_CONFIG_HOME", &dir)
+        .uid(65534)
+        .gid(65534)
+        .stdin(Stdio::null())
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("pend starts as user 65534");
+    let _pend = crate::common::Pend(child);
+    let start = Instant::now();
+    while std::os::unix::net::UnixStream::connect(&path).is_err() {
+        assert!(
+            start.elapsed() < crate::common::GUARD,
+            "pend as user 65534 did not listen"
+        );
+        std::thread::sleep(Duration::from_millis(20));
+    }
+    let meta = std::fs::symlink_metadata(&path).expect("socket");
+    assert_eq!(
+        std::os::unix::fs::MetadataExt::uid(&meta),
+        65534,
+        "served by the other user"
+    );
+    match pen_host::client::Client::connect(&path) {
+        Ok(_) => panic!("a client took the events of user 65534's pend"),
+        Err(pen_host::client::ClientError::Io(e)) => {
+            assert_eq!(e.kind(), std::io::ErrorKind::PermissionDenied, "{e}");
+            assert!(e.to_string().contains("user 65534"), "names the server's user: {e}");
+        }
+        Err(e) => panic!("{e}"),
+    }
+}

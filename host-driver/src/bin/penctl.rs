@@ -412,7 +412,21 @@ fn monitor(args: &DeviceArgs, as_json: bool, count: Option<u64>) -> Result<()> {
     if !as_json {
         writeln!(out, "{}", monitor_header())?;
     }
+    // Dropped input is said on stderr, at most once a second: a line of pure garbage (a wrong
+    // port, baud rate or device) would otherwise show nothing at all.
+    let (mut told_dropped, mut told_at) = (0u64, None::<std::time::Instant>);
     while count.is_none_or(|n| printed < n) {
+        let dropped = device.dropped();
+        // Counted afresh at each attach.
+        told_dropped = told_dropped.min(dropped);
+        if dropped > told_dropped && told_at.is_none_or(|t| t.elapsed() >= Duration::from_secs(1)) {
+            eprintln!(
+                "penctl: warning: {dropped} invalid reports or frames dropped since {} attached (garbage on the line: \
+                 the wrong port or baud rate, or not a base station?)",
+                device.awaited()
+            );
+            (told_dropped, told_at) = (dropped, Some(std::time::Instant::now()));
+        }
         match device.next(Duration::from_millis(200)) {
             Some(DeviceEvent::Sample(s, lost)) => {
                 if as_json {

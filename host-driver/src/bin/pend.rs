@@ -1,9 +1,9 @@
 //! `pend`: the pen daemon. Attaches to the base station (USB HID by default, `--source
 //! serial:PATH`, or `--source sim` for the simulated pen), applies the calibration, and serves pen events to any number
 //! of clients (a bounded number at once) on a Unix domain socket as JSON lines (docs/events.md). SIGTERM and SIGINT stop it:
-//! the socket is removed and the exit status is 0.
+//! the socket is removed and the exit status is 0. SIGHUP reloads the calibration.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 use std::sync::Arc;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -12,9 +12,9 @@ use std::time::Duration;
 use anyhow::{Context, Result};
 use clap::Parser;
 use pen_host::calibration::{Calibration, DisplaySize};
-use pen_host::daemon::{self, DEFAULT_MAX_CLIENTS, DEFAULT_QUEUE, Hub};
+use pen_host::daemon::{self, DEFAULT_MAX_CLIENTS, DEFAULT_QUEUE, Hub, MAX_QUEUE};
 use pen_host::pipeline::Pipeline;
-use pen_host::source::{DeviceArgs, SimScenario, SourceError};
+use pen_host::source::{DeviceArgs, SimScenario, Source, SourceError};
 use pen_host::virtual_tablet::{self, Extent, VirtualTablet};
 
 /// `pend --help`'s end: what the defaults mean, and examples.
@@ -26,7 +26,7 @@ const AFTER_HELP: &str = "The simulated pen (--source sim) plays `modeling-sessi
     pend                                     # the first base station on USB\n  \
     pend --source serial:/dev/ttyACM0        # its serial link\n  \
     pend --source sim                        # the simulated pen, in real time\n  \
-    pend --source sim:hold --speed 0 --socket /tmp/pend.sock\n  \
+    pend --source sim:hold --speed 0 --socket $XDG_RUNTIME_DIR/sim.sock\n  \
     pend --virtual-tablet                    # and a uinput pen for every program\n\
     docs/events.md (the socket's lines) and docs/cli.md (the flags every tool shares).";
 /// `pend --help`'s end, in a build without the simulated pen.
@@ -57,9 +57,11 @@ struct Cli {
     /// It is applied only to the base station it records.
     #[arg(long, value_name = "FILE")]
     calibration: Option<PathBuf>,
-    /// Events a client may have waiting before it misses some.
-    #[arg(long, default_value_t = DEFAULT_QUEUE)]
-    queue: usize,
+    /// Events a client may have waiting before it misses some (at most 16384; each queue holds
+    /// at most N × 512 bytes of lines).
+    #[arg(long, value_name = "N", default_value_t = DEFAULT_QUEUE as u64,
+          value_parser = clap::value_parser!(u64).range(1..=MAX_QUEUE as u64))]
+    queue: u64,
     /// Clients served at once; one more is sent a `refused` line and closed.
     #[arg(long, value_name = "N", default_value_t = DEFAULT_MAX_CLIENTS as u16,
           value_parser = clap::value_parser!(u16).range(1..))]
@@ -71,26 +73,40 @@ struct Cli {
     virtual_tablet: bool,
 }
 
-fn run(cli: Cli) -> Result<()> {
-    let source = cli.device.source()?;
-    let calibration = match cli
-        .calibration
-        .or_else(|| pen_host::calibration::default_path_for_source(&source).filter(|p| p.exists()))
-    {
+/// The calibration file pend uses: the one given, or the default if it exists (looked for
+/// again at each SIGHUP, so one made since is taken).
+fn calibration_path(given: Option<&Path>, source: &Source) -> Option<PathBuf> {
+    given
+        .map(Path::to_path_buf)
+        .or_else(|| pen_host::calibration::default_path_for_source(source).filter(|p| p.exists()))
+}
+
+/// Loads the calibration at `path`, or the identity without one; says which on stderr.
+fn load_calibration(path: Option<&Path>) -> Result<(Calibration, String)> {
+    match path {
         Some(path) => {
-            let c = Calibration::load(&path)?;
+            let c = Calibration::load(path)?;
             let whose = c.device.map(|d| format!(", base station {d}")).unwrap_or_default();
-            eprintln!("pend: calibration {} (RMS {:.2} mm{whose})", path.display(), c.rms_mm());
-            if let Some(warning) = c.unbound_warning(&path) {
+            let fit = match c.residuals.len() {
+                0 => "no fit targets".to_string(),
+                _ => format!("RMS {:.2} mm", c.rms_mm()),
+            };
+            if let Some(warning) = c.unbound_warning(path) {
                 eprintln!("pend: warning: {warning}");
             }
-            c
+            Ok((c, format!("calibration {} ({fit}{whose})", path.display())))
         }
-        None => {
-            eprintln!("pend: no calibration; tracker coordinates are display coordinates (penctl calibrate)");
-            Calibration::identity(DisplaySize::REFERENCE)
-        }
-    };
+        None => Ok((
+            Calibration::identity(DisplaySize::REFERENCE),
+            "no calibration; tracker coordinates are display coordinates (penctl calibrate)".to_string(),
+        )),
+    }
+}
+
+fn run(cli: Cli) -> Result<()> {
+    let source = cli.device.source()?;
+    let (calibration, what) = load_calibration(calibration_path(cli.calibration.as_deref(), &source).as_deref())?;
+    eprintln!("pend: {what}");
     // Made before anything is served, so that a refusal (no access to /dev/uinput) ends pend
     // at once with the reason.
     let mut tablet = match cli.virtual_tablet {
@@ -119,15 +135,23 @@ fn run(cli: Cli) -> Result<()> {
     for signal in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
         signal_hook::flag::register(signal, stop.clone()).context("installing signal handlers")?;
     }
+    // SIGHUP reloads the calibration, as daemons reread their configuration; by default it
+    // would end pend and leave its socket behind.
+    let reload = Arc::new(AtomicBool::new(false));
+    signal_hook::flag::register(signal_hook::consts::SIGHUP, reload.clone()).context("installing signal handlers")?;
+    let (reloads_tx, reloads) = std::sync::mpsc::channel();
+    let given = cli.calibration.clone();
+    let sources = source.clone();
     let hub = Arc::new(Hub::new(usize::from(cli.max_clients)));
     let (h, s) = (hub.clone(), stop.clone());
-    let queue = cli.queue;
+    // In range by the parser: at most MAX_QUEUE.
+    let queue = usize::try_from(cli.queue).unwrap_or(MAX_QUEUE);
     std::thread::spawn(move || daemon::accept(listener, h, queue, s));
     let (h, s) = (hub.clone(), stop.clone());
     // The transport lives on the device thread: the simulated pen is not Send.
     std::thread::spawn(move || {
         let mut failed = false;
-        daemon::run_device_with(
+        daemon::run_device_reloading(
             Pipeline::new(source, calibration),
             h,
             s,
@@ -142,11 +166,22 @@ fn run(cli: Cli) -> Result<()> {
                     failed = true;
                 }
             },
+            &reloads,
         )
     });
 
     while !stop.load(Ordering::Relaxed) {
         std::thread::sleep(Duration::from_millis(50));
+        if reload.swap(false, Ordering::Relaxed) {
+            let path = calibration_path(given.as_deref(), &sources);
+            match load_calibration(path.as_deref()) {
+                // The device thread applies it between polls and says whether it took it.
+                Ok(loaded) => {
+                    let _ = reloads_tx.send(loaded);
+                }
+                Err(e) => eprintln!("pend: SIGHUP: kept the calibration in use: {e:#}"),
+            }
+        }
     }
     let _ = std::fs::remove_file(&socket);
     let (delivered, missed) = hub.counts();

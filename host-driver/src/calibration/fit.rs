@@ -265,14 +265,16 @@ impl Calibration {
         }
     }
 
-    /// RMS of the residuals, mm.
+    /// RMS of the residuals, mm; 0 without any (not fitted).
     pub fn rms_mm(&self) -> f64 {
         let n = self.residuals.len().max(1) as f64;
+        // A fold from +0, not `sum`: an empty float sum is -0.0 in Rust, and a calibration
+        // without targets printed "RMS -0.00 mm".
         (self
             .residuals
             .iter()
             .map(|r| r.residual_mm * r.residual_mm)
-            .sum::<f64>()
+            .fold(0.0, |a, b| a + b)
             / n)
             .sqrt()
     }

@@ -687,7 +687,7 @@ fn step_pend_hid() -> Result<String> {
     let log = File::create(PEND_HID_LOG)?;
     // Started before the device exists: it says what it waits for. Notices every 0.5 s
     // instead of 5 s, so the wait after the loss is logged soon.
-    let mut pend = pend_command("hid", "/tmp/pend-hid.sock")
+    let mut pend = pend_command("hid", "/tmp/penscape-guest/hid.sock")
         .env("PENSCAPE_NOTICE_SECS", "0.5")
         .stdin(Stdio::null())
         .stdout(Stdio::null())
@@ -756,7 +756,7 @@ fn pend_hid(pend: &mut Child) -> Result<String> {
     expected.push(("device_found", None, None));
     promised(&pens_after, &mut expected);
 
-    let mut client = SocketClient::connect(Path::new("/tmp/pend-hid.sock"))?;
+    let mut client = SocketClient::connect(Path::new("/tmp/penscape-guest/hid.sock"))?;
     client.take(Duration::from_secs(5))?;
     ensure!(
         client.hello == Some(None),
@@ -876,7 +876,7 @@ fn pend_hid(pend: &mut Child) -> Result<String> {
 }
 
 /// Where the refusal step's pend is told to serve: it must not.
-const REFUSED_SOCKET: &str = "/tmp/pend-refused.sock";
+const REFUSED_SOCKET: &str = "/tmp/penscape-guest/refused.sock";
 
 /// The uinput node as devtmpfs made it: the misc device's number (from
 /// `/sys/class/misc/uinput/dev`) and its permission bits.
@@ -995,7 +995,7 @@ fn pend_refused() -> Result<String> {
 /// back through evdev.
 fn step_virtual_tablet() -> Result<String> {
     let log = File::create("/tmp/pend-vt.log")?;
-    let mut pend = pend_command("sim:draw-figures", "/tmp/pend-vt.sock")
+    let mut pend = pend_command("sim:draw-figures", "/tmp/penscape-guest/vt.sock")
         .args(["--speed", "4", "--virtual-tablet"])
         .stdin(Stdio::null())
         .stdout(Stdio::null())
