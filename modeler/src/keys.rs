@@ -70,9 +70,26 @@ pub fn action(name: &str, display_mm: [f64; 2]) -> Option<KeyAction> {
 /// The help panel's lines: the keys, then the pen's `gestures` (the tool on's and the shared
 /// ones, [`crate::interaction::Interaction::help`]), in two aligned columns.
 pub fn help_lines(gestures: &[(&str, &str)]) -> Vec<String> {
-    let width = KEYS.iter().chain(gestures).map(|(k, _)| k.len()).max().unwrap_or(0);
+    help_lines_with(gestures, &[])
+}
+
+/// [`help_lines`], with `mouse` (the mouse's switches, [`crate::mouse::HELP`]) after the keys
+/// when the mouse is the pen.
+pub fn help_lines_with(gestures: &[(&str, &str)], mouse: &[(&str, &str)]) -> Vec<String> {
+    let width = KEYS
+        .iter()
+        .chain(gestures)
+        .chain(mouse)
+        .map(|(k, _)| k.len())
+        .max()
+        .unwrap_or(0);
     let mut lines = vec!["keys".to_string()];
     lines.extend(KEYS.iter().map(|(k, d)| format!("  {k:width$}  {d}")));
+    if !mouse.is_empty() {
+        lines.push(String::new());
+        lines.push("mouse (the pen)".to_string());
+        lines.extend(mouse.iter().map(|(k, d)| format!("  {k:width$}  {d}")));
+    }
     lines.push(String::new());
     lines.push("pen".to_string());
     lines.extend(gestures.iter().map(|(k, d)| format!("  {k:width$}  {d}")));

@@ -29,6 +29,15 @@ pub const WHEEL_MM: f64 = 5.0;
 /// The highest the wheel lifts the pen, mm: about what the pen's tracker reaches above a display.
 pub const MAX_HEIGHT_MM: f64 = 300.0;
 
+/// The mapping as the window's help shows it: what the mouse does for each switch.
+pub const HELP: [(&str, &str); 5] = [
+    ("left button", "SW1: the tip on the surface"),
+    ("right button", "SW2"),
+    ("middle / Space", "SW3"),
+    ("wheel + right", "lift the pen (5 mm a notch)"),
+    ("off the picture", "out of range"),
+];
+
 /// The pointer as the window reports it.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PointerState {

@@ -194,7 +194,10 @@ pub fn run(
                 panel(
                     &mut frame,
                     &viewport,
-                    &keys::help_lines(&session.interaction.help()),
+                    &keys::help_lines_with(
+                        &session.interaction.help(),
+                        if mouse.is_some() { &penmodel::mouse::HELP } else { &[] },
+                    ),
                     Place::Centre,
                     style,
                 );
