@@ -4,9 +4,9 @@
 # Debian packages the scripts need: binutils for `size` (firmware image figures), QEMU for the
 # firmware core's run on an emulated Cortex-M4F (hil-tests/tests/qemu.rs) and for Debian's own
 # kernel on x86-64 (hil-tests/kernel, which fetches the kernel and busybox with apt-get download);
-# Xvfb and xdotool for the modeler's window driven by a synthetic mouse (modeler/tests/
+# Xvfb, xdotool and xwd (x11-apps) for the modeler's window driven by a synthetic mouse (modeler/tests/
 # mouse_window.rs), with the X libraries winit loads at run time.
-DEB_PACKAGES=(binutils qemu-system-arm qemu-system-x86 xvfb xdotool libxcursor1 libxrandr2 libxi6
+DEB_PACKAGES=(binutils qemu-system-arm qemu-system-x86 xvfb xdotool x11-apps libxcursor1 libxrandr2 libxi6
     libxkbcommon-x11-0)
 # The board's target, the bench rig's (Raspberry Pi Pico, hil-tests/rig), static x86-64 programs
 # for the real-kernel test's initramfs; clippy and rustfmt for the checks.

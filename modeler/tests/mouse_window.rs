@@ -1,9 +1,10 @@
 //! Issue 42: a user with only a mouse models in a real window. Xvfb gives the X server, xdotool
 //! the synthetic input (XTest, as a person's mouse reaches X), and `penmodel open --source
 //! mouse` runs unchanged: the test draws a closed region and a point in it, grabs the point,
-//! lifts it with the wheel, sets its slope, saves and quits, then reads the document back.
+//! lifts it with the wheel, sets its slope, shows the help (a screenshot with `xwd` finds it
+//! over the picture's middle), saves and quits, then reads the document back.
 //!
-//! Xvfb and xdotool are installed by `scripts/setup.sh`; without them the test says so and is
+//! Xvfb, xdotool and xwd are installed by `scripts/setup.sh`; without them the test says so and is
 //! skipped, unless `PEN_REQUIRE_X` is set (as `scripts/test.sh` sets it), when it fails.
 
 use std::io::{BufRead, BufReader};
@@ -77,6 +78,73 @@ impl X {
     }
 }
 
+impl X {
+    /// The window's pixels, through `xwd` (x11-apps).
+    fn screenshot(&self) -> Shot {
+        let out = Command::new("xwd")
+            .args(["-silent", "-id", &self.window])
+            .env("DISPLAY", &self.display)
+            .output()
+            .expect("xwd runs");
+        assert!(out.status.success(), "xwd: {}", String::from_utf8_lossy(&out.stderr));
+        Shot::from_xwd(&out.stdout)
+    }
+}
+
+/// A screenshot: 0RGB pixels, row after row.
+struct Shot {
+    width: usize,
+    height: usize,
+    pixels: Vec<u32>,
+}
+
+impl Shot {
+    /// Reads an XWD file (X11's window dump: a header of 25 big-endian words, the window's
+    /// name, the colour map, then the image) of a 24- or 32-bit true-colour window.
+    fn from_xwd(b: &[u8]) -> Shot {
+        let word = |i: usize| u32::from_be_bytes([b[4 * i], b[4 * i + 1], b[4 * i + 2], b[4 * i + 3]]) as usize;
+        let (header, width, height) = (word(0), word(4), word(5));
+        let (byte_order, bits_per_pixel, bytes_per_line, ncolors) = (word(7), word(11), word(12), word(19));
+        assert_eq!(bits_per_pixel, 32, "a 32-bit image");
+        let start = header + 12 * ncolors;
+        let mut pixels = Vec::with_capacity(width * height);
+        for y in 0..height {
+            for x in 0..width {
+                let p = &b[start + y * bytes_per_line + 4 * x..][..4];
+                let v = if byte_order == 0 {
+                    u32::from_le_bytes([p[0], p[1], p[2], p[3]])
+                } else {
+                    u32::from_be_bytes([p[0], p[1], p[2], p[3]])
+                };
+                pixels.push(v & 0x00ff_ffff);
+            }
+        }
+        Shot { width, height, pixels }
+    }
+
+    /// How many pixels differ from `other`'s.
+    fn changed(&self, other: &Shot) -> usize {
+        self.pixels.iter().zip(&other.pixels).filter(|(a, b)| a != b).count()
+    }
+
+    /// The columns and rows (first, last) within which pixels differ from `other`'s.
+    fn changed_box(&self, other: &Shot) -> ((usize, usize), (usize, usize)) {
+        let (mut x, mut y) = ((usize::MAX, 0), (usize::MAX, 0));
+        for (i, _) in self
+            .pixels
+            .iter()
+            .zip(&other.pixels)
+            .enumerate()
+            .filter(|(_, (a, b))| a != b)
+        {
+            let (c, r) = (i % self.width, i / self.width);
+            x = (x.0.min(c), x.1.max(c));
+            y = (y.0.min(r), y.1.max(r));
+        }
+        (x, y)
+    }
+}
+
 /// Starts Xvfb on a display number nobody uses; its socket is there when it returns.
 fn xvfb() -> (Killed, String) {
     let n = (90..190)
@@ -102,7 +170,7 @@ fn xvfb() -> (Killed, String) {
 
 #[test]
 fn a_mouse_draws_a_region_and_pulls_a_point_in_a_real_window() {
-    let missing: Vec<&str> = ["Xvfb", "xdotool"].into_iter().filter(|t| !found(t)).collect();
+    let missing: Vec<&str> = ["Xvfb", "xdotool", "xwd"].into_iter().filter(|t| !found(t)).collect();
     if !missing.is_empty() {
         assert!(
             std::env::var_os("PEN_REQUIRE_X").is_none(),
@@ -211,8 +279,40 @@ fn a_mouse_draws_a_region_and_pulls_a_point_in_a_real_window() {
     }
     x.button("mouseup", 2);
     x.button("mouseup", 3);
-    // Save and quit from the keyboard (the window needs the focus: Xvfb has no window manager).
+    // The keys need the focus (Xvfb has no window manager to give it).
     x.xdo(&["windowfocus", "--sync", &x.window]);
+    // `h` draws the help over the middle of the picture: a screenshot shows it there.
+    // First the picture settles (the pull's tilt eases back, the erosion catches up).
+    let until = Instant::now() + GUARD;
+    let mut before = x.screenshot();
+    loop {
+        std::thread::sleep(Duration::from_millis(300));
+        let now = x.screenshot();
+        if now.changed(&before) == 0 {
+            break;
+        }
+        assert!(Instant::now() < until, "the picture never settled");
+        before = now;
+    }
+    x.xdo(&["key", "h"]);
+    let until = Instant::now() + GUARD;
+    let after = loop {
+        let now = x.screenshot();
+        if now.changed(&before) > 0 {
+            break now;
+        }
+        assert!(Instant::now() < until, "h drew nothing");
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    let (w, h) = (after.width, after.height);
+    let (box_x, box_y) = after.changed_box(&before);
+    assert!(
+        box_x.0 < w / 2 && box_x.1 > w / 2 && box_y.0 < h / 2 && box_y.1 > h / 2,
+        "the help is drawn over the middle: changed x {box_x:?}, y {box_y:?} of {w} × {h}"
+    );
+    assert!(after.changed(&before) > w * h / 20, "a panel, not a few pixels");
+    x.xdo(&["key", "h"]);
+    // Save and quit from the keyboard.
     x.xdo(&["key", "s"]);
     wait_for("saved");
     x.xdo(&["key", "q"]);
