@@ -158,6 +158,8 @@ pub enum PenSource {
         source: Source,
         /// The calibration file.
         calibration: Option<PathBuf>,
+        /// A simulated scenario plays again and again rather than once (`--loop`).
+        looping: bool,
     },
 }
 
@@ -185,6 +187,7 @@ impl PenSource {
                 Ok(PenSource::Device {
                     source,
                     calibration: None,
+                    looping: false,
                 })
             }
         }
@@ -221,7 +224,11 @@ pub fn spawn(source: PenSource, capacity: usize) -> (Receiver<Feed>, JoinHandle<
                             .into(),
                     ),
                 ),
-                PenSource::Device { source, calibration } => run_device(&tx, source, calibration),
+                PenSource::Device {
+                    source,
+                    calibration,
+                    looping,
+                } => run_device(&tx, source, calibration, looping),
             };
             // A closed channel means the modeler is gone: nothing to tell.
             if let Err(Stop::Failed(why)) = result {
@@ -388,7 +395,7 @@ fn not_connected(path: &std::path::Path, e: &ClientError) -> String {
     }
 }
 
-fn run_device(tx: &SyncSender<Feed>, source: Source, calibration: Option<PathBuf>) -> Result<(), Stop> {
+fn run_device(tx: &SyncSender<Feed>, source: Source, calibration: Option<PathBuf>, looping: bool) -> Result<(), Stop> {
     // The simulated pen's calibration is its own; each is applied only to the base station it
     // records (the pipeline refuses another), and one recording none is used with a warning.
     let path = calibration.or_else(|| pen_host::calibration::default_path_for_source(&source).filter(|p| p.exists()));
@@ -412,8 +419,14 @@ fn run_device(tx: &SyncSender<Feed>, source: Source, calibration: Option<PathBuf
     };
     send(tx, Feed::Display(display_mm(&calibration)))?;
     send(tx, Feed::Status(format!("pen: {source}")))?;
+    // A simulated scenario plays once, unless asked to loop: its end is the session's.
+    let mut ends = None;
     if let Source::Sim(o) = &source {
         send(tx, Feed::Clock(o.plug.clock()))?;
+        if !looping {
+            let end_us = (o.scenario.timeline.duration_s() * 1e6) as u64;
+            ends = Some((o.plug.clock(), end_us, o.scenario.name.clone()));
+        }
     }
     let mut pipeline = Pipeline::new(source, calibration);
     let mut events = Vec::new();
@@ -424,6 +437,14 @@ fn run_device(tx: &SyncSender<Feed>, source: Source, calibration: Option<PathBuf
         }
         for e in events.drain(..) {
             send(tx, Feed::Event(e))?;
+        }
+        if let Some((clock, end_us, name)) = &ends
+            && clock.now_us().is_some_and(|t| t >= *end_us)
+        {
+            return send(
+                tx,
+                Feed::End(format!("the scenario {name} is over (--loop plays it again)")),
+            );
         }
     }
 }

@@ -530,3 +530,17 @@ fn open_writes_its_results_beside_the_document() {
     let _ = child.wait();
     assert!(!dir.path().join("out").exists(), "nothing in ./out");
 }
+
+/// Issue 42: a pen-sim scenario plays once and the session ends with it (`--loop` repeats it).
+#[test]
+fn a_simulated_scenario_plays_once() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out = crate::common::penmodel(
+        dir.path(),
+        &["--source", "sim:draw-figures", "--speed", "0", "--fps", "0", "--size", "64x36"],
+    );
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stderr}");
+    assert!(stderr.contains("the scenario draw-figures is over"), "{stderr}");
+    assert!(dir.path().join("out/document.json").exists(), "{stderr}");
+}

@@ -91,6 +91,10 @@ pub struct LiveArgs {
     /// The demo's randomness.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Play a pen-sim scenario (sim:SCENARIO) again and again; without it the session ends with
+    /// the scenario.
+    #[arg(long = "loop")]
+    r#loop: bool,
     /// Stereo mode.
     #[arg(long, value_enum, default_value = "none")]
     stereo: StereoArg,
@@ -325,6 +329,9 @@ fn pen_source(args: &LiveArgs, open: Option<&Path>, window_wanted: bool) -> Resu
             format!("--speed is the simulated pen's (--source sim); {source_name} runs in real time\n"),
         )
         .exit();
+    }
+    if let PenSource::Device { looping, .. } = &mut source {
+        *looping = args.r#loop;
     }
     if let PenSource::Demo { seed, .. } = &mut source {
         *seed = args.seed;
