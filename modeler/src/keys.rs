@@ -17,6 +17,8 @@ pub enum KeyAction {
     Overview,
     /// Save the document now.
     Save,
+    /// Fill the screen with the window, or give it back its size.
+    Fullscreen,
     /// An edit or a change of view.
     Command(KeyCommand),
 }
@@ -37,6 +39,7 @@ pub const KEYS: &[(&str, &str)] = &[
     ("Del", "delete the highlighted figure"),
     ("s", "save the document"),
     ("o", "overview in a corner"),
+    ("F11", "full screen, or back"),
     ("q Esc", "save and quit"),
 ];
 
@@ -51,6 +54,7 @@ pub fn action(name: &str, display_mm: [f64; 2]) -> Option<KeyAction> {
         "h" | "?" | "F1" => Some(KeyAction::Help),
         "o" => Some(KeyAction::Overview),
         "s" => Some(KeyAction::Save),
+        "F11" => Some(KeyAction::Fullscreen),
         "u" | "z" => Some(KeyAction::Command(KeyCommand::Undo)),
         "r" | "y" => Some(KeyAction::Command(KeyCommand::Redo)),
         "Delete" | "Backspace" => Some(KeyAction::Command(KeyCommand::Delete)),

@@ -537,7 +537,16 @@ fn a_simulated_scenario_plays_once() {
     let dir = tempfile::tempdir().expect("temp dir");
     let out = crate::common::penmodel(
         dir.path(),
-        &["--source", "sim:draw-figures", "--speed", "0", "--fps", "0", "--size", "64x36"],
+        &[
+            "--source",
+            "sim:draw-figures",
+            "--speed",
+            "0",
+            "--fps",
+            "0",
+            "--size",
+            "64x36",
+        ],
     );
     let stderr = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{stderr}");

@@ -22,7 +22,7 @@ use winit::dpi::PhysicalSize;
 use winit::event::{ElementState, MouseButton, MouseScrollDelta, WindowEvent};
 use winit::event_loop::{ActiveEventLoop, EventLoop, EventLoopProxy};
 use winit::keyboard::{Key, NamedKey};
-use winit::window::{Window, WindowId};
+use winit::window::{Fullscreen, Window, WindowId};
 
 use crate::Frame;
 
@@ -69,6 +69,7 @@ pub struct Pointer {
 
 enum Command {
     Show(Arc<Frame>),
+    Fullscreen(bool),
     Close,
 }
 
@@ -233,6 +234,11 @@ impl ApplicationHandler<Command> for App {
                     w.request_redraw();
                 }
             }
+            Command::Fullscreen(on) => {
+                if let Some(w) = &self.window {
+                    w.set_fullscreen(on.then_some(Fullscreen::Borderless(None)));
+                }
+            }
             Command::Close => el.exit(),
         }
     }
@@ -386,6 +392,13 @@ impl Viewer {
         }
         self.proxy
             .send_event(Command::Show(Arc::new(frame)))
+            .map_err(|_| WindowError::Closed)
+    }
+
+    /// Fills the screen with the window (borderless, on its monitor), or gives it back its size.
+    pub fn set_fullscreen(&mut self, on: bool) -> Result<(), WindowError> {
+        self.proxy
+            .send_event(Command::Fullscreen(on))
             .map_err(|_| WindowError::Closed)
     }
 

@@ -91,6 +91,10 @@ pub struct LiveArgs {
     /// The demo's randomness.
     #[arg(long, default_value_t = 1)]
     seed: u64,
+    /// Open the window full screen (F11 toggles it), so the picture covers the display and lines
+    /// up with the pen's tip.
+    #[arg(long)]
+    fullscreen: bool,
     /// Play a pen-sim scenario (sim:SCENARIO) again and again; without it the session ends with
     /// the scenario.
     #[arg(long = "loop")]
@@ -242,7 +246,12 @@ pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
     let viewer = if window_wanted {
         let (w, h) = args.size.unwrap_or((1280, 720));
         match Viewer::open("penmodel", w, h) {
-            Ok(v) => Some(v),
+            Ok(mut v) => {
+                if args.fullscreen {
+                    v.set_fullscreen(true)?;
+                }
+                Some(v)
+            }
             Err(e @ WindowError::NoDisplay) if args.show == Show::Auto => {
                 eprintln!("penmodel: {e}; writing files instead");
                 None
@@ -265,7 +274,11 @@ pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
     let written = match viewer {
         Some(v) => {
             let mouse = mouse_pen.then(penmodel::mouse::MousePen::new);
-            window::run(v, &rx, &mut session, &look, &mut painter, &stop, mouse)?
+            let options = window::Options {
+                mouse,
+                fullscreen: args.fullscreen,
+            };
+            window::run(v, &rx, &mut session, &look, &mut painter, &stop, options)?
         }
         None => headless::run(args, &rx, &mut session, &look, &mut painter, &stop, demo_us)?,
     };

@@ -58,6 +58,14 @@ fn tell_feed(session: &mut Session, feed: Feed, notice: &mut Option<Notice>) {
     }
 }
 
+/// How the window takes input and starts.
+pub struct Options {
+    /// The pointer is the pen.
+    pub mouse: Option<MousePen>,
+    /// The window was opened full screen.
+    pub fullscreen: bool,
+}
+
 /// Host time, µs since the Unix epoch, as a pen's events carry it.
 fn now_us() -> u64 {
     std::time::SystemTime::now()
@@ -74,13 +82,15 @@ pub fn run(
     look: &Look,
     painter: &mut Painter,
     stop: &AtomicBool,
-    mut mouse: Option<MousePen>,
+    options: Options,
 ) -> Result<Written> {
+    let Options { mut mouse, fullscreen } = options;
     const FRAME: Duration = Duration::from_millis(16);
     let mut dirty = true;
     let mut last = Instant::now() - FRAME;
     let mut frames = 0;
     let mut help = false;
+    let mut fullscreen = fullscreen;
     let mut notice: Option<Notice> = None;
     'session: while viewer.is_open() && !stop.load(Ordering::Relaxed) {
         while let Some(e) = viewer.poll() {
@@ -118,6 +128,10 @@ pub fn run(
                         Overview::Off
                     };
                     painter.set_overview(next)?;
+                }
+                Some(KeyAction::Fullscreen) => {
+                    fullscreen = !fullscreen;
+                    viewer.set_fullscreen(fullscreen)?;
                 }
                 Some(KeyAction::Save) => {
                     let said = match session.editor.save() {
