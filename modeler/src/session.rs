@@ -262,7 +262,10 @@ impl Session {
         if let Some(at) = self.frame_started_at.take() {
             self.predictor.drawn(at.elapsed().as_micros() as u64);
         }
-        if let (Some(done_us), Some((burst_us, prediction_ms))) = (self.paced_now_us(), self.head_burst) {
+        // Once the pen has ended, its last head pose only grows older: frames after it measure
+        // nothing of the chain.
+        let live = matches!(self.state, State::Running);
+        if let (true, Some(done_us), Some((burst_us, prediction_ms))) = (live, self.paced_now_us(), self.head_burst) {
             self.latency.frame(
                 started.unwrap_or(done_us),
                 done_us,
