@@ -34,6 +34,13 @@ pub enum QemuError {
     /// Building `pen-qemu` failed.
     #[error("building pen-qemu failed:\n{0}")]
     Build(String),
+    /// The firmware's sources are not where this program was built from.
+    #[error(
+        "the firmware's sources are not at {0} (this program was built elsewhere): give the image with \
+         --elf FILE (build it in the repository's firmware/ with `cargo build --release -p pen-qemu`), \
+         or set PEN_FIRMWARE_DIR to the firmware folder"
+    )]
+    NoFirmware(PathBuf),
     /// QEMU did not finish in time.
     #[error("QEMU did not finish within {0:?}")]
     Timeout(Duration),
@@ -111,15 +118,22 @@ impl QemuRun {
     }
 }
 
-/// The firmware workspace.
+/// The firmware workspace: `PEN_FIRMWARE_DIR`, or the one beside the sources this program was
+/// built from.
 pub fn firmware_dir() -> PathBuf {
-    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../firmware"))
+    std::env::var_os("PEN_FIRMWARE_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../firmware")))
 }
 
-/// Builds `pen-qemu` (release, for the board's target) and returns its ELF.
+/// Builds `pen-qemu` (release, for the board's target) and returns its ELF; without the
+/// firmware's sources (a copied binary), says how to give the image instead.
 pub fn build_pen_qemu() -> Result<PathBuf, QemuError> {
     let cargo = std::env::var("CARGO").unwrap_or_else(|_| "cargo".into());
     let dir = firmware_dir();
+    if !dir.join("Cargo.toml").is_file() {
+        return Err(QemuError::NoFirmware(dir));
+    }
     let out = Command::new(&cargo)
         .args(["build", "--release", "--locked", "-q", "-p", "pen-qemu"])
         .current_dir(&dir)

@@ -102,3 +102,21 @@ fn write_replay_seeds() {
         eprintln!("sim-{name}: {} cycles, {} bytes", records.len(), bytes.len());
     }
 }
+
+/// Issue 42: a `pen-sim` copied away from the sources it was built from cannot build the
+/// firmware: it says how to give the image instead of failing inside cargo.
+#[test]
+fn without_the_firmwares_sources_qemu_says_how_to_give_the_image() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_pen-sim"))
+        .args(["qemu", "--seconds", "0.1"])
+        .env("PEN_FIRMWARE_DIR", "/nonexistent/firmware")
+        .output()
+        .expect("pen-sim runs");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(1), "{stderr}");
+    assert!(
+        stderr.contains("/nonexistent/firmware") && stderr.contains("--elf FILE"),
+        "{stderr}"
+    );
+    assert!(!stderr.contains("panicked"), "{stderr}");
+}

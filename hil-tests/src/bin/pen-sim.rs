@@ -126,6 +126,9 @@ enum Command {
         /// Seed of the randomness.
         #[arg(long, default_value_t = 1)]
         seed: u64,
+        /// The pen-qemu image to run [default: built from the repository's firmware/].
+        #[arg(long, value_name = "FILE")]
+        elf: Option<std::path::PathBuf>,
         /// Print the figures as one JSON object.
         #[arg(long)]
         json: bool,
@@ -357,13 +360,17 @@ fn run(cli: Cli) -> Result<()> {
             scenario: name,
             seconds,
             seed,
+            elf,
             json,
         } => {
             let s = scenario(&name)?;
             let mut sim = Simulation::new(&s, seed);
             let records = sim.run_for(seconds);
             let host: Vec<pen_sim::Sent> = records.iter().flat_map(|r| r.sent.clone()).collect();
-            let elf = qemu::build_pen_qemu()?;
+            let elf = match elf {
+                Some(e) => e,
+                None => qemu::build_pen_qemu()?,
+            };
             let run = qemu::run(
                 &elf,
                 &qemu::replay(&s.config, s.head, &records),
