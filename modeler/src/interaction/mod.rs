@@ -286,6 +286,18 @@ impl Interaction {
         layers
     }
 
+    /// The tool buttons on the display: each tool's name, its button, and whether it is on.
+    pub fn buttons(&self) -> Vec<(&'static str, palette::Button, bool)> {
+        self.tools
+            .iter()
+            .enumerate()
+            .filter_map(|(i, e)| {
+                let b = e.place.button(self.view.display_mm)?;
+                Some((e.tool.name(), b, i == self.active))
+            })
+            .collect()
+    }
+
     /// The gauge the tool on shows (the slope bar while a slope is set).
     pub fn gauge(&self, doc: &Document) -> Option<SlopeBar> {
         self.tools[self.active].tool.gauge(&self.seen(doc))

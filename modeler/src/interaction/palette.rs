@@ -47,10 +47,11 @@ impl Button {
 pub enum Place {
     /// No button: the tool the others go back to (seed 000's figures).
     Home,
-    /// On the display's left edge, 8 mm in, its lower edge `v` mm up.
+    /// On the display's left edge, 8 mm in, its lower edge `v` mm up from the display's lower
+    /// edge (`v` grows up the display, as the pen's `v` does).
     Left(f64),
-    /// In the display's top right corner, 8 mm in.
-    TopRight,
+    /// In the display's lower right corner, 8 mm in from both edges.
+    BottomRight,
 }
 
 impl Place {
@@ -59,7 +60,7 @@ impl Place {
         let corner_mm = match self {
             Place::Home => return None,
             Place::Left(v) => [8.0, v],
-            Place::TopRight => [display_mm[0] - 8.0 - BUTTON_MM, 8.0],
+            Place::BottomRight => [display_mm[0] - 8.0 - BUTTON_MM, 8.0],
         };
         Some(Button {
             corner_mm,
@@ -84,7 +85,7 @@ pub fn tools() -> Vec<Entry> {
         entry::<Figures>(Place::Home),
         entry::<Rocks>(Place::Left(8.0)),
         entry::<Rivers>(Place::Left(32.0)),
-        entry::<Ridges>(Place::TopRight),
+        entry::<Ridges>(Place::BottomRight),
         entry::<Trees>(Place::Left(56.0)),
     ]
 }

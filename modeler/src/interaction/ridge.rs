@@ -5,7 +5,7 @@
 //! tool"). SW1 is the tip switch (the pen reports the tip on the surface while it is pressed), so
 //! a line in the air cannot be drawn with SW1 held; it is started by a touch:
 //!
-//! - **Pick the tool**: tap the ridge button (the display's top right corner) with the tip; tap it
+//! - **Pick the tool**: tap the ridge button (the display's lower right corner) with the tip; tap it
 //!   again to go back to figures.
 //! - **A 3D ridgeline**: touch (SW1) where it starts, lift and draw in the air: the pen's height
 //!   is the ridge's elevation (the vertical scale of a pull); touching again snaps it to the

@@ -165,6 +165,13 @@ pub enum Place {
     Centre,
     /// At the top left, under the mode line (a notice).
     UnderModeLine,
+    /// Centred on this pixel of the frame (a tool button's label).
+    CentredOn {
+        /// Column.
+        x: i64,
+        /// Row.
+        y: i64,
+    },
 }
 
 /// Draws `lines` on a translucent panel in `viewport`; a line longer than the viewport is cut
@@ -182,6 +189,11 @@ pub fn panel(frame: &mut Frame, viewport: &Bounds, lines: &[String], place: Plac
     let (x, y) = match place {
         Place::Centre => (vx0 + ((vw - w) / 2).max(MARGIN), vy0 + ((vh - h) / 2).max(MARGIN)),
         Place::UnderModeLine => (vx0 + MARGIN, vy0 + MARGIN * 2 + line_h),
+        // Kept inside the viewport, so a label at its edge is read whole.
+        Place::CentredOn { x, y } => (
+            (x - w / 2).clamp(vx0 + MARGIN, (vx0 + vw - w - MARGIN).max(vx0 + MARGIN)),
+            (y - h / 2).clamp(vy0 + MARGIN, (vy0 + vh - h - MARGIN).max(vy0 + MARGIN)),
+        ),
     };
     fill(
         frame,
@@ -208,6 +220,31 @@ mod tests {
             .filter(|(_, p)| **p == colour)
             .map(|(i, _)| (i as u32 % w, i as u32 / w))
             .collect()
+    }
+
+    #[test]
+    fn a_label_centred_at_the_edge_is_kept_whole_inside() {
+        let style = Style::default();
+        let mut frame = Frame::new(320, 200).expect("frame");
+        frame.pixels_mut().fill([100, 100, 100, 255]);
+        let all = Bounds {
+            x0: 0,
+            x1: 320,
+            y0: 0,
+            y1: 200,
+        };
+        let label = vec!["rivers".to_string()];
+        panel(&mut frame, &all, &label, Place::CentredOn { x: 0, y: 100 }, &style);
+        let text = lit(&frame, style.text_colour);
+        let x0 = text.iter().map(|p| p.0).min().expect("text drawn");
+        assert!(x0 >= MARGIN as u32, "starts inside, at {x0}");
+        // As wide as the whole label: nothing was cut at the edge.
+        let x1 = text.iter().map(|p| p.0).max().expect("text drawn");
+        let s = style.text_scale.max(1);
+        assert!(
+            x1 - x0 + 1 >= text::width("rivers", s) - text::CELL_WIDTH * s,
+            "{x0}..{x1}"
+        );
     }
 
     #[test]

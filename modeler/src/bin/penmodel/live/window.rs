@@ -204,6 +204,15 @@ pub fn run(
                 Place::UnderModeLine,
                 style,
             );
+            // The tool buttons' names, on the display where the buttons are, whatever the zoom.
+            let display = session.interaction.view().display_mm;
+            for (name, b, on) in session.interaction.buttons() {
+                let centre = [b.corner_mm[0] + 0.5 * b.side_mm, b.corner_mm[1] + 0.5 * b.side_mm];
+                let x = (centre[0] / display[0] * f64::from(w)).round() as i64;
+                let y = ((1.0 - centre[1] / display[1]) * f64::from(h)).round() as i64;
+                let label = if on { format!("[{name}]") } else { name.to_string() };
+                panel(&mut frame, &viewport, &[label], Place::CentredOn { x, y }, style);
+            }
             if help {
                 panel(
                     &mut frame,
