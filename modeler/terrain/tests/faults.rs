@@ -309,7 +309,7 @@ fn a_byte_order_mark_before_a_document_is_skipped() {
     fs::write(&path, marked.as_bytes()).expect("written");
     assert_eq!(Document::load(&path).expect("a BOM file loads"), plain);
     // The checks on the text after it still apply: terrain settings need version 4.
-    let old = "\u{feff}{\"version\": 3, \"grid\": {\"cols\": 4, \"rows\": 4, \"cell_size\": 1.0}, \"terrain\": {}}";
+    let old = "\u{feff}{\"version\": 3, \"grid\": {\"cols\": 4, \"rows\": 4, \"cell_size\": 1.0}, \"regions\": [], \"terrain\": {}}";
     let err = Document::from_json(old).expect_err("version 3 with terrain settings");
     assert!(err.to_string().contains("terrain"), "{err}");
 }
