@@ -19,7 +19,6 @@ mod rivers;
 mod rock_fields;
 mod rocks;
 mod simd;
-mod thin_grids;
 mod tree_documents;
 mod trees;
 mod validation;
