@@ -222,9 +222,8 @@ mod tests {
             .collect()
     }
 
-    #[test]
-    fn a_label_centred_at_the_edge_is_kept_whole_inside() {
-        let style = Style::default();
+    /// The default style, a 320 × 200 grey frame and its whole bounds.
+    fn grey_frame() -> (Style, Frame, Bounds) {
         let mut frame = Frame::new(320, 200).expect("frame");
         frame.pixels_mut().fill([100, 100, 100, 255]);
         let all = Bounds {
@@ -233,6 +232,12 @@ mod tests {
             y0: 0,
             y1: 200,
         };
+        (Style::default(), frame, all)
+    }
+
+    #[test]
+    fn a_label_centred_at_the_edge_is_kept_whole_inside() {
+        let (style, mut frame, all) = grey_frame();
         let label = vec!["rivers".to_string()];
         panel(&mut frame, &all, &label, Place::CentredOn { x: 0, y: 100 }, &style);
         let text = lit(&frame, style.text_colour);
@@ -249,15 +254,7 @@ mod tests {
 
     #[test]
     fn a_panel_darkens_its_box_and_writes_each_line_inside_it() {
-        let style = Style::default();
-        let mut frame = Frame::new(320, 200).expect("frame");
-        frame.pixels_mut().fill([100, 100, 100, 255]);
-        let all = Bounds {
-            x0: 0,
-            x1: 320,
-            y0: 0,
-            y1: 200,
-        };
+        let (style, mut frame, all) = grey_frame();
         let lines = vec!["keys".to_string(), "  u  undo".to_string()];
         panel(&mut frame, &all, &lines, Place::Centre, &style);
         let text = lit(&frame, style.text_colour);
