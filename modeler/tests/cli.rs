@@ -553,3 +553,84 @@ fn a_simulated_scenario_plays_once() {
     assert!(stderr.contains("the scenario draw-figures is over"), "{stderr}");
     assert!(dir.path().join("out/document.json").exists(), "{stderr}");
 }
+
+#[test]
+fn a_failed_open_removes_the_out_folder_it_created() {
+    // Issue 47: `penmodel open` on a document it cannot read left the `--out` folder behind.
+    let dir = tempfile::tempdir().unwrap();
+    let bad = dir.path().join("bad.json");
+    std::fs::write(&bad, "not json").unwrap();
+    let out_dir = dir.path().join("results");
+    let out = penmodel(&[
+        "open",
+        s(&bad),
+        "--out",
+        s(&out_dir),
+        "--source",
+        "sim:modeling-session",
+        "--show",
+        "headless",
+        "--fps",
+        "0",
+    ]);
+    assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(!out_dir.exists(), "the --out folder it made is gone");
+    // A folder that was there before stays.
+    std::fs::create_dir(&out_dir).unwrap();
+    let out = penmodel(&[
+        "open",
+        s(&bad),
+        "--out",
+        s(&out_dir),
+        "--source",
+        "sim:modeling-session",
+        "--show",
+        "headless",
+        "--fps",
+        "0",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    assert!(out_dir.is_dir(), "a folder it did not make is kept");
+}
+
+#[test]
+fn a_document_starting_with_a_byte_order_mark_renders() {
+    let dir = tempfile::tempdir().unwrap();
+    let doc = dir.path().join("bom.json");
+    let mut text = b"\xef\xbb\xbf".to_vec();
+    text.extend(std::fs::read(example("02-twin-hills.json")).unwrap());
+    std::fs::write(&doc, text).unwrap();
+    let png = dir.path().join("t.png");
+    let out = penmodel(&["generate", s(&doc), "--png", s(&png)]);
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(png.exists());
+}
+
+#[test]
+fn long_and_thin_grids_render_and_analyse() {
+    // Issue 47, item 3: the land look's and `analyze --sky`'s sweeps held the square of the
+    // long side (262144 × 1 aborted asking for 275 GB).
+    let dir = tempfile::tempdir().unwrap();
+    for (cols, rows) in [(4096, 2), (1, 1000), (2, 3), (262_144, 1)] {
+        let doc = dir.path().join(format!("g{cols}x{rows}.json"));
+        std::fs::write(
+            &doc,
+            format!("{{\"version\": 1, \"grid\": {{\"cols\": {cols}, \"rows\": {rows}, \"cell_size\": 2.0}}, \"regions\": []}}"),
+        )
+        .unwrap();
+        let png = dir.path().join("r.png");
+        let out = penmodel(&["render", s(&doc), "--png", s(&png), "--size", "160x90"]);
+        assert!(
+            out.status.success(),
+            "{cols}×{rows} render: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let sky = dir.path().join("s.png");
+        let out = penmodel(&["analyze", s(&doc), "--sky", s(&sky), "--sky-directions", "8"]);
+        assert!(
+            out.status.success(),
+            "{cols}×{rows} sky: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}

@@ -330,3 +330,64 @@ fn scene_bench_turning_times_a_moving_view_and_keeps_the_still_pictures() {
         assert!(String::from_utf8_lossy(&out.stderr).contains("--turn"), "{bad}");
     }
 }
+
+#[test]
+fn fit_refuses_a_dot_a_line_and_a_filled_square() {
+    // Issue 47: a solid square ran 400 s, a line fitted maps `trees stats` refuses, a single
+    // pixel "fitted" at 0.85 into a 568,000-polygon tree.
+    let dir = tempfile::tempdir().expect("dir");
+    let s = Species::preset(Preset::Cypress);
+    let side = silhouette::render(&s, View::Side, 64, 0.02);
+    let file = std::fs::File::create(dir.path().join("side.png")).expect("created");
+    side.write_png(std::io::BufWriter::new(file)).expect("written");
+    let mut cases = Vec::new();
+    let mut dot = silhouette::Image::new(32, 32);
+    dot.data[16 * 32 + 16] = 1.0;
+    cases.push(("dot.png", dot, "the front silhouette is a single pixel"));
+    let mut line = silhouette::Image::new(32, 32);
+    for r in 2..30 {
+        line.data[r * 32 + 16] = 1.0;
+    }
+    cases.push((
+        "line.png",
+        line,
+        "the front silhouette is a line (1 × 28 pixels covered)",
+    ));
+    let mut square = silhouette::Image::new(32, 32);
+    for r in 4..28 {
+        for c in 4..28 {
+            square.data[r * 32 + c] = 1.0;
+        }
+    }
+    cases.push((
+        "square.png",
+        square,
+        "the front silhouette is a filled rectangle (24 × 24 pixels",
+    ));
+    for (name, img, message) in cases {
+        let file = std::fs::File::create(dir.path().join(name)).expect("created");
+        img.write_png(std::io::BufWriter::new(file)).expect("written");
+        let out = penmodel(dir.path(), &["trees", "fit", name, "side.png", "--json", "fit.json"]);
+        failed_with(&out, message);
+        assert!(!dir.path().join("fit.json").exists(), "{name}: nothing written");
+    }
+}
+
+#[test]
+fn mesh_refuses_a_time_or_wind_that_is_not_a_number() {
+    // Issue 47: `--t nan` exited 0 with every vertex NaN (and an invalid glTF).
+    let dir = tempfile::tempdir().expect("dir");
+    for (args, message) in [
+        (&["--wind", "1:1", "--t", "nan"][..], "--t: NaN is not a finite number"),
+        (&["--wind", "1:1", "--t", "inf"][..], "--t: inf is not a finite number"),
+        (
+            &["--wind", "nan:1"][..],
+            "--wind: \"nan:1\" is not AMPLITUDE:FREQUENCY[:REST] of finite numbers",
+        ),
+    ] {
+        let mut all = vec!["trees", "mesh", "--obj", "t.obj"];
+        all.extend_from_slice(args);
+        failed_with(&penmodel(dir.path(), &all), message);
+        assert!(!dir.path().join("t.obj").exists(), "{args:?}: nothing written");
+    }
+}

@@ -213,6 +213,9 @@ struct TerrainStated {
 impl Document {
     /// Parses and validates a document.
     pub fn from_json(text: &str) -> Result<Document, LoadError> {
+        // Editors on some systems start UTF-8 text with a byte-order mark; it is no JSON, and
+        // users expect the file to open (issue 47).
+        let text = strip_bom(text);
         // The version decides how to read the rest, so it is checked before the shape.
         let version: VersionOnly = parse(text)?;
         match version.version.as_u64() {
@@ -303,6 +306,11 @@ pub fn read_document(path: &Path) -> Result<(Document, Vec<u8>), LoadError> {
     })?;
     let doc = Document::from_json(text)?;
     Ok((doc, bytes))
+}
+
+/// `text` without a leading UTF-8 byte-order mark (U+FEFF), which JSON does not allow.
+pub fn strip_bom(text: &str) -> &str {
+    text.strip_prefix('\u{feff}').unwrap_or(text)
 }
 
 fn parse<'de, T: Deserialize<'de>>(text: &'de str) -> Result<T, LoadError> {

@@ -297,3 +297,19 @@ fn a_second_stale_journal_does_not_overwrite_the_first() {
     );
     assert_eq!(fs::read(&second_aside).expect("kept"), second);
 }
+
+#[test]
+fn a_byte_order_mark_before_a_document_is_skipped() {
+    // Issue 47: a UTF-8 BOM gave "expected value (line 1, column 1)".
+    let plain = Document::from_json(&volcano()).expect("the example loads");
+    let marked = format!("\u{feff}{}", volcano());
+    assert_eq!(Document::from_json(&marked).expect("loads with a BOM"), plain);
+    let dir = tempfile::tempdir().expect("a scratch folder");
+    let path = dir.path().join("bom.json");
+    fs::write(&path, marked.as_bytes()).expect("written");
+    assert_eq!(Document::load(&path).expect("a BOM file loads"), plain);
+    // The checks on the text after it still apply: terrain settings need version 4.
+    let old = "\u{feff}{\"version\": 3, \"grid\": {\"cols\": 4, \"rows\": 4, \"cell_size\": 1.0}, \"regions\": [], \"terrain\": {}}";
+    let err = Document::from_json(old).expect_err("version 3 with terrain settings");
+    assert!(err.to_string().contains("terrain"), "{err}");
+}

@@ -19,6 +19,7 @@ mod rivers;
 mod rock_fields;
 mod rocks;
 mod simd;
+mod thin_grids;
 mod tree_documents;
 mod trees;
 mod validation;

@@ -218,14 +218,15 @@ pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
         ..document::Created::default()
     };
     std::fs::create_dir_all(args.out()).with_context(|| format!("cannot create {}", args.out().display()))?;
-    let (editor, doc_path) = document::open(args, open, recover, demo, &mut created)?;
+    let opened = document::open(args, open, recover, demo, &mut created);
+    let (editor, doc_path) = created.on_error(opened)?;
     let mut session = Session::new(editor, [600.0, 340.0], Tuning::default());
     session.set_vertical_scale(args.vertical_scale);
     let look = look(args);
 
     let stop = Arc::new(AtomicBool::new(false));
     for signal in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
-        signal_hook::flag::register(signal, stop.clone()).context("installing signal handlers")?;
+        created.on_error(signal_hook::flag::register(signal, stop.clone()).context("installing signal handlers"))?;
     }
     let demo_us = demo.then(|| (feed::demo_scenario().0.timeline.duration_s() * 1e6) as u64);
     if let PenSource::Demo { seed, .. } = &source {
@@ -256,7 +257,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
                 eprintln!("penmodel: {e}; writing files instead");
                 None
             }
-            Err(e) => return Err(e.into()),
+            Err(e) => return created.on_error(Err(e.into())),
         }
     } else {
         None
@@ -270,7 +271,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
         (true, _) | (false, true) => Overview::Off,
         (false, false) => Overview::Beside,
     };
-    let mut painter = Painter::new(w, h, layout)?;
+    let mut painter = created.on_error(Painter::new(w, h, layout).map_err(anyhow::Error::from))?;
     let written = match viewer {
         Some(v) => {
             let mouse = mouse_pen.then(penmodel::mouse::MousePen::new);
@@ -278,9 +279,16 @@ pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
                 mouse,
                 fullscreen: args.fullscreen,
             };
-            window::run(v, &rx, &mut session, &look, &mut painter, &stop, options)?
+            window::run(v, &rx, &mut session, &look, &mut painter, &stop, options)
         }
-        None => headless::run(args, &rx, &mut session, &look, &mut painter, &stop, demo_us)?,
+        None => headless::run(args, &rx, &mut session, &look, &mut painter, &stop, demo_us),
+    };
+    // A session that failed before modeling anything leaves nothing behind; one that modeled
+    // keeps its document and journal.
+    let written = if session.editor.can_undo() || session.editor.can_redo() {
+        written?
+    } else {
+        created.on_error(written)?
     };
     drop(rx);
 

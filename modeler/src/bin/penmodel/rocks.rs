@@ -7,8 +7,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result, bail};
 use penmodel_terrain::export;
 use penmodel_terrain::rocks::place::{self, Placement};
-use penmodel_terrain::rocks::{Amount, Layer, Recipe, RecipeError, Sampler, Scatter, Shape, scatter, top_view};
-use serde_json::{Value, json};
+use penmodel_terrain::rocks::{Amount, Layer, Recipe, RecipeError, Sampler, Shape, scatter, top_view};
+
+mod json;
 
 use crate::out::write;
 
@@ -263,91 +264,12 @@ fn flag_message(e: &RecipeError, args: &Args) -> String {
     }
 }
 
-fn points2(p: &[[f64; 2]]) -> Value {
-    Value::Array(p.iter().map(|q| json!(q)).collect())
-}
-
-fn points3(p: &[[f64; 3]]) -> Value {
-    Value::Array(p.iter().map(|q| json!(q)).collect())
-}
-
-/// The JSON document of docs/rocks.md.
-fn to_json(recipe: &Recipe, s: &Scatter) -> Value {
-    let diagrams: Vec<Value> = s
-        .diagrams
-        .iter()
-        .enumerate()
-        .map(|(i, d)| {
-            let layer = &recipe.layers[i];
-            let amount = match layer.amount {
-                Amount::Fraction(f) => json!({"fraction": f}),
-                Amount::Count(c) => json!({"count": c}),
-            };
-            let cells: Vec<Value> = s
-                .rocks
-                .iter()
-                .filter(|r| r.diagram == i)
-                .map(|r| json!({"seed": r.cell, "polygon": points2(r.polygon)}))
-                .collect();
-            json!({
-                "radius": d.radius,
-                "order": d.order,
-                "goal": amount,
-                "shape": {"widths": layer.shape.widths, "heights": layer.shape.heights},
-                "seeds": points2(&d.seeds),
-                "cells_tried": d.tried,
-                "reached": d.reached,
-                "cells_kept": d.cells.len(),
-                "area_cells": d.pixels,
-                "fraction": s.fraction(i),
-                "cells": cells,
-            })
-        })
-        .collect();
-    let rocks: Vec<Value> = s
-        .rocks
-        .iter()
-        .map(|r| {
-            let k = r.polygon.len();
-            json!({
-                "diagram": r.diagram,
-                "seed": r.cell,
-                "polygon": points2(r.polygon),
-                "added": points2(r.mesh.added),
-                "moved": points3(&r.mesh.vertices[k..]),
-                "vertices": points3(r.mesh.vertices),
-                "triangles": r.mesh.triangles,
-            })
-        })
-        .collect();
-    let t = s.timing;
-    json!({
-        "size": [s.width, s.height],
-        "seed": recipe.seed,
-        "sampler": match recipe.sampler { Sampler::Saturate => json!("saturate"), Sampler::Darts { fill } => json!({"darts": {"fill": fill}}) },
-        "field_cells": s.field_pixels,
-        "diagrams": diagrams,
-        "rocks": rocks,
-        "timing_ms": {
-            "seeds_and_diagrams": t.seeds_and_diagrams,
-            "seeds_cpu": t.seeds,
-            "diagrams_cpu": t.diagrams,
-            "selection": t.selection,
-            "polygons": t.polygons,
-            "meshes": t.meshes,
-            "total": t.total,
-        },
-    })
-}
-
 /// Runs the command.
 pub fn run(args: &Args) -> Result<()> {
     let recipe = recipe(args)?;
     let s = scatter(&recipe, None).map_err(|e| anyhow::anyhow!(flag_message(&e, args)))?;
     if let Some(path) = &args.json {
-        let mut text = serde_json::to_string(&to_json(&recipe, &s))?;
-        text.push('\n');
-        write(path, text.as_bytes())?;
+        crate::out::write_with(path, |w| json::write(&recipe, &s, w).map_err(std::io::Error::from))?;
     }
     if args.obj.is_some() || args.glb.is_some() {
         // On flat ground, one unit per cell.

@@ -181,7 +181,7 @@ fn species(args: &SpeciesArgs) -> Result<Species> {
             let bytes = persist::read_input(path, persist::MAX_INPUT_BYTES)
                 .with_context(|| format!("cannot read {}", path.display()))?;
             let text = String::from_utf8(bytes).with_context(|| format!("{}: not UTF-8 text", path.display()))?;
-            let maps: Vec<IfsMap> = serde_json::from_str(&text).with_context(|| {
+            let maps: Vec<IfsMap> = serde_json::from_str(persist::strip_bom(&text)).with_context(|| {
                 format!(
                     "{}: not a list of maps ({{\"y\", \"s\", \"theta_z\", \"theta_y\"}}, …)",
                     path.display()
@@ -302,9 +302,9 @@ fn parse_wind(specs: &[String], direction: f64) -> Result<Option<Wind>> {
     for s in specs {
         let parts: Vec<&str> = s.split(':').collect();
         let num = |v: &str| {
-            v.trim()
-                .parse::<f64>()
-                .map_err(|_| anyhow::anyhow!("--wind: {s:?} is not AMPLITUDE:FREQUENCY[:REST] (e.g. 5:0.8)"))
+            v.trim().parse::<f64>().ok().filter(|x| x.is_finite()).ok_or_else(|| {
+                anyhow::anyhow!("--wind: {s:?} is not AMPLITUDE:FREQUENCY[:REST] of finite numbers (e.g. 5:0.8)")
+            })
         };
         match parts[..] {
             [a, f] => generations.push(Sway {
@@ -348,6 +348,12 @@ fn parse_mix(specs: &[String], preset: &str) -> Result<Vec<GroveSpecies>> {
 
 fn mesh(args: &MeshArgs) -> Result<()> {
     check_q(args.q, "--q")?;
+    // NaN made every vertex NaN and an invalid glTF (issue 47).
+    for (flag, v) in [("--t", args.t), ("--wind-direction", args.wind_direction)] {
+        if !v.is_finite() {
+            bail!("{flag}: {v} is not a finite number");
+        }
+    }
     if !(args.height > 0.0 && args.height <= penmodel_terrain::trees::MAX_HEIGHT) {
         bail!(
             "--height: {} m is not above 0 and at most {} m",

@@ -23,6 +23,7 @@ pub mod filter;
 pub mod gradient;
 pub mod grow;
 pub mod layer;
+mod packed;
 pub mod polygon;
 pub mod rain;
 mod scratch;

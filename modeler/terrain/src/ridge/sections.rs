@@ -85,12 +85,23 @@ impl Sections {
         start..end.max(start)
     }
 
-    /// The heights of lines `b0..b0 + nb` into `block[u·nb + j]` (line `b0 + j`, column u) where
-    /// the line is on the grid. `zc` is the grid with its columns contiguous (`zc[u·h + v]`),
+    /// The lines with a sample at column u (both its rows on the grid, or the upper one's weight
+    /// 0): those whose lower row there is in `0..h`, less the last when the upper row counts.
+    pub fn lines_at(&self, u: usize) -> Range<isize> {
+        let first = -self.o[u];
+        let last = self.h as isize - 1 - self.o[u] - isize::from(self.hi[u] > 0.0);
+        first..(last + 1).max(first)
+    }
+
+    /// The heights of lines `b0..b0 + nb` into `block[(u − u0)·nb + j]` (line `b0 + j`, column
+    /// u ≥ u0) where the line is on the grid. `zc` is the grid with its columns contiguous (`zc[u·h + v]`),
     /// an element more: per column the lines' samples are then one shifted linear interpolation
     /// of contiguous cells (vectorised).
-    pub fn block_heights(&self, zc: &[f32], b0: isize, nb: usize, block: &mut [f32]) {
-        for (u, dst) in block.chunks_exact_mut(nb).enumerate().take(self.w) {
+    pub fn block_heights(&self, zc: &[f32], b0: isize, nb: usize, u0: usize, block: &mut [f32]) {
+        for (u, dst) in block.chunks_exact_mut(nb).enumerate().map(|(i, d)| (u0 + i, d)) {
+            if u >= self.w {
+                break;
+            }
             let j = self.valid(u, b0, nb);
             if j.is_empty() {
                 continue;

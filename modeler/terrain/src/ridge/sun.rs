@@ -24,11 +24,13 @@
 //!   ([`DIFFUSE`], 0.2: a clear sky's share).
 
 use std::f64::consts::TAU;
+use std::ops::Range;
 
 use rayon::prelude::*;
 
 use super::RidgeError;
 use super::gradient::sobel;
+use super::packed::Packed;
 use super::scratch;
 use super::sections::{Sections, transpose};
 use super::walk::{LANES, OFF_GRID, Walk};
@@ -117,31 +119,33 @@ pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
         (zp, rows, cols, dy, dx)
     };
     let lines = Sections::new(w, h, slope(du, dv), cell);
-    let all = lines.lines();
-    let blocks = all.len().div_ceil(BLOCK);
-    let mut values = scratch::zeros(blocks * w * BLOCK);
-    values
-        .par_chunks_mut(w * BLOCK)
-        .enumerate()
-        .for_each_init(Scratch::default, |buf, (k, block)| {
-            let b0 = all.start + (k * BLOCK) as isize;
-            horizon_block(&zc, &lines, du > 0.0, b0, block, buf);
-        });
+    let packed = Packed::new(&lines, BLOCK);
+    let mut values = scratch::zeros(0);
     // Per cell the sum of its lines' tangents and of their weights, columns contiguous.
     let (mut sum, mut weight) = (scratch::zeros(w * h), scratch::zeros(w * h));
-    sum.par_chunks_mut(h * SPREAD_COLUMNS)
-        .zip(weight.par_chunks_mut(h * SPREAD_COLUMNS))
-        .enumerate()
-        .for_each(|(piece, (sums, weights))| {
-            for (i, (col, wcol)) in sums.chunks_exact_mut(h).zip(weights.chunks_exact_mut(h)).enumerate() {
-                let u = piece * SPREAD_COLUMNS + i;
-                for (k, block) in values.chunks_exact(w * BLOCK).enumerate() {
-                    let b0 = all.start + (k * BLOCK) as isize;
-                    let nb = BLOCK.min((all.end - b0) as usize);
-                    lines.column_spread_weighted(u, b0, &block[u * BLOCK..u * BLOCK + nb], col, wcol);
+    for pass in packed.passes(pass_budget(w * h)) {
+        packed
+            .split(pass.clone(), &mut values)
+            .into_par_iter()
+            .for_each_init(Scratch::default, |buf, (k, block)| {
+                let (b0, cols) = packed.block(k);
+                horizon_block(&zc, &lines, du > 0.0, (b0, cols), block, buf);
+            });
+        let span = packed.columns(pass.clone());
+        let values = &values[..];
+        sum[span.start * h..span.end * h]
+            .par_chunks_mut(h * SPREAD_COLUMNS)
+            .zip(weight[span.start * h..span.end * h].par_chunks_mut(h * SPREAD_COLUMNS))
+            .enumerate()
+            .for_each(|(piece, (sums, weights))| {
+                for (i, (col, wcol)) in sums.chunks_exact_mut(h).zip(weights.chunks_exact_mut(h)).enumerate() {
+                    let u = span.start + piece * SPREAD_COLUMNS + i;
+                    packed.at_column(&lines, pass.clone(), values, u, |b0, src| {
+                        lines.column_spread_weighted(u, b0, src, col, wcol)
+                    });
                 }
-            }
-        });
+            });
+    }
     if x_major {
         // Back to the grid's layout: u ran along the grid's rows.
         let (s, w) = (transpose(&sum, rows, cols, 0), transpose(&weight, rows, cols, 0));
@@ -156,9 +160,16 @@ pub fn horizons(field: Field<'_>, azimuth: f64, mut f: impl FnMut(usize, f64)) {
 /// The lines `b0..b0 + BLOCK` of `lines` as one block (`block`, laid out like
 /// [`Sections::block_heights`]'s): their heights, then in their place each sample's horizon
 /// tangent towards u's sign `up` (NaN with nothing ahead), walked side by side ([`Walk`]).
-fn horizon_block(zc: &[f32], lines: &Sections, up: bool, b0: isize, block: &mut [f32], buf: &mut Scratch) {
+fn horizon_block(
+    zc: &[f32],
+    lines: &Sections,
+    up: bool,
+    (b0, cols): (isize, Range<usize>),
+    block: &mut [f32],
+    buf: &mut Scratch,
+) {
     let Scratch { heights, walk } = buf;
-    let Some((z, out)) = block_samples(zc, lines, b0, block, heights) else {
+    let Some((z, out)) = block_samples(zc, lines, (b0, cols), block, heights) else {
         return;
     };
     if up {
@@ -326,31 +337,29 @@ const SPREAD_COLUMNS: usize = 16;
 fn sky_sweep(zc: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &mut Layout, values: &mut Vec<f32>) {
     let (w, h) = (layout.w, layout.h);
     let lines = Sections::new(w, h, slope(du, dv), cell);
-    let all = lines.lines();
-    let blocks = (all.len()).div_ceil(BLOCK);
-    values.resize(blocks * w * BLOCK, 0.0);
-    values
-        .par_chunks_mut(w * BLOCK)
-        .enumerate()
-        .for_each_init(Scratch::default, |buf, (k, block)| {
-            let b0 = all.start + (k * BLOCK) as isize;
-            sweep_block(zc, &lines, (du, both), b0, block, buf);
-        });
-    let values = &values[..];
-    layout
-        .sum
-        .par_chunks_mut(h * SPREAD_COLUMNS)
-        .enumerate()
-        .for_each(|(piece, cols)| {
-            for (i, col) in cols.chunks_exact_mut(h).enumerate() {
-                let u = piece * SPREAD_COLUMNS + i;
-                for (k, block) in values.chunks_exact(w * BLOCK).take(blocks).enumerate() {
-                    let b0 = all.start + (k * BLOCK) as isize;
-                    let nb = BLOCK.min((all.end - b0) as usize);
-                    lines.column_spread(u, b0, &block[u * BLOCK..u * BLOCK + nb], col);
+    let packed = Packed::new(&lines, BLOCK);
+    for pass in packed.passes(pass_budget(w * h)) {
+        packed
+            .split(pass.clone(), values)
+            .into_par_iter()
+            .for_each_init(Scratch::default, |buf, (k, block)| {
+                let (b0, cols) = packed.block(k);
+                sweep_block(zc, &lines, (du, both), (b0, cols), block, buf);
+            });
+        let span = packed.columns(pass.clone());
+        let values = &values[..];
+        layout.sum[span.start * h..span.end * h]
+            .par_chunks_mut(h * SPREAD_COLUMNS)
+            .enumerate()
+            .for_each(|(piece, cols)| {
+                for (i, col) in cols.chunks_exact_mut(h).enumerate() {
+                    let u = span.start + piece * SPREAD_COLUMNS + i;
+                    packed.at_column(&lines, pass.clone(), values, u, |b0, src| {
+                        lines.column_spread(u, b0, src, col)
+                    });
                 }
-            }
-        });
+            });
+    }
     let passes = if both { 2.0 } else { 1.0 };
     for u in 0..w {
         layout.first[u] += passes * lines.weight(u, 0);
@@ -363,10 +372,17 @@ fn sky_sweep(zc: &[f32], cell: f64, (du, dv): (f64, f64), both: bool, layout: &m
 /// [`Sections::block_heights`]'s, [`OFF_GRID`] where a line is off the grid): their heights,
 /// then in their place the `sin² H` of each sample (towards `du`'s sign, and with `both` the
 /// opposite way added).
-fn sweep_block(zc: &[f32], lines: &Sections, (du, both): (f64, bool), b0: isize, block: &mut [f32], buf: &mut Scratch) {
+fn sweep_block(
+    zc: &[f32],
+    lines: &Sections,
+    (du, both): (f64, bool),
+    (b0, cols): (isize, Range<usize>),
+    block: &mut [f32],
+    buf: &mut Scratch,
+) {
     let sp2 = lines.spacing * lines.spacing;
     let Scratch { heights, walk } = buf;
-    let Some((z, out)) = block_samples(zc, lines, b0, block, heights) else {
+    let Some((z, out)) = block_samples(zc, lines, (b0, cols), block, heights) else {
         return;
     };
     match (du > 0.0 || both, du < 0.0 || both) {
@@ -380,30 +396,28 @@ fn sweep_block(zc: &[f32], lines: &Sections, (du, both): (f64, bool), b0: isize,
 }
 
 /// The heights of the lines `b0..b0 + BLOCK` into `heights` ([`OFF_GRID`] where a line is
-/// off the grid), over the columns where any of them is on it: those columns of the heights and
-/// of `block` (laid out alike), or `None` when the lines miss the grid. The walks skip the other
-/// columns.
+/// off the grid) over `cols`, the columns where any of them is on it ([`Packed`]'s block, laid
+/// out like `block`): the heights and `block`, or `None` when the lines miss the grid.
 fn block_samples<'a>(
     zc: &[f32],
     lines: &Sections,
-    b0: isize,
+    (b0, cols): (isize, Range<usize>),
     block: &'a mut [f32],
     heights: &'a mut Vec<f32>,
 ) -> Option<(&'a [f32], &'a mut [f32])> {
-    let (mut u0, mut u1) = (usize::MAX, 0);
-    for b in b0..b0 + BLOCK as isize {
-        let cols = lines.columns(b);
-        if !cols.is_empty() {
-            (u0, u1) = (u0.min(cols.start), u1.max(cols.end));
-        }
-    }
-    if u0 >= u1 {
+    if cols.is_empty() {
         return None;
     }
-    heights.resize(block.len(), 0.0);
-    heights[u0 * BLOCK..u1 * BLOCK].fill(OFF_GRID);
-    lines.block_heights(zc, b0, BLOCK, heights);
-    Some((&heights[u0 * BLOCK..u1 * BLOCK], &mut block[u0 * BLOCK..u1 * BLOCK]))
+    heights.clear();
+    heights.resize(block.len(), OFF_GRID);
+    lines.block_heights(zc, b0, BLOCK, cols.start, heights);
+    Some((&heights[..], block))
+}
+
+/// The values a pass of blocks may hold for a grid of `cells`: twice the grid (an ordinary
+/// grid's lines fit in one pass, as before), and never so little that a pass is a few blocks.
+fn pass_budget(cells: usize) -> usize {
+    (2 * cells).max(1 << 20)
 }
 
 /// Buffers reused from block to block: the block's heights and its walks.

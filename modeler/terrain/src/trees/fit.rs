@@ -66,6 +66,19 @@ pub enum FitError {
     /// A silhouette has nothing in it.
     #[error("the {0} silhouette is blank")]
     Blank(&'static str),
+    /// A silhouette no tree casts: a dot, a line, a filled rectangle.
+    #[error(
+        "the {which} silhouette is {what}: a tree's outline is needed (a crown and a trunk, at least 3 × 3 pixels, not filling its box)"
+    )]
+    Degenerate {
+        /// `front` or `side`.
+        which: &'static str,
+        /// What it is.
+        what: String,
+    },
+    /// The fitted maps make a tree past the branch limit.
+    #[error("the fitted tree is refused: {0}")]
+    Refused(String),
     /// No preset to start from.
     #[error("no template to start from")]
     NoTemplate,
@@ -82,6 +95,11 @@ fn prepare(img: &Image) -> Option<Image> {
 
 impl Target {
     fn score(&self, s: &Species) -> [f64; 2] {
+        // A tree past the branch limit is no answer (`trees stats` would refuse its maps, issue
+        // 47), and rendering one is what made a fit run for minutes: the lowest correlation.
+        if crate::validate::species(&s.maps, "maps").is_err() {
+            return [-1.0, -1.0];
+        }
         let f = silhouette::render(s, View::Front, SIZE, FIT_STOP).blurred(2);
         let d = silhouette::render(s, View::Side, SIZE, FIT_STOP).blurred(2);
         [ncc(&f, &self.front), ncc(&d, &self.side)]
@@ -173,6 +191,8 @@ fn ascend(target: &Target, mut p: Vec<f64>, mut best: [f64; 2], iterations: usiz
 /// Fits a species to a front and a side silhouette (coverage images of any size; each is
 /// framed on its own).
 pub fn fit(front: &Image, side: &Image, options: Options) -> Result<Fit, FitError> {
+    check_outline(front, "front")?;
+    check_outline(side, "side")?;
     let target = Target {
         front: prepare(front).ok_or(FitError::Blank("front"))?,
         side: prepare(side).ok_or(FitError::Blank("side"))?,
@@ -196,7 +216,41 @@ pub fn fit(front: &Image, side: &Image, options: Options) -> Result<Fit, FitErro
             });
         }
     }
-    result.ok_or(FitError::NoTemplate)
+    let result = result.ok_or(FitError::NoTemplate)?;
+    crate::validate::species(&result.species.maps, "maps").map_err(|e| FitError::Refused(e.to_string()))?;
+    Ok(result)
+}
+
+/// Refuses a silhouette that is a dot or a line (its covered box under 3 pixels across) or a
+/// filled rectangle (over 95 % of its box covered): no tree casts one, and the ascent would
+/// chase it into a degenerate tree (issue 47: one pixel "fitted" at 0.85 with 568,000 polygons).
+fn check_outline(img: &Image, which: &'static str) -> Result<(), FitError> {
+    let (mut c0, mut c1, mut r0, mut r1, mut covered) = (usize::MAX, 0, usize::MAX, 0, 0usize);
+    for (i, &v) in img.data.iter().enumerate() {
+        if v > 0.5 {
+            let (c, r) = (i % img.width.max(1), i / img.width.max(1));
+            (c0, c1, r0, r1) = (c0.min(c), c1.max(c), r0.min(r), r1.max(r));
+            covered += 1;
+        }
+    }
+    if covered == 0 {
+        return Err(FitError::Blank(which));
+    }
+    let (w, h) = (c1 - c0 + 1, r1 - r0 + 1);
+    let what = if w < 3 || h < 3 {
+        format!(
+            "{} ({w} × {h} pixels covered)",
+            if w * h == 1 { "a single pixel" } else { "a line" }
+        )
+    } else if covered as f64 > 0.95 * (w * h) as f64 {
+        format!(
+            "a filled rectangle ({w} × {h} pixels, {:.0} % covered)",
+            100.0 * covered as f64 / (w * h) as f64
+        )
+    } else {
+        return Ok(());
+    };
+    Err(FitError::Degenerate { which, what })
 }
 
 /// A few deterministic numbers in [−1, 1] from `seed` (xorshift64), for experiments.

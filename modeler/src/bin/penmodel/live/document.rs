@@ -29,6 +29,16 @@ pub struct Created {
 }
 
 impl Created {
+    /// `result`, with what was created removed first when it is an error (issue 47: a failed
+    /// `penmodel open` left the `--out` folder it made).
+    pub fn on_error<T>(&self, result: Result<T>) -> Result<T> {
+        if result.is_err() {
+            // The first error is the one to report; a failure to tidy up is secondary.
+            let _ = self.remove();
+        }
+        result
+    }
+
     /// Removes what was created; folders only if empty.
     pub fn remove(&self) -> Result<()> {
         let remove = |path: &Path| match std::fs::remove_file(path) {
