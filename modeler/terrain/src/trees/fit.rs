@@ -97,7 +97,7 @@ impl Target {
     fn score(&self, s: &Species) -> [f64; 2] {
         // A tree past the branch limit is no answer (`trees stats` would refuse its maps, issue
         // 47), and rendering one is what made a fit run for minutes: the lowest correlation.
-        if crate::validate::species(&s.maps, "maps").is_err() {
+        if !within_branch_limit(s) {
             return [-1.0, -1.0];
         }
         let f = silhouette::render(s, View::Front, SIZE, FIT_STOP).blurred(2);
@@ -217,8 +217,19 @@ pub fn fit(front: &Image, side: &Image, options: Options) -> Result<Fit, FitErro
         }
     }
     let result = result.ok_or(FitError::NoTemplate)?;
-    crate::validate::species(&result.species.maps, "maps").map_err(|e| FitError::Refused(e.to_string()))?;
+    if !within_branch_limit(&result.species) {
+        return Err(FitError::Refused(format!(
+            "more than {} branches",
+            super::nodes::MAX_NODES
+        )));
+    }
     Ok(result)
+}
+
+/// Whether `s` stays within the branch limit `validate::species` enforces. The parameters are
+/// clamped to `BOUNDS`, so this is the one check of it a fitted species can fail.
+fn within_branch_limit(s: &Species) -> bool {
+    super::nodes::count_nodes(s, super::nodes::STOP, super::nodes::MAX_NODES).is_some()
 }
 
 /// Refuses a silhouette that is a dot or a line (its covered box under 3 pixels across) or a
