@@ -167,6 +167,18 @@ fn refused_quickly(path: &std::path::Path) -> String {
     }
 }
 
+/// Makes a FIFO at `path` with mkfifo(3), not by running `mkfifo`: a child forked while another
+/// test holds a document lock holds that lock too until it execs, and that test's next open
+/// would find its own document locked.
+fn mkfifo(path: &std::path::Path) {
+    use std::os::unix::ffi::OsStrExt;
+    let c = std::ffi::CString::new(path.as_os_str().as_bytes()).unwrap();
+    // SAFETY: `c` is a NUL-terminated path that lives across the call.
+    #[allow(unsafe_code)]
+    let made = unsafe { libc::mkfifo(c.as_ptr(), 0o600) };
+    assert_eq!(made, 0, "mkfifo {}", path.display());
+}
+
 #[test]
 fn dev_zero_a_fifo_and_a_folder_are_refused_before_reading() {
     let msg = refused_quickly(std::path::Path::new("/dev/zero"));
@@ -177,8 +189,7 @@ fn dev_zero_a_fifo_and_a_folder_are_refused_before_reading() {
 
     let dir = tempfile::tempdir().unwrap();
     let fifo = dir.path().join("pipe.json");
-    let made = std::process::Command::new("mkfifo").arg(&fifo).status().unwrap();
-    assert!(made.success());
+    mkfifo(&fifo);
     let msg = refused_quickly(&fifo);
     assert!(msg.contains("a FIFO (named pipe), not a regular file"), "{msg}");
 
@@ -188,11 +199,7 @@ fn dev_zero_a_fifo_and_a_folder_are_refused_before_reading() {
     // A journal that is a FIFO is refused the same way, naming the journal.
     let doc = dir.path().join("d.json");
     sample().save(&doc).unwrap();
-    let made = std::process::Command::new("mkfifo")
-        .arg(journal::path_for(&doc))
-        .status()
-        .unwrap();
-    assert!(made.success());
+    mkfifo(&journal::path_for(&doc));
     let msg = refused_quickly(&doc);
     assert!(msg.contains("d.json.journal") && msg.contains("a FIFO"), "{msg}");
 }
