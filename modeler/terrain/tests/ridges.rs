@@ -28,10 +28,26 @@ fn on_triangle(t: &Tri, q: [f64; 2]) -> Option<f64> {
     (s >= -eps && u >= -eps && s + u <= 1.0 + eps).then(|| a[2] + s * (b[2] - a[2]) + u * (c[2] - a[2]))
 }
 
-/// The polygons of a polyline as the module docs describe them, as triangles: each segment's
-/// two flank quads (split in two), a triangle filling each joint's outer gap (turns under 90°),
-/// and two triangles capping each end.
-fn triangles(points: &[[f64; 3]], slope: f64) -> Vec<Tri> {
+/// A cone sector: apex `p` (x, y, elevation) falling at `tan`, over the directions `w` from
+/// it with `inside(w)`.
+struct Cone {
+    p: [f64; 3],
+    tan: f64,
+    inside: Box<dyn Fn([f64; 2]) -> bool>,
+}
+
+impl Cone {
+    fn at(&self, q: [f64; 2]) -> Option<f64> {
+        let w = [q[0] - self.p[0], q[1] - self.p[1]];
+        let z = self.p[2] - w[0].hypot(w[1]) * self.tan;
+        ((self.inside)(w) && z >= 0.0).then_some(z)
+    }
+}
+
+/// The polygons of a polyline as the module docs describe them: each segment's two flank quads
+/// (split in two triangles), and the cone falling at α from each joint over its outer gap
+/// (turns under 90°) and from each end over the half plane beyond it.
+fn polygons(points: &[[f64; 3]], slope: f64) -> (Vec<Tri>, Vec<Cone>) {
     let tan = slope.tan();
     let mut out = Vec::new();
     let dir = |a: [f64; 3], b: [f64; 3]| {
@@ -48,17 +64,22 @@ fn triangles(points: &[[f64; 3]], slope: f64) -> Vec<Tri> {
             out.push([p, qq, pp]);
         }
     }
-    // Joints: the outer side of the turn.
+    let cross = |a: [f64; 2], b: [f64; 2]| a[0] * b[1] - a[1] * b[0];
+    let mut cones = Vec::new();
+    // Joints: the outer side of the turn, between the two segments' outer normals.
     for k in 1..points.len() - 1 {
         let (a, p, b) = (points[k - 1], points[k], points[k + 1]);
         let (u, v) = (dir(a, p), dir(p, b));
-        let cross = u[0] * v[1] - u[1] * v[0];
-        let side = if cross > 0.0 { -1.0 } else { 1.0 }; // left turn: the gap is on the right
+        let side = if cross(u, v) > 0.0 { -1.0 } else { 1.0 }; // left turn: the gap is on the right
         let (n1, n2) = ([-u[1] * side, u[0] * side], [-v[1] * side, v[0] * side]);
-        let r = p[2] / tan;
-        out.push([p, off(p, n1, r), off(p, n2, r)]);
+        let turn = cross(n1, n2);
+        cones.push(Cone {
+            p,
+            tan,
+            inside: Box::new(move |w| cross(n1, w) * turn >= 0.0 && cross(w, n2) * turn >= 0.0),
+        });
     }
-    // Ends: the half disc beyond, as two triangles.
+    // Ends: the half plane beyond.
     let ends = [
         (points[0], dir(points[1], points[0])),
         (
@@ -67,12 +88,13 @@ fn triangles(points: &[[f64; 3]], slope: f64) -> Vec<Tri> {
         ),
     ];
     for (p, out_dir) in ends {
-        let r = p[2] / tan;
-        let (left, right) = ([-out_dir[1], out_dir[0]], [out_dir[1], -out_dir[0]]);
-        out.push([p, off(p, left, r), off(p, out_dir, r)]);
-        out.push([p, off(p, out_dir, r), off(p, right, r)]);
+        cones.push(Cone {
+            p,
+            tan,
+            inside: Box::new(move |w| w[0] * out_dir[0] + w[1] * out_dir[1] >= 0.0),
+        });
     }
-    out
+    (out, cones)
 }
 
 fn lines() -> Vec<Vec<[f64; 3]>> {
@@ -90,12 +112,20 @@ fn unfiltered_dtm_is_the_max_over_the_polygons_at_cell_centres() {
     let skels: Vec<Skeleton> = ls.iter().map(|l| Skeleton::polyline(l, slope)).collect();
     let ids: Vec<(u32, &Skeleton)> = skels.iter().enumerate().map(|(i, s)| (i as u32, s)).collect();
     let dtm = Dtm::build(cols, rows, cell, Filter::NONE, &ids);
-    let tris: Vec<Tri> = ls.iter().flat_map(|l| triangles(l, slope)).collect();
+    let (tris, cones): (Vec<Vec<Tri>>, Vec<Vec<Cone>>) = ls.iter().map(|l| polygons(l, slope)).unzip();
+    let (tris, cones): (Vec<Tri>, Vec<Cone>) = (
+        tris.into_iter().flatten().collect(),
+        cones.into_iter().flatten().collect(),
+    );
     let mut covered = 0;
     for r in 0..rows {
         for c in 0..cols {
             let q = [(f64::from(c) + 0.5) * cell, (f64::from(r) + 0.5) * cell];
-            let want = tris.iter().filter_map(|t| on_triangle(t, q)).fold(0.0f64, f64::max);
+            let want = tris
+                .iter()
+                .filter_map(|t| on_triangle(t, q))
+                .chain(cones.iter().filter_map(|k| k.at(q)))
+                .fold(0.0f64, f64::max);
             let got = f64::from(dtm.raw()[(r * cols + c) as usize]);
             assert!((got - want).abs() < 1e-3, "cell ({c}, {r}): DTM {got}, polygons {want}");
             covered += usize::from(want > 0.0);
@@ -110,6 +140,45 @@ fn unfiltered_dtm_is_the_max_over_the_polygons_at_cell_centres() {
 }
 
 /// A random polyline of 2 to 6 points inside a `w × h` metre field.
+/// Issue 47: a level ridgeline's ends and joints fell steeper than α (39° for α = 30°, 45° off
+/// an end, across the seed's planar triangles); every flank, end and joint must fall at α, so
+/// no two neighbouring cells differ by more than tan α times their distance.
+#[test]
+fn every_flank_end_and_joint_falls_at_the_slope() {
+    let (cols, rows, cell) = (120u32, 100u32, 1.0);
+    let slope = 30f64.to_radians();
+    let line = [[30.0, 30.0, 20.0], [70.0, 35.0, 20.0], [80.0, 70.0, 20.0]];
+    let dtm = Dtm::build(
+        cols,
+        rows,
+        cell,
+        Filter::NONE,
+        &[(0, &Skeleton::polyline(&line, slope))],
+    );
+    let z = dtm.raw();
+    let (mut worst, mut at) = (0.0f64, (0, 0));
+    for r in 0..rows - 1 {
+        for c in 0..cols - 1 {
+            let i = (r * cols + c) as usize;
+            for (j, d) in [
+                (i + 1, 1.0),
+                (i + cols as usize, 1.0),
+                (i + cols as usize + 1, 2f64.sqrt()),
+            ] {
+                let fall = (f64::from(z[i]) - f64::from(z[j])).abs() / (d * cell);
+                if fall > worst {
+                    (worst, at) = (fall, (c, r));
+                }
+            }
+        }
+    }
+    assert!(
+        worst.atan().to_degrees() <= 30.0 + 1e-3,
+        "{:.2}° at cell {at:?}",
+        worst.atan().to_degrees()
+    );
+}
+
 fn random_line(rng: &mut ChaCha8Rng, w: f64, h: f64) -> Vec<[f64; 3]> {
     let n = rng.random_range(2..7);
     (0..n)

@@ -7,9 +7,13 @@
 //!   p0 + n·z0/tan α` (`n` the side's unit normal); the pair is one [`Polygon::Flanks`].
 //! - **Joints**: at a node P (elevation zP) the segments leave it in directions sorted by angle.
 //!   Between two neighbouring directions more than 180° apart, their flanks leave a wedge
-//!   uncovered; triangles with apex P (at zP) and outer corners at distance `R = zP/tan α` on the
-//!   ground fill it, one per at most 90° of wedge. A ridgeline's end is such a node with one
-//!   segment: its 180° wedge gets two triangles, a hipped end instead of a cliff.
+//!   uncovered; the seed fills it with triangles. Planar triangles with their corners on the
+//!   cone's foot fall steeper than α between the corners (by 1/cos of half their angle: 39° for
+//!   α = 30° across a 90° triangle), so here the wedge is filled by the cone itself,
+//!   `z = zP − |q − P|·tan α`, which falls at α in every direction. Triangles with apex P, one
+//!   per at most 90° of wedge, circumscribe the cone's sectors (their outer corners beyond the
+//!   foot `R = zP/tan α`): they bound where the cone is evaluated. A ridgeline's end is such a
+//!   node with one segment: its 180° wedge gets a half cone, a rounded hip instead of a cliff.
 //!
 //! The polygons of one node are one [`Polygon::Fan`]. Everything below the ground (z ≤ 0) is
 //! left out, so a segment reaching down to 0 narrows to a point.
@@ -45,14 +49,16 @@ pub enum Polygon {
         /// tan α.
         tan: f64,
     },
-    /// The triangles around a node: apex `[x, y]` at elevation `z`, each triangle's two outer
-    /// corners on the ground.
+    /// The cone sectors around a node: apex `[x, y]` at elevation `z`, falling at α; each
+    /// sector bounded by a triangle from the apex to two outer corners.
     Fan {
         /// The node `[x, y]`.
         apex: [f64; 2],
         /// Its elevation.
         z: f64,
-        /// The triangles' outer corners.
+        /// tan α.
+        tan: f64,
+        /// The bounding triangles' outer corners.
         triangles: Vec<[[f64; 2]; 2]>,
     },
 }
@@ -137,9 +143,15 @@ impl Polygon {
                     empty: len2 == 0.0,
                 }
             }
-            Polygon::Fan { apex, z, triangles } => Prepared::Fan {
+            Polygon::Fan {
+                apex,
+                z,
+                tan,
+                triangles,
+            } => Prepared::Fan {
                 apex: *apex,
                 z: *z,
+                tan: *tan,
                 triangles: triangles
                     .iter()
                     .filter_map(|[a, b]| {
@@ -183,6 +195,7 @@ pub enum Prepared {
     Fan {
         apex: [f64; 2],
         z: f64,
+        tan: f64,
         triangles: Vec<Triangle>,
     },
 }
@@ -215,24 +228,26 @@ impl Prepared {
                 let z = z0 + t * dz - r * tan;
                 (z >= 0.0).then_some(z)
             }
-            Prepared::Fan { apex, z, triangles } => {
-                let mut best: Option<f64> = None;
-                for tri in triangles {
-                    if let Some(l) = tri.apex_weight(*apex, q) {
-                        let v = z * l;
-                        best = Some(best.map_or(v, |b: f64| b.max(v)));
-                    }
+            Prepared::Fan {
+                apex,
+                z,
+                tan,
+                triangles,
+            } => {
+                if !triangles.iter().any(|tri| tri.contains(*apex, q)) {
+                    return None;
                 }
-                best
+                let v = z - (q[0] - apex[0]).hypot(q[1] - apex[1]) * tan;
+                (v >= 0.0).then_some(v)
             }
         }
     }
 }
 
 impl Triangle {
-    /// The apex's barycentric weight at `q` if `q` is in the triangle.
+    /// Whether `q` is in the triangle.
     #[inline]
-    fn apex_weight(&self, apex: [f64; 2], q: [f64; 2]) -> Option<f64> {
+    fn contains(&self, apex: [f64; 2], q: [f64; 2]) -> bool {
         let (a, b) = (self.a, self.b);
         let e = [b[0] - a[0], b[1] - a[1]];
         let lp = (e[0] * (q[1] - a[1]) - e[1] * (q[0] - a[0])) * self.inv_den;
@@ -240,7 +255,7 @@ impl Triangle {
         let f = [apex[0] - a[0], apex[1] - a[1]];
         let lb = -(f[0] * (q[1] - a[1]) - f[1] * (q[0] - a[0])) * self.inv_den;
         let la = 1.0 - lp - lb;
-        (lp >= 0.0 && lb >= 0.0 && la >= 0.0).then_some(lp)
+        lp >= 0.0 && lb >= 0.0 && la >= 0.0
     }
 }
 
@@ -295,9 +310,12 @@ pub fn polygons(s: &Skeleton) -> Vec<(Part, Polygon)> {
                 continue;
             }
             let n = (wedge / FRAC_PI_2).ceil().max(1.0) as usize;
+            // Corners at R / cos(half the triangle's angle): its outer edge touches the foot's
+            // circle, so the triangle holds the whole sector.
+            let out = reach / (wedge / n as f64 / 2.0).cos();
             let corner = |j: usize| {
                 let ang = a + FRAC_PI_2 + wedge * j as f64 / n as f64;
-                [p[0] + reach * ang.cos(), p[1] + reach * ang.sin()]
+                [p[0] + out * ang.cos(), p[1] + out * ang.sin()]
             };
             for j in 0..n {
                 triangles.push([corner(j), corner(j + 1)]);
@@ -309,6 +327,7 @@ pub fn polygons(s: &Skeleton) -> Vec<(Part, Polygon)> {
                 Polygon::Fan {
                     apex: [p[0], p[1]],
                     z: p[2],
+                    tan,
                     triangles,
                 },
             ));
