@@ -413,6 +413,56 @@ fn a_v_shaped_valley_gathers_its_rain_on_the_axis() {
     assert!(last as usize > z.len() / 2, "the outlet passes {last} drops");
 }
 
+/// Issue 47: on one straight ridge, which has no valley, 38 % of the sloped cells were "valley"
+/// by the count alone (a plane flank's count grows with the distance run). With the longest
+/// path's test no cell of its flanks is valley, while a V-shaped valley's axis still is.
+#[test]
+fn a_straight_ridge_has_no_valley_and_a_v_valley_has_one() {
+    let (cols, rows, cell) = (200u32, 160u32, 1.0);
+    let slope = 30f64.to_radians();
+    // 30 m high: its foot (52 m out) is inside the grid.
+    let line = [[60.0, 80.0, 30.0], [140.0, 80.0, 30.0]];
+    let dtm = Dtm::build(
+        cols,
+        rows,
+        cell,
+        Filter::DEFAULT,
+        &[(0, &Skeleton::polyline(&line, slope))],
+    );
+    let z = dtm.heights();
+    let next = rain::directions(z, cols, rows, cell);
+    let (counts, longest) = (rain::accumulate(&next), rain::longest_paths(&next));
+    let sloped = z.iter().filter(|&&v| v > 0.0).count();
+    let share = |classes: rain::Classes| {
+        let v = classes.valleys(&counts, &longest);
+        z.iter().zip(&v).filter(|&(&h, &v)| h > 0.0 && v > 0.0).count() as f64 / sloped as f64
+    };
+    let seeds = rain::Classes {
+        valley_convergence: 1,
+        ..rain::Classes::DEFAULT
+    };
+    assert!(
+        share(seeds) > 0.2,
+        "the count alone: {:.1} % valley",
+        100.0 * share(seeds)
+    );
+    assert_eq!(share(rain::Classes::DEFAULT), 0.0, "valley cells on a straight ridge");
+
+    // The V: sides falling 0.5 per cell towards the axis, the valley 0.1 per row.
+    let (cols, rows, axis) = (41u32, 60u32, 20u32);
+    let z: Vec<f32> = (0..rows)
+        .flat_map(|r| (0..cols).map(move |c| 0.5 * (c as f32 - axis as f32).abs() + 0.1 * (rows - r) as f32))
+        .collect();
+    let next = rain::directions(&z, cols, rows, cell);
+    let v = rain::Classes::DEFAULT.valleys(&rain::accumulate(&next), &rain::longest_paths(&next));
+    for r in 0..rows {
+        let row: Vec<u32> = (0..cols).filter(|&c| v[(r * cols + c) as usize] > 0.0).collect();
+        assert!(row.is_empty() || row == [axis], "row {r}: valley cells {row:?}");
+    }
+    let on_axis = (0..rows).filter(|&r| v[(r * cols + axis) as usize] > 0.0).count();
+    assert!(on_axis > rows as usize / 2, "{on_axis} of {rows} axis cells are valley");
+}
+
 /// A bumpy terrain: cones and a ridge.
 fn bumpy(cols: u32, rows: u32) -> Vec<f32> {
     let mut z = vec![0.0f32; (cols * rows) as usize];

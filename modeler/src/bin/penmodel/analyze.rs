@@ -35,7 +35,7 @@ pub struct Args {
     /// Ridge areas: 1 where at most --ridge-max drops pass and the cell sheds water, else 0.
     #[arg(long, value_name = "FILE")]
     ridges: Option<PathBuf>,
-    /// Valley areas: 1 where at least --valley-min drops pass, else 0.
+    /// Valley areas: 1 where at least --valley-min drops pass, and --valley-convergence times the drops of the longest path there (water gathers, not a flank), else 0.
     #[arg(long, value_name = "FILE")]
     valleys: Option<PathBuf>,
     /// A cell passed by at most this many drops (its own included) is ridge.
@@ -44,6 +44,9 @@ pub struct Args {
     /// A cell passed by at least this many drops is valley.
     #[arg(long, value_name = "N", default_value_t = Classes::DEFAULT.valley_min)]
     valley_min: u32,
+    /// A valley cell's count is at least this many times its longest path's: 1 is the seed's count alone, which calls the lower part of any long plane flank valley.
+    #[arg(long, value_name = "K", default_value_t = Classes::DEFAULT.valley_convergence, value_parser = clap::value_parser!(u32).range(1..))]
+    valley_convergence: u32,
     /// The sun: azimuth in degrees from the grid's +x axis towards +y, elevation above the horizon in degrees (0, 90].
     #[arg(long, value_name = "AZ,EL", value_parser = parse_sun, allow_hyphen_values = true)]
     sun: Option<(f64, f64)>,
@@ -177,9 +180,16 @@ pub fn run(args: &Args) -> Result<()> {
         let classes = Classes {
             ridge_max: args.ridge_max,
             valley_min: args.valley_min,
+            valley_convergence: args.valley_convergence,
         };
         write(args.json, map, &args.ridges, &classes.ridges(&counts, &next), |v| v)?;
-        write(args.json, map, &args.valleys, &classes.valleys(&counts), |v| v)?;
+        write(
+            args.json,
+            map,
+            &args.valleys,
+            &classes.valleys(&counts, &rain::longest_paths(&next)),
+            |v| v,
+        )?;
     }
     let direct = match sun {
         Some(s) if args.direct.is_some() || args.insolation.is_some() => {

@@ -91,6 +91,32 @@ pub fn accumulate(next: &[u32]) -> Vec<u32> {
     count
 }
 
+/// Per cell, the number of cells on the longest path of moves `next` ([`directions`]) that ends
+/// there, its own included: the count a cell would have if no two paths joined above it. On a
+/// plane every path runs beside the others and the pass count equals it; where water gathers,
+/// as in a valley, the count exceeds it many times.
+pub fn longest_paths(next: &[u32]) -> Vec<u32> {
+    let mut inflow = vec![0u32; next.len()];
+    for &n in next {
+        if n != STOP {
+            inflow[n as usize] += 1;
+        }
+    }
+    let mut longest = vec![1u32; next.len()];
+    let mut ready: Vec<u32> = (0..next.len() as u32).filter(|&i| inflow[i as usize] == 0).collect();
+    while let Some(i) = ready.pop() {
+        let n = next[i as usize];
+        if n != STOP {
+            longest[n as usize] = longest[n as usize].max(longest[i as usize] + 1);
+            inflow[n as usize] -= 1;
+            if inflow[n as usize] == 0 {
+                ready.push(n);
+            }
+        }
+    }
+    longest
+}
+
 /// The cells a drop starting in cell `start` passes through, `start` first.
 pub fn trace(next: &[u32], start: u32) -> Vec<u32> {
     let mut path = vec![start];
@@ -107,15 +133,22 @@ pub fn trace(next: &[u32], start: u32) -> Vec<u32> {
 pub struct Classes {
     /// A cell passed by at most this many drops is ridge.
     pub ridge_max: u32,
-    /// A cell passed by at least this many drops is valley.
+    /// A cell passed by at least this many drops is valley…
     pub valley_min: u32,
+    /// … and by at least this many times the drops of its longest path ([`longest_paths`]):
+    /// water gathers there rather than running down a flank. 1 is the seed's count alone, under
+    /// which a long plane flank is "valley" from some way down (38 % of a straight ridge's
+    /// slopes at 32 drops).
+    pub valley_convergence: u32,
 }
 
 impl Classes {
-    /// Ridge: no drop but its own passes (1) and its own moves on; valley: 32 drops or more.
+    /// Ridge: no drop but its own passes (1) and its own moves on; valley: 32 drops or more,
+    /// at least twice its longest path's.
     pub const DEFAULT: Classes = Classes {
         ridge_max: 1,
         valley_min: 32,
+        valley_convergence: 2,
     };
 
     /// 1.0 where the count is ridge, else 0.0. A cell whose drop stays put (a flat or a pit,
@@ -128,11 +161,17 @@ impl Classes {
             .collect()
     }
 
-    /// 1.0 where the count is valley, else 0.0.
-    pub fn valleys(&self, counts: &[u32]) -> Vec<f32> {
+    /// Whether a cell of pass count `count` and longest path `longest` is valley.
+    pub fn is_valley(&self, count: u32, longest: u32) -> bool {
+        count >= self.valley_min && u64::from(count) >= u64::from(self.valley_convergence) * u64::from(longest)
+    }
+
+    /// 1.0 where the cell is valley ([`Classes::is_valley`]), else 0.0.
+    pub fn valleys(&self, counts: &[u32], longest: &[u32]) -> Vec<f32> {
         counts
             .iter()
-            .map(|&n| f32::from(u8::from(n >= self.valley_min)))
+            .zip(longest)
+            .map(|(&n, &l)| f32::from(u8::from(self.is_valley(n, l))))
             .collect()
     }
 }
