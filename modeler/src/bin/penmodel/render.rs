@@ -166,9 +166,9 @@ pub struct Args {
     /// elevation EL (0, 90]: 0.8·direct (shadows exactly dark) + 0.2·sky view over 32 azimuths.
     #[arg(long, value_name = "AZ,EL", value_parser = crate::analyze::parse_sun, allow_hyphen_values = true)]
     sun: Option<(f64, f64)>,
-    /// Overlay the ridge and valley areas (seed 002): the valley network (cells passed by at
-    /// least 32 rain drops, along the flow) in blue, the ridge cells' crest lines (the document's
-    /// ridgelines and trees) in orange.
+    /// Overlay the ridge and valley areas (seed 002, `analyze`'s default thresholds): the valley
+    /// network (along the flow through valley cells) in blue, the ridge cells (no drop but their
+    /// own passes) in yellow, row by row, and the document's ridgelines and trees in orange.
     #[arg(long)]
     areas: bool,
     /// One line of text at the top left.
@@ -376,18 +376,21 @@ pub fn ramp_top(hi: f32) -> f32 {
 
 /// Valley colour of `--areas`.
 const VALLEY_COLOUR: render::Rgba = [40, 110, 230, 255];
-/// Ridge colour of `--areas`.
+/// Ridgeline colour of `--areas`.
 const RIDGE_COLOUR: render::Rgba = [245, 150, 30, 255];
+/// Colour of `--areas`' ridge cells.
+const RIDGE_AREA_COLOUR: render::Rgba = [250, 215, 70, 255];
 
 /// `--areas`: the valley network as draped lines along the rain's flow through valley cells
 /// (one line from each valley cell no valley cell flows into, down to where the flow leaves the
-/// valley cells), and the document's ridgelines and trees' segments at their elevations.
+/// valley cells), the ridge cells as runs along each row (a lone cell a dot), and the document's
+/// ridgelines and trees' segments at their elevations.
 fn ridge_overlays(doc: &penmodel_terrain::Document, map: &penmodel_terrain::Heightmap) -> Vec<render::Overlay> {
     use penmodel_terrain::ridge::rain::{self, Classes, STOP};
     let (cols, rows, cell) = (map.cols(), map.rows(), map.cell_size());
     let next = rain::directions(map.heights(), cols, rows, cell);
-    let counts = rain::accumulate(&next);
-    let valley = |i: usize| counts[i] >= Classes::DEFAULT.valley_min;
+    let (counts, longest) = (rain::accumulate(&next), rain::longest_paths(&next));
+    let valley = |i: usize| Classes::DEFAULT.is_valley(counts[i], longest[i]);
     let mut fed = vec![false; next.len()];
     for (i, &n) in next.iter().enumerate() {
         if n != STOP && valley(i) {
@@ -412,6 +415,32 @@ fn ridge_overlays(doc: &penmodel_terrain::Document, map: &penmodel_terrain::Heig
                 closed: false,
                 colour: VALLEY_COLOUR,
                 width: 2.0,
+                height: None,
+            });
+        }
+    }
+    let ridge = Classes::DEFAULT.ridges(&counts, &next);
+    for (r, row) in ridge.chunks(cols as usize).enumerate() {
+        let mut c = 0;
+        while c < row.len() {
+            if row[c] == 0.0 {
+                c += 1;
+                continue;
+            }
+            let start = c;
+            while c < row.len() && row[c] > 0.0 {
+                c += 1;
+            }
+            let at = |c: usize| centre(r as u32 * cols + c as u32);
+            out.push(render::Overlay {
+                points: if c - start == 1 {
+                    vec![at(start)]
+                } else {
+                    vec![at(start), at(c - 1)]
+                },
+                closed: false,
+                colour: RIDGE_AREA_COLOUR,
+                width: 1.0,
                 height: None,
             });
         }
