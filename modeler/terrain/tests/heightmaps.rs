@@ -218,3 +218,21 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn a_document_saved_in_another_folder_still_finds_its_base() {
+    let dir = tempfile::tempdir().unwrap();
+    let doc = with_base(dir.path(), &ramp(40, 40));
+    let path = dir.path().join("doc.json");
+    fs::write(&path, doc.to_json()).unwrap();
+    let (mut editor, _) = Editor::open(&path).unwrap();
+    fs::create_dir(dir.path().join("elsewhere")).unwrap();
+    let moved = dir.path().join("elsewhere").join("doc.json");
+    editor.save_as(&moved).unwrap();
+    drop(editor);
+    let loaded = Document::load(&moved).unwrap();
+    assert_eq!(
+        generate(&loaded).unwrap(),
+        generate(&Document::load(&path).unwrap()).unwrap()
+    );
+}
