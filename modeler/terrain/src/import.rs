@@ -16,8 +16,22 @@ use thiserror::Error;
 use crate::document::{Base, BaseHeights, Grid};
 use crate::export::{self, HeightRange};
 
-/// The largest heightmap file read, bytes: 4 GiB (a 32768² float32 grid).
-pub const MAX_FILE_BYTES: u64 = 4 << 30;
+/// The largest heightmap file read, bytes: 256 MiB (the largest grid,
+/// [`MAX_CELLS`](crate::validate::MAX_CELLS) cells, is 64 MiB as float32).
+pub const MAX_FILE_BYTES: u64 = 256 << 20;
+
+/// Refuses a heightmap of more cells than a document's grid may have, before anything is
+/// allocated for it.
+fn check_cells(cols: u32, rows: u32) -> Result<(), String> {
+    let cells = u64::from(cols) * u64::from(rows);
+    if cells > crate::validate::MAX_CELLS {
+        return Err(format!(
+            "it is {cols} × {rows} cells, more than a document's grid may have ({}); resample it smaller",
+            crate::validate::MAX_CELLS
+        ));
+    }
+    Ok(())
+}
 
 /// A heightmap file's kind.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -107,6 +121,7 @@ pub fn read(path: &Path, options: &Options) -> Result<Read, ImportError> {
         Kind::Png16 => read_png(&bytes, options).map_err(bad)?,
         Kind::GeoTiff => {
             let t = export::read_geotiff(&bytes).map_err(bad)?;
+            check_cells(t.cols, t.rows).map_err(bad)?;
             let cell = match t.pixel_scale {
                 Some([x, y]) if (x.abs() - y.abs()).abs() > 1e-9 * x.abs().max(y.abs()) => {
                     return Err(bad(format!(
@@ -133,6 +148,7 @@ pub fn read(path: &Path, options: &Options) -> Result<Read, ImportError> {
                     "a raw float32 heightmap needs its size: give --size ROWSxCOLS".into()
                 ));
             };
+            check_cells(cols, rows).map_err(bad)?;
             let want = u64::from(rows) * u64::from(cols) * 4;
             if bytes.len() as u64 != want {
                 return Err(bad(format!(
@@ -175,6 +191,7 @@ fn read_png(bytes: &[u8], options: &Options) -> Result<Decoded, String> {
         .map_err(|e| format!("not a PNG heightmap: {e}"))?;
     let info = reader.info();
     let (cols, rows) = (info.width, info.height);
+    check_cells(cols, rows)?;
     if info.color_type != png::ColorType::Grayscale || info.bit_depth != png::BitDepth::Sixteen {
         return Err(format!(
             "the PNG is {:?} at {} bits; a heightmap here is 16-bit grayscale",

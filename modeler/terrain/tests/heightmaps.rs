@@ -60,6 +60,15 @@ fn geotiff_reads_back_with_its_size_scale_origin_and_heights() {
     for n in [0, 3, 8, 20, bytes.len() / 2, bytes.len() - 1] {
         assert!(export::read_geotiff(&bytes[..n]).is_err(), "cut at {n}");
     }
+    // A size far beyond the file is refused before anything is allocated for it.
+    let mut huge = bytes.clone();
+    let ifd = u32::from_le_bytes([huge[4], huge[5], huge[6], huge[7]]) as usize;
+    for entry in [0, 1] {
+        let at = ifd + 2 + entry * 12 + 8;
+        huge[at..at + 4].copy_from_slice(&u32::MAX.to_le_bytes());
+    }
+    let e = export::read_geotiff(&huge).unwrap_err();
+    assert!(e.contains("cut off") && e.contains("4294967295 × 4294967295"), "{e}");
 }
 
 /// A document on a 40 × 40 grid with one region, and a base heightmap file beside it.
@@ -198,6 +207,21 @@ fn a_png_base_reads_within_its_16_bit_step() {
 
 proptest! {
     #![proptest_config(ProptestConfig { cases: 24, ..ProptestConfig::default() })]
+
+    /// A GeoTIFF with bytes changed anywhere (in its header, its tags, their values) reads as
+    /// some heightmap or is an error: never a panic, never an allocation the file cannot back.
+    #[test]
+    fn a_damaged_geotiff_is_an_error_not_a_panic(changes in prop::collection::vec((any::<prop::sample::Index>(), any::<u8>()), 1..8)) {
+        let mut bytes = Vec::new();
+        export::write_geotiff(&map(6, 5), GeoRef::default(), &mut bytes).unwrap();
+        // Most changes land in the tags and values after the samples.
+        let tags = 8 + 6 * 5 * 4;
+        for (at, b) in changes {
+            let i = tags + at.index(bytes.len() - tags);
+            bytes[i] = b;
+        }
+        let _ = export::read_geotiff(&bytes);
+    }
 
     /// With a base, an edited terrain still equals a full regeneration to the bit, with or
     /// without detail and erosion.

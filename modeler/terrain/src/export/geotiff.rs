@@ -263,7 +263,15 @@ pub fn read_geotiff(bytes: &[u8]) -> Result<GeoTiff, String> {
     }
     let offsets = get(tag::STRIP_OFFSETS).ok_or("the TIFF has no strip offsets")?;
     let counts = get(tag::STRIP_BYTES).ok_or("the TIFF has no strip byte counts")?;
-    let want = cols as usize * rows as usize * 4;
+    // The samples cannot be more than the file: checked before anything is allocated.
+    let want = u128::from(cols) * u128::from(rows) * 4;
+    if want > bytes.len() as u128 {
+        return Err(format!(
+            "the TIFF is cut off: its {cols} × {rows} float32 samples need {want} bytes, the file has {}",
+            bytes.len()
+        ));
+    }
+    let want = want as usize;
     let mut data = Vec::with_capacity(want);
     for (&o, &c) in offsets.iter().zip(counts) {
         let (o, c) = (o as usize, c as usize);
