@@ -74,17 +74,21 @@ fn generate_writes_only_the_outputs_asked_for_and_needs_one() {
     let doc = doc.to_str().expect("UTF-8 path");
     let out = penmodel(dir.path(), &["generate", doc, "--png", "only.png"]);
     assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
-    let written: Vec<_> = std::fs::read_dir(dir.path())
+    let mut written: Vec<_> = std::fs::read_dir(dir.path())
         .expect("dir")
         .map(|e| e.expect("entry").file_name())
         .collect();
-    assert_eq!(written, ["only.png"]);
+    written.sort();
+    // The PNG and its sidecar (issue 46), nothing else.
+    assert_eq!(written, ["only.png", "only.png.json"]);
 
     let out = penmodel(dir.path(), &["generate", doc]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert_eq!(out.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("--raw <OUT.f32>|--png <OUT.png>|--obj <OUT.obj>|--glb <OUT.glb>"),
+        err.contains(
+            "--raw <OUT.f32>|--png <OUT.png>|--raw16 <OUT.r16>|--geotiff <OUT.tif>|--obj <OUT.obj>|--glb <OUT.glb>"
+        ),
         "{err}"
     );
 }

@@ -2,6 +2,7 @@
 mod cli;
 mod common;
 mod demo_cli;
+mod heightmaps_cli;
 mod help_examples;
 mod interaction;
 mod kill_loop;

@@ -8,7 +8,7 @@
 use serde::{Deserialize, Serialize};
 
 /// The format version this build writes (and reads).
-pub const VERSION: u32 = 5;
+pub const VERSION: u32 = 6;
 
 /// The oldest version this build reads: a version 1 to 3 document (no rock fields, no rivers, no
 /// terrain settings) loads as the current version, with seed 000's taxicab distances.
@@ -87,6 +87,85 @@ pub struct TerrainSettings {
     /// Thermal erosion of the regions' terrain, after the detail; none when left out.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub erosion: Option<Erosion>,
+    /// A heightmap the sketch is added onto (version 6); none when left out: the sketch
+    /// stands on 0 m.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub base: Option<Base>,
+}
+
+/// A heightmap under the sketch (`crate::import`): the regions' terrain (with its detail) is
+/// added to its heights, and the erosion runs on the sum.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Base {
+    /// The heightmap file, relative to the document's folder (or absolute): `.png` a 16-bit
+    /// PNG, `.tif`/`.tiff` a float32 GeoTIFF, else raw float32 of the grid's size. Its size
+    /// must be the grid's.
+    pub path: String,
+    /// The height of a 16-bit PNG's value 0, metres, instead of its `tEXt` chunk (with `max`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub min: Option<f64>,
+    /// The height of a 16-bit PNG's value 65535, metres (with `min`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max: Option<f64>,
+    /// The heights read from `path` when the document was read from its file
+    /// ([`crate::import::load_base`]); not part of the JSON.
+    #[serde(skip)]
+    pub heights: BaseHeights,
+}
+
+impl Base {
+    /// A base naming `path`, its heights not loaded.
+    pub fn new(path: impl Into<String>) -> Base {
+        Base {
+            path: path.into(),
+            min: None,
+            max: None,
+            heights: BaseHeights::default(),
+        }
+    }
+}
+
+/// A base's heights, row-major over the grid, shared between copies of the document (an edit
+/// copies the document; the heights stay one buffer). Equal when they are the same buffer or
+/// hold the same heights.
+#[derive(Clone, Default)]
+pub struct BaseHeights(Option<std::sync::Arc<[f32]>>);
+
+impl BaseHeights {
+    /// Heights loaded.
+    pub fn new(heights: Vec<f32>) -> BaseHeights {
+        BaseHeights(Some(heights.into()))
+    }
+
+    /// The heights, if loaded.
+    pub fn get(&self) -> Option<&[f32]> {
+        self.0.as_deref()
+    }
+
+    /// The shared buffer, if loaded.
+    pub fn shared(&self) -> Option<std::sync::Arc<[f32]>> {
+        self.0.clone()
+    }
+}
+
+impl PartialEq for BaseHeights {
+    fn eq(&self, other: &BaseHeights) -> bool {
+        match (&self.0, &other.0) {
+            (Some(a), Some(b)) => std::sync::Arc::ptr_eq(a, b) || a[..] == b[..],
+            (None, None) => true,
+            _ => false,
+        }
+    }
+}
+
+impl std::fmt::Debug for BaseHeights {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match &self.0 {
+            Some(h) => write!(f, "BaseHeights({} heights)", h.len()),
+            None => f.write_str("BaseHeights(not loaded)"),
+        }
+    }
 }
 
 impl TerrainSettings {

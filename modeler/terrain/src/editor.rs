@@ -840,6 +840,20 @@ impl Editor {
             true => None,
             false => Some(DocumentLock::acquire(&target, lock::mode_of(&target))?),
         };
+        // A base heightmap named relative to the old file's folder is named by its whole path
+        // in a file elsewhere, so the new file still finds it.
+        if let (Some(store), Some(base)) = (&self.store, &mut self.doc.terrain.base)
+            && Path::new(&base.path).is_relative()
+            && store.lock.document().parent() != target.parent()
+            && let Some(whole) = store
+                .lock
+                .document()
+                .parent()
+                .and_then(|dir| std::fs::canonicalize(dir.join(&base.path)).ok())
+                .and_then(|p| p.to_str().map(str::to_owned))
+        {
+            base.path = whole;
+        }
         // Document first: a crash between the two leaves a journal whose base no longer matches,
         // which is then set aside rather than replayed twice.
         let bytes = self.doc.save(&target)?;

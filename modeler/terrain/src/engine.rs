@@ -26,6 +26,9 @@
 //! - with the document's fractal detail, [`crate::detail`] adds its noise to that terrain (the
 //!   regions paint the terrain before it and their gates; the detail follows the rectangle that
 //!   changed, grown by a cell).
+//! - with the document's base heightmap (`terrain.base`), its heights are added to that terrain
+//!   (the regions, or the detail, write the sketch before it; the base follows the rectangle
+//!   that changed, cell by cell), so the erosion below runs on the sum.
 //! - with the document's erosion, [`crate::erosion`] erodes the terrain (with detail) after that
 //!   (the regions, or the detail, write the terrain before it; the erosion follows the rectangle
 //!   that changed, grown by its steps).
@@ -102,6 +105,8 @@ pub struct TerrainEngine {
     map: Heightmap,
     /// The fractal detail and the regions' terrain before it, if the document has detail.
     detail: Option<detail::Layer>,
+    /// The base heightmap and the sketch before it is added, if the document has a base.
+    base: Option<BaseLayer>,
     /// The erosion and the terrain before it, if the document has erosion.
     erosion: Option<erosion::Layer>,
     /// The ridgelines (seed 002) and the ground they make with `map`.
@@ -158,6 +163,41 @@ impl FluvialLayer {
         }
         self.run = None;
         self.restart = true;
+        rect
+    }
+}
+
+/// A base heightmap under the sketch (`terrain.base`).
+struct BaseLayer {
+    /// The document's entry, its heights shared.
+    settings: crate::document::Base,
+    heights: std::sync::Arc<[f32]>,
+    /// The sketch (the regions' terrain, with detail) before the base is added.
+    sketch: Heightmap,
+}
+
+impl BaseLayer {
+    fn new(doc: &Document) -> Option<BaseLayer> {
+        let settings = doc.terrain.base.clone()?;
+        let heights = settings.heights.shared()?;
+        Some(BaseLayer {
+            settings,
+            heights,
+            sketch: Heightmap::new(&doc.grid),
+        })
+    }
+
+    /// Writes `sketch + base` into `out` over `rect`; returns `rect` (the sum is per cell).
+    fn apply(&self, rect: Rect, out: &mut Heightmap) -> Rect {
+        let cols = out.cols() as usize;
+        let sketch = self.sketch.heights();
+        let out = out.heights_mut();
+        for r in rect.r0..rect.r0 + rect.height {
+            let row = r as usize * cols;
+            for i in row + rect.c0 as usize..row + (rect.c0 + rect.width) as usize {
+                out[i] = sketch[i] + self.heights[i];
+            }
+        }
         rect
     }
 }
@@ -220,6 +260,7 @@ impl TerrainEngine {
     /// Validates `doc` and generates its terrain.
     pub fn new(doc: &Document) -> Result<TerrainEngine, ValidationError> {
         validate::document(doc)?;
+        validate::base_loaded(doc)?;
         Ok(TerrainEngine::build(doc))
     }
 
@@ -229,20 +270,31 @@ impl TerrainEngine {
         let regions: Vec<RegionNode> = doc.regions.iter().map(|r| region_node(doc, r)).collect();
         let mut map = Heightmap::new(&grid);
         let mut detail = doc.terrain.detail.map(|d| detail::Layer::new(&grid, d));
+        let mut base = BaseLayer::new(doc);
         let mut erosion = thermal(doc).map(|e| erosion::Layer::new(&grid, e));
-        // The terrain before erosion: the erosion's, or the map itself.
+        // The terrain before erosion: the erosion's, or the map itself; the sketch before the
+        // base: the base's, or that.
         let before = erosion.as_mut().map_or(&mut map, |e| &mut e.before);
-        for (node, r) in regions.iter().zip(&doc.regions) {
-            match &mut detail {
-                Some(layer) => {
-                    node.paint_all(&r.figures, 0.0, &mut layer.smooth);
-                    node.paint_gates(&mut layer.gate, grid.cols);
+        {
+            let sketch = match &mut base {
+                Some(b) => &mut b.sketch,
+                None => &mut *before,
+            };
+            for (node, r) in regions.iter().zip(&doc.regions) {
+                match &mut detail {
+                    Some(layer) => {
+                        node.paint_all(&r.figures, 0.0, &mut layer.smooth);
+                        node.paint_gates(&mut layer.gate, grid.cols);
+                    }
+                    None => node.paint_all(&r.figures, 0.0, sketch),
                 }
-                None => node.paint_all(&r.figures, 0.0, before),
+            }
+            if let Some(layer) = &detail {
+                layer.apply(whole(&grid), sketch);
             }
         }
-        if let Some(layer) = &detail {
-            layer.apply(whole(&grid), before);
+        if let Some(b) = &base {
+            b.apply(whole(&grid), before);
         }
         if let Some(layer) = &erosion {
             layer.apply(whole(&grid), &mut map);
@@ -260,6 +312,7 @@ impl TerrainEngine {
             regions,
             map,
             detail,
+            base,
             erosion,
             ridges,
             fluvial,
@@ -361,8 +414,13 @@ impl TerrainEngine {
                 // The detail follows the regions' terrain that changed (and the cells beside it),
                 // the erosion the terrain before it (and the cells its steps reach).
                 let before = self.erosion.as_mut().map_or(&mut self.map, |e| &mut e.before);
-                let rect = match &self.detail {
-                    Some(layer) => layer.apply(rect, before),
+                let rect = match (&self.detail, &mut self.base) {
+                    (Some(layer), Some(b)) => layer.apply(rect, &mut b.sketch),
+                    (Some(layer), None) => layer.apply(rect, before),
+                    (None, _) => rect,
+                };
+                let rect = match &self.base {
+                    Some(b) => b.apply(rect, before),
                     None => rect,
                 };
                 let rect = match &self.erosion {
@@ -402,11 +460,13 @@ impl TerrainEngine {
             regions,
             map,
             detail,
+            base,
             erosion,
             ..
         } = self;
         // Settings are not edits with a scope: a change of them regenerates everything.
         if detail.as_ref().map(|l| *l.settings()) != doc.terrain.detail
+            || base.as_ref().map(|b| &b.settings) != doc.terrain.base.as_ref()
             || erosion.as_ref().map(|l| *l.settings()) != thermal(doc)
             || (regions.len() == doc.regions.len()
                 && regions
@@ -417,9 +477,10 @@ impl TerrainEngine {
             return None;
         }
         // With detail the regions paint the terrain before it, and the shapes' gates.
-        let (map, mut gate) = match detail {
-            Some(detail::Layer { smooth, gate, .. }) => (smooth, Some(gate.as_mut_slice())),
-            None => (erosion.as_mut().map_or(map, |e| &mut e.before), None),
+        let (map, mut gate) = match (detail, base) {
+            (Some(detail::Layer { smooth, gate, .. }), _) => (smooth, Some(gate.as_mut_slice())),
+            (None, Some(b)) => (&mut b.sketch, None),
+            (None, None) => (erosion.as_mut().map_or(map, |e| &mut e.before), None),
         };
         let grid = doc.grid;
         let before = match scope {

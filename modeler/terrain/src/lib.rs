@@ -35,6 +35,7 @@ pub mod fluvial;
 pub mod fuzzing;
 pub mod geometry;
 mod heightmap;
+pub mod import;
 pub mod journal;
 mod json;
 pub mod lock;

@@ -257,6 +257,9 @@ impl Document {
         if doc.version < 5 && doc.terrain.erosion.is_some_and(|e| e.fluvial.is_some()) {
             return Err(ValidationError::new("terrain.erosion.fluvial", Defect::NeedsVersion(5)).into());
         }
+        if doc.version < 6 && doc.terrain.base.is_some() {
+            return Err(ValidationError::new("terrain.base", Defect::NeedsVersion(6)).into());
+        }
         doc.version = VERSION;
         validate::document(&doc)?;
         Ok(doc)
@@ -304,7 +307,16 @@ pub fn read_document(path: &Path) -> Result<(Document, Vec<u8>), LoadError> {
             ),
         }
     })?;
-    let doc = Document::from_json(text)?;
+    let mut doc = Document::from_json(text)?;
+    // The base heightmap is named relative to the document's folder.
+    let grid = doc.grid;
+    if let Some(base) = &mut doc.terrain.base {
+        let dir = path.parent().unwrap_or(Path::new(""));
+        crate::import::load_base(base, dir, &grid).map_err(|e| {
+            ValidationError::new("terrain.base.path", crate::validate::TerrainDefect::Base(e.to_string()))
+        })?;
+        crate::validate::base(&doc)?;
+    }
     Ok((doc, bytes))
 }
 

@@ -12,6 +12,7 @@ mod exports;
 mod faults;
 mod fluvial;
 mod fuzz_corpus;
+mod heightmaps;
 mod limits;
 mod properties;
 mod ridges;

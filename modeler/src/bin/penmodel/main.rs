@@ -10,6 +10,7 @@ mod analyze;
 mod bench;
 mod erode;
 mod generate;
+mod import;
 mod live;
 mod out;
 mod render;
@@ -69,6 +70,8 @@ enum Command {
     },
     /// Generate a document's terrain and export it.
     Generate(generate::Args),
+    /// Make a document from a heightmap (16-bit PNG, float32 GeoTIFF, raw float32): the sketch is added on top.
+    Import(import::Args),
     /// Render a document's terrain into a PNG.
     Render(render::Args),
     /// Measure the renderer's frame time and the terrain update while pulling.
@@ -97,6 +100,7 @@ fn main() -> ExitCode {
             live,
         }) => live::run(&live, Some(&document), recover),
         Some(Command::Generate(args)) => generate::run(&args),
+        Some(Command::Import(args)) => import::run(&args),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
         Some(Command::Rocks(args)) => rocks::run(&args),

@@ -1,4 +1,5 @@
-//! Exports of a heightmap: 16-bit PNG, raw float32, and meshes (OBJ, binary glTF, PLY).
+//! Exports of a heightmap: 16-bit PNG, RAW16, float32 GeoTIFF, raw float32 (the heightmaps with a
+//! JSON sidecar, [`Sidecar`]), and meshes (OBJ, binary glTF, PLY).
 //!
 //! Conventions shared by all formats:
 //! - grid row r, column c is image row r (top to bottom), column c (left to right), and raw
@@ -9,23 +10,29 @@
 //!   PNG; two triangles per square of four neighbouring centres, counter-clockwise seen from
 //!   above (+Y), with per-vertex normals from central differences.
 
+mod geotiff;
 mod glb;
 mod mesh;
 mod obj;
 mod ply;
 mod png;
 mod raw;
+mod raw16;
+mod sidecar;
 
 use std::io;
 
 use thiserror::Error;
 
+pub use geotiff::{GeoRef, GeoTiff, read_geotiff, write_geotiff};
 pub use glb::{write_glb, write_glb_meshes, write_glb_with};
 pub use mesh::Mesh;
 pub use obj::{write_meshes, write_obj, write_obj_with};
 pub use ply::write_ply;
 pub use png::{HeightRange, KEY_CELL_SIZE, KEY_HEIGHT_MAX, KEY_HEIGHT_MIN, read_png_range, write_png};
 pub use raw::{read_raw, write_raw};
+pub use raw16::write_raw16;
+pub use sidecar::{Format, Sidecar, sidecar_path};
 
 /// Checks that every height of `map` is finite, so no file gets NaN or infinity in it.
 pub fn check_finite(map: &crate::Heightmap) -> Result<(), ExportError> {

@@ -34,7 +34,8 @@ impl HeightRange {
     }
 }
 
-fn quantise(h: f32, min: f32, max: f32) -> u16 {
+/// The 16-bit step of height `h` in `min..=max` (0 for a flat range): PNG's and RAW16's.
+pub(crate) fn quantise(h: f32, min: f32, max: f32) -> u16 {
     if max <= min {
         return 0;
     }

@@ -52,7 +52,9 @@ pub use memory::{engine_bytes, memory};
 pub use ridges::ridges;
 pub use rivers::{RiverDefect, rivers};
 pub use rocks::{RockDefect, rock_fields};
-pub use terrain::{MAX_DETAIL_OCTAVES, MAX_EROSION_ITERATIONS, MAX_FLUVIAL_STEPS, TerrainDefect, erosion, terrain};
+pub use terrain::{
+    MAX_DETAIL_OCTAVES, MAX_EROSION_ITERATIONS, MAX_FLUVIAL_STEPS, TerrainDefect, base, base_loaded, erosion, terrain,
+};
 pub use trees::{TreeDefect, groves, species, trees};
 
 /// The most cells a grid may have: 4096 × 4096. The engine keeps about 16 bytes per cell per

@@ -16,6 +16,9 @@ pub enum TerrainDefect {
         range: String,
         value: f64,
     },
+    /// The base heightmap's (`terrain.base`): not found, not readable, not of the grid's size.
+    #[error("{0}")]
+    Base(String),
 }
 
 /// The most octaves of fractal detail: the twelfth's wavelength is 1/2048 of the first's.
@@ -31,6 +34,7 @@ pub const MAX_EROSION_ITERATIONS: u32 = 200;
 /// ([`erosion`]). (The metric's names are checked when the text is read.)
 pub fn terrain(doc: &Document) -> Result<(), ValidationError> {
     erosion(doc)?;
+    base(doc)?;
     let Some(d) = &doc.terrain.detail else { return Ok(()) };
     let range = |what: &'static str, range: String, value: f64| {
         Err(ValidationError::new(
@@ -122,4 +126,63 @@ fn fluvial(f: &Fluvial) -> Result<(), ValidationError> {
         }
     }
     Ok(())
+}
+
+/// Checks the base heightmap's entry: a path, a PNG range of finite numbers given whole (both
+/// or neither, `min` ≤ `max`), and loaded heights, if any, of the grid's size, every one finite.
+pub fn base(doc: &Document) -> Result<(), ValidationError> {
+    let Some(b) = &doc.terrain.base else { return Ok(()) };
+    let defect = |path: &str, m: String| Err(ValidationError::new(path, TerrainDefect::Base(m)));
+    if b.path.trim().is_empty() {
+        return defect("terrain.base.path", "the base heightmap's path is empty".into());
+    }
+    if let Some(min) = b.min {
+        finite(min, || "terrain.base.min".into())?;
+    }
+    if let Some(max) = b.max {
+        finite(max, || "terrain.base.max".into())?;
+    }
+    match (b.min, b.max) {
+        (Some(min), Some(max)) if min > max => {
+            return defect(
+                "terrain.base.max",
+                format!("max ({}) is below min ({})", Num(max), Num(min)),
+            );
+        }
+        (Some(_), None) | (None, Some(_)) => {
+            return defect("terrain.base", "give both min and max, or neither".into());
+        }
+        _ => {}
+    }
+    if let Some(h) = b.heights.get() {
+        if h.len() != doc.grid.cells() {
+            return defect(
+                "terrain.base",
+                format!("{} heights loaded for the grid's {} cells", h.len(), doc.grid.cells()),
+            );
+        }
+        if let Some(i) = h.iter().position(|v| !v.is_finite()) {
+            return defect(
+                "terrain.base",
+                format!("the base height of cell {i} is not a finite number"),
+            );
+        }
+    }
+    Ok(())
+}
+
+/// Checks that a document's base heightmap, if it has one, is loaded: the terrain needs its
+/// heights, which only a document read from its file ([`crate::Document::load`]) or given them
+/// ([`crate::import::load_base`]) has.
+pub fn base_loaded(doc: &Document) -> Result<(), ValidationError> {
+    match &doc.terrain.base {
+        Some(b) if b.heights.get().is_none() => Err(ValidationError::new(
+            "terrain.base",
+            TerrainDefect::Base(format!(
+                "the base heightmap {} is not loaded: read the document from its file",
+                b.path
+            )),
+        )),
+        _ => Ok(()),
+    }
 }
