@@ -349,7 +349,7 @@ impl Editor {
                     // The bad lines are cut off only by a writer, after they are copied aside.
                     let copy = free_name(&jpath, "corrupt");
                     if write {
-                        let bytes = persist::read_input(&jpath, persist::MAX_JOURNAL_BYTES)
+                        let bytes = crate::input::read_input(&jpath, persist::MAX_JOURNAL_BYTES)
                             .and_then(|bytes| {
                                 persist::write_atomic_with_mode(&copy, &bytes, Some(lock::mode_of(&target)))
                             })

@@ -112,7 +112,7 @@ pub fn read(path: &Path, options: &Options) -> Result<Read, ImportError> {
         path: path.to_owned(),
         message,
     };
-    let bytes = crate::persist::read_input(path, MAX_FILE_BYTES).map_err(|cause| ImportError::Io {
+    let bytes = crate::input::read_input(path, MAX_FILE_BYTES).map_err(|cause| ImportError::Io {
         path: path.to_owned(),
         cause,
     })?;

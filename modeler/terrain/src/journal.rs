@@ -156,7 +156,7 @@ pub fn read_recovering(path: &Path, base: &str) -> Result<Replay, JournalError> 
 }
 
 fn read_with(path: &Path, base: &str, recover: bool) -> Result<Replay, JournalError> {
-    let bytes = match persist::read_input(path, persist::MAX_JOURNAL_BYTES) {
+    let bytes = match crate::input::read_input(path, persist::MAX_JOURNAL_BYTES) {
         Ok(b) => b,
         Err(e) if e.kind() == io::ErrorKind::NotFound => return Ok(Replay::Missing),
         Err(cause) => {

@@ -36,6 +36,7 @@ pub mod fuzzing;
 pub mod geometry;
 mod heightmap;
 pub mod import;
+pub mod input;
 pub mod journal;
 mod json;
 pub mod lock;

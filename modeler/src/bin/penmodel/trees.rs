@@ -178,7 +178,7 @@ fn check_q(q: f64, flag: &str) -> Result<()> {
 fn species(args: &SpeciesArgs) -> Result<Species> {
     match &args.maps {
         Some(path) => {
-            let bytes = persist::read_input(path, persist::MAX_INPUT_BYTES)
+            let bytes = penmodel_terrain::input::read_input(path, penmodel_terrain::input::MAX_INPUT_BYTES)
                 .with_context(|| format!("cannot read {}", path.display()))?;
             let text = String::from_utf8(bytes).with_context(|| format!("{}: not UTF-8 text", path.display()))?;
             let maps: Vec<IfsMap> = serde_json::from_str(persist::strip_bom(&text)).with_context(|| {
@@ -481,7 +481,7 @@ fn append(dst: &mut Mesh, src: &Mesh) {
 }
 
 fn read_silhouette(path: &Path) -> Result<Image> {
-    let file = persist::open_input(path, persist::MAX_INPUT_BYTES)
+    let file = penmodel_terrain::input::open_input(path, penmodel_terrain::input::MAX_INPUT_BYTES)
         .with_context(|| format!("cannot read {}", path.display()))?;
     Image::read_png(std::io::BufReader::new(file)).with_context(|| format!("{}", path.display()))
 }
