@@ -1,7 +1,7 @@
 //! `penctl`: inspect, configure and calibrate the 3D pen from the command line.
 //!
 //! Exit status: 0 on success, 1 when the input, the device or a request fails (the reason on
-//! stderr), 2 on a usage error.
+//! stderr), 2 on a usage error, 3 when `penctl list` finds no base station attached.
 
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -50,8 +50,8 @@ type DeviceArgs = source::DeviceArgs<SimSwitch>;
 
 #[derive(Subcommand)]
 enum Command {
-    /// List the base stations attached (HID interfaces and serial links).
-    #[command(after_help = "Example:\n  penctl list")]
+    /// List the base stations attached (HID interfaces and serial links); exit status 3 when there is none.
+    #[command(after_help = "Example:\n  penctl list || echo \"no base station\"")]
     List,
     /// Print the device's information and configuration.
     #[command(
@@ -752,6 +752,22 @@ fn unframe(bytes: &[u8]) -> Result<Vec<u8>> {
     payload.context("no frame in the input")
 }
 
+/// `penctl list` found no base station: not a failure of anything, but not success either, so a
+/// script can tell it from both (exit status 3).
+#[derive(Debug)]
+struct NothingAttached;
+
+impl std::fmt::Display for NothingAttached {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("no base station attached")
+    }
+}
+
+impl std::error::Error for NothingAttached {}
+
+/// The exit status of `penctl list` with nothing attached.
+const EXIT_NOTHING_ATTACHED: u8 = 3;
+
 fn list() -> Result<()> {
     let hids = hid::list()?;
     let serials = serial::list();
@@ -762,6 +778,7 @@ fn list() -> Result<()> {
             ""
         };
         eprintln!("penctl: no base station attached (udev rules: docs/flashing.md{hint})");
+        return Err(NothingAttached.into());
     }
     for h in hids {
         outln!(
@@ -826,6 +843,8 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         // The reader went away (`penctl monitor | head`): not an error, as for any Unix tool.
         Err(e) if pen_host::help::broken_pipe(&e) => ExitCode::SUCCESS,
+        // Said on stderr already, with the hint.
+        Err(e) if e.downcast_ref::<NothingAttached>().is_some() => ExitCode::from(EXIT_NOTHING_ATTACHED),
         // Flags that parse but do not go together: a usage error.
         Err(e) if e.downcast_ref::<UsageError>().is_some() || e.downcast_ref::<source::SourceError>().is_some() => {
             eprintln!("penctl: {e:#}");
