@@ -218,7 +218,7 @@ pub fn run(
                     &mut frame,
                     &viewport,
                     &keys::help_lines_with(
-                        &session.interaction.help(),
+                        &session.interaction.help_by_tool(),
                         if mouse.is_some() { &penmodel::mouse::HELP } else { &[] },
                     ),
                     Place::Centre,
