@@ -170,6 +170,8 @@ pub struct Interaction {
     tools: Vec<Entry>,
     /// The tool on, an index into `tools`; 0 is the home tool.
     active: usize,
+    /// The status line carries the last message for a while.
+    messages_on_status: bool,
 }
 
 /// The event's time on the device's clock, µs; `None` for events not from a report (device
@@ -194,6 +196,7 @@ impl Interaction {
             messages: Messages::default(),
             tools,
             active: 0,
+            messages_on_status: true,
         }
     }
 
@@ -334,6 +337,13 @@ impl Interaction {
         sections
     }
 
+    /// Whether [`status`](Interaction::status) ends with the last message for 3 s (the default:
+    /// a headless animation shows messages nowhere else). The window shows each message once,
+    /// under the status line, and turns this off.
+    pub fn set_messages_on_status(&mut self, on: bool) {
+        self.messages_on_status = on;
+    }
+
     /// One line saying what the pen is doing and what it can do next.
     pub fn status(&self, doc: &Document) -> String {
         let seen = self.seen(doc);
@@ -351,7 +361,9 @@ impl Interaction {
             (_, None) => String::new(),
         };
         match (&self.messages.last, self.messages.now) {
-            (Some((t, m)), Some(now)) if now.saturating_sub(*t) < 3_000_000 => format!("{line}  | {m}"),
+            (Some((t, m)), Some(now)) if self.messages_on_status && now.saturating_sub(*t) < 3_000_000 => {
+                format!("{line}  | {m}")
+            }
             _ => line,
         }
     }

@@ -85,6 +85,8 @@ pub fn run(
     options: Options,
 ) -> Result<Written> {
     let Options { mut mouse, fullscreen } = options;
+    // Messages show under the status line (the notice), so not on it as well.
+    session.interaction.set_messages_on_status(false);
     const FRAME: Duration = Duration::from_millis(16);
     let mut dirty = true;
     let mut last = Instant::now() - FRAME;
