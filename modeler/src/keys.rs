@@ -77,7 +77,7 @@ pub fn help_lines(tools: &[(String, Vec<(&str, &str)>)]) -> Vec<String> {
     help_lines_with(tools, &[])
 }
 
-/// [`help_lines`], with `mouse` (the mouse's switches, [`crate::mouse::HELP`]) after the keys
+/// [`help_lines`], with `mouse` (the mouse's switches, [`crate::mouse::MouseMap::help`]) after the keys
 /// when the mouse is the pen.
 pub fn help_lines_with(tools: &[(String, Vec<(&str, &str)>)], mouse: &[(&str, &str)]) -> Vec<String> {
     let width = KEYS

@@ -87,6 +87,8 @@ pub fn run(
     let Options { mut mouse, fullscreen } = options;
     // Messages show under the status line (the notice), so not on it as well.
     session.interaction.set_messages_on_status(false);
+    let mouse_help = mouse.as_ref().map(|m| m.map().help()).unwrap_or_default();
+    let mouse_help: Vec<(&str, &str)> = mouse_help.iter().map(|(k, d)| (k.as_str(), d.as_str())).collect();
     const FRAME: Duration = Duration::from_millis(16);
     let mut dirty = true;
     let mut last = Instant::now() - FRAME;
@@ -219,10 +221,7 @@ pub fn run(
                 panel(
                     &mut frame,
                     &viewport,
-                    &keys::help_lines_with(
-                        &session.interaction.help_by_tool(),
-                        if mouse.is_some() { &penmodel::mouse::HELP } else { &[] },
-                    ),
+                    &keys::help_lines_with(&session.interaction.help_by_tool(), &mouse_help),
                     Place::Centre,
                     style,
                 );
