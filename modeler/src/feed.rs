@@ -127,7 +127,11 @@ impl CalibrationPicture {
                 self.state.pen_mm = Some([at.x, at.y]);
                 self.state.pressed = *pressed;
             }
-            Prompt::Lift | Prompt::Again { .. } | Prompt::Pivot { .. } | Prompt::Pivoted { .. } => return None,
+            Prompt::Lift
+            | Prompt::Again { .. }
+            | Prompt::Pivot { .. }
+            | Prompt::PivotAgain { .. }
+            | Prompt::Pivoted { .. } => return None,
         }
         Some(self.state.clone())
     }

@@ -64,6 +64,11 @@ pub enum Prompt {
         /// Where, on the display.
         at_mm: DVec2,
     },
+    /// The pivot's fixes made no sphere: it is asked again ([`super::run::calibrate`]).
+    PivotAgain {
+        /// Why.
+        why: String,
+    },
     /// The pivot was taken.
     Pivoted {
         /// Fixes taken.
