@@ -591,31 +591,11 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
         write_device: a.write_device,
     };
     let tty = std::io::stderr().is_terminal();
-    let tell = |step: &Prompt| match step {
-        Prompt::Touch {
-            index,
-            count,
-            target_mm,
-        } => eprintln!(
-            "target {}/{count}: touch ({:.0}, {:.0}) mm from the display's lower-left corner, and press",
-            index + 1,
-            target_mm.x,
-            target_mm.y
-        ),
-        Prompt::Pivot { at_mm } => eprintln!(
-            "pivot: hold the tip on ({:.0}, {:.0}) mm and press; keep it there while you tilt the pen, its top \
-             circling once, leaning it more and less (about 3 s); then lift",
-            at_mm.x, at_mm.y
-        ),
-        Prompt::PivotAgain { why } => eprintln!("  {why}"),
-        Prompt::Pen { .. } => {}
-        Prompt::Lift => eprintln!("  lift the pen first"),
-        // After a touch or the pivot alike.
-        Prompt::Again { fixes } => eprintln!("  too short ({fixes} fixes): press again and hold it longer"),
-        Prompt::Taken { fixes, .. } | Prompt::Pivoted { fixes } => {
-            if tty {
-                eprintln!("  taken ({fixes} fixes)")
-            }
+    let tell = |step: &Prompt| {
+        // "taken" only where a person watches; a log has the targets and the table.
+        let quiet = matches!(step, Prompt::Taken { .. } | Prompt::Pivoted { .. }) && !tty;
+        if let Some(line) = step.says().filter(|_| !quiet) {
+            eprintln!("{line}");
         }
     };
     let run::Outcome {
