@@ -30,7 +30,7 @@ fn pixel(x: f64, y: f64) -> (i64, i64) {
     ((fx * PICTURE.0).round() as i64, (fy * PICTURE.1).round() as i64)
 }
 
-fn found(tool: &str) -> bool {
+pub(crate) fn found(tool: &str) -> bool {
     Command::new("sh")
         .args(["-c", &format!("command -v {tool}")])
         .stdout(Stdio::null())
@@ -39,7 +39,7 @@ fn found(tool: &str) -> bool {
 }
 
 /// Kills a child when the test ends, however it ends.
-struct Killed(Child);
+pub(crate) struct Killed(pub(crate) Child);
 
 impl Drop for Killed {
     fn drop(&mut self) {
@@ -92,16 +92,16 @@ impl X {
 }
 
 /// A screenshot: 0RGB pixels, row after row.
-struct Shot {
-    width: usize,
-    height: usize,
-    pixels: Vec<u32>,
+pub(crate) struct Shot {
+    pub(crate) width: usize,
+    pub(crate) height: usize,
+    pub(crate) pixels: Vec<u32>,
 }
 
 impl Shot {
     /// Reads an XWD file (X11's window dump: a header of 25 big-endian words, the window's
     /// name, the colour map, then the image) of a 24- or 32-bit true-colour window.
-    fn from_xwd(b: &[u8]) -> Shot {
+    pub(crate) fn from_xwd(b: &[u8]) -> Shot {
         let word = |i: usize| u32::from_be_bytes([b[4 * i], b[4 * i + 1], b[4 * i + 2], b[4 * i + 3]]) as usize;
         let (header, width, height) = (word(0), word(4), word(5));
         let (byte_order, bits_per_pixel, bytes_per_line, ncolors) = (word(7), word(11), word(12), word(19));
@@ -146,8 +146,11 @@ impl Shot {
 }
 
 /// Starts Xvfb on a display number nobody uses; its socket is there when it returns.
-fn xvfb() -> (Killed, String) {
-    let n = (90..190)
+pub(crate) fn xvfb() -> (Killed, String) {
+    // Each call its own number, so that tests running at once never pick the same free one.
+    static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(90);
+    let n = std::iter::from_fn(|| Some(NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)))
+        .take_while(|n| *n < 190)
         .find(|n| {
             !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() && !Path::new(&format!("/tmp/.X{n}-lock")).exists()
         })
