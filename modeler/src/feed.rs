@@ -73,8 +73,9 @@ pub struct Calibrating {
 /// Device µs between two pictures of the pen during calibration: 30 a second is smooth enough.
 const CALIBRATION_PEN_US: u64 = 33_000;
 
-/// Turns the procedure's prompts into [`Calibrating`] pictures; `send` gets each new one.
-struct CalibrationPicture {
+/// Turns the procedure's prompts into [`Calibrating`] pictures (the demo's, `penmodel
+/// calibrate`'s).
+pub struct CalibrationPicture {
     state: Calibrating,
     /// Sum of (target − touched) over the taken targets, for the pen's guessed offset.
     offset_sum: DVec2,
@@ -82,7 +83,8 @@ struct CalibrationPicture {
 }
 
 impl CalibrationPicture {
-    fn new(targets: &[DVec2]) -> CalibrationPicture {
+    /// Nothing taken yet of `targets`.
+    pub fn new(targets: &[DVec2]) -> CalibrationPicture {
         CalibrationPicture {
             state: Calibrating {
                 targets: targets.iter().map(|t| [t.x, t.y]).collect(),
@@ -96,7 +98,7 @@ impl CalibrationPicture {
     }
 
     /// The picture after `prompt`, if it changed enough to be worth sending.
-    fn after(&mut self, prompt: &Prompt) -> Option<Calibrating> {
+    pub fn after(&mut self, prompt: &Prompt) -> Option<Calibrating> {
         match prompt {
             Prompt::Touch { index, .. } => self.state.taken = *index,
             Prompt::Taken { touched_mm, .. } => {

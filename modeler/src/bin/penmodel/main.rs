@@ -8,6 +8,7 @@
 
 mod analyze;
 mod bench;
+mod calibrate;
 mod erode;
 mod generate;
 mod live;
@@ -67,6 +68,8 @@ enum Command {
         #[command(flatten)]
         live: live::LiveArgs,
     },
+    /// Calibrate the pen on the display itself: the targets drawn full screen one at a time, the residual plot at the end.
+    Calibrate(calibrate::Args),
     /// Generate a document's terrain and export it.
     Generate(generate::Args),
     /// Render a document's terrain into a PNG.
@@ -96,6 +99,7 @@ fn main() -> ExitCode {
             recover,
             live,
         }) => live::run(&live, Some(&document), recover),
+        Some(Command::Calibrate(args)) => calibrate::run(&args),
         Some(Command::Generate(args)) => generate::run(&args),
         Some(Command::Render(args)) => render::run(&args),
         Some(Command::Bench(args)) => bench::run(&args),
