@@ -156,3 +156,74 @@ fn penmodel_calibrate_headless_prompts_at_the_terminal() {
     assert!(file.exists());
     assert!(!dir.path().join(".config/penscape/calibration.toml").exists());
 }
+
+/// Esc before the plot ends at once without saving (exit 1), though the procedure still waits
+/// for a touch.
+#[test]
+fn escape_before_the_plot_saves_nothing() {
+    if ["Xvfb", "xdotool"].iter().any(|t| !found(t)) {
+        assert!(
+            std::env::var_os("PEN_REQUIRE_X").is_none(),
+            "Xvfb or xdotool not installed"
+        );
+        return;
+    }
+    let dir = tempfile::tempdir().expect("temp dir");
+    let file = dir.path().join("calibration.toml");
+    let (_server, display) = xvfb();
+    let child = Command::new(env!("CARGO_BIN_EXE_penmodel"))
+        .args([
+            "calibrate",
+            "--source",
+            "sim",
+            "--speed",
+            "0.2",
+            "--show",
+            "window",
+            "--windowed",
+        ])
+        .arg("--calibration")
+        .arg(&file)
+        .env("DISPLAY", &display)
+        .env_remove("WAYLAND_DISPLAY")
+        .env("HOME", dir.path())
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("penmodel starts");
+    let mut penmodel = Killed(child);
+    let until = Instant::now() + GUARD;
+    let window = loop {
+        let out = Command::new("xdotool")
+            .args(["search", "--onlyvisible", "--name", "^penmodel calibrate$"])
+            .env("DISPLAY", &display)
+            .output()
+            .expect("xdotool runs");
+        if let Some(w) = String::from_utf8_lossy(&out.stdout).lines().next() {
+            break w.to_string();
+        }
+        assert!(Instant::now() < until, "no calibration window");
+        std::thread::sleep(Duration::from_millis(100));
+    };
+    let key = Command::new("xdotool")
+        .args(["windowfocus", "--sync", &window, "key", "Escape"])
+        .env("DISPLAY", &display)
+        .status()
+        .expect("xdotool runs");
+    assert!(key.success());
+    let end = Instant::now() + Duration::from_secs(20);
+    let status = loop {
+        if let Some(s) = penmodel.0.try_wait().expect("wait") {
+            break s;
+        }
+        assert!(Instant::now() < end, "Esc did not end penmodel calibrate at once");
+        std::thread::sleep(Duration::from_millis(50));
+    };
+    let mut err = String::new();
+    if let Some(mut e) = penmodel.0.stderr.take() {
+        std::io::Read::read_to_string(&mut e, &mut err).expect("stderr");
+    }
+    assert_eq!(status.code(), Some(1), "{err}");
+    assert!(err.contains("nothing saved"), "{err}");
+    assert!(!file.exists());
+}

@@ -150,10 +150,12 @@ pub fn run(a: &Args) -> Result<()> {
         Some(v) => run_window(v, &rx, &plan, a)?,
         None => run_terminal(&rx)?,
     };
-    let _ = worker.join();
+    // Stopped before the end, the calibration's thread may be waiting for a touch: it ends with
+    // the process, as `penctl calibrate` stopped by Ctrl-C does.
     let Some(outcome) = outcome else {
-        bail!("the window was closed before the calibration ended: nothing saved");
+        bail!("stopped before the calibration ended: nothing saved");
     };
+    let _ = worker.join();
     save(&outcome.calibration, a, sim)
 }
 
