@@ -225,10 +225,7 @@ pub fn spawn(source: PenSource, capacity: usize) -> (Receiver<Feed>, JoinHandle<
                 PenSource::None => send(&tx, Feed::Status("no pen: keyboard only".into())),
                 PenSource::Mouse => send(
                     &tx,
-                    Feed::Status(
-                        "the mouse is the pen: left draws, right grabs, wheel lifts, middle/Space is SW3; h: help"
-                            .into(),
-                    ),
+                    Feed::Status("the mouse is the pen; h shows its buttons and every tool's gestures".into()),
                 ),
                 PenSource::Device {
                     source,

@@ -99,6 +99,33 @@ impl MouseMap {
         sw
     }
 
+    /// The mapping in a few words, as the window says it when it opens (`left draws, right
+    /// grabs, middle/Space is SW3, wheel lifts`).
+    pub fn summary(&self) -> String {
+        let names = ["left", "right", "middle/Space"];
+        let mut parts: Vec<String> = names
+            .iter()
+            .zip(self.buttons)
+            .filter_map(|(n, s)| {
+                let does = match s {
+                    Switch::Sw1 => "draws",
+                    Switch::Sw2 => "grabs",
+                    Switch::Sw3 => "is SW3",
+                    Switch::None => return None,
+                };
+                Some(format!("{n} {does}"))
+            })
+            .collect();
+        if self.buttons.iter().any(|s| matches!(s, Switch::Sw2 | Switch::Sw3)) {
+            parts.push(if self.wheel_mm > 0.0 {
+                "wheel lifts".to_string()
+            } else {
+                "wheel (turned round) lifts".to_string()
+            });
+        }
+        parts.join(", ")
+    }
+
     /// The mapping as the window's help shows it: what each button does, the wheel, and off
     /// the picture.
     pub fn help(&self) -> Vec<(String, String)> {
@@ -338,6 +365,14 @@ mod tests {
             help.iter()
                 .any(|(k, d)| k == "wheel + middle/right" && d.contains("2 mm a notch")),
             "{help:?}"
+        );
+        assert_eq!(
+            MouseMap::default().summary(),
+            "left draws, right grabs, middle/Space is SW3, wheel lifts"
+        );
+        assert_eq!(
+            map.summary(),
+            "left draws, right is SW3, middle/Space grabs, wheel (turned round) lifts"
         );
         let none = MouseMap {
             buttons: [Switch::Sw1, Switch::None, Switch::None],
