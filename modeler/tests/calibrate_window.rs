@@ -227,3 +227,27 @@ fn escape_before_the_plot_saves_nothing() {
     assert!(err.contains("nothing saved"), "{err}");
     assert!(!file.exists());
 }
+
+/// As in pend and penctl, a source that does not read and `--speed` with a real device are
+/// usage errors (2), before anything is opened.
+#[test]
+fn penmodel_calibrate_refuses_a_bad_source_or_speed_as_usage_errors() {
+    for args in [
+        &["calibrate", "--source", "bogus"][..],
+        &["calibrate", "--source", "serial:/dev/null", "--speed", "2"][..],
+        &["calibrate", "--targets", "7"][..],
+    ] {
+        let out = Command::new(env!("CARGO_BIN_EXE_penmodel"))
+            .args(args)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .expect("penmodel runs");
+        assert_eq!(
+            out.status.code(),
+            Some(2),
+            "{args:?}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+}

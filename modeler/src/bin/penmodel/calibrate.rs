@@ -32,11 +32,11 @@ use crate::live::Show;
 pub struct Args {
     /// Which base station: hid (the first on USB), hid:PATH, serial:PATH, or sim (the simulated
     /// pen touching the targets).
-    #[arg(long, default_value = "hid", value_name = "SOURCE")]
+    #[arg(long, default_value = "hid", value_name = "SOURCE", value_parser = source_arg)]
     source: String,
-    /// The simulated pen's speed: device seconds per second (0: as fast as it is read).
-    #[arg(long, default_value_t = 1.0, value_parser = pen_host::source::speed_value)]
-    speed: f64,
+    /// The simulated pen's speed: device seconds per second (0: as fast as it is read) [default: 1].
+    #[arg(long, value_parser = pen_host::source::speed_value)]
+    speed: Option<f64>,
     /// Targets: 4 (corners), 5 (and the centre) or 9 (a 3 × 3 grid).
     #[arg(long, default_value_t = 5, value_parser = target_count)]
     targets: u8,
@@ -77,6 +77,14 @@ fn size<T: std::str::FromStr>(s: &str) -> Result<(T, T), String> {
         .ok_or_else(|| format!("expected WIDTHxHEIGHT, such as 600x340, got {s:?}"))
 }
 
+/// A source `--source` names, for clap (a usage error otherwise).
+fn source_arg(s: &str) -> Result<String, String> {
+    if s == "sim" {
+        return Ok(s.to_string());
+    }
+    s.parse::<Source>().map(|_| s.to_string()).map_err(|e| e.to_string())
+}
+
 /// 4, 5 or 9 targets, for clap.
 fn target_count(s: &str) -> Result<u8, String> {
     match s.trim().parse::<u8>() {
@@ -110,13 +118,26 @@ pub fn run(a: &Args) -> Result<()> {
         plan.pivot_at = None;
     }
     let sim = a.source == "sim";
-    let source = if sim {
-        run::sim_source(&plan.targets, plan.pivot_at, a.speed)
+    let mut source = if sim {
+        run::sim_source(&plan.targets, plan.pivot_at, 1.0)
     } else {
         a.source
             .parse::<Source>()
             .map_err(|e| anyhow::anyhow!("--source: {e}"))?
     };
+    match (&mut source, a.speed) {
+        (Source::Sim(o), Some(speed)) => o.speed = speed,
+        (_, None) => {}
+        // As in pend and penctl: a usage error (2), before anything is opened.
+        (_, Some(_)) => clap::Error::raw(
+            clap::error::ErrorKind::ArgumentConflict,
+            format!(
+                "--speed is the simulated pen's (--source sim); {} runs in real time\n",
+                a.source
+            ),
+        )
+        .exit(),
+    }
     let window_wanted = match a.show {
         Show::Headless => false,
         Show::Window => true,
