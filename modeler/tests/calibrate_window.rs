@@ -66,6 +66,13 @@ fn penmodel_calibrate_draws_the_targets_then_the_residual_plot() {
         if let Some(w) = String::from_utf8_lossy(&out.stdout).lines().next() {
             break w.to_string();
         }
+        if let Some(status) = penmodel.0.try_wait().expect("wait") {
+            let mut err = String::new();
+            if let Some(mut e) = penmodel.0.stderr.take() {
+                std::io::Read::read_to_string(&mut e, &mut err).expect("stderr");
+            }
+            panic!("penmodel calibrate ended before its window showed: {status:?}: {err}");
+        }
         assert!(Instant::now() < until, "no calibration window");
         std::thread::sleep(Duration::from_millis(100));
     };
@@ -201,6 +208,13 @@ fn escape_before_the_plot_saves_nothing() {
             .expect("xdotool runs");
         if let Some(w) = String::from_utf8_lossy(&out.stdout).lines().next() {
             break w.to_string();
+        }
+        if let Some(status) = penmodel.0.try_wait().expect("wait") {
+            let mut err = String::new();
+            if let Some(mut e) = penmodel.0.stderr.take() {
+                std::io::Read::read_to_string(&mut e, &mut err).expect("stderr");
+            }
+            panic!("penmodel calibrate ended before its window showed: {status:?}: {err}");
         }
         assert!(Instant::now() < until, "no calibration window");
         std::thread::sleep(Duration::from_millis(100));

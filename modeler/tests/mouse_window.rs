@@ -146,29 +146,45 @@ impl Shot {
 }
 
 /// Starts Xvfb on a display number nobody uses; its socket is there when it returns.
-pub(crate) fn xvfb() -> (Killed, String) {
-    // Each call its own number, so that tests running at once never pick the same free one.
-    static NEXT: std::sync::atomic::AtomicU32 = std::sync::atomic::AtomicU32::new(90);
-    let n = std::iter::from_fn(|| Some(NEXT.fetch_add(1, std::sync::atomic::Ordering::Relaxed)))
-        .take_while(|n| *n < 190)
-        .find(|n| {
-            !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() && !Path::new(&format!("/tmp/.X{n}-lock")).exists()
-        })
-        .expect("a free display number");
-    let display = format!(":{n}");
-    let child = Command::new("Xvfb")
-        .args([display.as_str(), "-screen", "0", "1400x900x24", "-nolisten", "tcp"])
-        .stdout(Stdio::null())
+/// The X server a test started: stopped with SIGTERM, so that it removes its socket and lock
+/// file (SIGKILL left them behind, using up display numbers run after run).
+pub(crate) struct Server(Child);
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = Command::new("kill").args(["-TERM", &self.0.id().to_string()]).status();
+        let end = Instant::now() + Duration::from_secs(3);
+        while Instant::now() < end {
+            if let Ok(Some(_)) = self.0.try_wait() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+pub(crate) fn xvfb() -> (Server, String) {
+    // Xvfb picks a display number nobody uses and writes it on `-displayfd` once it accepts
+    // clients: no race with another test (or another user's) choosing the same free number.
+    let mut child = Command::new("Xvfb")
+        .args(["-displayfd", "1", "-screen", "0", "1400x900x24", "-nolisten", "tcp"])
+        .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn()
         .expect("Xvfb starts");
-    let server = Killed(child);
-    let until = Instant::now() + GUARD;
-    while !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
-        assert!(Instant::now() < until, "Xvfb {display} never made its socket");
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    (server, display)
+    let stdout = child.stdout.take().expect("stdout");
+    let server = Server(child);
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let mut line = String::new();
+        let _ = BufReader::new(stdout).read_line(&mut line);
+        let _ = tx.send(line);
+    });
+    let line = rx.recv_timeout(GUARD).expect("Xvfb said its display number");
+    let n: u32 = line.trim().parse().expect("a display number");
+    (server, format!(":{n}"))
 }
 
 #[test]
