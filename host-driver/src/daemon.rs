@@ -13,6 +13,10 @@
 //! Clients are bounded (`--max-clients`, 64 by default): one more is sent a `refused` line
 //! saying why, and closed, instead of costing a thread.
 //!
+//! The simulated pen is served otherwise ([`Sessions`]): each client gets a session of its own,
+//! from the scenario's start, on a device thread of its own that ends when the client leaves,
+//! so a modeler that connects late never joins a scripted stroke half drawn.
+//!
 //! `head` lines go only to clients that asked for them (events version 4: a `subscribe` line
 //! the client writes, which its writer reads between writes, [`crate::requests`]), so a client
 //! built for version 2 reads only the lines it knows.
@@ -531,6 +535,203 @@ pub fn run_device_reloading(
             }
             hub.publish(e);
             each(e);
+        }
+    }
+}
+
+/// The calibration the simulated pen's sessions take ([`run_session`]): set again at SIGHUP,
+/// numbered so that each session takes each one once.
+pub struct CurrentCalibration {
+    inner: Mutex<(u64, Calibration, String)>,
+}
+
+impl CurrentCalibration {
+    /// `calibration`, described by `what`, as the first.
+    pub fn new(calibration: Calibration, what: String) -> CurrentCalibration {
+        CurrentCalibration {
+            inner: Mutex::new((0, calibration, what)),
+        }
+    }
+
+    /// Replaces the calibration: running sessions take it between polls, new ones start with it.
+    pub fn set(&self, calibration: Calibration, what: String) {
+        let mut inner = lock(&self.inner);
+        let n = inner.0 + 1;
+        *inner = (n, calibration, what);
+    }
+
+    /// The calibration now, its number and what it is.
+    pub fn get(&self) -> (u64, Calibration, String) {
+        lock(&self.inner).clone()
+    }
+}
+
+/// The simulated pen's clients (`pend --source sim`), each served by a session of its own from
+/// the scenario's start: a hub with that client alone, fed by its own device thread.
+pub struct Sessions {
+    /// Only refuses: a client beyond the limit is told so by it.
+    gate: Hub,
+    live: Mutex<Vec<Arc<Hub>>>,
+    started: AtomicU64,
+    /// Events delivered and missed in sessions that have ended.
+    ended: Mutex<(u64, u64)>,
+}
+
+impl Sessions {
+    /// At most `max_clients` sessions at once (at least one).
+    pub fn new(max_clients: usize) -> Sessions {
+        Sessions {
+            gate: Hub::new(max_clients),
+            live: Mutex::new(Vec::new()),
+            started: AtomicU64::new(0),
+            ended: Mutex::new((0, 0)),
+        }
+    }
+
+    /// Sessions whose client is still connected.
+    pub fn clients(&self) -> usize {
+        let mut live = lock(&self.live);
+        let mut ended = lock(&self.ended);
+        live.retain(|hub| {
+            let here = hub.clients() > 0;
+            if !here {
+                let (d, m) = hub.counts();
+                ended.0 += d;
+                ended.1 += m;
+            }
+            here
+        });
+        live.len()
+    }
+
+    /// Sessions started so far.
+    pub fn started(&self) -> u64 {
+        self.started.load(Ordering::Relaxed)
+    }
+
+    /// Events delivered and missed, over every session.
+    pub fn counts(&self) -> (u64, u64) {
+        let live = lock(&self.live);
+        let ended = lock(&self.ended);
+        live.iter().fold(*ended, |(d, m), hub| {
+            let (hd, hm) = hub.counts();
+            (d + hd, m + hm)
+        })
+    }
+
+    /// Clients refused because `max_clients` sessions were running.
+    pub fn refused(&self) -> u64 {
+        self.gate.refused()
+    }
+
+    /// The most sessions at once.
+    pub fn max_clients(&self) -> usize {
+        self.gate.max_clients()
+    }
+
+    /// Takes a connected client: refused beyond the limit, else given a hub of its own (the
+    /// greeting queued), which is returned with the session's number (from 1).
+    fn take(&self, stream: UnixStream, queue_len: usize) -> Option<(Arc<Hub>, u64)> {
+        if self.clients() >= self.gate.max_clients() {
+            self.gate.refuse(stream);
+            return None;
+        }
+        let hub = Arc::new(Hub::new(1));
+        if !hub.connect(stream, queue_len) {
+            return None;
+        }
+        lock(&self.live).push(hub.clone());
+        Some((hub, self.started.fetch_add(1, Ordering::Relaxed) + 1))
+    }
+}
+
+/// Accepts clients until `stop` is set, each served by a session of its own: `start(hub, n)`
+/// is called with the client's hub (the client connected to it) and the session's number, and
+/// must return at once — it starts the session's device thread, which runs [`run_session`].
+pub fn accept_sessions(
+    bound: socket::Bound,
+    sessions: Arc<Sessions>,
+    queue_len: usize,
+    stop: Arc<AtomicBool>,
+    mut start: impl FnMut(Arc<Hub>, u64),
+) {
+    let listener = &bound.listener;
+    if listener.set_nonblocking(true).is_err() {
+        return;
+    }
+    while !stop.load(Ordering::Relaxed) {
+        match listener.accept() {
+            Ok((stream, _)) => {
+                if stream.set_nonblocking(false).is_ok()
+                    && let Some((hub, n)) = sessions.take(stream, queue_len)
+                {
+                    start(hub, n);
+                }
+            }
+            Err(_) => std::thread::sleep(Duration::from_millis(20)),
+        }
+    }
+}
+
+/// One client's session: reads `pipeline` (opened for it, so the simulated pen starts its
+/// scenario) and publishes its events to `hub` until its client has left or `stop` is set,
+/// taking each newer calibration from `current` between polls.
+pub fn run_session(
+    mut pipeline: Pipeline,
+    hub: Arc<Hub>,
+    stop: Arc<AtomicBool>,
+    current: &CurrentCalibration,
+    taken: u64,
+    log: impl Fn(&str),
+) {
+    let mut taken = taken;
+    let mut events = Vec::new();
+    while !stop.load(Ordering::Relaxed) && hub.clients() > 0 {
+        let (n, calibration, what) = current.get();
+        if n != taken {
+            taken = n;
+            if let Err(e) = pipeline.set_calibration(calibration) {
+                log(&format!("SIGHUP: kept the calibration in use, not {what}: {e}"));
+            }
+        }
+        events.clear();
+        pipeline.poll(Duration::from_millis(50), &mut events);
+        if let Some(notice) = pipeline.take_notice() {
+            log(&notice);
+        }
+        for e in &events {
+            if let EventKind::DeviceLost { reason } = &e.kind {
+                log(&format!("device lost ({reason}); waiting for it"));
+            }
+            hub.publish(e);
+        }
+    }
+}
+
+/// Opens `pipeline`'s device once, before any client, and says what pend would serve: that it
+/// attached (the device's name), or why it is refused (a calibration for another base station).
+/// Gives up after `within`.
+pub fn probe(mut pipeline: Pipeline, within: Duration, log: impl Fn(&str)) {
+    let end = std::time::Instant::now() + within;
+    let mut events = Vec::new();
+    while std::time::Instant::now() < end {
+        events.clear();
+        pipeline.poll(Duration::from_millis(50), &mut events);
+        if let Some(notice) = pipeline.take_notice() {
+            log(&notice);
+        }
+        for e in &events {
+            match &e.kind {
+                EventKind::DeviceFound { device } => {
+                    log(&format!("attached {device}"));
+                    return;
+                }
+                EventKind::DeviceLost { reason } => log(&format!("device lost ({reason}); waiting for it")),
+                _ => {}
+            }
+        }
+        if pipeline.refused().is_some() {
+            return;
         }
     }
 }

@@ -551,7 +551,9 @@ fn clients_beyond_the_limit_are_refused_and_cost_no_thread() {
         assert!(Instant::now() < end, "pend did not listen");
         std::thread::sleep(Duration::from_millis(20));
     }
-    // Threads settle to pend's own (main, acceptor, device) once the probe above is gone.
+    // Threads settle to pend's own once the probe above is gone: main and acceptor, since the
+    // simulated pen's device threads are each client's own (issue 42: a session per client;
+    // before, main, acceptor and one shared device thread, and a writer per client).
     let wait_threads = |want: usize| {
         let end = Instant::now() + GUARD;
         while threads(pend.id()) != want {
@@ -559,7 +561,7 @@ fn clients_beyond_the_limit_are_refused_and_cost_no_thread() {
             std::thread::sleep(Duration::from_millis(20));
         }
     };
-    wait_threads(3);
+    wait_threads(2);
     let mut served: Vec<UnixStream> = (0..4)
         .map(|_| {
             let (s, line) = first_line(&path);
@@ -567,7 +569,7 @@ fn clients_beyond_the_limit_are_refused_and_cost_no_thread() {
             s
         })
         .collect();
-    assert_eq!(threads(pend.id()), 3 + 4, "a writer per client");
+    assert_eq!(threads(pend.id()), 2 + 2 * 4, "a writer and a session per client");
     for _ in 0..50 {
         let (stream, line) = first_line(&path);
         match parse_line(line.trim_end()) {
@@ -581,10 +583,10 @@ fn clients_beyond_the_limit_are_refused_and_cost_no_thread() {
         let n = BufReader::new(stream).read_line(&mut rest).expect("closed");
         assert_eq!(n, 0, "closed after the refusal: {rest}");
     }
-    assert_eq!(threads(pend.id()), 3 + 4, "refused clients cost no thread");
-    // One leaves: its writer ends and its place is taken by the next.
+    assert_eq!(threads(pend.id()), 2 + 2 * 4, "refused clients cost no thread");
+    // One leaves: its writer and its session end and its place is taken by the next.
     drop(served.pop());
-    wait_threads(3 + 3);
+    wait_threads(2 + 2 * 3);
     let (_, line) = first_line(&path);
     assert!(line.contains(r#""type":"hello""#), "{line}");
     let _ = pend.kill();
@@ -782,4 +784,78 @@ fn sighup_reloads_the_calibration_and_pend_serves_on() {
         .expect("kill");
     assert!(status.success());
     assert_eq!(pend.wait().expect("exits").code(), Some(0));
+}
+
+/// Issue 42: `pend --source sim` serves each client the scripted session from its start. A
+/// modeler that connected 1.5 s after another joined the one session mid-stroke; now its first
+/// report is at the scenario's start on the device's clock, as the first client's was, and the
+/// two sessions are the same script, so their first motions are at the same points.
+#[test]
+fn each_client_of_the_simulated_pen_gets_the_session_from_its_start() {
+    let (_dir, path) = socket_path("sessions");
+    let mut pend = Command::new(env!("CARGO_BIN_EXE_pend"))
+        .args(["--source", "sim", "--speed", "1", "--socket"])
+        .arg(&path)
+        .stderr(Stdio::piped())
+        .spawn()
+        .expect("pend starts");
+    let stderr = pend.stderr.take().expect("stderr");
+    let (tx, log) = std::sync::mpsc::channel();
+    std::thread::spawn(move || {
+        for line in BufReader::new(stderr).lines().map_while(Result::ok) {
+            let _ = tx.send(line);
+        }
+    });
+    let end = Instant::now() + GUARD;
+    let connect = || loop {
+        if let Ok(s) = UnixStream::connect(&path) {
+            break s;
+        }
+        assert!(Instant::now() < end, "pend did not listen");
+        std::thread::sleep(Duration::from_millis(20));
+    };
+    let device_us = |e: &PenEvent| e.seq.map(|(_, d)| d);
+    let first = connect();
+    let started = Instant::now();
+    // The first client reads for 1.5 s of the session.
+    let (_, a) = read_events(first.try_clone().expect("clone"), |_| {
+        started.elapsed() > Duration::from_millis(1500)
+    });
+    let a_first = a.iter().find_map(device_us).expect("reports");
+    let a_last = a.iter().rev().find_map(device_us).expect("reports");
+    assert!(
+        a_last > a_first + 1_000_000,
+        "the first session ran on: {a_first}..{a_last} µs"
+    );
+    // The second joins now: its session starts afresh, not where the first one is.
+    let (_, b) = read_events(connect(), {
+        let mut n = 0;
+        move |e| {
+            n += usize::from(e.kind == EventKind::Motion);
+            n >= 20
+        }
+    });
+    let b_first = b.iter().find_map(device_us).expect("reports");
+    assert!(
+        b_first < a_first + 300_000,
+        "the second client's first report at {b_first} µs, the first's at {a_first} µs, and it was at {a_last} µs"
+    );
+    let motions = |events: &[PenEvent]| -> Vec<(i64, i64)> {
+        events
+            .iter()
+            .filter(|e| e.kind == EventKind::Motion)
+            .filter_map(|e| e.point)
+            .map(|p| ((p.u_mm * 10.0).round() as i64, (p.v_mm * 10.0).round() as i64))
+            .take(10)
+            .collect()
+    };
+    assert_eq!(motions(&a), motions(&b), "the same script from the same start");
+    drop(first);
+    let _ = Command::new("kill").args(["-TERM", &pend.id().to_string()]).status();
+    assert_eq!(pend.wait().expect("exits").code(), Some(0));
+    // pend has ended: its stderr closes, and the reader's channel with it.
+    let log: Vec<String> = log.iter().collect();
+    let log = log.join("\n");
+    assert!(log.contains("a session of its own"), "{log}");
+    assert!(log.contains("stopped; 2 sessions"), "{log}");
 }

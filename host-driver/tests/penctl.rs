@@ -282,6 +282,28 @@ fn no_device_is_a_clear_error() {
     );
 }
 
+/// Nothing attached (as on the test machine, which has no base station): exit status 3, the
+/// reason and the hint on stderr, nothing on stdout. With a base station plugged in the test
+/// only checks that each line names one.
+#[test]
+fn list_with_nothing_attached_exits_3() {
+    let out = penctl(&["list"]);
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    if stdout.is_empty() {
+        assert_eq!(out.status.code(), Some(3), "{out:?}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains("no base station attached"), "{err}");
+    } else {
+        assert!(out.status.success(), "{out:?}");
+        assert!(
+            stdout
+                .lines()
+                .all(|l| l.starts_with("hid ") || l.starts_with("serial ")),
+            "{stdout}"
+        );
+    }
+}
+
 /// The real device's calibration as a user has it: the simulated pen must never replace it.
 const REAL_CALIBRATION: &str = r#"# a real base station's calibration
 version = 2

@@ -73,8 +73,9 @@ pub struct Calibrating {
 /// Device µs between two pictures of the pen during calibration: 30 a second is smooth enough.
 const CALIBRATION_PEN_US: u64 = 33_000;
 
-/// Turns the procedure's prompts into [`Calibrating`] pictures; `send` gets each new one.
-struct CalibrationPicture {
+/// Turns the procedure's prompts into [`Calibrating`] pictures (the demo's, `penmodel
+/// calibrate`'s).
+pub struct CalibrationPicture {
     state: Calibrating,
     /// Sum of (target − touched) over the taken targets, for the pen's guessed offset.
     offset_sum: DVec2,
@@ -82,7 +83,8 @@ struct CalibrationPicture {
 }
 
 impl CalibrationPicture {
-    fn new(targets: &[DVec2]) -> CalibrationPicture {
+    /// Nothing taken yet of `targets`.
+    pub fn new(targets: &[DVec2]) -> CalibrationPicture {
         CalibrationPicture {
             state: Calibrating {
                 targets: targets.iter().map(|t| [t.x, t.y]).collect(),
@@ -96,7 +98,7 @@ impl CalibrationPicture {
     }
 
     /// The picture after `prompt`, if it changed enough to be worth sending.
-    fn after(&mut self, prompt: &Prompt) -> Option<Calibrating> {
+    pub fn after(&mut self, prompt: &Prompt) -> Option<Calibrating> {
         match prompt {
             Prompt::Touch { index, .. } => self.state.taken = *index,
             Prompt::Taken { touched_mm, .. } => {
@@ -127,7 +129,11 @@ impl CalibrationPicture {
                 self.state.pen_mm = Some([at.x, at.y]);
                 self.state.pressed = *pressed;
             }
-            Prompt::Lift | Prompt::Again { .. } | Prompt::Pivot { .. } | Prompt::Pivoted { .. } => return None,
+            Prompt::Lift
+            | Prompt::Again { .. }
+            | Prompt::Pivot { .. }
+            | Prompt::PivotAgain { .. }
+            | Prompt::Pivoted { .. } => return None,
         }
         Some(self.state.clone())
     }
@@ -219,10 +225,7 @@ pub fn spawn(source: PenSource, capacity: usize) -> (Receiver<Feed>, JoinHandle<
                 PenSource::None => send(&tx, Feed::Status("no pen: keyboard only".into())),
                 PenSource::Mouse => send(
                     &tx,
-                    Feed::Status(
-                        "the mouse is the pen: left draws, right grabs, wheel lifts, middle/Space is SW3; h: help"
-                            .into(),
-                    ),
+                    Feed::Status("the mouse is the pen; h shows its buttons and every tool's gestures".into()),
                 ),
                 PenSource::Device {
                     source,

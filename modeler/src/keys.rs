@@ -71,32 +71,35 @@ pub fn action(name: &str, display_mm: [f64; 2]) -> Option<KeyAction> {
     }
 }
 
-/// The help panel's lines: the keys, then the pen's `gestures` (the tool on's and the shared
-/// ones, [`crate::interaction::Interaction::help`]), in two aligned columns.
-pub fn help_lines(gestures: &[(&str, &str)]) -> Vec<String> {
-    help_lines_with(gestures, &[])
+/// The help panel's lines: the keys, then the pen's gestures tool by tool (`tools`: a title and
+/// its lines each, [`crate::interaction::Interaction::help_by_tool`]), in aligned columns.
+pub fn help_lines(tools: &[(String, Vec<(&str, &str)>)]) -> Vec<String> {
+    help_lines_with(tools, &[])
 }
 
-/// [`help_lines`], with `mouse` (the mouse's switches, [`crate::mouse::HELP`]) after the keys
+/// [`help_lines`], with `mouse` (the mouse's switches, [`crate::mouse::MouseMap::help`]) after the keys
 /// when the mouse is the pen.
-pub fn help_lines_with(gestures: &[(&str, &str)], mouse: &[(&str, &str)]) -> Vec<String> {
+pub fn help_lines_with(tools: &[(String, Vec<(&str, &str)>)], mouse: &[(&str, &str)]) -> Vec<String> {
     let width = KEYS
         .iter()
-        .chain(gestures)
+        .chain(tools.iter().flat_map(|(_, lines)| lines))
         .chain(mouse)
-        .map(|(k, _)| k.len())
+        .map(|(k, _)| k.chars().count())
         .max()
         .unwrap_or(0);
+    let row = |(k, d): &(&str, &str)| format!("  {k:width$}  {d}");
     let mut lines = vec!["keys".to_string()];
-    lines.extend(KEYS.iter().map(|(k, d)| format!("  {k:width$}  {d}")));
+    lines.extend(KEYS.iter().map(row));
     if !mouse.is_empty() {
         lines.push(String::new());
         lines.push("mouse (the pen)".to_string());
-        lines.extend(mouse.iter().map(|(k, d)| format!("  {k:width$}  {d}")));
+        lines.extend(mouse.iter().map(row));
     }
-    lines.push(String::new());
-    lines.push("pen".to_string());
-    lines.extend(gestures.iter().map(|(k, d)| format!("  {k:width$}  {d}")));
+    for (title, gestures) in tools {
+        lines.push(String::new());
+        lines.push(format!("pen: {title}"));
+        lines.extend(gestures.iter().map(row));
+    }
     lines
 }
 
@@ -139,8 +142,8 @@ mod tests {
     #[test]
     fn the_help_names_every_key_that_acts() {
         let view = View::fit([600.0, 340.0], &blank_document().grid);
-        let gestures = Interaction::new(view, Tuning::default()).help();
-        let help = help_lines(&gestures).join("\n");
+        let tools = Interaction::new(view, Tuning::default()).help_by_tool();
+        let help = help_lines(&tools).join("\n");
         for (keys, _) in KEYS {
             for key in keys.split(' ') {
                 let name = match key {
@@ -156,12 +159,40 @@ mod tests {
             }
             assert!(help.contains(keys));
         }
-        for (gesture, _) in &gestures {
-            assert!(help.contains(gesture));
+        for (title, gestures) in &tools {
+            assert!(help.contains(&format!("pen: {title}")), "{title}");
+            for (gesture, what) in gestures {
+                assert!(help.contains(gesture) && help.contains(what), "{gesture}");
+            }
         }
         assert_eq!(action("h", [1.0, 1.0]), Some(KeyAction::Help));
         assert_eq!(action("F1", [1.0, 1.0]), Some(KeyAction::Help));
         assert_eq!(action("?", [1.0, 1.0]), Some(KeyAction::Help));
         assert_eq!(action("x", [1.0, 1.0]), None);
+    }
+
+    /// `h` lists every tool's gestures, whichever tool is on, each from the tool's own lines.
+    #[test]
+    fn the_help_lists_every_tools_gestures() {
+        let view = View::fit([600.0, 340.0], &blank_document().grid);
+        let ui = Interaction::new(view, Tuning::default());
+        let tools = ui.help_by_tool();
+        let titles: Vec<&str> = tools.iter().map(|(t, _)| t.as_str()).collect();
+        assert_eq!(
+            titles,
+            ["figures (on)", "rocks", "rivers", "ridges", "trees", "every tool"],
+            "the palette's tools"
+        );
+        let help = help_lines(&tools).join("\n");
+        for needle in [
+            "grab the highlighted figure",
+            "a rock field inside it",
+            "a river from source to mouth",
+            "a ridgeline in the air",
+            "plant a grove inside it",
+            "undo; with SW2 held: redo",
+        ] {
+            assert!(help.contains(needle), "{needle} missing from\n{help}");
+        }
     }
 }

@@ -7,7 +7,8 @@
 //! - [`feed`] and [`session`]: pen events from the built-in demo, `pend` or a device, on a thread
 //!   of their own, into an editor.
 //! - [`keys`]: the live window's keys and the help it shows for them; [`mouse`]: the window's
-//!   pointer as the pen, for users without a base station.
+//!   pointer as the pen, for users without a base station; [`config`]: the settings file
+//!   (the mouse's mapping).
 //! - [`picture`]: what a frame of the session shows — the document and the interaction turned
 //!   into the renderer's plain-data scene.
 //! - [`painter`]: frames of a session — the view, the overview and map, the trees held to the
@@ -15,6 +16,7 @@
 //!   old the pose a frame shows is.
 #![cfg_attr(not(test), warn(clippy::unwrap_used))]
 
+pub mod config;
 pub mod feed;
 pub mod head_prediction;
 pub mod interaction;

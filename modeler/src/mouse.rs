@@ -13,6 +13,9 @@
 //! | middle button or Space held | SW3 |
 //! | wheel, with SW2 or SW3 held and the tip up | the pen's height above the surface, [`WHEEL_MM`] a notch |
 //!
+//! The buttons' switches and the wheel's step are the user's to change ([`MouseMap`], read from
+//! the settings file by [`crate::config`]); the table is the default.
+//!
 //! So a right-drag over a figure grabs it (right held, left pressed and let go), the wheel
 //! lifts it, and releasing the right button commits the pull, as lifting the pen and opening
 //! SW2 does; Space held with sideways motion sets its slope. The height returns to the surface
@@ -29,14 +32,124 @@ pub const WHEEL_MM: f64 = 5.0;
 /// The highest the wheel lifts the pen, mm: about what the pen's tracker reaches above a display.
 pub const MAX_HEIGHT_MM: f64 = 300.0;
 
-/// The mapping as the window's help shows it: what the mouse does for each switch.
-pub const HELP: [(&str, &str); 5] = [
-    ("left button", "SW1: the tip on the surface"),
-    ("right button", "SW2"),
-    ("middle / Space", "SW3"),
-    ("wheel + right", "lift the pen (5 mm a notch)"),
-    ("off the picture", "out of range"),
-];
+/// A pen switch a mouse button stands for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Switch {
+    /// The tip switch: the tip on the surface.
+    Sw1,
+    /// The barrel switch nearer the tip.
+    Sw2,
+    /// The other barrel switch.
+    Sw3,
+    /// The button does nothing.
+    None,
+}
+
+impl Switch {
+    /// The switch's index in a report's `[SW1, SW2, SW3]`; `None` for no switch.
+    fn index(self) -> Option<usize> {
+        match self {
+            Switch::Sw1 => Some(0),
+            Switch::Sw2 => Some(1),
+            Switch::Sw3 => Some(2),
+            Switch::None => None,
+        }
+    }
+
+    /// What the help says the button does.
+    fn says(self) -> &'static str {
+        match self {
+            Switch::Sw1 => "SW1: the tip on the surface",
+            Switch::Sw2 => "SW2",
+            Switch::Sw3 => "SW3",
+            Switch::None => "nothing",
+        }
+    }
+}
+
+/// Which pen switch each mouse button is, and how far a wheel notch lifts the pen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MouseMap {
+    /// The switch of the left, right and middle button (Space is the middle button).
+    pub buttons: [Switch; 3],
+    /// The pen's height per wheel notch away from the user, mm; negative turns the wheel round.
+    pub wheel_mm: f64,
+}
+
+impl Default for MouseMap {
+    /// Left SW1, right SW2, middle (and Space) SW3, [`WHEEL_MM`] a notch.
+    fn default() -> MouseMap {
+        MouseMap {
+            buttons: [Switch::Sw1, Switch::Sw2, Switch::Sw3],
+            wheel_mm: WHEEL_MM,
+        }
+    }
+}
+
+impl MouseMap {
+    /// The pen's switches `[SW1, SW2, SW3]` while the mouse's `[left, right, middle]` are held.
+    pub fn switches(&self, buttons: [bool; 3]) -> [bool; 3] {
+        let mut sw = [false; 3];
+        for (held, s) in buttons.iter().zip(self.buttons) {
+            if let Some(i) = s.index() {
+                sw[i] |= *held;
+            }
+        }
+        sw
+    }
+
+    /// The mapping in a few words, as the window says it when it opens (`left draws, right
+    /// grabs, middle/Space is SW3, wheel lifts`).
+    pub fn summary(&self) -> String {
+        let names = ["left", "right", "middle/Space"];
+        let mut parts: Vec<String> = names
+            .iter()
+            .zip(self.buttons)
+            .filter_map(|(n, s)| {
+                let does = match s {
+                    Switch::Sw1 => "draws",
+                    Switch::Sw2 => "grabs",
+                    Switch::Sw3 => "is SW3",
+                    Switch::None => return None,
+                };
+                Some(format!("{n} {does}"))
+            })
+            .collect();
+        if self.buttons.iter().any(|s| matches!(s, Switch::Sw2 | Switch::Sw3)) {
+            parts.push(if self.wheel_mm > 0.0 {
+                "wheel lifts".to_string()
+            } else {
+                "wheel (turned round) lifts".to_string()
+            });
+        }
+        parts.join(", ")
+    }
+
+    /// The mapping as the window's help shows it: what each button does, the wheel, and off
+    /// the picture.
+    pub fn help(&self) -> Vec<(String, String)> {
+        let names = ["left button", "right button", "middle / Space"];
+        let mut lines: Vec<(String, String)> = names
+            .iter()
+            .zip(self.buttons)
+            .map(|(n, s)| (n.to_string(), s.says().to_string()))
+            .collect();
+        let lifts = [Switch::Sw2, Switch::Sw3]
+            .iter()
+            .filter_map(|s| names.iter().zip(self.buttons).find(|(_, b)| b == s).map(|(n, _)| *n))
+            .map(|n| n.split(' ').next().unwrap_or(n))
+            .collect::<Vec<_>>();
+        if !lifts.is_empty() {
+            lines.push((
+                format!("wheel + {}", lifts.join("/")),
+                format!("lift the pen ({} mm a notch)", self.wheel_mm.abs()),
+            ));
+        }
+        lines.push(("off the picture".to_string(), "out of range".to_string()));
+        lines
+    }
+}
 
 /// The pointer as the window reports it.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -53,6 +166,7 @@ pub struct PointerState {
 /// The mouse as a pen over a display of `display_mm`, shown in a picture of `picture_px`.
 #[derive(Debug, Clone)]
 pub struct MousePen {
+    map: MouseMap,
     detector: EventDetector,
     height_mm: f64,
     seq: u16,
@@ -66,9 +180,15 @@ impl Default for MousePen {
 }
 
 impl MousePen {
-    /// Out of range, nothing held, on the surface.
+    /// Out of range, nothing held, on the surface, with the default mapping.
     pub fn new() -> MousePen {
+        MousePen::with_map(MouseMap::default())
+    }
+
+    /// [`MousePen::new`] with the buttons and wheel mapped by `map`.
+    pub fn with_map(map: MouseMap) -> MousePen {
         MousePen {
+            map,
             detector: EventDetector::new(),
             height_mm: 0.0,
             seq: 0,
@@ -81,6 +201,11 @@ impl MousePen {
         self.height_mm
     }
 
+    /// The mapping in use.
+    pub fn map(&self) -> &MouseMap {
+        &self.map
+    }
+
     /// The pen events of the pointer's new state at host time `t_us` (µs since the epoch), for a
     /// display of `display_mm` (width, height) shown in a picture of `picture_px` pixels.
     pub fn update(
@@ -90,13 +215,13 @@ impl MousePen {
         picture_px: [u32; 2],
         t_us: u64,
     ) -> Vec<PenEvent> {
-        let [tip, sw2, sw3] = pointer.buttons;
+        let [tip, sw2, sw3] = self.map.switches(pointer.buttons);
         if self.seq == 0 {
             self.started_us = t_us;
         }
         if sw2 || sw3 {
             if pointer.wheel.is_finite() {
-                self.height_mm = (self.height_mm + pointer.wheel * WHEEL_MM).clamp(0.0, MAX_HEIGHT_MM);
+                self.height_mm = (self.height_mm + pointer.wheel * self.map.wheel_mm).clamp(0.0, MAX_HEIGHT_MM);
             }
         } else {
             self.height_mm = 0.0;
@@ -210,6 +335,51 @@ mod tests {
         assert_eq!(m.height_mm(), MAX_HEIGHT_MM);
         m.update(state(at, [false; 3], 0.0), DISPLAY, PICTURE, 7);
         assert_eq!(m.height_mm(), 0.0, "released, back on the surface");
+    }
+
+    #[test]
+    fn a_mapping_swaps_the_buttons_and_turns_the_wheel_round() {
+        let map = MouseMap {
+            buttons: [Switch::Sw1, Switch::Sw3, Switch::Sw2],
+            wheel_mm: -2.0,
+        };
+        assert_eq!(map.switches([false, true, false]), [false, false, true]);
+        assert_eq!(map.switches([false, false, true]), [false, true, false]);
+        let mut m = MousePen::with_map(map);
+        let at = [0.2, 0.2];
+        // The middle button is SW2 now: its events say button 2, and the wheel lifts the pen
+        // when turned towards the user.
+        let kinds: Vec<EventKind> = [
+            m.update(state(at, [false; 3], 0.0), DISPLAY, PICTURE, 1),
+            m.update(state(at, [false, false, true], -3.0), DISPLAY, PICTURE, 2),
+        ]
+        .concat()
+        .into_iter()
+        .map(|e| e.kind)
+        .collect();
+        assert!(kinds.contains(&EventKind::ButtonDown { button: 2 }), "{kinds:?}");
+        assert_eq!(m.height_mm(), 6.0);
+        let help = map.help();
+        assert_eq!(help[1], ("right button".to_string(), "SW3".to_string()));
+        assert!(
+            help.iter()
+                .any(|(k, d)| k == "wheel + middle/right" && d.contains("2 mm a notch")),
+            "{help:?}"
+        );
+        assert_eq!(
+            MouseMap::default().summary(),
+            "left draws, right grabs, middle/Space is SW3, wheel lifts"
+        );
+        assert_eq!(
+            map.summary(),
+            "left draws, right is SW3, middle/Space grabs, wheel (turned round) lifts"
+        );
+        let none = MouseMap {
+            buttons: [Switch::Sw1, Switch::None, Switch::None],
+            wheel_mm: 5.0,
+        };
+        assert_eq!(none.switches([true, true, true]), [true, false, false]);
+        assert!(!none.help().iter().any(|(k, _)| k.starts_with("wheel")));
     }
 
     #[test]

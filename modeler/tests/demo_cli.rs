@@ -277,3 +277,43 @@ fn a_real_session_never_overwrites_a_document() {
         "{stderr}"
     );
 }
+
+/// Issue 42: the mouse's mapping is read from the settings file; a bad one ends penmodel
+/// before anything is created (no window needed to find out), naming the file, key and line.
+#[test]
+fn a_bad_mouse_mapping_is_refused_before_anything_is_created() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let config = dir.path().join("config/penscape");
+    std::fs::create_dir_all(&config).expect("config folder");
+    let settings = config.join("modeler.toml");
+    std::fs::write(&settings, "[mouse]\nleft = \"sw1\"\nright = \"sw4\"\n").expect("write");
+    let doc = dir.path().join("doc.json");
+    std::fs::copy(crate::common::example("01-ridges-and-peaks.json"), &doc).expect("copy");
+    let out = Command::new(env!("CARGO_BIN_EXE_penmodel"))
+        .current_dir(dir.path())
+        .args([
+            "open",
+            &doc.display().to_string(),
+            "--source",
+            "mouse",
+            "--show",
+            "window",
+        ])
+        .env("XDG_CONFIG_HOME", dir.path().join("config"))
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .expect("penmodel runs");
+    assert_eq!(out.status.code(), Some(1), "{out:?}");
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains(&settings.display().to_string()) && err.contains("sw4") && err.contains("line 3"),
+        "{err}"
+    );
+    let mut left: Vec<String> = std::fs::read_dir(dir.path())
+        .expect("read_dir")
+        .map(|e| e.expect("entry").file_name().to_string_lossy().into_owned())
+        .collect();
+    left.sort();
+    assert_eq!(left, ["config", "doc.json"], "nothing created");
+}

@@ -250,6 +250,19 @@ fn a_figure_outside_every_region_is_refused_with_a_message() {
     );
 }
 
+/// The status line carries a message for a while, unless the window shows it under the line
+/// (issue 42: each message was shown twice there).
+#[test]
+fn a_message_is_on_the_status_line_unless_the_window_shows_it() {
+    let mut pen = Pen::new(blank());
+    pen.hover(100.0, 100.0).touch().lift(HOVER).click(2);
+    let status = pen.ui.status(pen.doc());
+    assert!(status.contains("outside every region"), "{status}");
+    pen.ui.set_messages_on_status(false);
+    let status = pen.ui.status(pen.doc());
+    assert!(!status.contains("outside every region"), "{status}");
+}
+
 #[test]
 fn grab_pull_and_slope_are_one_undoable_edit() {
     let mut pen = Pen::new(blank());

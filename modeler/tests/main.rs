@@ -1,4 +1,5 @@
 //! The integration tests of penmodel, in one binary: a module per area.
+mod calibrate_window;
 mod cli;
 mod common;
 mod demo_cli;

@@ -30,7 +30,7 @@ fn pixel(x: f64, y: f64) -> (i64, i64) {
     ((fx * PICTURE.0).round() as i64, (fy * PICTURE.1).round() as i64)
 }
 
-fn found(tool: &str) -> bool {
+pub(crate) fn found(tool: &str) -> bool {
     Command::new("sh")
         .args(["-c", &format!("command -v {tool}")])
         .stdout(Stdio::null())
@@ -39,7 +39,7 @@ fn found(tool: &str) -> bool {
 }
 
 /// Kills a child when the test ends, however it ends.
-struct Killed(Child);
+pub(crate) struct Killed(pub(crate) Child);
 
 impl Drop for Killed {
     fn drop(&mut self) {
@@ -92,16 +92,16 @@ impl X {
 }
 
 /// A screenshot: 0RGB pixels, row after row.
-struct Shot {
-    width: usize,
-    height: usize,
-    pixels: Vec<u32>,
+pub(crate) struct Shot {
+    pub(crate) width: usize,
+    pub(crate) height: usize,
+    pub(crate) pixels: Vec<u32>,
 }
 
 impl Shot {
     /// Reads an XWD file (X11's window dump: a header of 25 big-endian words, the window's
     /// name, the colour map, then the image) of a 24- or 32-bit true-colour window.
-    fn from_xwd(b: &[u8]) -> Shot {
+    pub(crate) fn from_xwd(b: &[u8]) -> Shot {
         let word = |i: usize| u32::from_be_bytes([b[4 * i], b[4 * i + 1], b[4 * i + 2], b[4 * i + 3]]) as usize;
         let (header, width, height) = (word(0), word(4), word(5));
         let (byte_order, bits_per_pixel, bytes_per_line, ncolors) = (word(7), word(11), word(12), word(19));
@@ -146,26 +146,45 @@ impl Shot {
 }
 
 /// Starts Xvfb on a display number nobody uses; its socket is there when it returns.
-fn xvfb() -> (Killed, String) {
-    let n = (90..190)
-        .find(|n| {
-            !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() && !Path::new(&format!("/tmp/.X{n}-lock")).exists()
-        })
-        .expect("a free display number");
-    let display = format!(":{n}");
-    let child = Command::new("Xvfb")
-        .args([display.as_str(), "-screen", "0", "1400x900x24", "-nolisten", "tcp"])
-        .stdout(Stdio::null())
+/// The X server a test started: stopped with SIGTERM, so that it removes its socket and lock
+/// file (SIGKILL left them behind, using up display numbers run after run).
+pub(crate) struct Server(Child);
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = Command::new("kill").args(["-TERM", &self.0.id().to_string()]).status();
+        let end = Instant::now() + Duration::from_secs(3);
+        while Instant::now() < end {
+            if let Ok(Some(_)) = self.0.try_wait() {
+                return;
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+pub(crate) fn xvfb() -> (Server, String) {
+    // Xvfb picks a display number nobody uses and writes it on `-displayfd` once it accepts
+    // clients: no race with another test (or another user's) choosing the same free number.
+    let mut child = Command::new("Xvfb")
+        .args(["-displayfd", "1", "-screen", "0", "1400x900x24", "-nolisten", "tcp"])
+        .stdout(Stdio::piped())
         .stderr(Stdio::null())
         .spawn()
         .expect("Xvfb starts");
-    let server = Killed(child);
-    let until = Instant::now() + GUARD;
-    while !Path::new(&format!("/tmp/.X11-unix/X{n}")).exists() {
-        assert!(Instant::now() < until, "Xvfb {display} never made its socket");
-        std::thread::sleep(Duration::from_millis(50));
-    }
-    (server, display)
+    let stdout = child.stdout.take().expect("stdout");
+    let server = Server(child);
+    let (tx, rx) = mpsc::channel();
+    std::thread::spawn(move || {
+        let mut line = String::new();
+        let _ = BufReader::new(stdout).read_line(&mut line);
+        let _ = tx.send(line);
+    });
+    let line = rx.recv_timeout(GUARD).expect("Xvfb said its display number");
+    let n: u32 = line.trim().parse().expect("a display number");
+    (server, format!(":{n}"))
 }
 
 #[test]

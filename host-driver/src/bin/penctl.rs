@@ -1,7 +1,7 @@
 //! `penctl`: inspect, configure and calibrate the 3D pen from the command line.
 //!
 //! Exit status: 0 on success, 1 when the input, the device or a request fails (the reason on
-//! stderr), 2 on a usage error.
+//! stderr), 2 on a usage error, 3 when `penctl list` finds no base station attached.
 
 use std::io::{IsTerminal, Write};
 use std::path::PathBuf;
@@ -11,6 +11,7 @@ use std::time::Duration;
 use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use pen_host::calibration::procedure::{self as calibrate, Prompt};
+use pen_host::calibration::run;
 use pen_host::calibration::{self, Calibration, CalibrationError, DeviceId, DisplaySize, FitKind, plot};
 use pen_host::device::{Device, DeviceEvent};
 use pen_host::hex;
@@ -50,8 +51,8 @@ type DeviceArgs = source::DeviceArgs<SimSwitch>;
 
 #[derive(Subcommand)]
 enum Command {
-    /// List the base stations attached (HID interfaces and serial links).
-    #[command(after_help = "Example:\n  penctl list")]
+    /// List the base stations attached (HID interfaces and serial links); exit status 3 when there is none.
+    #[command(after_help = "Example:\n  penctl list || echo \"no base station\"")]
     List,
     /// Print the device's information and configuration.
     #[command(
@@ -540,13 +541,7 @@ fn calibration_source(device: &DeviceArgs, targets: &[glam::DVec2], pivot: Optio
     if !device.is_sim() {
         return Ok(device.source()?);
     }
-    let rig = pen_sim::rig::Rig::hand_placed_display();
-    Ok(Source::Sim(pen_host::transport::sim::SimOptions {
-        scenario: pen_sim::scenarios::calibration(targets, pivot, rig),
-        seed: 1,
-        speed: device.speed(),
-        plug: Default::default(),
-    }))
+    Ok(run::sim_source(targets, pivot, device.speed()))
 }
 
 /// The device to calibrate.
@@ -580,68 +575,34 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
     let source = calibration_source(&a.device, &targets, pivot_at)?;
     let mut device = Device::new(source);
     calibrate::attach(&mut device, Duration::from_secs(2))?;
-    // The calibration records its base station, and is refused for any other.
-    let id = match device.info() {
-        Ok(info) => DeviceId::of(info),
-        Err(why) => bail!("cannot read the base station's unique ID, which the calibration records: {why}"),
-    };
+    let id = run::device_id(&mut device)?;
     // Chosen before the touches, so that a missing home is said at once.
     let out = match a.out {
         Some(p) => p,
         None => calibration::default_path_for(a.device.is_sim() || id.is_simulated())
             .context("neither XDG_CONFIG_HOME nor HOME is set; give --out")?,
     };
-    let original = calibrate::prepare(&mut device)?;
-    let patience = Duration::from_secs_f64(a.patience.max(1.0));
+    let plan = run::Plan {
+        display,
+        targets,
+        kind,
+        pivot_at,
+        patience: Duration::from_secs_f64(a.patience.max(1.0)),
+        write_device: a.write_device,
+    };
     let tty = std::io::stderr().is_terminal();
-    let tell = |step: &Prompt| match step {
-        Prompt::Touch {
-            index,
-            count,
-            target_mm,
-        } => eprintln!(
-            "target {}/{count}: touch ({:.0}, {:.0}) mm from the display's lower-left corner, and press",
-            index + 1,
-            target_mm.x,
-            target_mm.y
-        ),
-        Prompt::Pivot { at_mm } => eprintln!(
-            "pivot: hold the tip on ({:.0}, {:.0}) mm and press; keep it there while you tilt the pen, its top \
-             circling once, leaning it more and less (about 3 s); then lift",
-            at_mm.x, at_mm.y
-        ),
-        Prompt::Pen { .. } => {}
-        Prompt::Lift => eprintln!("  lift the pen first"),
-        // After a touch or the pivot alike.
-        Prompt::Again { fixes } => eprintln!("  too short ({fixes} fixes): press again and hold it longer"),
-        Prompt::Taken { fixes, .. } | Prompt::Pivoted { fixes } => {
-            if tty {
-                eprintln!("  taken ({fixes} fixes)")
-            }
+    let tell = |step: &Prompt| {
+        // "taken" only where a person watches; a log has the targets and the table.
+        let quiet = matches!(step, Prompt::Taken { .. } | Prompt::Pivoted { .. }) && !tty;
+        if let Some(line) = step.says().filter(|_| !quiet) {
+            eprintln!("{line}");
         }
     };
-    let taken = calibrate::collect_touches(&mut device, &targets, patience, tell).and_then(|touched| {
-        let pivot = match pivot_at {
-            Some(at) => Some(take_pivot(&mut device, at, patience, tell)?),
-            None => None,
-        };
-        Ok((touched, pivot))
-    });
-    let (touched, pivot) = match taken {
-        Ok(t) => t,
-        Err(e) => {
-            // Leave the device as it was.
-            if let Some(t) = device.transport() {
-                let _ = t.set_feature(&Message::Config(original));
-            }
-            return Err(e.into());
-        }
-    };
-    let mut cal = calibration::fit(&targets, &touched, kind, display)?;
-    cal.device = Some(id);
-    if let (Some(p), Some(at)) = (pivot, pivot_at) {
-        let offset = calibration::pivot::tip_offset(&cal, &p, at);
-        cal.tip_offset_mm = Some(offset);
+    let run::Outcome {
+        calibration: cal,
+        pivot,
+    } = run::calibrate(&mut device, &plan, tell)?;
+    if let (Some(p), Some(offset)) = (pivot, cal.tip_offset_mm) {
         outln!(
             "pivot: the emitter is {:.1} mm from the tip ({:.0}° of tilt, {:.2} mm RMS off the sphere); the pen's \
              emitter-to-tip vector ({:.1}, {:.1}, {:.1}) mm is taken out of the glasses' positions",
@@ -692,42 +653,10 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
         plot::write_residual_plot(&cal, png, 900).with_context(|| format!("writing {}", png.display()))?;
         outln!("plot {}", png.display());
     }
-    let t = transport(&mut device)?;
-    let restored = if a.write_device {
-        Config {
-            display: Some(cal.to_device()),
-            report_display_frame: true,
-            ..original
-        }
-    } else {
-        original
-    };
-    request(t, &Message::Config(restored))?;
     if a.write_device {
         outln!("written to the device: it now reports display coordinates (`penctl config save` keeps them)");
     }
     Ok(())
-}
-
-/// The pivot's sphere: asked again (up to three times) while its fixes do not make one, with
-/// the reason.
-fn take_pivot(
-    device: &mut Device,
-    at: glam::DVec2,
-    patience: Duration,
-    mut tell: impl FnMut(&Prompt),
-) -> Result<calibration::pivot::Pivot, calibrate::CalibrateError> {
-    const TRIES: usize = 3;
-    let mut tries = 0;
-    loop {
-        let fixes = calibrate::collect_pivot(device, at, patience, &mut tell)?;
-        tries += 1;
-        match calibration::pivot::fit_pivot(&fixes) {
-            Ok(p) => return Ok(p),
-            Err(why) if tries >= TRIES => return Err(calibrate::CalibrateError::Pivot { tries, why }),
-            Err(why) => eprintln!("  {why}"),
-        }
-    }
 }
 
 fn decode(hex_args: &[String], frame: bool) -> Result<()> {
@@ -752,6 +681,22 @@ fn unframe(bytes: &[u8]) -> Result<Vec<u8>> {
     payload.context("no frame in the input")
 }
 
+/// `penctl list` found no base station: not a failure of anything, but not success either, so a
+/// script can tell it from both (exit status 3).
+#[derive(Debug)]
+struct NothingAttached;
+
+impl std::fmt::Display for NothingAttached {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("no base station attached")
+    }
+}
+
+impl std::error::Error for NothingAttached {}
+
+/// The exit status of `penctl list` with nothing attached.
+const EXIT_NOTHING_ATTACHED: u8 = 3;
+
 fn list() -> Result<()> {
     let hids = hid::list()?;
     let serials = serial::list();
@@ -762,6 +707,7 @@ fn list() -> Result<()> {
             ""
         };
         eprintln!("penctl: no base station attached (udev rules: docs/flashing.md{hint})");
+        return Err(NothingAttached.into());
     }
     for h in hids {
         outln!(
@@ -826,6 +772,8 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         // The reader went away (`penctl monitor | head`): not an error, as for any Unix tool.
         Err(e) if pen_host::help::broken_pipe(&e) => ExitCode::SUCCESS,
+        // Said on stderr already, with the hint.
+        Err(e) if e.downcast_ref::<NothingAttached>().is_some() => ExitCode::from(EXIT_NOTHING_ATTACHED),
         // Flags that parse but do not go together: a usage error.
         Err(e) if e.downcast_ref::<UsageError>().is_some() || e.downcast_ref::<source::SourceError>().is_some() => {
             eprintln!("penctl: {e:#}");

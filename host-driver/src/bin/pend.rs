@@ -20,7 +20,7 @@ use pen_host::virtual_tablet::{self, Extent, VirtualTablet};
 /// `pend --help`'s end: what the defaults mean, and examples.
 #[cfg(feature = "sim")]
 const AFTER_HELP: &str = "The simulated pen (--source sim) plays `modeling-session` here: a session of modeling gestures, \
-    the events a modeler sees. While the base station is not there, pend says what it waits for and why every \
+    the events a modeler sees, for each client from its start (with --virtual-tablet one session, from pend's start). While the base station is not there, pend says what it waits for and why every \
     5 s; access without root: host-driver/udev/70-penscape.rules.\n\
     Examples:\n  \
     pend                                     # the first base station on USB\n  \
@@ -127,13 +127,18 @@ fn run(cli: Cli) -> Result<()> {
         }
         false => None,
     };
-    let socket = cli.socket.unwrap_or_else(daemon::default_socket);
+    let socket = cli.socket.clone().unwrap_or_else(daemon::default_socket);
     let listener = daemon::bind(&socket)?;
     eprintln!("pend: serving {source} on {}", socket.display());
 
     let stop = Arc::new(AtomicBool::new(false));
     for signal in [signal_hook::consts::SIGTERM, signal_hook::consts::SIGINT] {
         signal_hook::flag::register(signal, stop.clone()).context("installing signal handlers")?;
+    }
+    // The simulated pen plays a script: each client gets it from its start, in a session of its
+    // own. The virtual tablet follows one pen from pend's start, so with it the session is shared.
+    if cli.device.is_sim() && tablet.is_none() {
+        return serve_sessions(source, calibration, what, &socket, listener, &cli, &stop);
     }
     // SIGHUP reloads the calibration, as daemons reread their configuration; by default it
     // would end pend and leave its socket behind.
@@ -189,6 +194,76 @@ fn run(cli: Cli) -> Result<()> {
     eprintln!(
         "pend: stopped; {delivered} events delivered, {missed} missed by slow clients, {refused} clients refused (more than {} at once)",
         hub.max_clients()
+    );
+    Ok(())
+}
+
+/// `pend --source sim`: each client a session of its own from the scenario's start, until
+/// SIGTERM or SIGINT; SIGHUP's calibration goes to the running sessions and the next ones.
+fn serve_sessions(
+    source: Source,
+    calibration: Calibration,
+    what: String,
+    socket: &Path,
+    listener: pen_host::socket::Bound,
+    cli: &Cli,
+    stop: &Arc<AtomicBool>,
+) -> Result<()> {
+    let reload = Arc::new(AtomicBool::new(false));
+    signal_hook::flag::register(signal_hook::consts::SIGHUP, reload.clone()).context("installing signal handlers")?;
+    // Said once before any client: the device attaches, or why it is refused.
+    let (probed, c) = (source.clone(), calibration.clone());
+    let probe = std::thread::spawn(move || {
+        daemon::probe(Pipeline::new(probed, c), Duration::from_secs(10), |m| {
+            eprintln!("pend: {m}")
+        })
+    });
+    let _ = probe.join();
+    eprintln!("pend: each client gets a session of its own, from the scenario's start");
+    let current = Arc::new(daemon::CurrentCalibration::new(calibration, what));
+    let sessions = Arc::new(daemon::Sessions::new(usize::from(cli.max_clients)));
+    // In range by the parser: at most MAX_QUEUE.
+    let queue = usize::try_from(cli.queue).unwrap_or(MAX_QUEUE);
+    let sources = source.clone();
+    let (sn, s, cur) = (sessions.clone(), stop.clone(), current.clone());
+    std::thread::spawn(move || {
+        daemon::accept_sessions(listener, sn, queue, s.clone(), |hub, n| {
+            let (source, stop, current) = (source.clone(), s.clone(), cur.clone());
+            // The transport lives on the session's thread: the simulated pen is not Send.
+            let spawned = std::thread::Builder::new()
+                .name(format!("pend-session-{n}"))
+                .spawn(move || {
+                    let (taken, calibration, _) = current.get();
+                    daemon::run_session(Pipeline::new(source, calibration), hub, stop, &current, taken, |m| {
+                        eprintln!("pend: client {n}: {m}")
+                    })
+                });
+            if spawned.is_err() {
+                eprintln!("pend: client {n}: no thread for its session");
+            }
+        })
+    });
+    while !stop.load(Ordering::Relaxed) {
+        std::thread::sleep(Duration::from_millis(50));
+        if reload.swap(false, Ordering::Relaxed) {
+            let path = calibration_path(cli.calibration.as_deref(), &sources);
+            match load_calibration(path.as_deref()) {
+                Ok((c, what)) => {
+                    eprintln!("pend: SIGHUP: reloaded: {what} (the sessions running and the next ones)");
+                    current.set(c, what);
+                }
+                Err(e) => eprintln!("pend: SIGHUP: kept the calibration in use: {e:#}"),
+            }
+        }
+    }
+    let _ = std::fs::remove_file(socket);
+    let (delivered, missed) = sessions.counts();
+    eprintln!(
+        "pend: stopped; {} sessions, {delivered} events delivered, {missed} missed by slow clients, {} clients \
+         refused (more than {} at once)",
+        sessions.started(),
+        sessions.refused(),
+        sessions.max_clients()
     );
     Ok(())
 }

@@ -91,8 +91,9 @@ impl Calibration {
 }
 
 /// The folder the calibrations are kept in: `$XDG_CONFIG_HOME/penscape`
-/// (`~/.config/penscape`); `None` when neither variable is set.
-fn config_dir() -> Option<PathBuf> {
+/// (`~/.config/penscape`); `None` when neither variable is set. The modeler keeps its settings
+/// there too.
+pub fn config_dir() -> Option<PathBuf> {
     let base = std::env::var_os("XDG_CONFIG_HOME")
         .filter(|d| !d.is_empty())
         .map(PathBuf::from)

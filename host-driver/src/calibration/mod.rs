@@ -8,6 +8,8 @@
 //! * [`procedure`]: leading the user (or the simulated pen) through the targets and the pivot.
 //! * [`pivot`]: where the pen's tip is from its emitter, from the pen tilted about its tip; the
 //!   tracked glasses' positions have it taken out.
+//! * [`run`]: the whole calibration on an attached device, as `penctl calibrate` and `penmodel
+//!   calibrate` run it.
 //! * [`plot`]: the residuals as a PNG.
 //! * [`delays`]: each receiver's transducer delay from a pen held at surveyed points
 //!   (`penctl delays`).
@@ -19,6 +21,7 @@ pub mod fit;
 pub mod pivot;
 pub mod plot;
 pub mod procedure;
+pub mod run;
 
 pub use device::{DeviceId, SIMULATED_ID, default_path, default_path_for, default_path_for_source, default_sim_path};
 pub use file::{FILE_VERSION, FILE_VERSION_BOUND, FILE_VERSION_UNBOUND};

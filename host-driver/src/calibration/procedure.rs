@@ -64,6 +64,11 @@ pub enum Prompt {
         /// Where, on the display.
         at_mm: DVec2,
     },
+    /// The pivot's fixes made no sphere: it is asked again ([`super::run::calibrate`]).
+    PivotAgain {
+        /// Why.
+        why: String,
+    },
     /// The pivot was taken.
     Pivoted {
         /// Fixes taken.
@@ -76,6 +81,36 @@ pub enum Prompt {
         /// Fixes averaged.
         fixes: usize,
     },
+}
+
+impl Prompt {
+    /// What a terminal says for this step (`penctl calibrate`, `penmodel calibrate` headless);
+    /// `None` for the pen's moves.
+    pub fn says(&self) -> Option<String> {
+        Some(match self {
+            Prompt::Touch {
+                index,
+                count,
+                target_mm,
+            } => format!(
+                "target {}/{count}: touch ({:.0}, {:.0}) mm from the display's lower-left corner, and press",
+                index + 1,
+                target_mm.x,
+                target_mm.y
+            ),
+            Prompt::Pivot { at_mm } => format!(
+                "pivot: hold the tip on ({:.0}, {:.0}) mm and press; keep it there while you tilt the pen, its top \
+                 circling once, leaning it more and less (about 3 s); then lift",
+                at_mm.x, at_mm.y
+            ),
+            Prompt::PivotAgain { why } => format!("  {why}"),
+            Prompt::Pen { .. } => return None,
+            Prompt::Lift => "  lift the pen first".to_string(),
+            // After a touch or the pivot alike.
+            Prompt::Again { fixes } => format!("  too short ({fixes} fixes): press again and hold it longer"),
+            Prompt::Taken { fixes, .. } | Prompt::Pivoted { fixes } => format!("  taken ({fixes} fixes)"),
+        })
+    }
 }
 
 /// Why the procedure stopped.

@@ -149,6 +149,13 @@ enum Hub {
     Held,
 }
 
+/// The help lines of the gestures every tool shares (the hub's own).
+const SHARED_HELP: [(&str, &str); 3] = [
+    ("tool button", "pick its tool; again: back to figures"),
+    ("SW3 click", "undo; with SW2 held: redo"),
+    ("SW3 held, move", "pan; up and down zooms"),
+];
+
 /// The pen interaction: turns pen events into edits of an [`Editor`]'s document.
 #[derive(Debug)]
 pub struct Interaction {
@@ -163,6 +170,8 @@ pub struct Interaction {
     tools: Vec<Entry>,
     /// The tool on, an index into `tools`; 0 is the home tool.
     active: usize,
+    /// The status line carries the last message for a while.
+    messages_on_status: bool,
 }
 
 /// The event's time on the device's clock, µs; `None` for events not from a report (device
@@ -187,6 +196,7 @@ impl Interaction {
             messages: Messages::default(),
             tools,
             active: 0,
+            messages_on_status: true,
         }
     }
 
@@ -306,12 +316,32 @@ impl Interaction {
     /// The help panel's pen lines: the tool on's gestures, then those every tool shares.
     pub fn help(&self) -> Vec<(&'static str, &'static str)> {
         let mut lines = self.tools[self.active].tool.help().to_vec();
-        lines.extend([
-            ("tool button", "pick its tool; again: back to figures"),
-            ("SW3 click", "undo; with SW2 held: redo"),
-            ("SW3 held, move", "pan; up and down zooms"),
-        ]);
+        lines.extend(SHARED_HELP);
         lines
+    }
+
+    /// Every tool's gestures, from each tool's own help lines: the tool on first (its name
+    /// marked `on`), the others in the palette's order, then the gestures every tool shares
+    /// (`every tool`). Each section is a title and its lines.
+    pub fn help_by_tool(&self) -> Vec<(String, Vec<(&'static str, &'static str)>)> {
+        let on = &self.tools[self.active].tool;
+        let mut sections = vec![(format!("{} (on)", on.name()), on.help().to_vec())];
+        sections.extend(
+            self.tools
+                .iter()
+                .enumerate()
+                .filter(|(i, _)| *i != self.active)
+                .map(|(_, e)| (e.tool.name().to_string(), e.tool.help().to_vec())),
+        );
+        sections.push(("every tool".to_string(), SHARED_HELP.to_vec()));
+        sections
+    }
+
+    /// Whether [`status`](Interaction::status) ends with the last message for 3 s (the default:
+    /// a headless animation shows messages nowhere else). The window shows each message once,
+    /// under the status line, and turns this off.
+    pub fn set_messages_on_status(&mut self, on: bool) {
+        self.messages_on_status = on;
     }
 
     /// One line saying what the pen is doing and what it can do next.
@@ -331,7 +361,9 @@ impl Interaction {
             (_, None) => String::new(),
         };
         match (&self.messages.last, self.messages.now) {
-            (Some((t, m)), Some(now)) if now.saturating_sub(*t) < 3_000_000 => format!("{line}  | {m}"),
+            (Some((t, m)), Some(now)) if self.messages_on_status && now.saturating_sub(*t) < 3_000_000 => {
+                format!("{line}  | {m}")
+            }
             _ => line,
         }
     }

@@ -139,14 +139,17 @@ pub(crate) fn slope_bar(frame: &mut Frame, viewport: &Bounds, bar: &SlopeBar, st
     );
 }
 
-/// Draws the mode line at the top left of `viewport`, on a panel.
+/// Draws the mode line at the top left of `viewport`, on a panel; a line wider than the viewport
+/// is cut with `…`.
 pub(crate) fn mode_line(frame: &mut Frame, viewport: &Bounds, mode: &str, style: &Style) {
     if mode.is_empty() {
         return;
     }
     let s = style.text_scale.max(1);
     let (x, y) = (i64::from(viewport.x0) + MARGIN, i64::from(viewport.y0) + MARGIN);
-    let w = i64::from(text::width(mode, s));
+    let room = i64::from(viewport.x1) - i64::from(viewport.x0) - 2 * MARGIN;
+    let mode = text::ellipsize(mode, text::fitting(room, s));
+    let w = i64::from(text::width(&mode, s));
     let h = i64::from(text::height(s));
     fill(
         frame,
@@ -155,15 +158,16 @@ pub(crate) fn mode_line(frame: &mut Frame, viewport: &Bounds, mode: &str, style:
         [0, 0, 0, 255],
         PANEL_SHOW,
     );
-    text::draw(frame, viewport, (x, y), mode, style.text_colour, s);
+    text::draw(frame, viewport, (x, y), &mode, style.text_colour, s);
 }
 
 /// Where [`panel`] puts its text.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Place {
-    /// In the middle of the viewport (the help).
+    /// In the middle of the viewport (the help): in columns, and at a smaller scale, when the
+    /// lines do not fit otherwise.
     Centre,
-    /// At the top left, under the mode line (a notice).
+    /// At the top left, under the mode line (a notice): lines wider than the viewport wrap.
     UnderModeLine,
     /// Centred on this pixel of the frame (a tool button's label).
     CentredOn {
@@ -174,18 +178,107 @@ pub enum Place {
     },
 }
 
-/// Draws `lines` on a translucent panel in `viewport`; a line longer than the viewport is cut
-/// by the viewport, not wrapped. Nothing is drawn for no lines.
+/// Glyph cells between two columns of a panel.
+const COLUMN_GAP_CELLS: u32 = 3;
+
+/// A panel's text laid out: its scale, its columns of lines, and each column's width in glyphs.
+struct Layout {
+    scale: u32,
+    columns: Vec<Vec<String>>,
+    column_chars: usize,
+}
+
+impl Layout {
+    fn line_h(&self) -> i64 {
+        i64::from(text::height(self.scale)) + i64::from(self.scale)
+    }
+
+    fn gap(&self) -> i64 {
+        i64::from(COLUMN_GAP_CELLS * text::CELL_WIDTH * self.scale)
+    }
+
+    fn column_w(&self) -> i64 {
+        i64::from(text::CELL_WIDTH * self.scale) * self.column_chars as i64
+    }
+
+    fn size(&self) -> (i64, i64) {
+        let cols = self.columns.len() as i64;
+        let rows = self.columns.iter().map(Vec::len).max().unwrap_or(0) as i64;
+        (
+            cols * self.column_w() + (cols - 1).max(0) * self.gap(),
+            rows * self.line_h(),
+        )
+    }
+
+    /// `lines` in one column at `scale`, each cut to `chars` glyphs.
+    fn one(lines: Vec<String>, scale: u32, chars: usize) -> Layout {
+        let lines: Vec<String> = lines.iter().map(|l| text::ellipsize(l, chars)).collect();
+        let column_chars = lines.iter().map(|l| l.chars().count()).max().unwrap_or(0);
+        Layout {
+            scale,
+            columns: vec![lines],
+            column_chars,
+        }
+    }
+
+    /// `lines` in as few columns as fit `room_h` and the largest scale up to `scale` at which
+    /// those columns fit `room_w`; at scale 1 lines still too wide are cut with `…`.
+    fn columns(lines: &[String], scale: u32, (room_w, room_h): (i64, i64)) -> Layout {
+        let widest = lines.iter().map(|l| l.chars().count()).max().unwrap_or(0);
+        for s in (1..=scale.max(1)).rev() {
+            let line_h = i64::from(text::height(s)) + i64::from(s);
+            let rows = ((room_h / line_h).max(1) as usize).min(lines.len().max(1));
+            let cols = lines.len().div_ceil(rows).max(1);
+            // Balanced: as many rows in each column as the first needs.
+            let rows = lines.len().div_ceil(cols);
+            let cell = i64::from(text::CELL_WIDTH * s);
+            let gap = i64::from(COLUMN_GAP_CELLS) * cell;
+            let need = cols as i64 * cell * widest as i64 + (cols as i64 - 1) * gap;
+            if need <= room_w || s == 1 {
+                let chars = if need <= room_w {
+                    widest
+                } else {
+                    text::fitting((room_w - (cols as i64 - 1) * gap) / cols as i64, s)
+                };
+                let columns: Vec<Vec<String>> = lines
+                    .chunks(rows)
+                    .map(|c| {
+                        // A column does not start with the blank line between two sections.
+                        let skip = usize::from(c.first().is_some_and(String::is_empty));
+                        c[skip..].iter().map(|l| text::ellipsize(l, chars)).collect()
+                    })
+                    .collect();
+                let column_chars = columns.iter().flatten().map(|l| l.chars().count()).max().unwrap_or(0);
+                return Layout {
+                    scale: s,
+                    columns,
+                    column_chars,
+                };
+            }
+        }
+        Layout::one(lines.to_vec(), 1, widest)
+    }
+}
+
+/// Draws `lines` on a translucent panel in `viewport`, kept within its width: the help
+/// ([`Place::Centre`]) in columns and smaller when it must, a notice wrapped, a label cut with
+/// `…`. Nothing is drawn for no lines.
 pub fn panel(frame: &mut Frame, viewport: &Bounds, lines: &[String], place: Place, style: &Style) {
     if lines.is_empty() {
         return;
     }
     let s = style.text_scale.max(1);
-    let line_h = i64::from(text::height(s)) + i64::from(s);
-    let w = lines.iter().map(|l| i64::from(text::width(l, s))).max().unwrap_or(0);
-    let h = line_h * lines.len() as i64;
     let (vx0, vy0) = (i64::from(viewport.x0), i64::from(viewport.y0));
     let (vw, vh) = (i64::from(viewport.x1) - vx0, i64::from(viewport.y1) - vy0);
+    let room = (vw - 2 * MARGIN, vh - 2 * MARGIN);
+    let chars = text::fitting(room.0, s);
+    let layout = match place {
+        Place::Centre => Layout::columns(lines, s, room),
+        Place::UnderModeLine => Layout::one(lines.iter().flat_map(|l| text::wrap(l, chars)).collect(), s, chars),
+        Place::CentredOn { .. } => Layout::one(lines.to_vec(), s, chars),
+    };
+    let (w, h) = layout.size();
+    let line_h = layout.line_h();
     let (x, y) = match place {
         Place::Centre => (vx0 + ((vw - w) / 2).max(MARGIN), vy0 + ((vh - h) / 2).max(MARGIN)),
         Place::UnderModeLine => (vx0 + MARGIN, vy0 + MARGIN * 2 + line_h),
@@ -202,8 +295,18 @@ pub fn panel(frame: &mut Frame, viewport: &Bounds, lines: &[String], place: Plac
         [0, 0, 0, 255],
         PANEL_SHOW / 2.0,
     );
-    for (i, line) in lines.iter().enumerate() {
-        text::draw(frame, viewport, (x, y + i as i64 * line_h), line, style.text_colour, s);
+    for (c, column) in layout.columns.iter().enumerate() {
+        let cx = x + c as i64 * (layout.column_w() + layout.gap());
+        for (i, line) in column.iter().enumerate() {
+            text::draw(
+                frame,
+                viewport,
+                (cx, y + i as i64 * line_h),
+                line,
+                style.text_colour,
+                layout.scale,
+            );
+        }
     }
 }
 
@@ -276,6 +379,64 @@ mod tests {
         let p = frame.pixels()[(y0 as usize - 2) * 320 + x0 as usize];
         assert!(p[0] < 100, "{p:?}");
         assert_eq!(frame.pixels()[0], [100, 100, 100, 255]);
+    }
+
+    /// The columns of text pixels `frame` shows, first and last.
+    fn text_span(frame: &Frame, style: &Style) -> (u32, u32, u32, u32) {
+        let text = lit(frame, style.text_colour);
+        (
+            text.iter().map(|p| p.0).min().expect("text drawn"),
+            text.iter().map(|p| p.0).max().expect("text drawn"),
+            text.iter().map(|p| p.1).min().expect("text drawn"),
+            text.iter().map(|p| p.1).max().expect("text drawn"),
+        )
+    }
+
+    #[test]
+    fn a_long_mode_line_ends_in_an_ellipsis_inside_the_viewport() {
+        let (style, mut frame, all) = grey_frame();
+        let long = "grabbed point 3: pull 1200 m, slope 0.40 | the polyline is outside every region";
+        mode_line(&mut frame, &all, long, &style);
+        let (_, x1, _, _) = text_span(&frame, &style);
+        assert!(i64::from(x1) < 320 - MARGIN, "text to column {x1} of 320");
+        // The last glyph drawn is the ellipsis: three dots on the baseline row.
+        let s = style.text_scale.max(1);
+        let cells = text::fitting(320 - 2 * MARGIN, s) as i64;
+        let last = MARGIN + (cells - 1) * i64::from(text::CELL_WIDTH * s);
+        let dots = lit(&frame, style.text_colour)
+            .iter()
+            .filter(|p| i64::from(p.0) >= last)
+            .count();
+        assert_eq!(dots as u32, 3 * s * s, "an ellipsis at the end");
+        // The panel behind it stops inside the frame too.
+        assert_eq!(frame.pixels()[10 * 320 + 318], [100, 100, 100, 255]);
+    }
+
+    #[test]
+    fn a_long_notice_wraps_within_the_viewport() {
+        let (style, mut frame, all) = grey_frame();
+        let long = "the polyline is outside every region: draw a closed curve around the place first".to_string();
+        panel(&mut frame, &all, &[long], Place::UnderModeLine, &style);
+        let (x0, x1, y0, y1) = text_span(&frame, &style);
+        assert!(i64::from(x0) >= MARGIN && i64::from(x1) < 320 - MARGIN, "{x0}..{x1}");
+        let line_h = text::height(style.text_scale) + style.text_scale;
+        assert!(y1 - y0 > 2 * line_h, "wrapped on three lines or more: rows {y0}..{y1}");
+    }
+
+    #[test]
+    fn a_help_taller_than_the_viewport_flows_into_columns_that_fit() {
+        let (style, mut frame, all) = grey_frame();
+        let lines: Vec<String> = (0..40).map(|i| format!("line {i:2} of the help")).collect();
+        panel(&mut frame, &all, &lines, Place::Centre, &style);
+        let (x0, x1, y0, y1) = text_span(&frame, &style);
+        assert!(i64::from(x0) >= MARGIN && i64::from(x1) < 320 - MARGIN, "{x0}..{x1}");
+        assert!(i64::from(y0) >= MARGIN && i64::from(y1) < 200 - MARGIN, "{y0}..{y1}");
+        // Every line is there: the last line's number shows, at scale 1 in several columns.
+        let layout = Layout::columns(&lines, style.text_scale, (320 - 2 * MARGIN, 200 - 2 * MARGIN));
+        assert!(layout.columns.len() > 1, "columns");
+        let shown: Vec<&String> = layout.columns.iter().flatten().collect();
+        assert_eq!(shown.len(), 40);
+        assert!(shown.iter().all(|l| !l.ends_with('…')), "{shown:?}");
     }
 
     #[test]

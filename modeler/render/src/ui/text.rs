@@ -151,6 +151,49 @@ pub(crate) fn height(scale: u32) -> u32 {
     CELL_HEIGHT * scale
 }
 
+/// How many glyphs fit in `max_px` at `scale` (0 when none does).
+pub(crate) fn fitting(max_px: i64, scale: u32) -> usize {
+    let cell = i64::from(CELL_WIDTH * scale.max(1));
+    (max_px.max(0) / cell) as usize
+}
+
+/// `text` cut to `chars` glyphs, its last one `…` when anything was cut.
+pub(crate) fn ellipsize(text: &str, chars: usize) -> String {
+    if text.chars().count() <= chars {
+        return text.to_string();
+    }
+    if chars == 0 {
+        return String::new();
+    }
+    let mut cut: String = text.chars().take(chars - 1).collect();
+    cut.truncate(cut.trim_end().len());
+    cut.push('…');
+    cut
+}
+
+/// `text` in lines of at most `chars` glyphs, broken at spaces; a word longer than a line is cut
+/// with `…`. At least one line (empty for empty text).
+pub(crate) fn wrap(text: &str, chars: usize) -> Vec<String> {
+    let chars = chars.max(1);
+    let mut lines = Vec::new();
+    let mut line = String::new();
+    for word in text.split(' ').filter(|w| !w.is_empty()) {
+        let word = ellipsize(word, chars);
+        let (have, add) = (line.chars().count(), word.chars().count());
+        if have > 0 && have + 1 + add > chars {
+            lines.push(std::mem::take(&mut line));
+        }
+        if !line.is_empty() {
+            line.push(' ');
+        }
+        line.push_str(&word);
+    }
+    if !line.is_empty() || lines.is_empty() {
+        lines.push(line);
+    }
+    lines
+}
+
 /// Draws `text` with its top-left corner at `(x, y)`; pixels outside `clip` or the frame are
 /// skipped.
 pub(crate) fn draw(frame: &mut Frame, clip: &Bounds, (x, y): (i64, i64), text: &str, colour: Rgba, scale: u32) {
@@ -190,6 +233,25 @@ mod tests {
         assert_eq!(unknown, glyph('?'));
         for ch in "°×µ—–−·…±²".chars() {
             assert_ne!(glyph(ch), unknown, "{ch}");
+        }
+    }
+
+    #[test]
+    fn a_long_text_is_cut_with_an_ellipsis_or_wrapped_at_spaces() {
+        assert_eq!(ellipsize("short", 5), "short");
+        assert_eq!(ellipsize("a longer line", 8), "a longe…");
+        assert_eq!(ellipsize("a b  c", 4), "a b…");
+        assert_eq!(ellipsize("any", 0), "");
+        assert_eq!(fitting(60, 2), 5);
+        assert_eq!(fitting(-3, 1), 0);
+        assert_eq!(
+            wrap("the polyline is outside every region", 14),
+            ["the polyline", "is outside", "every region"]
+        );
+        assert_eq!(wrap("unbreakable_word here", 6), ["unbre…", "here"]);
+        assert_eq!(wrap("", 10), [""]);
+        for line in wrap("x ".repeat(40).as_str(), 7) {
+            assert!(line.chars().count() <= 7, "{line}");
         }
     }
 

@@ -210,6 +210,12 @@ pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
         )
         .exit();
     }
+    // The mouse's mapping is read first, so a bad settings file ends the run before anything
+    // is created (exit 1, naming the file and the key).
+    let mouse_map = match source {
+        PenSource::Mouse => Some(penmodel::config::load()?.mouse),
+        _ => None,
+    };
     let demo = matches!(source, PenSource::Demo { .. });
     // What this session creates it removes again if nothing is modeled: no empty results.
     let mut created = document::Created {
@@ -240,7 +246,6 @@ pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
     // The pen thread is not joined: it notices the closed channel only at its next message, and
     // a silent pen (pend without a device, a base station unplugged) sends none. It ends with
     // the process; it holds nothing that needs closing beyond what the process's end closes.
-    let mouse_pen = matches!(source, PenSource::Mouse);
     let (rx, _thread) = feed::spawn(source, 256);
     eprintln!("penmodel: pen from {source_name}");
 
@@ -274,7 +279,7 @@ pub fn run(args: &LiveArgs, open: Option<&Path>, recover: bool) -> Result<()> {
     let mut painter = created.on_error(Painter::new(w, h, layout).map_err(anyhow::Error::from))?;
     let written = match viewer {
         Some(v) => {
-            let mouse = mouse_pen.then(penmodel::mouse::MousePen::new);
+            let mouse = mouse_map.map(penmodel::mouse::MousePen::with_map);
             let options = window::Options {
                 mouse,
                 fullscreen: args.fullscreen,

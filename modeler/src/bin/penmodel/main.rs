@@ -8,6 +8,7 @@
 
 mod analyze;
 mod bench;
+mod calibrate;
 mod erode;
 mod generate;
 mod import;
@@ -68,6 +69,8 @@ enum Command {
         #[command(flatten)]
         live: live::LiveArgs,
     },
+    /// Calibrate the pen on the display itself: the targets drawn full screen one at a time, the residual plot at the end.
+    Calibrate(calibrate::Args),
     /// Generate a document's terrain and export it.
     Generate(generate::Args),
     /// Make a document from a heightmap (16-bit PNG, float32 GeoTIFF, raw float32): the sketch is added on top.
@@ -99,6 +102,7 @@ fn main() -> ExitCode {
             recover,
             live,
         }) => live::run(&live, Some(&document), recover),
+        Some(Command::Calibrate(args)) => calibrate::run(&args),
         Some(Command::Generate(args)) => generate::run(&args),
         Some(Command::Import(args)) => import::run(&args),
         Some(Command::Render(args)) => render::run(&args),

@@ -85,13 +85,21 @@ pub fn run(
     options: Options,
 ) -> Result<Written> {
     let Options { mut mouse, fullscreen } = options;
+    // Messages show under the status line (the notice), so not on it as well.
+    session.interaction.set_messages_on_status(false);
+    let mut notice: Option<Notice> = None;
+    if let Some(m) = &mouse {
+        // What each button does, as the settings file maps them, for the first seconds.
+        tell(vec![format!("mouse: {}", m.map().summary())], &mut notice);
+    }
+    let mouse_help = mouse.as_ref().map(|m| m.map().help()).unwrap_or_default();
+    let mouse_help: Vec<(&str, &str)> = mouse_help.iter().map(|(k, d)| (k.as_str(), d.as_str())).collect();
     const FRAME: Duration = Duration::from_millis(16);
     let mut dirty = true;
     let mut last = Instant::now() - FRAME;
     let mut frames = 0;
     let mut help = false;
     let mut fullscreen = fullscreen;
-    let mut notice: Option<Notice> = None;
     'session: while viewer.is_open() && !stop.load(Ordering::Relaxed) {
         while let Some(e) = viewer.poll() {
             let k = match &e {
@@ -217,10 +225,7 @@ pub fn run(
                 panel(
                     &mut frame,
                     &viewport,
-                    &keys::help_lines_with(
-                        &session.interaction.help(),
-                        if mouse.is_some() { &penmodel::mouse::HELP } else { &[] },
-                    ),
+                    &keys::help_lines_with(&session.interaction.help_by_tool(), &mouse_help),
                     Place::Centre,
                     style,
                 );
