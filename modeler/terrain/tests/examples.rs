@@ -134,3 +134,22 @@ fn a_new_document_makes_a_cone() {
         "ring spread: euclidean {euclidean} m, taxicab {taxicab} m"
     );
 }
+
+/// Issue 47: the ridgeline example's flanks ran off the grid, leaving a 12.2 m wall at its edge
+/// in every render and export. The land of every example comes down to the ground inside it.
+#[test]
+fn every_example_comes_down_to_the_ground_at_the_grids_edge() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../examples");
+    let mut paths = vec![dir.join("ridges/ridgelines.json")];
+    paths.extend(examples().into_iter().map(|(name, _)| dir.join(name)));
+    for p in paths {
+        let map = generate(&Document::load(&p).unwrap()).unwrap();
+        let (cols, rows) = (map.cols(), map.rows());
+        let edge = (0..cols)
+            .flat_map(|c| [(c, 0), (c, rows - 1)])
+            .chain((0..rows).flat_map(|r| [(0, r), (cols - 1, r)]))
+            .map(|(c, r)| map.get(c, r))
+            .fold(0.0f32, f32::max);
+        assert!(edge < 0.01, "{}: {edge} m at the grid's edge", p.display());
+    }
+}
