@@ -10,9 +10,9 @@
 //!   uncovered; the seed fills it with triangles. Planar triangles with their corners on the
 //!   cone's foot fall steeper than α between the corners (by 1/cos of half their angle: 39° for
 //!   α = 30° across a 90° triangle), so here the wedge is filled by the cone itself,
-//!   `z = zP − |q − P|·tan α`, which falls at α in every direction. Triangles with apex P, one
-//!   per at most 90° of wedge, circumscribe the cone's sectors (their outer corners beyond the
-//!   foot `R = zP/tan α`): they bound where the cone is evaluated. A ridgeline's end is such a
+//!   `z = zP − |q − P|·tan α`, which falls at α in every direction. A convex outline from P
+//!   around the wedge, a corner every 30° at most (3.5 % beyond the foot `R = zP/tan α`, so
+//!   its edges touch the foot's circle), bounds the cells a row visits. A ridgeline's end is such a
 //!   node with one segment: its 180° wedge gets a half cone, a rounded hip instead of a cliff.
 //!
 //! The polygons of one node are one [`Polygon::Fan`]. Everything below the ground (z ≤ 0) is
@@ -49,8 +49,8 @@ pub enum Polygon {
         /// tan α.
         tan: f64,
     },
-    /// The cone sectors around a node: apex `[x, y]` at elevation `z`, falling at α; each
-    /// sector bounded by a triangle from the apex to two outer corners.
+    /// The cone sectors around a node: apex `[x, y]` at elevation `z`, falling at α over each
+    /// wedge, each wedge bounded by a convex outline from the apex around it.
     Fan {
         /// The node `[x, y]`.
         apex: [f64; 2],
@@ -58,8 +58,10 @@ pub enum Polygon {
         z: f64,
         /// tan α.
         tan: f64,
-        /// The bounding triangles' outer corners.
-        triangles: Vec<[[f64; 2]; 2]>,
+        /// The wedges `[from, to]` (radians, counter-clockwise, each at most 180°).
+        wedges: Vec<[f64; 2]>,
+        /// Per wedge, the convex outline holding it: the apex, then corners around the arc.
+        outlines: Vec<Vec<[f64; 2]>>,
     },
 }
 
@@ -76,9 +78,9 @@ impl Polygon {
                     p0[1].max(p1[1]) + reach,
                 ]
             }
-            Polygon::Fan { apex, triangles, .. } => {
+            Polygon::Fan { apex, outlines, .. } => {
                 let mut b = [apex[0], apex[1], apex[0], apex[1]];
-                for q in triangles.iter().flatten() {
+                for q in outlines.iter().flatten() {
                     b = [b[0].min(q[0]), b[1].min(q[1]), b[2].max(q[0]), b[3].max(q[1])];
                 }
                 b
@@ -107,8 +109,8 @@ impl Polygon {
         }
     }
 
-    /// Convex outlines whose union holds the polygon (the flanks' trapezoid, each fan
-    /// triangle): they bound the cells a row visits ([`span`]).
+    /// Convex outlines whose union holds the polygon (the flanks' trapezoid, each fan wedge's
+    /// outline): they bound the cells a row visits ([`span`]).
     pub fn outlines(&self) -> Vec<Vec<[f64; 2]>> {
         match self {
             Polygon::Flanks { p0, p1, z0, z1, tan } => {
@@ -122,7 +124,7 @@ impl Polygon {
                 let at = |p: &[f64; 2], r: f64| [p[0] + n[0] * r, p[1] + n[1] * r];
                 vec![vec![at(p0, r0), at(p1, r1), at(p1, -r1), at(p0, -r0)]]
             }
-            Polygon::Fan { apex, triangles, .. } => triangles.iter().map(|[a, b]| vec![*apex, *a, *b]).collect(),
+            Polygon::Fan { outlines, .. } => outlines.clone(),
         }
     }
 
@@ -144,38 +146,19 @@ impl Polygon {
                 }
             }
             Polygon::Fan {
-                apex,
-                z,
-                tan,
-                triangles,
+                apex, z, tan, wedges, ..
             } => Prepared::Fan {
                 apex: *apex,
                 z: *z,
                 tan: *tan,
-                triangles: triangles
+                reach2: (z / tan).powi(2),
+                wedges: wedges
                     .iter()
-                    .filter_map(|[a, b]| {
-                        // Barycentric weight of the apex: λ = ((b − a) × (q − a)) / ((b − a) × (P − a)).
-                        let e = [b[0] - a[0], b[1] - a[1]];
-                        let den = e[0] * (apex[1] - a[1]) - e[1] * (apex[0] - a[0]);
-                        (den != 0.0).then(|| Triangle {
-                            a: *a,
-                            b: *b,
-                            inv_den: 1.0 / den,
-                        })
-                    })
+                    .map(|&[from, to]| [[from.cos(), from.sin()], [to.cos(), to.sin()]])
                     .collect(),
             },
         }
     }
-}
-
-/// A fan triangle ready for barycentric tests.
-#[derive(Debug, Clone)]
-pub struct Triangle {
-    a: [f64; 2],
-    b: [f64; 2],
-    inv_den: f64,
 }
 
 /// A polygon in the form [`Prepared::value`] reads.
@@ -196,7 +179,10 @@ pub enum Prepared {
         apex: [f64; 2],
         z: f64,
         tan: f64,
-        triangles: Vec<Triangle>,
+        /// The foot's radius squared.
+        reach2: f64,
+        /// Each wedge's bounding directions, unit vectors.
+        wedges: Vec<[[f64; 2]; 2]>,
     },
 }
 
@@ -232,30 +218,24 @@ impl Prepared {
                 apex,
                 z,
                 tan,
-                triangles,
+                reach2,
+                wedges,
             } => {
-                if !triangles.iter().any(|tri| tri.contains(*apex, q)) {
+                let w = [q[0] - apex[0], q[1] - apex[1]];
+                let r2 = w[0] * w[0] + w[1] * w[1];
+                // Within a wedge of at most 180°: counter-clockwise of `from`, clockwise of `to`.
+                let cross = |a: [f64; 2], b: [f64; 2]| a[0] * b[1] - a[1] * b[0];
+                if r2 > *reach2
+                    || !wedges
+                        .iter()
+                        .any(|&[from, to]| cross(from, w) >= 0.0 && cross(w, to) >= 0.0)
+                {
                     return None;
                 }
-                let v = z - (q[0] - apex[0]).hypot(q[1] - apex[1]) * tan;
+                let v = z - r2.sqrt() * tan;
                 (v >= 0.0).then_some(v)
             }
         }
-    }
-}
-
-impl Triangle {
-    /// Whether `q` is in the triangle.
-    #[inline]
-    fn contains(&self, apex: [f64; 2], q: [f64; 2]) -> bool {
-        let (a, b) = (self.a, self.b);
-        let e = [b[0] - a[0], b[1] - a[1]];
-        let lp = (e[0] * (q[1] - a[1]) - e[1] * (q[0] - a[0])) * self.inv_den;
-        // Weight of b: ((P − a) × (q − a)) / ((P − a) × (b − a)) = −(…)/den.
-        let f = [apex[0] - a[0], apex[1] - a[1]];
-        let lb = -(f[0] * (q[1] - a[1]) - f[1] * (q[0] - a[0])) * self.inv_den;
-        let la = 1.0 - lp - lb;
-        lp >= 0.0 && lb >= 0.0 && la >= 0.0
     }
 }
 
@@ -294,7 +274,7 @@ pub fn polygons(s: &Skeleton) -> Vec<(Part, Polygon)> {
         }
         let reach = p[2] / tan;
         dirs.sort_by(f64::total_cmp);
-        let mut triangles = Vec::new();
+        let (mut outlines, mut wedges) = (Vec::new(), Vec::new());
         for k in 0..dirs.len() {
             let a = dirs[k];
             let gap = if dirs.len() == 1 {
@@ -309,26 +289,26 @@ pub fn polygons(s: &Skeleton) -> Vec<(Part, Polygon)> {
             if wedge <= 1e-12 {
                 continue;
             }
-            let n = (wedge / FRAC_PI_2).ceil().max(1.0) as usize;
-            // Corners at R / cos(half the triangle's angle): its outer edge touches the foot's
-            // circle, so the triangle holds the whole sector.
+            wedges.push([a + FRAC_PI_2, a + FRAC_PI_2 + wedge]);
+            let n = (wedge / (PI / 6.0)).ceil().max(1.0) as usize;
+            // Corners at R / cos(half the step): each edge between two touches the foot's circle,
+            // so the outline holds the whole sector; convex, since the wedge is at most 180°.
             let out = reach / (wedge / n as f64 / 2.0).cos();
             let corner = |j: usize| {
                 let ang = a + FRAC_PI_2 + wedge * j as f64 / n as f64;
                 [p[0] + out * ang.cos(), p[1] + out * ang.sin()]
             };
-            for j in 0..n {
-                triangles.push([corner(j), corner(j + 1)]);
-            }
+            outlines.push(std::iter::once([p[0], p[1]]).chain((0..=n).map(corner)).collect());
         }
-        if !triangles.is_empty() {
+        if !outlines.is_empty() {
             out.push((
                 Part::Node(i as u32),
                 Polygon::Fan {
                     apex: [p[0], p[1]],
                     z: p[2],
                     tan,
-                    triangles,
+                    wedges,
+                    outlines,
                 },
             ));
         }
