@@ -199,6 +199,36 @@ fn fit_returns_a_preset_and_names_bad_files() {
         assert!(reached[k].as_f64() >= start[k].as_f64().map(|s| s - 0.05), "{v}");
     }
     assert_eq!(v["maps"].as_array().map(Vec::len), Some(5));
+    assert_eq!(v["out_of_time"], false, "{v}");
+    // Issue 47: a fit has a time budget; past it the best so far is kept, with a warning.
+    let out = penmodel(
+        dir.path(),
+        &[
+            "trees",
+            "fit",
+            "front.png",
+            "side.png",
+            "--time-limit",
+            "0.001",
+            "--json",
+            "-",
+        ],
+    );
+    ok(&out);
+    let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    // Checked before each step: the ascent under way when time runs out finishes its step.
+    assert!(v["out_of_time"] == true && v["iterations"].as_u64() <= Some(1), "{v}");
+    assert!(
+        String::from_utf8_lossy(&out.stderr).contains("stopped at its time limit (0.001 s)"),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let usage = penmodel(
+        dir.path(),
+        &["trees", "fit", "front.png", "side.png", "--time-limit", "0"],
+    );
+    assert_eq!(usage.status.code(), Some(2), "a usage error");
+    assert!(String::from_utf8_lossy(&usage.stderr).contains("give a time limit above 0"));
     failed_with(
         &penmodel(dir.path(), &["trees", "fit", "nope.png", "side.png"]),
         "cannot read nope.png",

@@ -350,6 +350,7 @@ fn fitting_noisy_silhouettes_of_nudged_presets() {
             fit::Options {
                 iterations: 4,
                 starts: 1,
+                ..fit::Options::default()
             },
         )
         .expect("fits");

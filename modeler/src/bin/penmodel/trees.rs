@@ -148,8 +148,11 @@ struct FitArgs {
     #[arg(value_name = "SIDE.png")]
     side: PathBuf,
     /// Most gradient steps of each ascent.
-    #[arg(long, default_value_t = 30)]
-    iterations: usize,
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=1000))]
+    iterations: u32,
+    /// The longest the ascents may take together, in seconds; past it the best result so far is kept and a warning says so.
+    #[arg(long, value_name = "SECS", default_value_t = fit::BUDGET.as_secs_f64(), value_parser = parse_secs)]
+    time_limit: f64,
     /// How many of the best-matching presets an ascent starts from (the best result is kept).
     #[arg(long, default_value_t = fit::STARTS as u32, value_parser = clap::value_parser!(u32).range(1..=4))]
     starts: u32,
@@ -490,6 +493,16 @@ fn maps_json(s: &Species) -> Value {
     serde_json::to_value(&s.maps).unwrap_or(Value::Null)
 }
 
+/// A `--time-limit`: positive seconds, at most a day.
+fn parse_secs(s: &str) -> Result<f64, String> {
+    let v: f64 = s.parse().map_err(|_| format!("{s:?} is not a number of seconds"))?;
+    if v.is_finite() && v > 0.0 && v <= 86_400.0 {
+        Ok(v)
+    } else {
+        Err(format!("{s} s: give a time limit above 0 and at most 86400 s"))
+    }
+}
+
 fn fit_run(args: &FitArgs) -> Result<()> {
     let front = read_silhouette(&args.front)?;
     let side = read_silhouette(&args.side)?;
@@ -497,14 +510,21 @@ fn fit_run(args: &FitArgs) -> Result<()> {
         &front,
         &side,
         Options {
-            iterations: args.iterations,
+            iterations: args.iterations as usize,
             starts: args.starts as usize,
+            budget: std::time::Duration::from_secs_f64(args.time_limit),
         },
     )?;
+    if f.out_of_time {
+        eprintln!(
+            "warning: the fit stopped at its time limit ({} s) and keeps the best result so far; give --time-limit more seconds or fewer --iterations/--starts",
+            args.time_limit
+        );
+    }
     if let Some(path) = &args.json {
         let v = json!({
             "preset": f.preset.name(), "start": f.start, "reached": f.reached,
-            "iterations": f.iterations, "maps": maps_json(&f.species),
+            "iterations": f.iterations, "out_of_time": f.out_of_time, "maps": maps_json(&f.species),
         });
         let mut text = serde_json::to_string(&v)?;
         text.push('\n');

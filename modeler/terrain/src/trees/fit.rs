@@ -8,6 +8,8 @@
 //! measured in its own step ([`STEPS`]), on silhouettes blurred twice (a rasterised outline is a
 //! step function of the parameters; blurred, small changes change the objective smoothly).
 
+use std::time::{Duration, Instant};
+
 use rayon::prelude::*;
 
 use super::silhouette::{self, Image, View, ncc};
@@ -34,13 +36,23 @@ pub struct Options {
     pub iterations: usize,
     /// How many of the best templates an ascent starts from ([`STARTS`] by default).
     pub starts: usize,
+    /// The longest the ascents may take together ([`BUDGET`] by default): past it the best
+    /// result so far is kept and [`Fit::out_of_time`] says so. Checked before each step, so a
+    /// fit overruns it by at most one step.
+    pub budget: Duration,
 }
+
+/// The default time budget of a fit's ascents: 120 s. The seed's examples fit in a few seconds
+/// to a minute on two cores; a budget turns a fit that would run for many minutes into an
+/// answer with a message.
+pub const BUDGET: Duration = Duration::from_secs(120);
 
 impl Default for Options {
     fn default() -> Options {
         Options {
             iterations: 30,
             starts: STARTS,
+            budget: BUDGET,
         }
     }
 }
@@ -58,6 +70,8 @@ pub struct Fit {
     pub reached: [f64; 2],
     /// Gradient steps the kept ascent took.
     pub iterations: usize,
+    /// Whether the time budget ended the ascents before they converged or ran their steps.
+    pub out_of_time: bool,
 }
 
 /// Why a fit could not start.
@@ -137,10 +151,20 @@ fn sum(v: [f64; 2]) -> f64 {
 
 /// Gradient ascent from `p` (scoring `score`), at most `iterations` steps: the parameters, their
 /// correlations and the steps taken.
-fn ascend(target: &Target, mut p: Vec<f64>, mut best: [f64; 2], iterations: usize) -> (Vec<f64>, [f64; 2], usize) {
+/// Stops at `until`, saying so with the last value.
+fn ascend(
+    target: &Target,
+    mut p: Vec<f64>,
+    mut best: [f64; 2],
+    iterations: usize,
+    until: Instant,
+) -> (Vec<f64>, [f64; 2], usize, bool) {
     let mut steps = 0;
     let mut stride = 1.0;
     while steps < iterations {
+        if Instant::now() >= until {
+            return (p, best, steps, true);
+        }
         steps += 1;
         // The gradient in step units, its 2·4M renders on all cores.
         let grad: Vec<f64> = (0..p.len())
@@ -185,7 +209,7 @@ fn ascend(target: &Target, mut p: Vec<f64>, mut best: [f64; 2], iterations: usiz
             None => break,
         }
     }
-    (p, best, steps)
+    (p, best, steps, false)
 }
 
 /// Fits a species to a front and a side silhouette (coverage images of any size; each is
@@ -203,9 +227,18 @@ pub fn fit(front: &Image, side: &Image, options: Options) -> Result<Fit, FitErro
         .map(|p| (p, target.score(&Species::preset(p))))
         .collect();
     templates.sort_by(|a, b| sum(b.1).total_cmp(&sum(a.1)));
+    let until = Instant::now() + options.budget;
     let mut result: Option<Fit> = None;
+    let mut out_of_time = false;
     for &(preset, start) in templates.iter().take(options.starts.max(1)) {
-        let (p, reached, iterations) = ascend(&target, params(&Species::preset(preset)), start, options.iterations);
+        let (p, reached, iterations, late) = ascend(
+            &target,
+            params(&Species::preset(preset)),
+            start,
+            options.iterations,
+            until,
+        );
+        out_of_time |= late;
         if result.as_ref().is_none_or(|r| sum(reached) > sum(r.reached)) {
             result = Some(Fit {
                 preset,
@@ -213,10 +246,12 @@ pub fn fit(front: &Image, side: &Image, options: Options) -> Result<Fit, FitErro
                 start,
                 reached,
                 iterations,
+                out_of_time: false,
             });
         }
     }
-    let result = result.ok_or(FitError::NoTemplate)?;
+    let mut result = result.ok_or(FitError::NoTemplate)?;
+    result.out_of_time = out_of_time;
     if !within_branch_limit(&result.species) {
         return Err(FitError::Refused(format!(
             "more than {} branches",
