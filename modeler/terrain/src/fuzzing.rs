@@ -5,13 +5,16 @@
 use std::fs;
 use std::path::PathBuf;
 
-use crate::document::Document;
+use crate::TerrainEngine;
+use crate::document::{BaseHeights, Document};
 use crate::editor::Editor;
 use crate::journal;
 use crate::validate;
 
-/// Any bytes as a document file (either version): never a panic, and a document that loads is
-/// valid, and saves as text that loads to the same document and saves to the same text.
+/// Any bytes as a document file (any version): never a panic, and a document that loads is
+/// valid, and saves as text that loads to the same document and saves to the same text; and,
+/// on a small grid ([`TERRAIN_CELLS`], [`TERRAIN_WORK`]), its terrain builds with a finite height
+/// in every cell.
 pub fn document(bytes: &[u8]) {
     let Ok(text) = std::str::from_utf8(bytes) else {
         return;
@@ -20,6 +23,43 @@ pub fn document(bytes: &[u8]) {
         return;
     };
     check_document(&doc, "the document read");
+    check_terrain(&doc);
+}
+
+/// The most cells of a document whose terrain the document target builds: 64 × 64.
+pub const TERRAIN_CELLS: usize = 4096;
+
+/// The most cell-steps (cells × (1 + thermal iterations + fluvial steps)) of a terrain the
+/// document target builds, so that an execution stays within milliseconds.
+pub const TERRAIN_WORK: usize = 1 << 20;
+
+/// Builds the terrain of a valid document on a small grid: it must build, one finite height a
+/// cell. A base heightmap (`terrain.base`) names a file that is not read here: it gets heights
+/// made from the grid (a slope), so that the base's path through the engine runs too.
+fn check_terrain(doc: &Document) {
+    let cells = doc.grid.cells();
+    let erosion = doc.terrain.erosion.as_ref();
+    let steps = erosion.map_or(0, |e| e.iterations as usize)
+        + erosion.and_then(|e| e.fluvial.as_ref()).map_or(0, |f| f.steps as usize);
+    if cells > TERRAIN_CELLS || cells.saturating_mul(1 + steps) > TERRAIN_WORK {
+        return;
+    }
+    let mut doc = doc.clone();
+    if let Some(base) = &mut doc.terrain.base
+        && base.heights.get().is_none()
+    {
+        let cols = doc.grid.cols as usize;
+        base.heights = BaseHeights::new((0..cells).map(|i| (i % cols + i / cols) as f32 * 0.5).collect());
+    }
+    let engine = match TerrainEngine::new(&doc) {
+        Ok(engine) => engine,
+        Err(e) => panic!("a valid document's terrain does not build: {e}"),
+    };
+    let map = engine.heightmap();
+    assert_eq!(map.heights().len(), cells, "the terrain has not one height a cell");
+    if let Some(i) = map.heights().iter().position(|h| !h.is_finite()) {
+        panic!("the terrain's height at cell {i} is {}", map.heights()[i]);
+    }
 }
 
 fn check_document(doc: &Document, what: &str) {

@@ -52,3 +52,62 @@ fn the_journal_seeds_replay_edits() {
     let heights: Vec<f64> = editor.document().regions[0].figures.iter().map(|f| f.height).collect();
     assert_eq!(heights, [50.0]);
 }
+
+/// The corpus' documents of today's version with every element kind (issue 47 item 13: the
+/// corpus held versions 1 and 2 only).
+const EVERY_ELEMENT: [&str; 2] = ["v6-every-element.json", "v6-every-element-no-base.json"];
+
+#[test]
+fn the_document_seeds_hold_every_element_and_build() {
+    let corpus = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/document");
+    for name in EVERY_ELEMENT {
+        let text = fs::read_to_string(corpus.join(name)).expect("seed");
+        let doc = penmodel_terrain::Document::from_json(&text).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(doc.version, penmodel_terrain::document::VERSION, "{name}");
+        let ridges = doc.ridges.as_ref().expect("ridges");
+        let erosion = doc.terrain.erosion.as_ref().expect("erosion");
+        let nested = doc
+            .regions
+            .iter()
+            .flat_map(|r| &r.figures)
+            .any(|f| !f.figures.is_empty());
+        let kinds: Vec<_> = doc.regions.iter().flat_map(|r| &r.figures).map(|f| f.kind).collect();
+        assert!(
+            doc.regions.len() >= 2 && nested && kinds.len() >= 3,
+            "{name}: regions and figures"
+        );
+        assert!(
+            doc.regions.iter().any(|r| r.metric.is_some()),
+            "{name}: a region's metric"
+        );
+        assert!(
+            !doc.rocks.is_empty() && !doc.rivers.is_empty(),
+            "{name}: rocks and rivers"
+        );
+        assert!(
+            !ridges.lines.is_empty() && !ridges.trees.is_empty(),
+            "{name}: ridge lines and trees"
+        );
+        assert!(
+            doc.trees.len() >= 2 && !doc.groves.is_empty(),
+            "{name}: trees and groves"
+        );
+        assert!(
+            doc.trees.iter().any(|t| t.maps.is_some() && t.wind.is_some()),
+            "{name}: a tree's maps, wind"
+        );
+        assert!(
+            doc.terrain.detail.is_some() && erosion.fluvial.is_some(),
+            "{name}: detail, fluvial"
+        );
+        assert!(
+            doc.grid.cells() <= fuzzing::TERRAIN_CELLS,
+            "{name}: the target builds its terrain"
+        );
+        // Beyond loading: the document target builds its terrain (a panic would fail here).
+        fuzzing::document(text.as_bytes());
+    }
+    let with_base = fs::read_to_string(corpus.join(EVERY_ELEMENT[0])).expect("seed");
+    let doc = penmodel_terrain::Document::from_json(&with_base).expect("loads");
+    assert!(doc.terrain.base.is_some(), "the first seed has a base heightmap");
+}
