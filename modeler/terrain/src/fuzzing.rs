@@ -78,8 +78,9 @@ fn check_document(doc: &Document, what: &str) {
 /// The document the journal target edits: small, so that an execution stays cheap.
 pub const JOURNAL_BASE: &str = include_str!("../../examples/04-volcano.json");
 
-/// The journal's first line for [`JOURNAL_BASE`]: the fuzzed bytes follow it, so that the
-/// fuzzer need not guess the document's fingerprint to get past the first line.
+/// The journal's first line for [`JOURNAL_BASE`] in version 1 (no sequence numbers, no
+/// checksums): the fuzzed bytes follow it, so that the fuzzer need not guess the document's
+/// fingerprint to get past the first line.
 pub fn journal_open_line() -> String {
     format!(
         "{{\"op\":\"open\",\"journal\":1,\"base\":\"{}\"}}\n",
@@ -87,29 +88,64 @@ pub fn journal_open_line() -> String {
     )
 }
 
-/// Any bytes as the journal of [`JOURNAL_BASE`] after its `open` line, opened (read-only) as
-/// `penmodel open` does after a crash: never a panic; if it opens, the edited document is valid
-/// and saves and loads like any other; and the same files open to the same document again.
+/// The same first line in version 2, as the editor writes it: `{"seq":1,"crc32":…,"op":"open",…}`.
+pub fn journal_open_line_v2() -> String {
+    let open = journal::Entry::Open {
+        journal: journal::JOURNAL_VERSION,
+        base: journal::fingerprint(JOURNAL_BASE.as_bytes()),
+    };
+    String::from_utf8(journal::line(&open, journal::JOURNAL_VERSION, 1)).unwrap_or_default()
+}
+
+/// Any bytes as the journal of [`JOURNAL_BASE`] after its `open` line — a version-2 one when the
+/// bytes begin as a version-2 line does (`{"seq":`), else a version-1 one — opened (read-only)
+/// as `penmodel open` does after a crash: never a panic; if it opens, the edited document is
+/// valid and saves and loads like any other; and the same files open to the same document
+/// again. Then opened recovering (`penmodel open --recover`): that always opens, since the
+/// `open` line is good; to the same document as the plain open when that opened, with nothing
+/// left out, and otherwise to a valid document.
 pub fn journal(bytes: &[u8]) {
     let scratch = Scratch::new();
     let dir = &scratch.0;
     let doc = dir.join("doc.json");
-    let mut text = journal_open_line().into_bytes();
+    let open = match bytes.starts_with(b"{\"seq\":") {
+        true => journal_open_line_v2(),
+        false => journal_open_line(),
+    };
+    let mut text = open.into_bytes();
     text.extend_from_slice(bytes);
     let written = fs::write(&doc, JOURNAL_BASE).and_then(|()| fs::write(journal::path_for(&doc), &text));
     if let Err(e) = written {
         panic!("cannot write the scratch files in {}: {e}", dir.display());
     }
-    let Ok((editor, report)) = Editor::open_read_only(&doc) else {
-        return;
-    };
-    check_document(editor.document(), "the journalled document");
-    match Editor::open_read_only(&doc) {
-        Ok((again, report_again)) => {
-            assert_eq!(again.document(), editor.document(), "the journal replays differently");
-            assert_eq!(report_again.replayed, report.replayed);
+    let strict = Editor::open_read_only(&doc).ok();
+    if let Some((editor, report)) = &strict {
+        check_document(editor.document(), "the journalled document");
+        match Editor::open_read_only(&doc) {
+            Ok((again, report_again)) => {
+                assert_eq!(again.document(), editor.document(), "the journal replays differently");
+                assert_eq!(report_again.replayed, report.replayed);
+            }
+            Err(e) => panic!("the journal opened once, then not: {e}"),
         }
-        Err(e) => panic!("the journal opened once, then not: {e}"),
+    }
+    let (recovered, report) = match Editor::open_recovering(&doc) {
+        Ok(opened) => opened,
+        Err(e) => panic!("a journal with a good open line does not open recovering: {e}"),
+    };
+    match &strict {
+        Some((editor, _)) => {
+            assert_eq!(
+                recovered.document(),
+                editor.document(),
+                "recovering replays differently"
+            );
+            assert!(
+                report.recovered.is_none(),
+                "recovering left out lines of a good journal"
+            );
+        }
+        None => check_document(recovered.document(), "the recovered document"),
     }
 }
 

@@ -111,3 +111,156 @@ fn the_document_seeds_hold_every_element_and_build() {
     let doc = penmodel_terrain::Document::from_json(&with_base).expect("loads");
     assert!(doc.terrain.base.is_some(), "the first seed has a base heightmap");
 }
+
+/// The journal seeds the editor wrote (`write_fuzz_seeds`): each version-2 one, and its
+/// version-1 twin, replays every line it holds.
+#[test]
+fn the_journal_seeds_of_rivers_ridges_trees_and_groves_replay() {
+    let corpus = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/journal");
+    for (name, _) in journal_seeds() {
+        for (file, open) in [
+            (format!("v2-{name}"), fuzzing::journal_open_line_v2()),
+            (format!("v1-{name}"), fuzzing::journal_open_line()),
+        ] {
+            let lines = fs::read_to_string(corpus.join(&file)).unwrap_or_else(|e| panic!("{file}: {e}"));
+            let dir = tempfile::tempdir().expect("tempdir");
+            let doc = dir.path().join("doc.json");
+            fs::write(&doc, fuzzing::JOURNAL_BASE).expect("doc");
+            fs::write(penmodel_terrain::journal::path_for(&doc), open + &lines).expect("journal");
+            let (_, report) = penmodel_terrain::editor::Editor::open_read_only(&doc)
+                .unwrap_or_else(|e| panic!("{file} does not open: {e}"));
+            assert_eq!(report.replayed, lines.lines().count(), "{file}: every line replays");
+        }
+    }
+    // The damaged ones are refused at their bad line (3: a changed digit; 4: seq 5 after 3), and
+    // open recovering up to it.
+    for (file, line) in [("v2-damaged-changed-digit", 3), ("v2-damaged-lost-line", 4)] {
+        let lines = fs::read_to_string(corpus.join(file)).expect("seed");
+        let dir = tempfile::tempdir().expect("tempdir");
+        let doc = dir.path().join("doc.json");
+        fs::write(&doc, fuzzing::JOURNAL_BASE).expect("doc");
+        fs::write(
+            penmodel_terrain::journal::path_for(&doc),
+            fuzzing::journal_open_line_v2() + &lines,
+        )
+        .expect("journal");
+        let refused = penmodel_terrain::editor::Editor::open_read_only(&doc)
+            .err()
+            .expect("refused");
+        assert!(
+            refused.to_string().contains(&format!("line {line}:")),
+            "{file}: {refused}"
+        );
+        let (_, report) = penmodel_terrain::editor::Editor::open_recovering(&doc).expect("recovers");
+        assert_eq!(report.replayed, line - 2, "{file}: the lines before the bad one");
+        assert_eq!(report.recovered.expect("recovered").dropped.line, line, "{file}");
+    }
+}
+
+/// The edits of each journal seed, as the editor applies them: `undo` and `redo` as such.
+fn journal_seeds() -> Vec<(&'static str, Vec<&'static str>)> {
+    vec![
+        (
+            "rivers",
+            vec![
+                r#"{"op":"add_river","index":0,"river":{"points":[[100.0,160.0],[130.0,150.0],[150.0,175.0],[200.0,160.0]],"width":3.0,"depth":1.5,"iterations":2}}"#,
+                r#"{"op":"replace_river","index":0,"river":{"points":[[100.0,160.0],[130.0,140.0],[150.0,175.0],[210.0,165.0]],"width":4.0,"depth":1.0,"water":80.0,"hardness":3.0,"iterations":3}}"#,
+                "undo",
+                "redo",
+                r#"{"op":"add_river","index":1,"river":{"points":[[160.0,60.0],[160.0,120.0]],"width":2.0,"depth":1.0}}"#,
+                r#"{"op":"delete_river","index":0}"#,
+                "undo",
+            ],
+        ),
+        (
+            "ridges",
+            vec![
+                r#"{"op":"set_ridges","ridges":{"slope":30.0,"filter_radius":1,"filter_passes":2,"lines":[{"points":[[60.0,200.0,40.0],[160.0,180.0,110.0],[260.0,215.0,90.0]]}]}}"#,
+                r#"{"op":"set_ridges","ridges":{"slope":35.0,"filter_radius":2,"filter_passes":1,"lines":[{"points":[[60.0,200.0,40.0],[160.0,180.0,110.0],[260.0,215.0,90.0]]}],"trees":[{"nodes":[[160.0,100.0],[110.0,80.0],[210.0,80.0],[160.0,40.0]],"edges":[[0,1],[0,2],[0,3]],"theta":25.0,"h_end":5.0}]}}"#,
+                "undo",
+                "redo",
+                r#"{"op":"set_ridges","ridges":null}"#,
+                "undo",
+            ],
+        ),
+        (
+            "trees",
+            vec![
+                r#"{"op":"add_tree","index":0,"tree":{"at":[160.0,160.0],"height":12.0,"preset":"oak","seed":7}}"#,
+                r#"{"op":"add_tree","index":1,"tree":{"at":[120.0,140.0],"height":9.0,"seed":2,"maps":[{"y":0.4,"s":0.6,"theta_z":10.0,"theta_y":0.0},{"y":0.24,"s":0.55,"theta_z":40.0,"theta_y":60.0}],"wind":{"direction":30.0,"generations":[{"amplitude":2.0,"frequency":0.3},{"amplitude":6.0,"frequency":0.8,"rest":1.0}]}}}"#,
+                r#"{"op":"move_tree","index":0,"by":[5.0,-3.0]}"#,
+                r#"{"op":"replace_tree","index":0,"tree":{"at":[165.0,157.0],"height":15.0,"preset":"fir","seed":8}}"#,
+                "undo",
+                r#"{"op":"delete_tree","index":1}"#,
+                "undo",
+                "redo",
+            ],
+        ),
+        (
+            "groves",
+            vec![
+                r#"{"op":"add_grove","index":0,"grove":{"region":[[120.0,120.0],[200.0,120.0],[200.0,200.0],[120.0,120.0]],"density":100.0,"mix":[{"preset":"oak","weight":2.0},{"preset":"fir"}],"height":10.0,"seed":3}}"#,
+                r#"{"op":"move_grove","index":0,"by":[4.0,6.0]}"#,
+                r#"{"op":"replace_grove","index":0,"grove":{"region":[[124.0,126.0],[204.0,126.0],[204.0,206.0],[124.0,126.0]],"density":50.0,"height":12.0,"seed":4,"wind":{"direction":90.0,"generations":[{"amplitude":3.0,"frequency":0.5}]}}}"#,
+                "undo",
+                "redo",
+                r#"{"op":"delete_grove","index":0}"#,
+                "undo",
+            ],
+        ),
+    ]
+}
+
+/// Writes the journal seeds (the lines after the `open` one that the editor journals for each
+/// of [`journal_seeds`], in version 2 and the same entries in version 1; and two damaged
+/// version-2 ones: a changed digit, a line lost) into the corpus:
+/// `cargo test -p penmodel-terrain --test main write_fuzz_seeds -- --ignored`.
+#[test]
+#[ignore = "writes the corpora's seeds"]
+fn write_fuzz_seeds() {
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus");
+    for (name, edits) in journal_seeds() {
+        let dir = tempfile::tempdir().expect("tempdir");
+        let doc = dir.path().join("doc.json");
+        fs::write(&doc, fuzzing::JOURNAL_BASE).expect("doc");
+        {
+            let (mut editor, _) = penmodel_terrain::editor::Editor::open(&doc).expect("opens");
+            for edit in edits {
+                match edit {
+                    "undo" => assert!(editor.undo().expect("undo").is_some()),
+                    "redo" => assert!(editor.redo().expect("redo").is_some()),
+                    _ => {
+                        let edit: penmodel_terrain::Edit = serde_json::from_str(edit).expect("an edit");
+                        editor.apply(edit).unwrap_or_else(|e| panic!("{name}: {e}"));
+                    }
+                }
+            }
+        }
+        let journal = fs::read_to_string(penmodel_terrain::journal::path_for(&doc)).expect("journal");
+        let (open, lines) = journal.split_once('\n').expect("an open line");
+        assert_eq!(
+            format!("{open}\n"),
+            fuzzing::journal_open_line_v2(),
+            "the editor's open line"
+        );
+        fs::write(root.join(format!("journal/v2-{name}")), lines).expect("write");
+        // The same entries without their sequence numbers and checksums: version 1.
+        let plain: String = lines
+            .lines()
+            .map(|l| {
+                let body = &l[l.find("\"op\"").expect("an op")..];
+                format!("{{{body}\n")
+            })
+            .collect();
+        fs::write(root.join(format!("journal/v1-{name}")), plain).expect("write");
+        if name == "rivers" {
+            // A digit changed in the second line (its checksum fails), and the third line lost.
+            let changed = lines.replacen("130.0,140.0", "130.0,141.0", 1);
+            assert_ne!(changed, lines);
+            fs::write(root.join("journal/v2-damaged-changed-digit"), changed).expect("write");
+            let lost: Vec<&str> = lines.lines().collect();
+            let lost = [&lost[..2], &lost[3..]].concat().join("\n") + "\n";
+            fs::write(root.join("journal/v2-damaged-lost-line"), lost).expect("write");
+        }
+    }
+}
