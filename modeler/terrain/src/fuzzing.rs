@@ -9,6 +9,8 @@ use crate::TerrainEngine;
 use crate::document::{BaseHeights, Document};
 use crate::editor::Editor;
 use crate::journal;
+use crate::ridge::rain;
+use crate::ridge::sun::{self, Field, Sun};
 use crate::validate;
 
 /// Any bytes as a document file (any version): never a panic, and a document that loads is
@@ -147,6 +149,99 @@ pub fn journal(bytes: &[u8]) {
         }
         None => check_document(recovered.document(), "the recovered document"),
     }
+}
+
+/// The most cells of a grid the [`grid`] target makes: 65536 (4096 × 16, or 1 × 4096 …).
+pub const GRID_CELLS: usize = 1 << 16;
+
+/// The longest side of a grid the [`grid`] target makes.
+pub const GRID_SIDE: usize = 4096;
+
+/// A grid from fuzzed bytes: `(cols, rows, cell size, heights)`. Byte 0 and 1 give the long
+/// side (1 to [`GRID_SIDE`]), byte 2 the short one (1 to 16), byte 3's low bit whether the long
+/// side runs along the columns or the rows, byte 4 the cell size (0.25 to 64 m); the heights are
+/// the rest as little-endian `i16` half-metres, repeated to fill the grid (flat without any).
+/// Always finite, at most [`GRID_CELLS`] cells.
+pub fn grid_of(bytes: &[u8]) -> (u32, u32, f64, Vec<f32>) {
+    let at = |i: usize| bytes.get(i).copied().unwrap_or(0);
+    let long = (usize::from(u16::from_le_bytes([at(0), at(1)])) % GRID_SIDE) + 1;
+    let short = usize::from(at(2) % 16) + 1;
+    let (cols, rows) = if at(3) & 1 == 0 { (long, short) } else { (short, long) };
+    let cell = 0.25 * f64::from(1 + u32::from(at(4)) % 256);
+    let raw = bytes.get(8..).unwrap_or_default();
+    let samples: Vec<f32> = raw
+        .chunks_exact(2)
+        .map(|b| f32::from(i16::from_le_bytes([b[0], b[1]])) * 0.5)
+        .collect();
+    let z = match samples.is_empty() {
+        true => vec![0.0; cols * rows],
+        false => samples.iter().copied().cycle().take(cols * rows).collect(),
+    };
+    (cols as u32, rows as u32, cell, z)
+}
+
+/// Any bytes as a small, long or thin grid ([`grid_of`]: 1 × 1 up to 4096 × 16 and 1 × 4096) and
+/// a sun and 1 to 8 sky directions from bytes 5 to 7, through the analyses and the sweeps
+/// the renderer's land look uses: the rain's moves, pass counts and longest paths, the direct
+/// light, the sky view (`ridge::sun::sky_view`, the land look's sky) and the hillshade. Never a
+/// panic; every output one value a cell, finite and in its range (moves to a cell of the grid
+/// or none; counts and path lengths 1 to the cells; light and sky view in [0, 1]). Issue 47
+/// item 3: the sweeps once held every line over every column, the square of the long side —
+/// 4096 × 1 asked for 16 M floats — and a run of this target stays fast only while they are
+/// bounded by the grid.
+pub fn grid(bytes: &[u8]) {
+    let (cols, rows, cell, z) = grid_of(bytes);
+    let n = z.len();
+    let at = |i: usize| bytes.get(i).copied().unwrap_or(0);
+    let field = Field {
+        z: &z,
+        cols,
+        rows,
+        cell,
+    };
+    let shape = format!("{cols}×{rows}");
+    let next = rain::directions(&z, cols, rows, cell);
+    assert_eq!(next.len(), n, "{shape}: directions");
+    assert!(
+        next.iter().all(|&m| m == rain::STOP || (m as usize) < n),
+        "{shape}: a move off the grid"
+    );
+    for (name, values) in [
+        ("pass counts", rain::accumulate(&next)),
+        ("longest paths", rain::longest_paths(&next)),
+    ] {
+        assert_eq!(values.len(), n, "{shape}: {name}");
+        assert!(
+            values.iter().all(|&v| v >= 1 && v as usize <= n),
+            "{shape}: {name} out of 1..={n}"
+        );
+    }
+    let sun = Sun {
+        azimuth: f64::from(at(5)) / 256.0 * std::f64::consts::TAU,
+        elevation: (1.0 + f64::from(at(6) % 90)).to_radians(),
+    };
+    let k = u32::from(at(7) % 8) + 1;
+    for (name, values) in [
+        ("direct light", sun::direct(field, sun)),
+        ("sky view", sun::sky_view(field, k)),
+        ("hillshade", sun::hillshade(field, sun)),
+    ] {
+        assert_eq!(values.len(), n, "{shape}: {name}");
+        if let Some(i) = values
+            .iter()
+            .position(|v| !(v.is_finite() && (-1e-4..=1.0 + 1e-4).contains(v)))
+        {
+            panic!("{shape}: {name} at cell {i} is {}", values[i]);
+        }
+    }
+}
+
+/// The most the heap may grow while [`grid`] runs on a grid of `cells` cells (the `grid` target
+/// checks it with a counting allocator): 32 MiB, the sweeps' fixed passes (2²⁰ floats) and
+/// rayon's, plus 256 bytes a cell. The sweeps need some 40 bytes a cell; the square of a 4096
+/// long side would be 64 MiB of floats.
+pub fn grid_heap_bound(cells: usize) -> usize {
+    (32 << 20) + 256 * cells
 }
 
 /// A directory of this thread's own (tests run in parallel threads), removed when dropped: an

@@ -1,5 +1,6 @@
 //! The fuzz targets' corpora (modeler/terrain/fuzz/corpus/: the example documents, a version-2
-//! document with a rock field, journals of the edits the editor writes, grown by
+//! document with a rock field, version-6 documents with every element kind, journals of the
+//! edits the editor writes in versions 1 and 2, small, long and thin grids; grown by
 //! `cargo +nightly fuzz`) replayed on stable through the same properties the targets check
 //! (docs/reliability.md).
 
@@ -51,6 +52,11 @@ fn the_journal_seeds_replay_edits() {
     assert_eq!(report.replayed, 3);
     let heights: Vec<f64> = editor.document().regions[0].figures.iter().map(|f| f.height).collect();
     assert_eq!(heights, [50.0]);
+}
+
+#[test]
+fn grid_corpus() {
+    assert!(replay("grid", fuzzing::grid) >= 5);
 }
 
 /// The corpus' documents of today's version with every element kind (issue 47 item 13: the
@@ -213,7 +219,7 @@ fn journal_seeds() -> Vec<(&'static str, Vec<&'static str>)> {
 
 /// Writes the journal seeds (the lines after the `open` one that the editor journals for each
 /// of [`journal_seeds`], in version 2 and the same entries in version 1; and two damaged
-/// version-2 ones: a changed digit, a line lost) into the corpus:
+/// version-2 ones: a changed digit, a line lost) and the grid seeds into the corpora:
 /// `cargo test -p penmodel-terrain --test main write_fuzz_seeds -- --ignored`.
 #[test]
 #[ignore = "writes the corpora's seeds"]
@@ -263,4 +269,40 @@ fn write_fuzz_seeds() {
             fs::write(root.join("journal/v2-damaged-lost-line"), lost).expect("write");
         }
     }
+    fs::create_dir_all(root.join("grid")).expect("grid corpus");
+    for (name, bytes) in grid_seeds() {
+        fs::write(root.join("grid").join(name), bytes).expect("write");
+    }
+}
+
+/// A `grid` target input ([`fuzzing::grid_of`]): the long and short sides, whether the long side
+/// runs down the rows, the cell-size byte, the sun and the sky directions, the heights.
+fn grid_input(long: u16, short: u8, down: bool, cell: u8, sun: [u8; 2], k: u8, heights: &[i16]) -> Vec<u8> {
+    let mut b = Vec::new();
+    b.extend_from_slice(&(long - 1).to_le_bytes());
+    b.extend_from_slice(&[short - 1, u8::from(down), cell, sun[0], sun[1], k - 1]);
+    for h in heights {
+        b.extend_from_slice(&h.to_le_bytes());
+    }
+    b
+}
+
+fn grid_seeds() -> Vec<(&'static str, Vec<u8>)> {
+    let ramp: Vec<i16> = (0..64).map(|i| i * 10).collect();
+    let wall: Vec<i16> = (0..97).map(|i| if i == 48 { 200 } else { 0 }).collect();
+    let rough: Vec<i16> = (0..61i32).map(|i| ((i * 7919) % 601 - 300) as i16).collect();
+    let cone: Vec<i16> = (0..256i32)
+        .map(|i| (200 - ((i % 16 - 8).abs() + (i / 16 - 8).abs()) * 20) as i16)
+        .collect();
+    vec![
+        ("one-cell", grid_input(1, 1, false, 7, [0, 30], 8, &[10])),
+        ("flat-4096x1", grid_input(4096, 1, false, 7, [32, 20], 8, &[])),
+        ("flat-1x4096", grid_input(4096, 1, true, 7, [96, 20], 8, &[])),
+        ("ramp-4096x16", grid_input(4096, 16, false, 3, [160, 10], 16, &ramp)),
+        ("wall-16x4096", grid_input(4096, 16, true, 7, [0, 15], 4, &wall)),
+        ("rough-2x3", grid_input(2, 3, false, 0, [200, 45], 3, &rough)),
+        ("rough-1000x1", grid_input(1000, 1, false, 255, [64, 5], 7, &rough)),
+        ("cone-16x16", grid_input(16, 16, false, 7, [10, 40], 16, &cone)),
+        ("wall-97x2", grid_input(97, 2, false, 1, [128, 3], 2, &wall)),
+    ]
 }
