@@ -14,6 +14,7 @@ const TARGETS: &[(&str, &str)] = &[
     ("host-driver", "calibration"),
     ("modeler/terrain", "document"),
     ("modeler/terrain", "journal"),
+    ("modeler/terrain", "grid"),
     ("firmware/core", "replay"),
 ];
 

@@ -342,7 +342,7 @@ pub struct Writer {
 }
 
 /// `entry` as line number `seq` of a journal of format `version`, with its newline.
-fn line(entry: &Entry, version: u32, seq: u64) -> Vec<u8> {
+pub(crate) fn line(entry: &Entry, version: u32, seq: u64) -> Vec<u8> {
     // Our entries always serialise (no non-string map keys); a failure would be a bug.
     let json = serde_json::to_vec(entry).unwrap_or_default();
     let mut bytes = match (version, json.split_first()) {
