@@ -12,7 +12,7 @@ use anyhow::{Context, Result, bail};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use pen_host::calibration::procedure::{self as calibrate, Prompt};
 use pen_host::calibration::run;
-use pen_host::calibration::{self, Calibration, CalibrationError, DeviceId, DisplaySize, FitKind, plot};
+use pen_host::calibration::{self, Calibration, CalibrationError, DeviceId, FitKind, plot};
 use pen_host::device::{Device, DeviceEvent};
 use pen_host::hex;
 use pen_host::source::{self, SimSwitch, Source};
@@ -182,15 +182,8 @@ enum Fit {
 struct CalibrateArgs {
     #[command(flatten)]
     device: DeviceArgs,
-    /// Targets: 4 (corners), 5 (and the centre) or 9 (a 3 × 3 grid).
-    #[arg(long, default_value_t = 5, value_parser = target_count)]
-    targets: u8,
-    /// The display's active area, mm.
-    #[arg(long, value_name = "WxH", default_value = "600x340", value_parser = size::<f64>)]
-    display_mm: (f64, f64),
-    /// The display's resolution.
-    #[arg(long, value_name = "WxH", default_value = "2560x1440", value_parser = size::<u32>)]
-    display_px: (u32, u32),
+    #[command(flatten)]
+    display: pen_host::calibration::args::DisplayArgs,
     /// The transform to fit.
     #[arg(long, value_enum, default_value_t = Fit::Similarity)]
     fit: Fit,
@@ -213,22 +206,6 @@ struct CalibrateArgs {
     /// the tracked glasses' positions need (docs/calibration.md, "The pivot").
     #[arg(long)]
     no_pivot: bool,
-}
-
-/// `WIDTHxHEIGHT`, for clap (a usage error otherwise).
-fn size<T: std::str::FromStr>(s: &str) -> Result<(T, T), String> {
-    let parsed = s
-        .split_once(['x', 'X', '×'])
-        .and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
-    parsed.ok_or_else(|| format!("expected WIDTHxHEIGHT, such as 600x340, got {s:?}"))
-}
-
-/// The calibration's target counts, for clap: any other is refused, not rounded to one of these.
-fn target_count(s: &str) -> Result<u8, String> {
-    match s.trim().parse::<u8>() {
-        Ok(n @ (4 | 5 | 9)) => Ok(n),
-        _ => Err("a calibration has 4 targets (the corners), 5 (and the centre) or 9 (a 3 × 3 grid)".into()),
-    }
 }
 
 /// A usage error found after parsing (values that parse but do not go together or are out of
@@ -551,13 +528,7 @@ fn calibration_source(device: &DeviceArgs, _targets: &[glam::DVec2], _pivot: Opt
 }
 
 fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
-    let ((width_mm, height_mm), (width_px, height_px)) = (a.display_mm, a.display_px);
-    let display = DisplaySize {
-        width_mm,
-        height_mm,
-        width_px,
-        height_px,
-    };
+    let display = a.display.display();
     // Checked before the touches, not after the user has made them all.
     if let Err(e) = display.check() {
         let flag = match &e {
@@ -566,7 +537,7 @@ fn calibrate_cmd(a: CalibrateArgs) -> Result<()> {
         };
         return Err(UsageError(format!("{flag}: {e}")).into());
     }
-    let targets = display.targets(a.targets as usize);
+    let targets = display.targets(a.display.targets as usize);
     let kind = match a.fit {
         Fit::Rigid => FitKind::Rigid,
         Fit::Similarity => FitKind::Similarity,

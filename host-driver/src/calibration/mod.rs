@@ -14,6 +14,7 @@
 //! * [`delays`]: each receiver's transducer delay from a pen held at surveyed points
 //!   (`penctl delays`).
 
+pub mod args;
 pub mod delays;
 pub mod device;
 pub mod file;

@@ -13,7 +13,7 @@ use anyhow::{Context, Result, bail};
 use glam::DVec2;
 use pen_host::calibration::procedure::{self, Prompt};
 use pen_host::calibration::run::{self, Outcome, Plan};
-use pen_host::calibration::{self, Calibration, DisplaySize, plot};
+use pen_host::calibration::{self, Calibration, plot};
 use pen_host::device::Device;
 use pen_host::source::Source;
 use penmodel::feed::{Calibrating, CalibrationPicture};
@@ -37,15 +37,8 @@ pub struct Args {
     /// The simulated pen's speed: device seconds per second (0: as fast as it is read) [default: 1].
     #[arg(long, value_parser = pen_host::source::speed_value)]
     speed: Option<f64>,
-    /// Targets: 4 (corners), 5 (and the centre) or 9 (a 3 × 3 grid).
-    #[arg(long, default_value_t = 5, value_parser = target_count)]
-    targets: u8,
-    /// The display's active area, mm.
-    #[arg(long, value_name = "WxH", default_value = "600x340", value_parser = size::<f64>)]
-    display_mm: (f64, f64),
-    /// The display's resolution.
-    #[arg(long, value_name = "WxH", default_value = "2560x1440", value_parser = size::<u32>)]
-    display_px: (u32, u32),
+    #[command(flatten)]
+    display: pen_host::calibration::args::DisplayArgs,
     /// Where to save the calibration [default: $XDG_CONFIG_HOME/penscape/calibration.toml;
     /// calibration-sim.toml for the simulated pen]. The file pend reads.
     #[arg(long, value_name = "FILE")]
@@ -70,27 +63,12 @@ pub struct Args {
     close_after: Option<f64>,
 }
 
-/// `WIDTHxHEIGHT`, for clap.
-fn size<T: std::str::FromStr>(s: &str) -> Result<(T, T), String> {
-    s.split_once(['x', 'X', '×'])
-        .and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)))
-        .ok_or_else(|| format!("expected WIDTHxHEIGHT, such as 600x340, got {s:?}"))
-}
-
 /// A source `--source` names, for clap (a usage error otherwise).
 fn source_arg(s: &str) -> Result<String, String> {
     if s == "sim" {
         return Ok(s.to_string());
     }
     s.parse::<Source>().map(|_| s.to_string()).map_err(|e| e.to_string())
-}
-
-/// 4, 5 or 9 targets, for clap.
-fn target_count(s: &str) -> Result<u8, String> {
-    match s.trim().parse::<u8>() {
-        Ok(n @ (4 | 5 | 9)) => Ok(n),
-        _ => Err("a calibration has 4 targets (the corners), 5 (and the centre) or 9 (a 3 × 3 grid)".into()),
-    }
 }
 
 /// What the calibration thread tells the window.
@@ -101,17 +79,11 @@ enum Step {
 
 /// Runs `penmodel calibrate`.
 pub fn run(a: &Args) -> Result<()> {
-    let ((width_mm, height_mm), (width_px, height_px)) = (a.display_mm, a.display_px);
-    let display = DisplaySize {
-        width_mm,
-        height_mm,
-        width_px,
-        height_px,
-    };
+    let display = a.display.display();
     display.check().context("--display-mm or --display-px")?;
     let mut plan = Plan::new(
         display,
-        usize::from(a.targets),
+        usize::from(a.display.targets),
         Duration::from_secs_f64(a.patience.max(1.0)),
     );
     if a.no_pivot {

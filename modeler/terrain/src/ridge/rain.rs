@@ -69,26 +69,7 @@ pub fn counts(z: &[f32], cols: u32, rows: u32, cell: f64) -> Vec<u32> {
 
 /// The pass counts of the moves `next` ([`directions`]).
 pub fn accumulate(next: &[u32]) -> Vec<u32> {
-    let mut inflow = vec![0u32; next.len()];
-    for &n in next {
-        if n != STOP {
-            inflow[n as usize] += 1;
-        }
-    }
-    let mut count = vec![1u32; next.len()];
-    // Upstream-first (Kahn's order): a cell is passed on once every cell moving into it was.
-    let mut ready: Vec<u32> = (0..next.len() as u32).filter(|&i| inflow[i as usize] == 0).collect();
-    while let Some(i) = ready.pop() {
-        let n = next[i as usize];
-        if n != STOP {
-            count[n as usize] += count[i as usize];
-            inflow[n as usize] -= 1;
-            if inflow[n as usize] == 0 {
-                ready.push(n);
-            }
-        }
-    }
-    count
+    downstream(next, |from, to| to + from)
 }
 
 /// Per cell, the number of cells on the longest path of moves `next` ([`directions`]) that ends
@@ -96,25 +77,32 @@ pub fn accumulate(next: &[u32]) -> Vec<u32> {
 /// plane every path runs beside the others and the pass count equals it; where water gathers,
 /// as in a valley, the count exceeds it many times.
 pub fn longest_paths(next: &[u32]) -> Vec<u32> {
+    downstream(next, |from, to| to.max(from + 1))
+}
+
+/// Per cell a value, 1 to start with, passed down the moves `next` in upstream-first (Kahn's)
+/// order: a cell is passed on once every cell moving into it was, its value at the cell it moves
+/// to becoming `join(its value, the value there)`.
+fn downstream(next: &[u32], join: impl Fn(u32, u32) -> u32) -> Vec<u32> {
     let mut inflow = vec![0u32; next.len()];
     for &n in next {
         if n != STOP {
             inflow[n as usize] += 1;
         }
     }
-    let mut longest = vec![1u32; next.len()];
+    let mut value = vec![1u32; next.len()];
     let mut ready: Vec<u32> = (0..next.len() as u32).filter(|&i| inflow[i as usize] == 0).collect();
     while let Some(i) = ready.pop() {
         let n = next[i as usize];
         if n != STOP {
-            longest[n as usize] = longest[n as usize].max(longest[i as usize] + 1);
+            value[n as usize] = join(value[i as usize], value[n as usize]);
             inflow[n as usize] -= 1;
             if inflow[n as usize] == 0 {
                 ready.push(n);
             }
         }
     }
-    longest
+    value
 }
 
 /// The cells a drop starting in cell `start` passes through, `start` first.
