@@ -6,7 +6,7 @@
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use crate::mouse_window::{Killed, Shot, found, xvfb};
+use crate::mouse_window::{Killed, Shot, x_tools, xvfb};
 
 /// A hang guard only.
 const GUARD: Duration = Duration::from_secs(90);
@@ -29,28 +29,18 @@ fn count(shot: &Shot, colour: u32) -> usize {
     shot.pixels.iter().filter(|p| **p == colour).count()
 }
 
-#[test]
-fn penmodel_calibrate_draws_the_targets_then_the_residual_plot() {
-    let missing: Vec<&str> = ["Xvfb", "xdotool", "xwd"].into_iter().filter(|t| !found(t)).collect();
-    if !missing.is_empty() {
-        assert!(
-            std::env::var_os("PEN_REQUIRE_X").is_none(),
-            "{missing:?} not installed (scripts/setup.sh installs them)"
-        );
-        eprintln!("skipped: {missing:?} not installed (scripts/setup.sh installs them)");
-        return;
-    }
-    let dir = tempfile::tempdir().expect("temp dir");
-    let file = dir.path().join("calibration.toml");
-    let (_server, display) = xvfb();
+/// Starts `penmodel calibrate` with the simulated pen at `speed` in a window on `display`,
+/// saving to `file`, and waits for its window: the process and the window's id.
+fn start(dir: &std::path::Path, display: &str, file: &std::path::Path, args: &[&str]) -> (Killed, String) {
     let child = Command::new(env!("CARGO_BIN_EXE_penmodel"))
-        .current_dir(dir.path())
-        .args(["calibrate", "--source", "sim", "--speed", "3", "--targets", "4"])
+        .current_dir(dir)
+        .args(["calibrate", "--source", "sim"])
+        .args(args)
         .args(["--show", "window", "--windowed", "--calibration"])
-        .arg(&file)
-        .env("DISPLAY", &display)
+        .arg(file)
+        .env("DISPLAY", display)
         .env_remove("WAYLAND_DISPLAY")
-        .env("HOME", dir.path())
+        .env("HOME", dir)
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
@@ -60,7 +50,7 @@ fn penmodel_calibrate_draws_the_targets_then_the_residual_plot() {
     let window = loop {
         let out = Command::new("xdotool")
             .args(["search", "--onlyvisible", "--name", "^penmodel calibrate$"])
-            .env("DISPLAY", &display)
+            .env("DISPLAY", display)
             .output()
             .expect("xdotool runs");
         if let Some(w) = String::from_utf8_lossy(&out.stdout).lines().next() {
@@ -76,6 +66,19 @@ fn penmodel_calibrate_draws_the_targets_then_the_residual_plot() {
         assert!(Instant::now() < until, "no calibration window");
         std::thread::sleep(Duration::from_millis(100));
     };
+    (penmodel, window)
+}
+
+#[test]
+fn penmodel_calibrate_draws_the_targets_then_the_residual_plot() {
+    if !x_tools() {
+        return;
+    }
+    let dir = tempfile::tempdir().expect("temp dir");
+    let file = dir.path().join("calibration.toml");
+    let (_server, display) = xvfb();
+    let (mut penmodel, window) = start(dir.path(), &display, &file, &["--speed", "3", "--targets", "4"]);
+    let until = Instant::now() + GUARD;
     // While it goes: a target (yellow) and, once one is taken, the progress (green); at the end
     // the plot, whose residuals are red. Nothing is saved before the plot is closed.
     let (mut saw_target, mut saw_progress) = (false, false);
@@ -168,57 +171,13 @@ fn penmodel_calibrate_headless_prompts_at_the_terminal() {
 /// for a touch.
 #[test]
 fn escape_before_the_plot_saves_nothing() {
-    if ["Xvfb", "xdotool"].iter().any(|t| !found(t)) {
-        assert!(
-            std::env::var_os("PEN_REQUIRE_X").is_none(),
-            "Xvfb or xdotool not installed"
-        );
+    if !x_tools() {
         return;
     }
     let dir = tempfile::tempdir().expect("temp dir");
     let file = dir.path().join("calibration.toml");
     let (_server, display) = xvfb();
-    let child = Command::new(env!("CARGO_BIN_EXE_penmodel"))
-        .args([
-            "calibrate",
-            "--source",
-            "sim",
-            "--speed",
-            "0.2",
-            "--show",
-            "window",
-            "--windowed",
-        ])
-        .arg("--calibration")
-        .arg(&file)
-        .env("DISPLAY", &display)
-        .env_remove("WAYLAND_DISPLAY")
-        .env("HOME", dir.path())
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .expect("penmodel starts");
-    let mut penmodel = Killed(child);
-    let until = Instant::now() + GUARD;
-    let window = loop {
-        let out = Command::new("xdotool")
-            .args(["search", "--onlyvisible", "--name", "^penmodel calibrate$"])
-            .env("DISPLAY", &display)
-            .output()
-            .expect("xdotool runs");
-        if let Some(w) = String::from_utf8_lossy(&out.stdout).lines().next() {
-            break w.to_string();
-        }
-        if let Some(status) = penmodel.0.try_wait().expect("wait") {
-            let mut err = String::new();
-            if let Some(mut e) = penmodel.0.stderr.take() {
-                std::io::Read::read_to_string(&mut e, &mut err).expect("stderr");
-            }
-            panic!("penmodel calibrate ended before its window showed: {status:?}: {err}");
-        }
-        assert!(Instant::now() < until, "no calibration window");
-        std::thread::sleep(Duration::from_millis(100));
-    };
+    let (mut penmodel, window) = start(dir.path(), &display, &file, &["--speed", "0.2"]);
     let key = Command::new("xdotool")
         .args(["windowfocus", "--sync", &window, "key", "Escape"])
         .env("DISPLAY", &display)

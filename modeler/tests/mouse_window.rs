@@ -39,6 +39,21 @@ pub(crate) fn found(tool: &str) -> bool {
 }
 
 /// Kills a child when the test ends, however it ends.
+/// Whether Xvfb, xdotool and xwd are installed; without them a window test is skipped, unless
+/// `PEN_REQUIRE_X` is set (scripts/test.sh), where it fails.
+pub(crate) fn x_tools() -> bool {
+    let missing: Vec<&str> = ["Xvfb", "xdotool", "xwd"].into_iter().filter(|t| !found(t)).collect();
+    if missing.is_empty() {
+        return true;
+    }
+    assert!(
+        std::env::var_os("PEN_REQUIRE_X").is_none(),
+        "{missing:?} not installed (scripts/setup.sh installs them)"
+    );
+    eprintln!("skipped: {missing:?} not installed (scripts/setup.sh installs them)");
+    false
+}
+
 pub(crate) struct Killed(pub(crate) Child);
 
 impl Drop for Killed {
@@ -189,13 +204,7 @@ pub(crate) fn xvfb() -> (Server, String) {
 
 #[test]
 fn a_mouse_draws_a_region_and_pulls_a_point_in_a_real_window() {
-    let missing: Vec<&str> = ["Xvfb", "xdotool", "xwd"].into_iter().filter(|t| !found(t)).collect();
-    if !missing.is_empty() {
-        assert!(
-            std::env::var_os("PEN_REQUIRE_X").is_none(),
-            "{missing:?} not installed (scripts/setup.sh installs them)"
-        );
-        eprintln!("skipped: {missing:?} not installed (scripts/setup.sh installs them)");
+    if !x_tools() {
         return;
     }
     let dir = tempfile::tempdir().expect("temp dir");
