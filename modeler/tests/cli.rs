@@ -561,34 +561,26 @@ fn a_failed_open_removes_the_out_folder_it_created() {
     let bad = dir.path().join("bad.json");
     std::fs::write(&bad, "not json").unwrap();
     let out_dir = dir.path().join("results");
-    let out = penmodel(&[
-        "open",
-        s(&bad),
-        "--out",
-        s(&out_dir),
-        "--source",
-        "sim:modeling-session",
-        "--show",
-        "headless",
-        "--fps",
-        "0",
-    ]);
+    let open = || {
+        penmodel(&[
+            "open",
+            s(&bad),
+            "--out",
+            s(&out_dir),
+            "--source",
+            "sim:modeling-session",
+            "--show",
+            "headless",
+            "--fps",
+            "0",
+        ])
+    };
+    let out = open();
     assert_eq!(out.status.code(), Some(1), "{}", String::from_utf8_lossy(&out.stderr));
     assert!(!out_dir.exists(), "the --out folder it made is gone");
     // A folder that was there before stays.
     std::fs::create_dir(&out_dir).unwrap();
-    let out = penmodel(&[
-        "open",
-        s(&bad),
-        "--out",
-        s(&out_dir),
-        "--source",
-        "sim:modeling-session",
-        "--show",
-        "headless",
-        "--fps",
-        "0",
-    ]);
+    let out = open();
     assert_eq!(out.status.code(), Some(1));
     assert!(out_dir.is_dir(), "a folder it did not make is kept");
 }
