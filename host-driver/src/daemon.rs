@@ -469,6 +469,14 @@ pub fn bind(path: &Path) -> Result<socket::Bound, SocketError> {
 
 /// Accepts clients until `stop` is set; the socket's lock is held until then.
 pub fn accept(bound: socket::Bound, hub: Arc<Hub>, queue_len: usize, stop: Arc<AtomicBool>) {
+    accept_each(&bound, &stop, |stream| {
+        hub.connect(stream, queue_len);
+    });
+}
+
+/// Polls `bound`'s listener until `stop` is set, handing each client's stream, made blocking, to
+/// `each`. Writes block: a client that stops reading blocks only its own writer.
+fn accept_each(bound: &socket::Bound, stop: &AtomicBool, mut each: impl FnMut(UnixStream)) {
     let listener = &bound.listener;
     if listener.set_nonblocking(true).is_err() {
         return;
@@ -476,9 +484,8 @@ pub fn accept(bound: socket::Bound, hub: Arc<Hub>, queue_len: usize, stop: Arc<A
     while !stop.load(Ordering::Relaxed) {
         match listener.accept() {
             Ok((stream, _)) => {
-                // Writes block: a client that stops reading blocks only its own writer.
                 if stream.set_nonblocking(false).is_ok() {
-                    hub.connect(stream, queue_len);
+                    each(stream);
                 }
             }
             Err(_) => std::thread::sleep(Duration::from_millis(20)),
@@ -655,22 +662,11 @@ pub fn accept_sessions(
     stop: Arc<AtomicBool>,
     mut start: impl FnMut(Arc<Hub>, u64),
 ) {
-    let listener = &bound.listener;
-    if listener.set_nonblocking(true).is_err() {
-        return;
-    }
-    while !stop.load(Ordering::Relaxed) {
-        match listener.accept() {
-            Ok((stream, _)) => {
-                if stream.set_nonblocking(false).is_ok()
-                    && let Some((hub, n)) = sessions.take(stream, queue_len)
-                {
-                    start(hub, n);
-                }
-            }
-            Err(_) => std::thread::sleep(Duration::from_millis(20)),
+    accept_each(&bound, &stop, |stream| {
+        if let Some((hub, n)) = sessions.take(stream, queue_len) {
+            start(hub, n);
         }
-    }
+    });
 }
 
 /// One client's session: reads `pipeline` (opened for it, so the simulated pen starts its
