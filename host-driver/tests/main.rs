@@ -11,5 +11,8 @@ mod penctl;
 mod pend_faults;
 mod reliability_doc;
 mod socket;
+// The docs' generated sections, one helper with pen-protocol's docs test.
+#[path = "../../protocol/tests/common/splice.rs"]
+mod splice;
 mod vocabulary;
 mod waiting;

@@ -2,6 +2,7 @@
 //! `fuzz/corpus/<target>/`, which the crates' `fuzz_corpus` tests replay (issue 47 item 13: the
 //! page had drifted). `PEN_UPDATE_DOCS=1` rewrites the table, as for docs/protocol.md.
 
+use crate::splice::splice;
 use std::path::Path;
 
 const ROOT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/..");
@@ -23,15 +24,6 @@ fn files_in(dir: &Path) -> usize {
         .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
         .filter(|e| e.as_ref().is_ok_and(|e| e.file_type().is_ok_and(|t| t.is_file())))
         .count()
-}
-
-/// Replaces the text between `<!-- generated:NAME -->` and `<!-- end:NAME -->`.
-fn splice(doc: &str, name: &str, body: &str) -> String {
-    let begin = format!("<!-- generated:{name} -->");
-    let end = format!("<!-- end:{name} -->");
-    let b = doc.find(&begin).unwrap_or_else(|| panic!("marker {begin} missing")) + begin.len();
-    let e = doc[b..].find(&end).unwrap_or_else(|| panic!("marker {end} missing")) + b;
-    format!("{}{}{}", &doc[..b], body, &doc[e..])
 }
 
 #[test]

@@ -3,6 +3,7 @@
 
 use crate::common;
 
+use crate::common::splice::splice;
 use common::*;
 use hidreport::{Field, Report as HidReport, ReportDescriptor, VariableField};
 use pen_protocol::*;
@@ -128,15 +129,6 @@ fn hex_lines(bytes: &[u8]) -> String {
         .chunks(32)
         .map(|c| c.iter().map(|b| format!("{b:02x}")).collect::<String>() + "\n")
         .collect()
-}
-
-/// Replaces the text between `<!-- generated:NAME -->` and `<!-- end:NAME -->`.
-fn splice(doc: &str, name: &str, body: &str) -> String {
-    let begin = format!("<!-- generated:{name} -->");
-    let end = format!("<!-- end:{name} -->");
-    let b = doc.find(&begin).unwrap_or_else(|| panic!("marker {begin} missing")) + begin.len();
-    let e = doc[b..].find(&end).unwrap_or_else(|| panic!("marker {end} missing")) + b;
-    format!("{}{}{}", &doc[..b], body, &doc[e..])
 }
 
 #[test]

@@ -4,6 +4,8 @@
 use pen_protocol::*;
 use proptest::prelude::*;
 
+pub mod splice;
+
 /// The pen report the golden tests and the documentation's examples use.
 pub fn sample_pen() -> PenReport {
     PenReport {
