@@ -203,3 +203,89 @@ fn generate_names_a_bad_rock_field() {
         assert!(!dir.path().join("d.obj").exists());
     }
 }
+
+/// Issue 41: the `fig1` preset gave table 1's rows by list position, so `--radii 1,3,9` gave
+/// r = 1 the r = 9 coefficients. Each radius takes its own row, in any order.
+#[test]
+fn the_fig1_preset_goes_by_radius_not_by_position() {
+    let dir = tempfile::tempdir().expect("dir");
+    let shapes = |radii: &str, fractions: &str| {
+        let out = penmodel(
+            dir.path(),
+            &[
+                "rocks",
+                "--size",
+                "64x64",
+                "--radii",
+                radii,
+                "--fractions",
+                fractions,
+                "--json",
+                "-",
+            ],
+        );
+        assert!(out.status.success(), "{}", text(&out.stderr));
+        let v: Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        let mut by_radius: Vec<(f64, Value)> = v["diagrams"]
+            .as_array()
+            .expect("diagrams")
+            .iter()
+            .map(|d| (d["radius"].as_f64().expect("radius"), d["shape"].clone()))
+            .collect();
+        by_radius.sort_by(|a, b| a.0.total_cmp(&b.0));
+        by_radius
+    };
+    let listed_large_first = shapes("9,3,1", "0.2,0.24,0.3");
+    assert_eq!(shapes("1,3,9", "0.3,0.24,0.2"), listed_large_first);
+    // Table 1's row for r = 1: c_w 0.1, 0.1, 0.1.
+    assert_eq!(listed_large_first[0].1["widths"], serde_json::json!([0.1, 0.1, 0.1]));
+}
+
+/// Issue 41: a fraction the cells cannot reach ended with exit 0 and only `reached: false`;
+/// it is a warning, and an error (exit 1, the outputs written) under `--strict`.
+#[test]
+fn an_unreachable_fraction_warns_and_fails_under_strict() {
+    let dir = tempfile::tempdir().expect("dir");
+    let args = [
+        "rocks",
+        "--size",
+        "64x64",
+        "--radii",
+        "9,1",
+        "--fractions",
+        "0.2,0.8",
+        "--json",
+        "r.json",
+    ];
+    let out = penmodel(dir.path(), &args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let err = text(&out.stderr);
+    assert!(err.contains("warning: r 1: ") && err.contains("80.0 % asked"), "{err}");
+    let strict = penmodel(dir.path(), &[&args[..], &["--strict"]].concat());
+    assert_eq!(strict.status.code(), Some(1), "{}", text(&strict.stderr));
+    assert!(
+        text(&strict.stderr).contains("--strict: r 1: "),
+        "{}",
+        text(&strict.stderr)
+    );
+    assert!(dir.path().join("r.json").exists(), "the outputs are written first");
+    // A reachable one says nothing.
+    let fine = penmodel(
+        dir.path(),
+        &[
+            "rocks",
+            "--size",
+            "64x64",
+            "--radii",
+            "9,1",
+            "--fractions",
+            "0.2,0.3",
+            "--strict",
+        ],
+    );
+    assert!(
+        fine.status.success() && !text(&fine.stderr).contains("warning"),
+        "{}",
+        text(&fine.stderr)
+    );
+}

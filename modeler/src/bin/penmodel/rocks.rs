@@ -72,6 +72,9 @@ pub struct Args {
     /// Eq. 3's c_h1,c_h2,c_h3 for every diagram (height, × r; 0 to 10).
     #[arg(long, value_name = "C1,C2,C3", value_delimiter = ',', allow_hyphen_values = true)]
     heights: Vec<f64>,
+    /// Fail (exit 1, after writing the outputs) when a diagram cannot reach its amount; without it that is a warning.
+    #[arg(long)]
+    strict: bool,
     /// The random seed: the same seed, the same rocks.
     #[arg(long, default_value_t = 1)]
     seed: u64,
@@ -110,18 +113,20 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
     Ok((num(w)?, num(h)?))
 }
 
-/// Fig. 1's coefficients for its three diagrams, largest radius first.
+/// Fig. 1's coefficients for its three diagrams (table 1), largest radius first: a diagram takes
+/// the row of its radius's rank among the radii given (the largest the first row, the third
+/// largest and smaller the last), whatever order the radii are listed in.
 const FIG1: [([f64; 3], [f64; 3]); 3] = [
     ([0.0, 0.3, 0.3], [0.3, 0.3, 0.1]),
     ([0.0, 0.3, 0.1], [0.3, 0.3, 0.1]),
     ([0.1, 0.1, 0.1], [0.3, 0.0, 0.1]),
 ];
 
-fn preset_shape(preset: Preset, layer: usize) -> Shape {
+fn preset_shape(preset: Preset, rank: usize) -> Shape {
     let s = |widths, heights| Shape { widths, heights };
     match preset {
         Preset::Fig1 => {
-            let (w, h) = FIG1[layer.min(2)];
+            let (w, h) = FIG1[rank.min(2)];
             s(w, h)
         }
         Preset::Plain => s([0.0; 3], [0.3, 0.0, 0.1]),
@@ -188,9 +193,9 @@ fn recipe(args: &Args) -> Result<Recipe> {
     let layers = radii
         .iter()
         .zip(amounts)
-        .enumerate()
-        .map(|(i, (&radius, amount))| {
-            let mut shape = preset_shape(args.preset, i);
+        .map(|(&radius, amount)| {
+            let rank = radii.iter().filter(|&&other| other > radius).count();
+            let mut shape = preset_shape(args.preset, rank);
             if let [a, b, c] = args.widths[..] {
                 shape.widths = [a, b, c];
             }
@@ -339,6 +344,35 @@ pub fn run(args: &Args) -> Result<()> {
         eprintln!("{line}");
     } else {
         pen_host::outln!("{line}");
+    }
+    let short: Vec<String> = s
+        .diagrams
+        .iter()
+        .enumerate()
+        .filter(|(_, d)| !d.reached)
+        .map(|(i, d)| {
+            let asked = match recipe.layers.get(i).map(|l| l.amount) {
+                Some(Amount::Fraction(f)) => format!("{:.1} % asked", 100.0 * f),
+                Some(Amount::Count(n)) => format!("{n} rocks asked"),
+                None => "its amount".to_string(),
+            };
+            format!(
+                "r {}: {} rocks, {:.1} % of the field ({asked}): its cells ran out",
+                d.radius,
+                d.cells.len(),
+                100.0 * s.fraction(i)
+            )
+        })
+        .collect();
+    if !short.is_empty() {
+        let what = format!(
+            "{}; give less, a smaller radius, or more room (the larger diagrams take theirs first)",
+            short.join("; ")
+        );
+        if args.strict {
+            bail!("--strict: {what}");
+        }
+        eprintln!("warning: {what}");
     }
     Ok(())
 }
