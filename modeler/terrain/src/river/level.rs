@@ -21,7 +21,9 @@ pub struct Constants {
     pub volume_gain: f64,
     /// How fast the drive saturates.
     pub curvature_gain: f64,
-    /// The flow (m² × water) that counts as 1: the seed's example river, 3 m × 1.5 m × 60.
+    /// The flow (m² × water) that counts as 1: `modeler/examples/rivers/omega.json`'s river,
+    /// 3 m × 1.5 m × 60. Ours, not the seed's: its example is width 6, depth 5, water 60 in
+    /// voxels of an unstated size, which do not carry over to metres.
     pub flow_reference: f64,
 }
 
