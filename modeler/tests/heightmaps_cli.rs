@@ -199,6 +199,10 @@ fn bad_heightmaps_are_errors_not_panics() {
             vec!["import", "junk.tif", "--size", "2x2", "--out", "x.json"],
             "a GeoTIFF records its size",
         ),
+        (
+            vec!["import", "junk.png", "--size", "2x2", "--out", "x.json"],
+            "--size is for a raw float32 file; a PNG records its size",
+        ),
     ] {
         let out = penmodel(d, &args);
         let err = String::from_utf8_lossy(&out.stderr);

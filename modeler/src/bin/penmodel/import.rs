@@ -84,8 +84,12 @@ fn relative(target: &Path, from: &Path) -> Option<PathBuf> {
 
 /// Runs the command.
 pub fn run(args: &Args) -> Result<()> {
-    if (args.min.is_some() || args.size.is_some()) && import::Kind::of(&args.heightmap) == import::Kind::GeoTiff {
+    let kind = import::Kind::of(&args.heightmap);
+    if (args.min.is_some() || args.size.is_some()) && kind == import::Kind::GeoTiff {
         bail!("--min/--max and --size are for a PNG and a raw file; a GeoTIFF records its size and heights");
+    }
+    if args.size.is_some() && kind == import::Kind::Png16 {
+        bail!("--size is for a raw float32 file; a PNG records its size");
     }
     if let Some(cell) = args.cell
         && !(cell.is_finite() && cell > 0.0)
