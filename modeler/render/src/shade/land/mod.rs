@@ -59,8 +59,8 @@ use penmodel_terrain::revision::Mark;
 pub use ground::FINE_FADE;
 pub(crate) use ground::{Corner, Ground, faded};
 pub use material::{
-    DRY_GRASS, GRASS, GREY_ROCK, MEADOW, ROCK, SAND, SCREE, SHORE_CELLS, SHORE_METRES, SNOW, Shore, material,
-    material_parts, value_noise,
+    DRY_GRASS, GRASS, GREY_ROCK, MEADOW, ROCK, SAND, SCREE, SHORE_CELLS, SHORE_METRES, SNOW, Shore, ground_colours,
+    material, material_parts, value_noise,
 };
 use material::{colours, fine_wavelength, noise, shore};
 use sky::SkyLight;
