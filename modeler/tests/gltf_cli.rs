@@ -82,3 +82,32 @@ fn bad_tree_detail_is_refused() {
         assert!(err.contains("expected a roughness"), "{q}: {err}");
     }
 }
+
+#[test]
+fn obj_follows_the_same_flags() {
+    let dir = tempfile::tempdir().expect("dir");
+    let doc = document(dir.path());
+    let obj = |extra: &[&str]| {
+        let out = Command::new(env!("CARGO_BIN_EXE_penmodel"))
+            .args(["generate", doc.to_str().expect("utf-8"), "--obj", "o.obj"])
+            .args(extra)
+            .current_dir(dir.path())
+            .output()
+            .expect("runs");
+        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        std::fs::read_to_string(dir.path().join("o.obj")).expect("obj")
+    };
+    let objects = |text: &str| -> Vec<String> {
+        text.lines()
+            .filter_map(|l| l.strip_prefix("o "))
+            .map(str::to_string)
+            .collect()
+    };
+    let full = obj(&[]);
+    assert_eq!(objects(&full), ["terrain", "rocks 0", "water", "trees"]);
+    let coarse = obj(&["--tree-detail", "0.3"]);
+    assert_eq!(objects(&coarse), objects(&full));
+    assert!(coarse.len() < full.len(), "{} < {}", coarse.len(), full.len());
+    assert_eq!(objects(&obj(&["--no-trees", "--no-rocks", "--no-water"])), ["terrain"]);
+    assert_eq!(objects(&obj(&["--no-rocks"])), ["terrain", "water", "trees"]);
+}
