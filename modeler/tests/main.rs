@@ -3,6 +3,7 @@ mod calibrate_window;
 mod cli;
 mod common;
 mod demo_cli;
+mod gltf_cli;
 mod heightmaps_cli;
 mod help_examples;
 mod interaction;

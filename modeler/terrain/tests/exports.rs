@@ -129,3 +129,94 @@ fn glb_reads_back_with_an_independent_reader() {
     let bounds = gltf.accessors().next().unwrap();
     assert_eq!(bounds.max().unwrap()[1].as_f64().unwrap() as f32, map.range().1);
 }
+
+#[test]
+fn glb_scene_has_materials_and_instances() {
+    use export::{Alpha, GlbScene, Instance, Material, Mesh, Part};
+    let map = tiny();
+    let terrain = Mesh::of(&map).unwrap();
+    let tri = Mesh {
+        positions: vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]],
+        // One normal without a direction: written as +Y, which the validator accepts.
+        normals: vec![[0.0, 0.0, 1.0], [0.0, 0.0, 2.0], [0.0; 3]],
+        indices: vec![0, 1, 2],
+        colors: Vec::new(),
+    };
+    let at = |x: f32| Instance {
+        translation: [x, 0.0, 1.0],
+        rotation: [0.0, 0.0, 0.0, 1.0],
+        scale: [2.0; 3],
+    };
+    let empty = Mesh::default();
+    let scene = GlbScene {
+        materials: vec![
+            Material::plain("ground"),
+            Material::water(),
+            Material {
+                alpha: Alpha::Mask(0.5),
+                double_sided: true,
+                ..Material::opaque("leaves", [0.1, 0.4, 0.1], 0.8)
+            },
+        ],
+        parts: vec![
+            Part {
+                name: "terrain".into(),
+                primitives: vec![(&terrain, 0)],
+                instances: None,
+            },
+            Part {
+                name: "tris".into(),
+                primitives: vec![(&tri, 1), (&empty, 0)],
+                instances: Some(vec![at(1.0), at(2.0), at(3.0)]),
+            },
+            // No instances: left out.
+            Part {
+                name: "none".into(),
+                primitives: vec![(&tri, 1)],
+                instances: Some(Vec::new()),
+            },
+        ],
+    };
+    let mut bytes = Vec::new();
+    export::write_glb_scene(&scene, &mut bytes).unwrap();
+    let len = u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+    let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + len]).unwrap();
+    assert_eq!(json["extensionsUsed"], serde_json::json!([export::INSTANCING]));
+    assert_eq!(json["extensionsRequired"], serde_json::json!([export::INSTANCING]));
+    let nodes = json["nodes"].as_array().unwrap();
+    assert_eq!(nodes.len(), 2);
+    let ext = &nodes[1]["extensions"][export::INSTANCING]["attributes"];
+    for k in ["TRANSLATION", "ROTATION", "SCALE"] {
+        let a = &json["accessors"][ext[k].as_u64().unwrap() as usize];
+        assert_eq!(a["count"], 3, "{k}");
+    }
+    assert_eq!(json["materials"][1]["alphaMode"], "BLEND");
+    assert_eq!(json["materials"][2]["alphaMode"], "MASK");
+    assert_eq!(json["materials"][2]["alphaCutoff"], 0.5);
+    assert_eq!(json["materials"][2]["doubleSided"], true);
+    let prims = json["meshes"][1]["primitives"].as_array().unwrap();
+    assert_eq!(prims.len(), 1, "the empty primitive is left out");
+    assert_eq!(prims[0]["material"], 1);
+    // An independent reader: the materials, and the normals made unit.
+    let gltf = gltf::Gltf::from_slice_without_validation(&bytes).unwrap();
+    let blob = gltf.blob.clone().unwrap();
+    let mesh = gltf.meshes().nth(1).unwrap();
+    let prim = mesh.primitives().next().unwrap();
+    assert_eq!(prim.material().index(), Some(1));
+    assert_eq!(prim.material().alpha_mode(), gltf::material::AlphaMode::Blend);
+    let normals: Vec<[f32; 3]> = prim.reader(|_| Some(&blob)).read_normals().unwrap().collect();
+    assert_eq!(normals, [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 1.0, 0.0]]);
+    // A primitive naming a material not there is an error, not a broken file.
+    let bad = GlbScene {
+        materials: Vec::new(),
+        parts: vec![Part {
+            name: "t".into(),
+            primitives: vec![(&tri, 0)],
+            instances: None,
+        }],
+    };
+    assert!(matches!(
+        export::write_glb_scene(&bad, Vec::new()),
+        Err(export::ExportError::NoMaterial(0))
+    ));
+}

@@ -561,3 +561,60 @@ fn tree_previews_restore_commit_once_and_give_way() {
         .is_err()
     );
 }
+
+#[test]
+fn instanced_trees_are_each_species_once_at_every_trees_place() {
+    use glam::{DAffine3, DQuat, DVec3};
+    use penmodel_terrain::Heightmap;
+    use penmodel_terrain::trees::Forest;
+    use penmodel_terrain::trees::planted::bark_and_leaves;
+    let n = 128u32;
+    let d = forest_doc();
+    let heights: Vec<f32> = (0..n * n).map(|i| (f64::from(i % n) * 0.05).sin() as f32).collect();
+    let map = Heightmap::from_heights(n, n, 1.0, heights).expect("heights");
+    let forest = Forest::of(&d, &map);
+    let shared = forest.instanced(nodes_stop());
+    let total: usize = shared.iter().map(|s| s.instances.len()).sum();
+    assert_eq!(total, forest.trees().len());
+    // Trees of the same species share: fewer meshes than trees, one per node tree.
+    let species: std::collections::HashSet<*const _> = forest
+        .trees()
+        .iter()
+        .map(|t| std::sync::Arc::as_ptr(&t.nodes))
+        .collect();
+    assert_eq!(shared.len(), species.len());
+    assert!(shared.len() < total);
+    // Each instance's TRS is its tree's placement, and the shared mesh is the tree's unit drawing.
+    // In order of each species' first tree.
+    let mut k = vec![0usize; shared.len()];
+    let mut firsts: Vec<*const penmodel_terrain::trees::NodeTree> = Vec::new();
+    for t in forest.trees() {
+        let p = std::sync::Arc::as_ptr(&t.nodes);
+        let s = firsts.iter().position(|&q| q == p).unwrap_or_else(|| {
+            firsts.push(p);
+            firsts.len() - 1
+        });
+        let i = &shared[s].instances[k[s]];
+        k[s] += 1;
+        let [x, y, z, w] = i.rotation.map(f64::from);
+        let trs = DAffine3::from_scale_rotation_translation(
+            DVec3::from(i.scale.map(f64::from)),
+            DQuat::from_xyzw(x, y, z, w),
+            DVec3::from(i.translation.map(f64::from)),
+        );
+        let p = DVec3::new(0.3, 2.0, -0.7);
+        assert!((trs.transform_point3(p) - t.place().transform_point3(p)).length() < 1e-3);
+    }
+    // Bark and leaves split every triangle of the drawing, none lost.
+    let t = &forest.trees()[0];
+    let mut drawn = penmodel_terrain::trees::Drawn::default();
+    t.nodes.draw(nodes_stop(), &DAffine3::IDENTITY, None, &mut drawn);
+    let (bark, leaves) = bark_and_leaves(&drawn.mesh);
+    assert_eq!(bark.indices.len() + leaves.indices.len(), drawn.mesh.indices.len());
+    assert!(!bark.indices.is_empty() && !leaves.indices.is_empty());
+    assert!(bark.colors.is_empty() && leaves.colors.is_empty());
+}
+
+fn nodes_stop() -> f64 {
+    penmodel_terrain::trees::nodes::STOP
+}

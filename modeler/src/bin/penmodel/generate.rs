@@ -4,7 +4,10 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use penmodel_terrain::editor::Editor;
+use penmodel_terrain::export::{GlbScene, Material, Mesh, Part};
 use penmodel_terrain::rocks::cache::Rocks;
+use penmodel_terrain::trees::nodes::STOP;
+use penmodel_terrain::trees::planted::Shared;
 use penmodel_terrain::{Heightmap, export, journal, persist};
 
 use crate::out::write;
@@ -45,9 +48,34 @@ pub struct Args {
     /// The terrain mesh as Wavefront OBJ.
     #[arg(long, value_name = "OUT.obj")]
     obj: Option<PathBuf>,
-    /// The terrain mesh as binary glTF.
+    /// The terrain mesh as binary glTF: materials (the land look's ground colours per vertex,
+    /// water, rock, bark, leaves) and each species' tree once, drawn at every tree's place
+    /// (EXT_mesh_gpu_instancing, required).
     #[arg(long, value_name = "OUT.glb")]
     glb: Option<PathBuf>,
+    /// Leave the trees and groves out of the meshes (--obj, --glb).
+    #[arg(long)]
+    no_trees: bool,
+    /// Leave the rock fields out of the meshes.
+    #[arg(long)]
+    no_rocks: bool,
+    /// Leave the rivers' and lakes' water out of the meshes.
+    #[arg(long)]
+    no_water: bool,
+    /// The trees' roughness Q in [0.02, 1] in the meshes: branch groups no larger than Q·height
+    /// become crossed cards (untextured, leaf-coloured); 0.02 (the default) is the full tree.
+    #[arg(long, value_name = "Q", default_value_t = STOP, value_parser = parse_detail, conflicts_with = "no_trees")]
+    tree_detail: f64,
+}
+
+/// Parses `--tree-detail Q`: a roughness in [STOP, 1].
+fn parse_detail(text: &str) -> Result<f64, String> {
+    match text.trim().parse::<f64>() {
+        Ok(q) if (STOP..=1.0).contains(&q) => Ok(q),
+        _ => Err(format!(
+            "expected a roughness from {STOP} (the full tree) to 1 (cards only), got `{text}`"
+        )),
+    }
 }
 
 /// Parses `--origin X,Y`: two finite numbers, metres.
@@ -137,26 +165,40 @@ pub fn run(args: &Args) -> Result<()> {
     export_with_sidecar(map, &args.geotiff, export::Format::Geotiff, Some(geo), |m, out| {
         export::write_geotiff(m, geo, out)
     })?;
-    // The document's rock fields stand on the terrain in the meshes (an object or node each),
-    // and the rivers' water is one more.
-    let mut placed = if args.obj.is_some() || args.glb.is_some() {
+    let meshes = args.obj.is_some() || args.glb.is_some();
+    // The document's rock fields stand on the terrain in the meshes (an object or node each;
+    // each rock is seated on the ground, so no two are alike and none is instanced).
+    let rocks = if meshes && !args.no_rocks {
         Rocks::of(editor.document()).seated(map)
     } else {
         Vec::new()
     };
     // The rivers' and lakes' water surface: a separate mesh (object or node) "water".
-    if let Some(water) = editor.water().filter(|w| w.any())
-        && (args.obj.is_some() || args.glb.is_some())
-    {
-        placed.push(("water".to_string(), water.mesh(map.cell_size())));
+    let water = editor
+        .water()
+        .filter(|w| w.any() && meshes && !args.no_water)
+        .map(|w| w.mesh(map.cell_size()));
+    let trees = !editor.trees().trees().is_empty() && meshes && !args.no_trees;
+    if args.obj.is_some() {
+        let mut placed = rocks.clone();
+        placed.extend(water.iter().map(|w| ("water".to_string(), w.clone())));
+        // The trees and groves standing on the terrain at rest: one mesh "trees".
+        if trees {
+            let drawn = editor.trees().draw(|_| args.tree_detail, 0.0);
+            placed.push(("trees".to_string(), drawn.mesh));
+        }
+        export(map, &args.obj, |m, out| export::write_obj_with(m, &placed, out))?;
     }
-    // The trees and groves standing on the terrain, full geometry at rest: one mesh "trees".
-    if !editor.trees().trees().is_empty() && (args.obj.is_some() || args.glb.is_some()) {
-        let drawn = editor.trees().draw(|_| penmodel_terrain::trees::nodes::STOP, 0.0);
-        placed.push(("trees".to_string(), drawn.mesh));
+    if args.glb.is_some() {
+        let shared = if trees {
+            editor.trees().instanced(args.tree_detail)
+        } else {
+            Vec::new()
+        };
+        export(map, &args.glb, |m, out| {
+            write_scene(m, &rocks, water.as_ref(), &shared, out)
+        })?;
     }
-    export(map, &args.obj, |m, out| export::write_obj_with(m, &placed, out))?;
-    export(map, &args.glb, |m, out| export::write_glb_with(m, &placed, out))?;
     let (lo, hi) = map.range();
     let journal = if report.replayed > 0 {
         format!(", {} journal entries replayed", report.replayed)
@@ -165,4 +207,67 @@ pub fn run(args: &Args) -> Result<()> {
     };
     pen_host::outln!("{} × {} cells, heights {lo} to {hi} m{journal}", map.cols(), map.rows());
     Ok(())
+}
+
+/// sRGB (0–255) to linear (0–1), as glTF's colours are.
+fn linear(c: [f32; 3]) -> [f32; 3] {
+    c.map(|v| {
+        let v = (v / 255.0).clamp(0.0, 1.0);
+        if v <= 0.04045 {
+            v / 12.92
+        } else {
+            ((v + 0.055) / 1.055).powf(2.4)
+        }
+    })
+}
+
+/// The GLB of `generate`: the terrain with the land look's ground colours as COLOR_0, the rock
+/// fields, the water, and each species' tree once with its trees as instances.
+fn write_scene(
+    map: &Heightmap,
+    rocks: &[(String, Mesh)],
+    water: Option<&Mesh>,
+    trees: &[Shared],
+    out: &mut Vec<u8>,
+) -> Result<(), export::ExportError> {
+    use penmodel_render::land;
+    use penmodel_terrain::trees::shapes::{BARK, LEAF};
+    let mut terrain = Mesh::of(map)?;
+    terrain.colors = land::ground_colours(map, &penmodel_render::Style::land())
+        .into_iter()
+        .map(linear)
+        .collect();
+    let (ground, water_m, rock, bark, leaves) = (0, 1, 2, 3, 4);
+    let materials = vec![
+        Material::vertex_coloured("ground"),
+        Material::water(),
+        Material::opaque("rock", linear(land::ROCK.map(f32::from)), 0.95),
+        Material::opaque("bark", BARK, 0.9),
+        // Untextured leaves: plain green, opaque, seen from both sides.
+        Material {
+            double_sided: true,
+            ..Material::opaque("leaves", LEAF, 0.8)
+        },
+    ];
+    let mut parts = vec![Part {
+        name: "terrain".to_string(),
+        primitives: vec![(&terrain, ground)],
+        instances: None,
+    }];
+    parts.extend(rocks.iter().map(|(name, mesh)| Part {
+        name: name.clone(),
+        primitives: vec![(mesh, rock)],
+        instances: None,
+    }));
+    parts.extend(water.map(|mesh| Part {
+        name: "water".to_string(),
+        primitives: vec![(mesh, water_m)],
+        instances: None,
+    }));
+    parts.extend(trees.iter().map(|t| Part {
+        name: t.name.clone(),
+        primitives: vec![(&t.bark, bark), (&t.leaves, leaves)],
+        instances: Some(t.instances.clone()),
+    }));
+    export::write_glb_scene(&GlbScene { materials, parts }, out)
 }

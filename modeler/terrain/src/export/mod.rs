@@ -25,7 +25,9 @@ use std::io;
 use thiserror::Error;
 
 pub use geotiff::{GeoRef, GeoTiff, read_geotiff, write_geotiff};
-pub use glb::{write_glb, write_glb_meshes, write_glb_with};
+pub use glb::{
+    Alpha, GlbScene, INSTANCING, Instance, Material, Part, write_glb, write_glb_meshes, write_glb_scene, write_glb_with,
+};
 pub use mesh::Mesh;
 pub use obj::{write_meshes, write_obj, write_obj_with};
 pub use ply::write_ply;
@@ -69,4 +71,7 @@ pub enum ExportError {
     /// The mesh does not fit the format's 32-bit sizes.
     #[error("the mesh is too large for binary glTF ({0} bytes)")]
     TooLarge(u64),
+    /// A glTF primitive names a material the scene does not have (a bug of the caller).
+    #[error("a glTF primitive names material {0}, which the scene does not have")]
+    NoMaterial(usize),
 }

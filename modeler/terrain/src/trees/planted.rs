@@ -15,6 +15,7 @@ use super::nodes::NodeTree;
 use super::species::{Preset, Species};
 use super::wind;
 use crate::document::{Document, Grove, IfsMap, Point, Tree, Wind};
+use crate::export::{Instance, Mesh};
 use crate::heightmap::Heightmap;
 
 /// Where a standing tree comes from.
@@ -331,6 +332,45 @@ impl Forest {
         Arc::clone(&self.trees)
     }
 
+    /// The trees as instances of shared meshes, for exports: one [`Shared`] per species
+    /// (trees of the same maps share a node tree) drawn once at roughness `q` at rest, in the
+    /// tree's unit, with each of its trees' place ([`Standing::place`]). In order of the
+    /// species' first tree.
+    pub fn instanced(&self, q: f64) -> Vec<Shared> {
+        let mut shared: Vec<(*const NodeTree, Shared)> = Vec::new();
+        for tree in self.trees.iter() {
+            let key = Arc::as_ptr(&tree.nodes);
+            let k = match shared.iter().position(|(p, _)| *p == key) {
+                Some(k) => k,
+                None => {
+                    let mut drawn = Drawn::default();
+                    tree.nodes.draw(q, &DAffine3::IDENTITY, None, &mut drawn);
+                    let cards = super::lod::cards(&tree.nodes, &drawn.impostors);
+                    let (bark, mut leaves) = bark_and_leaves(&drawn.mesh);
+                    append(&mut leaves, &cards);
+                    let name = format!("trees {}", shared.len());
+                    shared.push((
+                        key,
+                        Shared {
+                            name,
+                            bark,
+                            leaves,
+                            instances: Vec::new(),
+                        },
+                    ));
+                    shared.len() - 1
+                }
+            };
+            let (turn, scale) = (tree.turn, tree.height / tree.nodes.height);
+            shared[k].1.instances.push(Instance {
+                translation: [tree.at[0] as f32, tree.base as f32, tree.at[1] as f32],
+                rotation: [0.0, (0.5 * turn).sin() as f32, 0.0, (0.5 * turn).cos() as f32],
+                scale: [scale as f32; 3],
+            });
+        }
+        shared.into_iter().map(|(_, s)| s).collect()
+    }
+
     /// Draws every tree at the roughness `q(tree)` gives and time `t` seconds.
     pub fn draw(&self, q: impl Fn(&Standing) -> f64, t: f64) -> Drawn {
         let mut out = Drawn::default();
@@ -339,4 +379,57 @@ impl Forest {
         }
         out
     }
+}
+
+/// One species' tree at one detail, in the tree's unit (base at the origin, +Y up), and where
+/// each tree of it stands: what an export writes once and draws at every place.
+#[derive(Debug, Clone)]
+pub struct Shared {
+    /// Its name in the export.
+    pub name: String,
+    /// The branches, without colours (the export's material is the bark's).
+    pub bark: Mesh,
+    /// The leaves and the simplified shapes' cards, without colours.
+    pub leaves: Mesh,
+    /// Where each tree of it stands ([`Standing::place`] as translation, rotation and scale).
+    pub instances: Vec<Instance>,
+}
+
+/// A drawn tree's triangles split by colour: the bark's and the rest (leaves), each with its
+/// own vertices and no colours.
+pub fn bark_and_leaves(mesh: &Mesh) -> (Mesh, Mesh) {
+    let (mut bark, mut leaves) = (Mesh::default(), Mesh::default());
+    // Per vertex of `mesh`: which part it went to and its index there.
+    let mut moved: Vec<Option<(bool, u32)>> = vec![None; mesh.positions.len()];
+    for t in mesh.indices.chunks_exact(3) {
+        let Some(&first) = t.first() else { continue };
+        let is_bark = mesh.colors.get(first as usize) == Some(&super::shapes::BARK);
+        let out = if is_bark { &mut bark } else { &mut leaves };
+        for &v in t {
+            let v = v as usize;
+            let i = match moved.get(v).copied().flatten() {
+                Some((b, i)) if b == is_bark => i,
+                _ => {
+                    let i = out.positions.len() as u32;
+                    out.positions.push(mesh.positions.get(v).copied().unwrap_or_default());
+                    out.normals
+                        .push(mesh.normals.get(v).copied().unwrap_or([0.0, 1.0, 0.0]));
+                    if let Some(m) = moved.get_mut(v) {
+                        *m = Some((is_bark, i));
+                    }
+                    i
+                }
+            };
+            out.indices.push(i);
+        }
+    }
+    (bark, leaves)
+}
+
+/// Appends `more` to `mesh`, dropping its colours.
+fn append(mesh: &mut Mesh, more: &Mesh) {
+    let base = mesh.positions.len() as u32;
+    mesh.positions.extend_from_slice(&more.positions);
+    mesh.normals.extend_from_slice(&more.normals);
+    mesh.indices.extend(more.indices.iter().map(|i| i + base));
 }

@@ -241,6 +241,25 @@ pub(super) fn noise(cols: usize, rows: usize, s: f64) -> Vec<[f32; 2]> {
     out
 }
 
+/// The land look's ground colour of every cell (sRGB 0–255, before light, row-major) with its
+/// fine noise's brightness, as the display draws it close up, but without the beach (which needs
+/// the scene's water): for exports' vertex colours.
+pub fn ground_colours(map: &penmodel_terrain::Heightmap, style: &Style) -> Vec<[f32; 3]> {
+    let (cols, rows) = (map.cols() as usize, map.rows() as usize);
+    let noise = noise(cols, rows, map.cell_size());
+    let mut out = vec![[0.0; 4]; cols * rows];
+    let all = Rect {
+        c0: 0,
+        c1: cols,
+        r0: 0,
+        r1: rows,
+    };
+    colours(map, style, &[], all, &noise, &mut out);
+    out.iter()
+        .map(|&[r, g, b, k]| [r, g, b].map(|v| (v * (1.0 + k)).clamp(0.0, 255.0)))
+        .collect()
+}
+
 /// The colours of the cells in `rect`.
 pub(super) fn colours(
     map: &penmodel_terrain::Heightmap,

@@ -59,8 +59,8 @@ use penmodel_terrain::revision::Mark;
 pub use ground::FINE_FADE;
 pub(crate) use ground::{Corner, Ground, faded};
 pub use material::{
-    DRY_GRASS, GRASS, GREY_ROCK, MEADOW, ROCK, SAND, SCREE, SHORE_CELLS, SHORE_METRES, SNOW, Shore, material,
-    material_parts, value_noise,
+    DRY_GRASS, GRASS, GREY_ROCK, MEADOW, ROCK, SAND, SCREE, SHORE_CELLS, SHORE_METRES, SNOW, Shore, ground_colours,
+    material, material_parts, value_noise,
 };
 use material::{colours, fine_wavelength, noise, shore};
 use sky::SkyLight;
@@ -403,6 +403,24 @@ mod tests {
             last: [1.0, 1.0],
             fine_metres: 30.0,
         }
+    }
+
+    #[test]
+    fn ground_colours_are_the_materials_of_the_cells() {
+        // A flat 4 × 4 grid: the left half under the sea, the right half above the snow line.
+        let style = Style::land();
+        let high = 2.0 * style.snow_line;
+        let heights: Vec<f32> = (0..16).map(|i| if i % 4 < 2 { -5.0 } else { high }).collect();
+        let map = penmodel_terrain::Heightmap::from_heights(4, 4, 10.0, heights).expect("heights");
+        let c = ground_colours(&map, &style);
+        assert_eq!(c.len(), 16);
+        let sea = material(&style, -5.0, 0.0, 0.5, 0.5, Shore::NONE);
+        assert_eq!(c[0], sea, "under the sea: the depth ramp");
+        // On top, flat, far from the edge between them: snow, within the fine noise's 7 %.
+        for (have, snow) in c[3].iter().zip(material::rgb(SNOW)) {
+            assert!((have - snow).abs() <= 0.05 * snow, "{:?}", c[3]);
+        }
+        assert!(c.iter().flatten().all(|v| (0.0..=255.0).contains(v)));
     }
 
     #[test]
