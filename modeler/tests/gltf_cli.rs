@@ -7,6 +7,8 @@ use std::process::Command;
 
 use penmodel_terrain::editor::Editor;
 
+use crate::common::outside_check;
+
 /// A river (the omega example) with a rock field, a fir and a grove.
 fn document(dir: &Path) -> std::path::PathBuf {
     let omega = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/rivers/omega.json");
@@ -32,32 +34,17 @@ fn glb_is_valid_for_the_khronos_validator_and_read_back_by_pygltflib() {
     let (editor, _) = Editor::open_read_only(&doc).expect("the document opens");
     let trees = editor.trees().trees().len();
     assert!(trees > 2, "{trees} trees");
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/gltf_peer.py");
-    let out = Command::new("python3")
-        .arg(&script)
-        .arg(env!("CARGO_BIN_EXE_penmodel"))
-        .arg(&doc)
-        .arg(trees.to_string())
-        .arg("150.5,60.5")
-        .output();
-    let out = match out {
-        Ok(out) => out,
-        Err(e) => {
-            eprintln!("SKIPPED glb_is_valid_for_the_khronos_validator: python3 cannot run ({e})");
-            return;
-        }
-    };
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
+    let trees = trees.to_string();
+    outside_check(
+        "glb_is_valid_for_the_khronos_validator",
+        "gltf_peer.py",
+        &[
+            env!("CARGO_BIN_EXE_penmodel").as_ref(),
+            doc.as_ref(),
+            trees.as_ref(),
+            "150.5,60.5".as_ref(),
+        ],
     );
-    if out.status.code() == Some(77) {
-        eprintln!("SKIPPED glb_is_valid_for_the_khronos_validator: {text}");
-        return;
-    }
-    assert!(out.status.success(), "{text}");
-    assert!(text.contains("all checks passed"), "{text}");
 }
 
 #[test]

@@ -3,9 +3,8 @@
 
 use std::fs;
 use std::path::Path;
-use std::process::Command;
 
-use crate::common::{example, penmodel};
+use crate::common::{example, outside_check, penmodel};
 
 fn s(p: &Path) -> &str {
     p.to_str().expect("UTF-8 path")
@@ -232,27 +231,9 @@ fn bad_heightmaps_are_errors_not_panics() {
 /// and generated again. Skipped, saying so, only when rasterio cannot be installed.
 #[test]
 fn geotiff_and_raw16_read_back_by_gdal() {
-    let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/heightmap_peer.py");
-    let out = Command::new("python3")
-        .arg(&script)
-        .arg(env!("CARGO_BIN_EXE_penmodel"))
-        .output();
-    let out = match out {
-        Ok(out) => out,
-        Err(e) => {
-            eprintln!("SKIPPED geotiff_and_raw16_read_back_by_gdal: python3 cannot run ({e})");
-            return;
-        }
-    };
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&out.stdout),
-        String::from_utf8_lossy(&out.stderr)
+    outside_check(
+        "geotiff_and_raw16_read_back_by_gdal",
+        "heightmap_peer.py",
+        &[env!("CARGO_BIN_EXE_penmodel").as_ref()],
     );
-    if out.status.code() == Some(77) {
-        eprintln!("SKIPPED geotiff_and_raw16_read_back_by_gdal: {text}");
-        return;
-    }
-    assert!(out.status.success(), "{text}");
-    assert!(text.contains("all checks passed"), "{text}");
 }
