@@ -14,6 +14,7 @@ use super::pivot::{self, Pivot};
 use super::procedure::{self, CalibrateError, Prompt};
 use super::{Calibration, DeviceId, DisplaySize, FitKind};
 use crate::device::Device;
+#[cfg(feature = "sim")]
 use crate::source::Source;
 
 /// What to calibrate.
