@@ -329,6 +329,21 @@ impl Tally {
 /// Applies the events waiting on `d` to `state`; counts key transitions into `tally`; returns
 /// how many events there were. A SYN_DROPPED (the buffer overflowed) is an error.
 fn drain(d: &mut Device, state: &mut PenState, tally: &mut Tally) -> Result<usize> {
+    drain_frames(d, state, tally, None, |_, _| Ok(()))
+}
+
+/// [`drain`], with `frame` called with the state at each `SYN_REPORT` and the frame's events in
+/// words: a read may end inside a frame (its buffer full), so the state is whole only there.
+/// Events stamped before `since` are passed over: `state` was read from the device after them
+/// (the reader's queue holds what came after it opened the device, before its state was read).
+fn drain_frames(
+    d: &mut Device,
+    state: &mut PenState,
+    tally: &mut Tally,
+    since: Option<std::time::SystemTime>,
+    mut frame: impl FnMut(&PenState, &str) -> Result<()>,
+) -> Result<usize> {
+    let mut words = String::new();
     let mut n = 0;
     let events: Vec<_> = match d.fetch_events() {
         Ok(events) => events.collect(),
@@ -336,19 +351,28 @@ fn drain(d: &mut Device, state: &mut PenState, tally: &mut Tally) -> Result<usiz
         Err(e) => return Err(e).context("reading evdev"),
     };
     for e in events {
+        if since.is_some_and(|t| e.timestamp() < t) {
+            continue;
+        }
         match e.event_type() {
             EventType::KEY => {
                 let name = format!("{:?} {}", KeyCode(e.code()), e.value());
+                words += &format!("{name}, ");
                 tally.add(name);
                 state.keys.insert(e.code(), e.value());
             }
             EventType::ABSOLUTE => {
+                words += &format!("{:?} {}, ", AbsoluteAxisCode(e.code()), e.value());
                 state.abs.insert(e.code(), e.value());
             }
             // hid-input sends the HID usage as MSC_SCAN before a button's key event.
             EventType::MISC => continue,
             EventType::SYNCHRONIZATION => {
                 ensure!(e.code() != 3, "SYN_DROPPED: events were lost");
+                if e.code() == 0 {
+                    frame(state, &words)?;
+                    words.clear();
+                }
                 continue;
             }
             other => bail!("unexpected {other:?} event code {}", e.code()),
@@ -1055,29 +1079,34 @@ fn read_virtual_tablet() -> Result<String> {
     ensure!(abs == want, "axes {abs:?}, expected {want:?}");
     pen.set_nonblocking(true)?;
     // pend moves the tablet from the start: what happened before this reader opened it is in
-    // the device's state.
+    // the device's state, and what the queue holds from before the state was read is not
+    // applied again on top of it.
+    let since = std::time::SystemTime::now();
     let mut state = PenState::of_device(&pen)?;
     let in_range_at_open = state.key(KeyCode::BTN_TOOL_PEN) == 1;
     let mut tally = Tally::default();
     let (mut frames, mut touching_moves) = (0u32, 0u32);
     let start = Instant::now();
     while start.elapsed() < Duration::from_secs(90) {
-        let n = drain(&mut pen, &mut state, &mut tally)?;
+        // Each frame whole, as a program reading the tablet sees it.
+        let n = drain_frames(&mut pen, &mut state, &mut tally, Some(since), |state, words| {
+            frames += 1;
+            let touch = state.key(KeyCode::BTN_TOUCH);
+            let pressure = state.abs(AbsoluteAxisCode::ABS_PRESSURE);
+            ensure!(pressure == touch * 1023, "pressure {pressure} with BTN_TOUCH {touch}");
+            if touch == 1 {
+                ensure!(state.key(KeyCode::BTN_TOOL_PEN) == 1, "touching out of proximity");
+                ensure!(
+                    state.abs(AbsoluteAxisCode::ABS_DISTANCE) == 0,
+                    "a distance while touching, frame {frames}: {words}"
+                );
+                touching_moves += 1;
+            }
+            Ok(())
+        })?;
         if n == 0 {
             std::thread::sleep(Duration::from_millis(5));
             continue;
-        }
-        frames += 1;
-        let touch = state.key(KeyCode::BTN_TOUCH);
-        let pressure = state.abs(AbsoluteAxisCode::ABS_PRESSURE);
-        ensure!(pressure == touch * 1023, "pressure {pressure} with BTN_TOUCH {touch}");
-        if touch == 1 {
-            ensure!(state.key(KeyCode::BTN_TOOL_PEN) == 1, "touching out of proximity");
-            ensure!(
-                state.abs(AbsoluteAxisCode::ABS_DISTANCE) == 0,
-                "a distance while touching"
-            );
-            touching_moves += 1;
         }
         let downs = tally.get("BTN_TOUCH 1");
         if downs >= 3 && downs == tally.get("BTN_TOUCH 0") && tally.get("BTN_STYLUS2 1") >= 3 {
