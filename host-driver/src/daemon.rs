@@ -529,19 +529,27 @@ pub fn run_device_reloading(
                 Err(e) => log(&format!("SIGHUP: kept the calibration in use, not {what}: {e}")),
             }
         }
-        events.clear();
-        pipeline.poll(Duration::from_millis(50), &mut events);
-        if let Some(notice) = pipeline.take_notice() {
-            log(&notice);
-        }
+        poll_logged(&mut pipeline, &mut events, true, &log);
         for e in &events {
-            match &e.kind {
-                EventKind::DeviceFound { device } => log(&format!("attached {device}")),
-                EventKind::DeviceLost { reason } => log(&format!("device lost ({reason}); waiting for it")),
-                _ => {}
-            }
             hub.publish(e);
             each(e);
+        }
+    }
+}
+
+/// One poll of `pipeline` into `events` (cleared first): the pipeline's notice logged, and each
+/// device loss (and, with `found`, each attach) in the order they came.
+fn poll_logged(pipeline: &mut Pipeline, events: &mut Vec<PenEvent>, found: bool, log: &impl Fn(&str)) {
+    events.clear();
+    pipeline.poll(Duration::from_millis(50), events);
+    if let Some(notice) = pipeline.take_notice() {
+        log(&notice);
+    }
+    for e in events.iter() {
+        match &e.kind {
+            EventKind::DeviceFound { device } if found => log(&format!("attached {device}")),
+            EventKind::DeviceLost { reason } => log(&format!("device lost ({reason}); waiting for it")),
+            _ => {}
         }
     }
 }
@@ -690,15 +698,8 @@ pub fn run_session(
                 log(&format!("SIGHUP: kept the calibration in use, not {what}: {e}"));
             }
         }
-        events.clear();
-        pipeline.poll(Duration::from_millis(50), &mut events);
-        if let Some(notice) = pipeline.take_notice() {
-            log(&notice);
-        }
+        poll_logged(&mut pipeline, &mut events, false, &log);
         for e in &events {
-            if let EventKind::DeviceLost { reason } = &e.kind {
-                log(&format!("device lost ({reason}); waiting for it"));
-            }
             hub.publish(e);
         }
     }
@@ -711,22 +712,8 @@ pub fn probe(mut pipeline: Pipeline, within: Duration, log: impl Fn(&str)) {
     let end = std::time::Instant::now() + within;
     let mut events = Vec::new();
     while std::time::Instant::now() < end {
-        events.clear();
-        pipeline.poll(Duration::from_millis(50), &mut events);
-        if let Some(notice) = pipeline.take_notice() {
-            log(&notice);
-        }
-        for e in &events {
-            match &e.kind {
-                EventKind::DeviceFound { device } => {
-                    log(&format!("attached {device}"));
-                    return;
-                }
-                EventKind::DeviceLost { reason } => log(&format!("device lost ({reason}); waiting for it")),
-                _ => {}
-            }
-        }
-        if pipeline.refused().is_some() {
+        poll_logged(&mut pipeline, &mut events, true, &log);
+        if events.iter().any(|e| matches!(e.kind, EventKind::DeviceFound { .. })) || pipeline.refused().is_some() {
             return;
         }
     }
