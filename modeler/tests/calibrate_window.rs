@@ -69,6 +69,31 @@ fn start(dir: &std::path::Path, display: &str, file: &std::path::Path, args: &[&
     (penmodel, window)
 }
 
+/// Presses `key` in `window` and waits at most `within` for penmodel to end (`late` if not).
+fn press(
+    display: &str,
+    window: &str,
+    key: &str,
+    penmodel: &mut Killed,
+    within: Duration,
+    late: &str,
+) -> std::process::ExitStatus {
+    let pressed = Command::new("xdotool")
+        .args(["windowfocus", "--sync", window, "key", key])
+        .env("DISPLAY", display)
+        .status()
+        .expect("xdotool runs");
+    assert!(pressed.success());
+    let end = Instant::now() + within;
+    loop {
+        if let Some(s) = penmodel.0.try_wait().expect("wait") {
+            return s;
+        }
+        assert!(Instant::now() < end, "{late}");
+        std::thread::sleep(Duration::from_millis(50));
+    }
+}
+
 #[test]
 fn penmodel_calibrate_draws_the_targets_then_the_residual_plot() {
     if !x_tools() {
@@ -107,20 +132,14 @@ fn penmodel_calibrate_draws_the_targets_then_the_residual_plot() {
         plot.pixels.iter().filter(|p| **p == 0xffffff).count() > 500,
         "the axes' labels and the legend"
     );
-    let key = Command::new("xdotool")
-        .args(["windowfocus", "--sync", &window, "key", "q"])
-        .env("DISPLAY", &display)
-        .status()
-        .expect("xdotool runs");
-    assert!(key.success());
-    let end = Instant::now() + GUARD;
-    let status = loop {
-        if let Some(s) = penmodel.0.try_wait().expect("wait") {
-            break s;
-        }
-        assert!(Instant::now() < end, "penmodel calibrate did not end at the key");
-        std::thread::sleep(Duration::from_millis(50));
-    };
+    let status = press(
+        &display,
+        &window,
+        "q",
+        &mut penmodel,
+        GUARD,
+        "penmodel calibrate did not end at the key",
+    );
     let mut out = String::new();
     if let Some(mut o) = penmodel.0.stdout.take() {
         std::io::Read::read_to_string(&mut o, &mut out).expect("stdout");
@@ -178,20 +197,14 @@ fn escape_before_the_plot_saves_nothing() {
     let file = dir.path().join("calibration.toml");
     let (_server, display) = xvfb();
     let (mut penmodel, window) = start(dir.path(), &display, &file, &["--speed", "0.2"]);
-    let key = Command::new("xdotool")
-        .args(["windowfocus", "--sync", &window, "key", "Escape"])
-        .env("DISPLAY", &display)
-        .status()
-        .expect("xdotool runs");
-    assert!(key.success());
-    let end = Instant::now() + Duration::from_secs(20);
-    let status = loop {
-        if let Some(s) = penmodel.0.try_wait().expect("wait") {
-            break s;
-        }
-        assert!(Instant::now() < end, "Esc did not end penmodel calibrate at once");
-        std::thread::sleep(Duration::from_millis(50));
-    };
+    let status = press(
+        &display,
+        &window,
+        "Escape",
+        &mut penmodel,
+        Duration::from_secs(20),
+        "Esc did not end penmodel calibrate at once",
+    );
     let mut err = String::new();
     if let Some(mut e) = penmodel.0.stderr.take() {
         std::io::Read::read_to_string(&mut e, &mut err).expect("stderr");

@@ -350,18 +350,13 @@ pub fn run(args: &Args) -> Result<()> {
         .iter()
         .enumerate()
         .filter(|(_, d)| !d.reached)
-        .map(|(i, d)| {
+        .map(|(i, _)| {
             let asked = match recipe.layers.get(i).map(|l| l.amount) {
                 Some(Amount::Fraction(f)) => format!("{:.1} % asked", 100.0 * f),
                 Some(Amount::Count(n)) => format!("{n} rocks asked"),
                 None => "its amount".to_string(),
             };
-            format!(
-                "r {}: {} rocks, {:.1} % of the field ({asked}): its cells ran out",
-                d.radius,
-                d.cells.len(),
-                100.0 * s.fraction(i)
-            )
+            format!("{} of the field ({asked}): its cells ran out", per[i])
         })
         .collect();
     if !short.is_empty() {
