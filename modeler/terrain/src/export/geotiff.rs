@@ -274,8 +274,13 @@ pub fn read_geotiff(bytes: &[u8]) -> Result<GeoTiff, String> {
     let want = want as usize;
     let mut data = Vec::with_capacity(want);
     for (&o, &c) in offsets.iter().zip(counts) {
-        let (o, c) = (o as usize, c as usize);
+        // Never more than the samples need: strips may overlap, so their sum is not bounded by
+        // the file's size.
+        let (o, c) = (o as usize, (c as usize).min(want - data.len()));
         data.extend_from_slice(bytes.get(o..o.saturating_add(c)).ok_or_else(truncated)?);
+        if data.len() == want {
+            break;
+        }
     }
     if data.len() < want {
         return Err(format!(
